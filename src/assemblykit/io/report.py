@@ -1,0 +1,89 @@
+"""JSON-ready values for every result type (DESIGN.md §5.3: the ``--json`` output).
+
+Results hold numpy arrays, numpy scalars, enums, paths, sets and nested dataclasses; the
+command line needs plain lists, numbers, strings and dictionaries. Numbers are rounded so
+that the output is readable (``6.123e-17`` from ``cos(pi/2)`` prints as ``0.0``) without
+ever hiding a mismatch: a value is snapped to zero only when it is below the tolerance in
+force (so the library itself would treat it as zero), and otherwise keeps
+``SIGNIFICANT_DIGITS`` significant digits, which never turns a non-zero value into zero.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+from collections.abc import Mapping
+from pathlib import PurePath
+from typing import Any
+
+import numpy as np
+
+from assemblykit.errors import NumericError
+from assemblykit.tolerance import Tolerance, current
+
+SIGNIFICANT_DIGITS = 12
+
+JsonValue = None | bool | int | float | str | list["JsonValue"] | dict[str, "JsonValue"]
+
+
+def json_number(x: float, tol: Tolerance | None = None) -> float | str:
+    """``x`` rounded for output: 0 below the tolerance, else 12 significant digits.
+
+    The zero threshold is the smaller of the length and angle tolerances, so the value
+    printed as 0 is one every predicate of the library already treats as 0. Infinite
+    and NaN values become the strings ``"inf"``, ``"-inf"`` and ``"nan"`` because JSON
+    has no literal for them and dropping them would hide a failure.
+    """
+    tol = current() if tol is None else tol
+    value = float(x)
+    if not math.isfinite(value):
+        return repr(value)
+    if abs(value) <= min(tol.length, tol.angle):
+        return 0.0
+    return float(f"{value:.{SIGNIFICANT_DIGITS}g}")
+
+
+def jsonable(obj: Any, tol: Tolerance | None = None) -> JsonValue:
+    """``obj`` as a value :func:`json.dumps` accepts, numbers rounded by :func:`json_number`.
+
+    Objects with a ``to_dict()`` method are converted through it; dataclasses become
+    dictionaries of their fields; mappings get string keys; sets become sorted lists
+    (so the output is deterministic); enums give their value; paths their text.
+    """
+    tol = current() if tol is None else tol
+    if obj is None or isinstance(obj, bool | str):
+        return obj
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, int | np.integer):
+        return int(obj)
+    if isinstance(obj, float | np.floating):
+        return json_number(float(obj), tol)
+    if isinstance(obj, enum.Enum):
+        return jsonable(obj.value, tol)
+    if isinstance(obj, PurePath):
+        return str(obj)
+    if isinstance(obj, np.ndarray):
+        return [jsonable(item, tol) for item in obj.tolist()]
+    if hasattr(obj, "to_dict") and not isinstance(obj, type):
+        return jsonable(obj.to_dict(), tol)
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: jsonable(getattr(obj, f.name), tol) for f in dataclasses.fields(obj)}
+    if isinstance(obj, Mapping):
+        return {str(key): jsonable(value, tol) for key, value in obj.items()}
+    if isinstance(obj, set | frozenset):
+        return sorted((jsonable(item, tol) for item in obj), key=repr)
+    if isinstance(obj, list | tuple):
+        return [jsonable(item, tol) for item in obj]
+    raise TypeError(f"cannot turn a {type(obj).__name__} into JSON")
+
+
+def pose_list(pose: Any, tol: Tolerance | None = None) -> list[list[float]]:
+    """A 4x4 homogeneous pose (DESIGN.md §4) as four rows of rounded floats."""
+    matrix = np.asarray(pose, dtype=np.float64)
+    if matrix.shape != (4, 4):
+        raise NumericError(f"a pose must be a 4x4 matrix, got shape {matrix.shape}")
+    if not np.all(np.isfinite(matrix)):
+        raise NumericError("a pose has non-finite entries")
+    return [[float(json_number(value, tol)) for value in row] for row in matrix]

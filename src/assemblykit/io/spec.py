@@ -1,0 +1,332 @@
+"""The task file in YAML or JSON (DESIGN.md §5.1), read into a validated :class:`Task`.
+
+The layout is checked with pydantic models; features are built by
+``assemblykit.features.primitives.feature_from_dict`` and relations by
+``Relation.parse``; then :meth:`Task.validate` checks every reference. Every error names
+the file and the place at fault, e.g. ``task.yaml: situations[1].relations[0]: unknown
+relation 'agains'``. The ``.rapt`` text language (``assemblykit.io.rapt``) builds the
+same mapping and passes the line of every entry as its place.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import MISSING, fields
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, StringConstraints, ValidationError
+
+from assemblykit.errors import InputError, SchemaError
+from assemblykit.features.primitives import FEATURE_TYPES, Feature, feature_from_dict, parse_angle
+from assemblykit.model.body import Body
+from assemblykit.model.relations import FeatureRef, Relation
+from assemblykit.model.task import Action, Situation, Task
+
+NAME_PATTERN = r"^[A-Za-z_][A-Za-z0-9_]*$"
+"""Body, feature and situation names: identifiers, so that ``body.feature`` and the
+``.rapt`` text can name them."""
+
+UNITS = ("mm", "cm", "m", "um", "in", "ft")
+
+Name = Annotated[str, StringConstraints(pattern=NAME_PATTERN)]
+Locate = Callable[[str], str]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class BodyModel(_Model):
+    """``bodies.<name>``: whether the body is the world, and its features by name."""
+
+    fixed: StrictBool = False
+    features: dict[Name, dict[str, Any]] = Field(default_factory=dict)
+
+
+class SituationModel(_Model):
+    """``situations[i]``: a name, relation lists and action lists."""
+
+    name: Name
+    relations: list[list[Any]] = Field(default_factory=list)
+    actions: list[list[Any]] = Field(default_factory=list)
+
+
+class TaskModel(_Model):
+    """The whole task file (DESIGN.md §5.1)."""
+
+    units: Literal[UNITS] = "mm"  # type: ignore[valid-type]
+    bodies: dict[Name, BodyModel]
+    situations: list[SituationModel]
+
+
+def load_task(path: str | Path) -> Task:
+    """Read and validate a task file: ``.yaml``/``.yml``, ``.json`` or ``.rapt``."""
+    path = Path(path)
+    source = path.name
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise InputError(f"cannot read the task file: {error.strerror}", source=str(path)) from None
+    suffix = path.suffix.lower()
+    if suffix == ".rapt":
+        from assemblykit.io.rapt import parse_rapt
+
+        return parse_rapt(text, source)
+    if suffix in (".yaml", ".yml"):
+        return parse_task(read_yaml(text, source), source)
+    if suffix == ".json":
+        return parse_task(read_json(text, source), source)
+    raise InputError(
+        f"unknown task file type {path.suffix!r} (expected .yaml, .yml, .json or .rapt)",
+        source=source,
+    )
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """A YAML loader that rejects a key given twice in one mapping (PyYAML keeps the last)."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            if key in seen:
+                raise SchemaError(
+                    f"duplicate key {key!r}", where=f"line {key_node.start_mark.line + 1}"
+                )
+            seen.add(key)
+        return super().construct_mapping(node, deep=deep)
+
+
+def read_yaml(text: str, source: str | None = None) -> Any:
+    """Parse YAML text; :class:`SchemaError` with the line for malformed text or a
+    duplicate key."""
+    try:
+        return yaml.load(text, Loader=_UniqueKeyLoader)
+    except SchemaError as error:
+        raise SchemaError(error.detail, source=source, where=error.where) from None
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = None if mark is None else f"line {mark.line + 1}, column {mark.column + 1}"
+        problem = getattr(error, "problem", None) or str(error)
+        raise SchemaError(f"malformed YAML: {problem}", source=source, where=where) from None
+
+
+def read_json(text: str, source: str | None = None) -> Any:
+    """Parse JSON text; :class:`SchemaError` with the line for malformed text or a
+    duplicate key."""
+
+    def unique(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        for key, value in pairs:
+            if key in out:
+                raise SchemaError(f"duplicate key {key!r}", source=source)
+            out[key] = value
+        return out
+
+    try:
+        return json.loads(text, object_pairs_hook=unique)
+    except json.JSONDecodeError as error:
+        raise SchemaError(
+            f"malformed JSON: {error.msg}",
+            source=source,
+            where=f"line {error.lineno}, column {error.colno}",
+        ) from None
+
+
+def parse_task(
+    data: Any, source: str | None = None, places: Mapping[str, str] | None = None
+) -> Task:
+    """Build and validate a :class:`Task` from the task-file mapping.
+
+    ``places`` maps field paths (``bodies.peg``, ``situations[0].relations[1]``) to places
+    shown in messages instead (the ``.rapt`` reader gives ``line N``); a path without an
+    entry is located by its longest listed prefix, or shown as it is.
+    """
+    locate = _locator(places or {})
+    if not isinstance(data, Mapping):
+        raise SchemaError(
+            "a task file must hold a mapping with bodies and situations", source=source
+        )
+    try:
+        model = TaskModel.model_validate(data)
+    except ValidationError as error:
+        raise _schema_error(error, source, locate) from None
+    try:
+        bodies = {
+            name: Body(
+                name,
+                {
+                    fname: feature_from_dict(
+                        fname, fdata, locate(f"bodies.{name}.features.{fname}")
+                    )
+                    for fname, fdata in body.features.items()
+                },
+                fixed=body.fixed,
+            )
+            for name, body in model.bodies.items()
+        }
+        situations = tuple(
+            _situation(situation, locate, f"situations[{index}]")
+            for index, situation in enumerate(model.situations)
+        )
+    except InputError as error:
+        raise _with_source(error, source) from None
+    return Task(model.units, bodies, situations, source).validate()
+
+
+def _situation(model: SituationModel, locate: Locate, place: str) -> Situation:
+    relations = tuple(
+        _relation(items, locate(f"{place}.relations[{index}]"))
+        for index, items in enumerate(model.relations)
+    )
+    actions = tuple(
+        _action(items, locate(f"{place}.actions[{index}]"))
+        for index, items in enumerate(model.actions)
+    )
+    return Situation(model.name, relations, actions)
+
+
+def _relation(items: list[Any], where: str) -> Relation:
+    """``[kind, body.feature, ..., {options}]``; a string option value is an angle such as
+    ``"30 deg"``, stored in radians."""
+    if items and isinstance(items[-1], Mapping):
+        options = {
+            key: parse_angle(value, f"{where}.{key}") if isinstance(value, str) else value
+            for key, value in items[-1].items()
+        }
+        items = [*items[:-1], options]
+    return Relation.parse(items, where)
+
+
+def _action(items: list[Any], where: str) -> Action:
+    """``[move, body]``, ``[move, body, {along: b.f, by: 5}]`` or
+    ``[turn, body, {about: b.f, by: 90 deg}]`` (``by`` in model units or radians)."""
+    if not (2 <= len(items) <= 3 and all(isinstance(item, str) for item in items[:2])):
+        raise SchemaError(f"expected [move|turn, body, {{options}}], got {items!r}", where=where)
+    kind, body = items[0], items[1]
+    options = items[2] if len(items) == 3 else {}
+    if not isinstance(options, Mapping):
+        raise SchemaError(f"action options must be a mapping, got {options!r}", where=where)
+    if unknown := sorted(set(options) - {"along", "about", "by"}):
+        raise SchemaError(
+            f"unknown action option(s) {', '.join(map(str, unknown))} (allowed: along, about, by)",
+            where=where,
+        )
+    along, about = (
+        None if options.get(key) is None else FeatureRef.parse(options[key], f"{where}.{key}")
+        for key in ("along", "about")
+    )
+    return Action(kind, body, along, about, _amount(kind, options.get("by"), where), where)
+
+
+def _amount(kind: str, value: Any, where: str) -> float | None:
+    if value is None:
+        return None
+    if kind == "turn":
+        return parse_angle(value, f"{where}.by")
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise SchemaError(f"'by' must be a finite length, got {value!r}", where=f"{where}.by")
+    return float(value)
+
+
+def task_to_dict(task: Task) -> dict[str, Any]:
+    """The task-file mapping of ``task`` (DESIGN.md §5.1); keys equal to their defaults
+    are left out, so the output reads like a hand-written file."""
+    return {
+        "units": task.units,
+        "bodies": {
+            name: {
+                **({"fixed": True} if body.fixed else {}),
+                "features": {fname: feature_to_dict(f) for fname, f in body.features.items()},
+            }
+            for name, body in task.bodies.items()
+        },
+        "situations": [
+            {
+                "name": s.name,
+                "relations": [
+                    [r.kind, *map(str, r.refs), *([dict(r.options)] if r.options else [])]
+                    for r in s.relations
+                ],
+                "actions": [_action_to_list(a) for a in s.actions],
+            }
+            for s in task.situations
+        ],
+    }
+
+
+def feature_to_dict(feature: Feature) -> dict[str, Any]:
+    """A feature's task-file mapping without the keys that hold their default value."""
+    defaults = {
+        item.name: item.default
+        for item in fields(FEATURE_TYPES[feature.type_name])  # type: ignore[arg-type]
+        if item.default is not MISSING
+    }
+    return {
+        key: value
+        for key, value in feature.to_dict().items()
+        if not (key in defaults and defaults[key] is not None and value == defaults[key])
+    }
+
+
+def _action_to_list(action: Action) -> list[Any]:
+    options: dict[str, Any] = {}
+    if action.ref is not None:
+        options["along" if action.kind == "move" else "about"] = str(action.ref)
+    if action.by is not None:
+        options["by"] = action.by
+    return [action.kind, action.body, *([options] if options else [])]
+
+
+def _locator(places: Mapping[str, str]) -> Locate:
+    def locate(path: str) -> str:
+        probe = path
+        while probe:
+            if probe in places:
+                return places[probe]
+            cut = max(probe.rfind("."), probe.rfind("["))
+            probe = probe[:cut] if cut > 0 else ""
+        return path
+
+    return locate
+
+
+def _path(loc: tuple[int | str, ...]) -> str:
+    text = ""
+    for part in loc:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else str(part))
+    return text
+
+
+def _schema_error(error: ValidationError, source: str | None, locate: Locate) -> SchemaError:
+    """The first pydantic error as one line naming the field path."""
+    first = error.errors()[0]
+    loc = tuple(first["loc"])
+    if first["type"] == "extra_forbidden":
+        message = f"unknown field {loc[-1]!r}"
+        loc = loc[:-1]
+    elif first["type"] == "missing":
+        message = f"missing field {loc[-1]!r}"
+        loc = loc[:-1]
+    elif first["type"] == "string_pattern_mismatch":
+        message = f"{first['input']!r} is not a valid name (letters, digits and _)"
+    else:
+        message = first["msg"]
+        if "input" in first and not isinstance(first["input"], Mapping | list):
+            message += f", got {first['input']!r}"
+    more = len(error.errors()) - 1
+    if more:
+        message += f" (and {more} more error{'s' if more > 1 else ''})"
+    path = _path(loc)
+    return SchemaError(message, source=source, where=locate(path) if path else None)
+
+
+def _with_source(error: InputError, source: str | None) -> InputError:
+    """The same error, naming the file."""
+    if error.source or source is None:
+        return error
+    return type(error)(error.detail, source=source, where=error.where)

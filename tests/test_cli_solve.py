@@ -1,0 +1,208 @@
+"""``assemblykit solve``: answers on the bundled examples, one line and exit 2 on bad input."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import assemblykit
+from assemblykit.cli import main
+
+try:
+    import assemblykit.inference
+except ImportError as missing:  # the engine is a separate layer; only its answers need it
+    ENGINE = f"the inference engine cannot be imported: {missing}"
+else:
+    ENGINE = ""
+
+EXAMPLES = Path(assemblykit.__file__).parent / "examples" / "tasks"
+
+GOOD = """\
+units mm
+body table fixed
+  plane top point (0,0,0) normal (0,0,1)
+end
+body block
+  plane bottom point (0,0,0) normal (0,0,-1)
+  hole bore point (5,5,10) axis (0,0,-1) radius 2
+  ball knob point (0,0,0) radius 1
+end
+body peg
+  shaft shaft point (0,0,0) axis (0,0,1) radius 2
+end
+situation s1
+  against bottom of block, top of table
+  fits shaft of peg, bore of block
+end
+situation s2
+  move block parallel bore of block by 5
+end
+"""
+
+BAD = {
+    "unknown feature type": (".rapt", GOOD.replace("shaft shaft", "shafts shaft"), "line 11"),
+    "zero normal": (".rapt", GOOD.replace("normal (0,0,1)", "normal (0,0,0)"), "line 3"),
+    "negative radius": (
+        ".rapt",
+        GOOD.replace("radius 2\nend\nsit", "radius -2\nend\nsit"),
+        "line 11",
+    ),
+    "against plane-shaft": (".rapt", GOOD.replace("top of table", "shaft of peg"), "line 14"),
+    "missing feature": (".rapt", GOOD.replace("bore of block\n", "bor of block\n"), "line 15"),
+    "unknown body": (".rapt", GOOD.replace("of block,", "of blok,"), "line 14"),
+    "duplicate names": (".rapt", GOOD.replace("body peg", "body block"), "line 10"),
+    "move along no axis": (
+        ".rapt",
+        GOOD.replace("bore of block by", "knob of block by"),
+        "line 18",
+    ),
+    "rapt syntax": (".rapt", GOOD.replace("(5,5,10)", "(5,5 10)"), "line 7, column 24"),
+    "malformed yaml": (".yaml", "units: mm\nbodies: {a: [1, 2}\n", "line 2"),
+    "unknown relation": (
+        ".yaml",
+        "bodies: {a: {fixed: true}}\nsituations: [{name: s, relations: [[agains, a.x, a.y]]}]\n",
+        "situations[0].relations[0]",
+    ),
+}
+
+
+def run(args: list[str]) -> int:
+    try:
+        main(args)
+    except SystemExit as done:
+        return int(done.code or 0)
+    return 0
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_input_exits_2_with_one_line_naming_file_and_place(
+    case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+):
+    suffix, text, place = BAD[case]
+    path = tmp_path / f"task{suffix}"
+    path.write_text(text)
+    assert run(["solve", str(path)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    lines = captured.err.splitlines()
+    assert len(lines) == 1, captured.err
+    assert lines[0].startswith(f"assemblykit: task{suffix}: ")
+    assert place in lines[0]
+
+
+def test_a_missing_file_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]):
+    assert run(["solve", str(tmp_path / "absent.rapt")]) == 2
+    assert len(capsys.readouterr().err.splitlines()) == 1
+
+
+def solve_json(name: str, capsys: pytest.CaptureFixture[str], *extra: str) -> dict:
+    assert run(["solve", str(EXAMPLES / name), "--json", *extra]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out) >= {"status", "bodies", "conflicts"}
+    for key, body in out["bodies"].items():
+        assert "@" in key
+        assert set(body) >= {"pose", "dof", "motion", "invariants"}
+        assert np.asarray(body["pose"]).shape == (4, 4)
+    return out
+
+
+def translation(body: dict) -> np.ndarray:
+    return np.asarray(body["pose"])[:3, 3]
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@pytest.mark.parametrize("suffix", [".yaml", ".rapt"])
+def test_peg_in_block_is_cylindrical_then_revolute(suffix: str, capsys):
+    out = solve_json(f"peg_in_block{suffix}", capsys)
+    assert out["status"] == "underconstrained" and out["conflicts"] == []
+    bodies = out["bodies"]
+    assert (bodies["block@s1"]["dof"], bodies["block@s1"]["motion"]) == (0, "fixed")
+    np.testing.assert_allclose(bodies["block@s1"]["pose"], np.eye(4), atol=1e-9)
+    assert (bodies["peg@s1"]["dof"], bodies["peg@s1"]["motion"]) == (2, "cylindrical")
+    assert (bodies["peg@s2"]["dof"], bodies["peg@s2"]["motion"]) == (1, "revolute")
+    np.testing.assert_allclose(translation(bodies["peg@s2"]), [5, 5, 10], atol=1e-9)
+
+
+ONE_DOF = {
+    "w2_slide": {"cube@s1": (1, "prismatic")},
+    "w4_pin": {"pin@s1": (1, "revolute")},
+    "triangle": {"a@s1": (1, "prismatic"), "b@s1": (1, "prismatic")},
+}
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@pytest.mark.parametrize("name", sorted(ONE_DOF))
+def test_one_dof_examples(name: str, capsys):
+    out = solve_json(f"{name}.yaml", capsys)
+    assert out["status"] == "underconstrained"
+    for body, (dof, motion) in ONE_DOF[name].items():
+        assert (out["bodies"][body]["dof"], out["bodies"][body]["motion"]) == (dof, motion)
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_four_bar_is_a_one_dof_mechanism(capsys):
+    out = solve_json("four_bar.rapt", capsys)
+    assert out["status"] == "underconstrained" and out["conflicts"] == []
+    bodies = out["bodies"]
+    assert (bodies["crank@s1"]["dof"], bodies["crank@s1"]["motion"]) == (1, "revolute")
+    assert (bodies["rocker@s1"]["dof"], bodies["rocker@s1"]["motion"]) == (1, "revolute")
+    assert (bodies["coupler@s1"]["dof"], bodies["coupler@s1"]["motion"]) == (1, "mechanism")
+    np.testing.assert_allclose(bodies["crank@s1"]["invariants"]["point"][:2], [0, 0], atol=1e-9)
+    np.testing.assert_allclose(bodies["rocker@s1"]["invariants"]["point"][:2], [40, 0], atol=1e-9)
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_slide_direction_and_triangle_offset(capsys):
+    cube = solve_json("w2_slide.rapt", capsys)["bodies"]["cube@s1"]
+    direction = np.asarray(cube["invariants"]["direction"])
+    np.testing.assert_allclose(np.abs(direction), [0, 1, 0], atol=1e-9)
+    b = solve_json("triangle.rapt", capsys)["bodies"]["b@s1"]
+    assert translation(b)[0] == pytest.approx(1.0, abs=1e-9)
+    assert translation(b)[2] == pytest.approx(0.0, abs=1e-9)
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_square_peg_has_four_poses(capsys):
+    out = solve_json("w14_square_peg.rapt", capsys)
+    peg = out["bodies"]["peg@s1"]
+    assert out["status"] == "ambiguous"
+    assert (peg["dof"], peg["solutions"]) == (0, 4)
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_unequal_pins_are_inconsistent_by_2(capsys):
+    out = solve_json("w6_unequal_pins.rapt", capsys)
+    assert out["status"] == "inconsistent"
+    (conflict,) = out["conflicts"]
+    assert conflict["kind"] == "distance"
+    assert conflict["value"] == pytest.approx(2.0, abs=1e-9)
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_actions_lift_then_turn_the_plate(capsys):
+    bodies = solve_json("stack_and_move.rapt", capsys)["bodies"]
+    np.testing.assert_allclose(bodies["plate@stacked"]["pose"], np.eye(4), atol=1e-9)
+    lifted = np.eye(4)
+    lifted[2, 3] = 30
+    np.testing.assert_allclose(bodies["plate@lifted"]["pose"], lifted, atol=1e-9)
+    c, s = math.cos(math.pi / 2), math.sin(math.pi / 2)
+    turned = np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 30], [0, 0, 0, 1]])
+    np.testing.assert_allclose(bodies["plate@turned"]["pose"], turned, atol=1e-9)
+    assert all(b["dof"] == 0 for b in bodies.values())
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_explain_adds_the_trace(capsys):
+    out = solve_json("w4_pin.yaml", capsys, "--explain")
+    assert out["trace"] and {"rule", "link"} <= set(out["trace"][0])
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_readable_output(capsys):
+    assert run(["solve", str(EXAMPLES / "w4_pin.rapt")]) == 0
+    text = capsys.readouterr().out
+    assert "underconstrained" in text and "pin@s1" in text and "revolute" in text
