@@ -5,6 +5,16 @@ patches where their faces coincide with opposite normals, and the curved patches
 cylinders, cones or spheres coincide. Seeds 003 and 004 start from exactly this: "the
 specification of the contact surfaces between parts".
 
+The functions below find them (:func:`find_contacts`): a broad phase over the parts'
+bounding boxes (an R-tree, boxes inflated by the length tolerance) keeps only pairs
+that may touch, so the cost grows with the number of touching pairs; then, vectorised
+over all candidate pairs at once, the coplanar groups of facets
+(:func:`~assemblykit.geometry.recognition.segment`) of one part are matched with the
+groups of the other that lie in the same plane with the opposite normal, and their
+overlap is measured by shapely in that plane. Curved contacts are coaxial cylinders
+and cones and concentric spheres of equal size, one convex and one concave, read from
+the parts' exact or recognised surfaces.
+
 Convention: every normal stored here is the outward normal of part ``a``'s surface, so
 it points from ``a`` into ``b``. Translating ``a`` infinitesimally along ``d`` pushes
 into ``b`` across a planar patch iff ``d . normal > 0`` (seed 004, DBG arcs).
@@ -13,10 +23,19 @@ into ``b`` across a planar patch iff ``d . normal > 0`` (seed 004, DBG arcs).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
+import shapely
 from numpy.typing import NDArray
+from rtree import index
+from shapely.geometry.polygon import orient
+
+from assemblykit.geometry.recognition import Segmentation, Surface, faces_on, segment
+from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
 
 CurvedKind = Literal["cylindrical", "conical", "spherical"]
 
@@ -76,3 +95,349 @@ class Contact:
     def pair(self) -> tuple[str, str]:
         """The two part names, ``(a, b)``."""
         return (self.a, self.b)
+
+
+def _expand(starts: NDArray[np.int64], counts: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Concatenate the index ranges ``starts[i] : starts[i] + counts[i]``."""
+    total = int(counts.sum())
+    firsts = np.repeat(np.cumsum(counts) - counts, counts)
+    return np.arange(total, dtype=np.int64) - firsts + np.repeat(starts, counts)
+
+
+def _cross_join(
+    left_owner: NDArray[np.int64], right_owner: NDArray[np.int64], n_owners: int
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """All pairs ``(i, j)`` of entries with the same owner; owners must be sorted."""
+    right_count = np.bincount(right_owner, minlength=n_owners)
+    right_start = np.cumsum(right_count) - right_count
+    per_left = right_count[left_owner]
+    left = np.repeat(np.arange(len(left_owner), dtype=np.int64), per_left)
+    right = _expand(right_start[left_owner], per_left)
+    return left, right
+
+
+def candidate_pairs(
+    bounds: NDArray[np.float64], margin: float, only: int | None = None
+) -> NDArray[np.int64]:
+    """Pairs ``(i, j)``, ``i < j``, of boxes (``n x 2 x 3``) that overlap once inflated by
+    ``margin`` (an R-tree query per box); with ``only``, just the pairs involving it."""
+    lo, hi = bounds[:, 0] - margin, bounds[:, 1] + margin
+    boxes = np.hstack([lo, hi])
+    tree = index.Index(
+        ((i, tuple(box), None) for i, box in enumerate(boxes)),
+        properties=index.Property(dimension=3),
+    )
+    queries = range(len(boxes)) if only is None else [only]
+    found = [(i, j) for i in queries for j in tree.intersection(tuple(boxes[i])) if j != i]
+    if not found:
+        return np.zeros((0, 2), dtype=np.int64)
+    pairs = np.sort(np.array(found, dtype=np.int64), axis=1)
+    return np.unique(pairs, axis=0)
+
+
+def _frames(normals: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Unit vectors ``u, v`` with ``(u, v, n)`` right-handed, for each row ``n``."""
+    helper = np.eye(3)[np.argmin(np.abs(normals), axis=1)]
+    u = np.cross(helper, normals)
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    return u, np.cross(normals, u)
+
+
+def _boxes_overlap(
+    lo_a: NDArray[np.float64],
+    hi_a: NDArray[np.float64],
+    lo_b: NDArray[np.float64],
+    hi_b: NDArray[np.float64],
+    margin: float,
+) -> NDArray[np.bool_]:
+    return np.all((lo_a <= hi_b + margin) & (lo_b <= hi_a + margin), axis=-1)
+
+
+@dataclass(frozen=True)
+class _Stack:
+    """All parts' triangles in one array (vertex indices offset per part)."""
+
+    vertices: NDArray[np.float64]
+    faces: NDArray[np.int64]
+    part: NDArray[np.int64]
+    face_start: NDArray[np.int64]
+
+
+def _stack(assembly: Assembly) -> _Stack:
+    meshes = [p.mesh for p in assembly.parts.values()]
+    n_vertices = np.array([len(m.vertices) for m in meshes], dtype=np.int64)
+    n_faces = np.array([len(m.faces) for m in meshes], dtype=np.int64)
+    vertex_start = np.cumsum(n_vertices) - n_vertices
+    faces = np.concatenate(
+        [np.asarray(m.faces, dtype=np.int64) + s for m, s in zip(meshes, vertex_start, strict=True)]
+    )
+    vertices = np.concatenate([np.asarray(m.vertices, dtype=np.float64) for m in meshes])
+    part = np.repeat(np.arange(len(meshes), dtype=np.int64), n_faces)
+    return _Stack(vertices, faces, part, np.cumsum(n_faces) - n_faces)
+
+
+def _planar_matches(
+    stack: _Stack,
+    seg: Segmentation,
+    group_part: NDArray[np.int64],
+    usable: NDArray[np.bool_],
+    part_lo: NDArray[np.float64],
+    part_hi: NDArray[np.float64],
+    pairs: NDArray[np.int64],
+    tol: Tolerance,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Group pairs ``(g, h)``, ``g`` of the first part of a pair and ``h`` of the second,
+    that are flat, face each other (opposite normals), overlap in their boxes, and are
+    coplanar: all vertices of one of them lie within the length tolerance of the
+    other's plane (so the contact region, inside both, is within the tolerance)."""
+    margin = tol.length
+    candidates = np.flatnonzero(usable)
+    candidates = candidates[np.argsort(group_part[candidates], kind="stable")]
+    count = np.bincount(group_part[candidates], minlength=len(part_lo))
+    start = np.cumsum(count) - count
+
+    def near(side: int, other: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        owners = pairs[:, side]
+        pair_of = np.repeat(np.arange(len(pairs), dtype=np.int64), count[owners])
+        groups = candidates[_expand(start[owners], count[owners])]
+        partner = pairs[pair_of, other]
+        keep = _boxes_overlap(
+            seg.lo[groups], seg.hi[groups], part_lo[partner], part_hi[partner], margin
+        )
+        return pair_of[keep], groups[keep]
+
+    pair_a, groups_a = near(0, 1)
+    pair_b, groups_b = near(1, 0)
+    i, j = _cross_join(pair_a, pair_b, len(pairs))
+    g, h = groups_a[i], groups_b[j]
+    n_g, n_h = seg.normal[g], seg.normal[h]
+    gap = seg.point[h] - seg.point[g]
+    # a centroid is within the largest vertex distance, so this keeps every true match
+    near_plane = np.minimum(
+        np.abs(np.einsum("ij,ij->i", n_g, gap)), np.abs(np.einsum("ij,ij->i", n_h, gap))
+    )
+    ok = (np.einsum("ij,ij->i", n_g, n_h) < 0) & (near_plane <= margin)
+    ok &= _boxes_overlap(seg.lo[g], seg.hi[g], seg.lo[h], seg.hi[h], margin)
+    g, h = g[ok], h[ok]
+    close = np.minimum(_deviation(stack, seg, h, g), _deviation(stack, seg, g, h)) <= margin
+    return g[close], h[close]
+
+
+def _deviation(
+    stack: _Stack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64]
+) -> NDArray[np.float64]:
+    """Per pair, the largest distance of a vertex of group ``g[k]`` from the plane of
+    group ``h[k]``."""
+    size = seg.start[g + 1] - seg.start[g]
+    owner = np.repeat(np.arange(len(g), dtype=np.int64), size)
+    corners = stack.vertices[stack.faces[seg.order[_expand(seg.start[g], size)]]]
+    offsets = np.einsum("fkj,fj->fk", corners - seg.point[h][owner, None], seg.normal[h][owner])
+    deviation = np.zeros(len(g))
+    np.maximum.at(deviation, owner, np.abs(offsets).max(axis=1))
+    return deviation
+
+
+def _triangles_2d(
+    corners: NDArray[np.float64], u: NDArray[np.float64], v: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    return np.stack([np.einsum("tkj,tj->tk", corners, u), np.einsum("tkj,tj->tk", corners, v)], -1)
+
+
+def _overlapping_triangles(
+    stack: _Stack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], tol: Tolerance
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Per matched group pair, the area where its triangles overlap in the common plane
+    (triangle pairs whose 2D boxes overlap by more than the tolerance are clipped by
+    shapely, vectorised); returns the matched pairs with positive area and their areas."""
+    match = np.arange(len(g), dtype=np.int64)
+    size_g = seg.start[g + 1] - seg.start[g]
+    size_h = seg.start[h + 1] - seg.start[h]
+    owner_a = np.repeat(match, size_g)
+    faces_a = seg.order[_expand(seg.start[g], size_g)]
+    owner_b = np.repeat(match, size_h)
+    faces_b = seg.order[_expand(seg.start[h], size_h)]
+    i, j = _cross_join(owner_a, owner_b, len(g))
+    owner = owner_a[i]
+    u, v = _frames(seg.normal[g])
+    tri_a = _triangles_2d(stack.vertices[stack.faces[faces_a[i]]], u[owner], v[owner])
+    tri_b = _triangles_2d(stack.vertices[stack.faces[faces_b[j]]], u[owner], v[owner])
+    width = np.minimum(tri_a.max(axis=1), tri_b.max(axis=1)) - np.maximum(
+        tri_a.min(axis=1), tri_b.min(axis=1)
+    )
+    keep = np.all(width > tol.length, axis=1)
+    pieces = shapely.intersection(shapely.polygons(tri_a[keep]), shapely.polygons(tri_b[keep]))
+    area = np.bincount(owner[keep], weights=shapely.area(pieces), minlength=len(g))
+    positive = np.flatnonzero(area > 0)
+    return positive, area[positive]
+
+
+def _patches(stack: _Stack, seg: Segmentation, g: int, h: int, tol: Tolerance) -> list[PlanarPatch]:
+    """The contact polygons of groups ``g`` (part a) and ``h`` (part b): the overlap of
+    their triangles' unions in ``g``'s plane, kept where wider than the tolerance."""
+    normal = seg.normal[g]
+    u, v = (w[0] for w in _frames(normal[None]))
+    height = (normal @ seg.point[g] + normal @ seg.point[h]) / 2
+
+    def region(group: int) -> shapely.Geometry:
+        corners = stack.vertices[stack.faces[seg.faces_of(group)]]
+        return shapely.union_all(shapely.polygons(np.stack([corners @ u, corners @ v], -1)))
+
+    overlap = shapely.intersection(region(g), region(h))
+    found = []
+    for poly in shapely.get_parts(overlap):
+        if not isinstance(poly, shapely.Polygon) or poly.area <= tol.length * poly.length / 2:
+            continue
+        ring = np.asarray(orient(poly, 1.0).exterior.coords)[:-1]
+        polygon = ring[:, :1] * u + ring[:, 1:2] * v + height * normal
+        found.append(PlanarPatch(normal=normal.copy(), polygon=polygon, area=float(poly.area)))
+    return found
+
+
+def _axial_overlap(
+    first: Surface, second: Surface, axis: NDArray[np.float64], origin: NDArray[np.float64]
+) -> tuple[float, float]:
+    """The common interval of two surfaces' extents, measured along ``axis`` from ``origin``."""
+
+    def span(s: Surface) -> tuple[float, float]:
+        base = float((s.point - origin) @ axis)
+        ends = [base + e * float(s.axis @ axis) for e in s.extent]
+        return min(ends), max(ends)
+
+    (lo_a, hi_a), (lo_b, hi_b) = span(first), span(second)
+    return max(lo_a, lo_b), min(hi_a, hi_b)
+
+
+def _boundary(
+    points: NDArray[np.float64],
+    axis: NDArray[np.float64],
+    origin: NDArray[np.float64],
+    lo: float,
+    hi: float,
+    tol: Tolerance,
+) -> NDArray[np.float64]:
+    along = (points - origin) @ axis
+    ends = (np.abs(along - lo) <= tol.length) | (np.abs(along - hi) <= tol.length)
+    return np.unique(points[ends], axis=0)
+
+
+def curved_contact(
+    first: Surface,
+    second: Surface,
+    names: tuple[str, str],
+    points: tuple[NDArray[np.float64], NDArray[np.float64]],
+    tol: Tolerance,
+) -> CurvedPatch | None:
+    """The curved contact of two surfaces of parts ``names``, or ``None``: equal coaxial
+    cylinders or cones, or equal concentric spheres, one convex and one concave, whose
+    axial extents overlap by more than the length tolerance (seed 003 §2: a shaft fits
+    a hole, a ball a socket). ``points``: each surface's vertices, to sample the
+    boundary."""
+    if first.kind != second.kind or first.convex == second.convex:
+        return None
+    inner = names[0] if first.convex else names[1]
+    every = np.vstack(points)
+    if first.kind == "sphere":
+        same_centre = np.linalg.norm(first.point - second.point) <= tol.length
+        if not (same_centre and abs(first.radius - second.radius) <= tol.length):
+            return None
+        return CurvedPatch("spherical", first.point, None, first.radius, inner, points=every)
+    if first.kind not in ("cylinder", "cone"):
+        return None
+    axis = first.axis
+    assert axis is not None and second.axis is not None
+    aligned = float(axis @ second.axis)
+    if np.linalg.norm(np.cross(axis, second.axis)) > tol.angle:
+        return None
+    offset = second.point - first.point
+    off_axis = np.linalg.norm(offset - (offset @ axis) * axis)
+    if first.kind == "cylinder":
+        if off_axis > tol.length or abs(first.radius - second.radius) > tol.length:
+            return None
+    elif (
+        aligned < 0
+        or np.linalg.norm(offset) > tol.length
+        or abs(first.half_angle - second.half_angle) > tol.angle
+    ):
+        return None
+    lo, hi = _axial_overlap(first, second, axis, first.point)
+    if hi - lo <= tol.length:
+        return None
+    kind: CurvedKind = "cylindrical" if first.kind == "cylinder" else "conical"
+    centre = first.point + lo * axis if kind == "cylindrical" else first.point
+    extent = (0.0, hi - lo) if kind == "cylindrical" else (lo, hi)
+    return CurvedPatch(
+        kind,
+        centre,
+        axis,
+        (first.radius + second.radius) / 2,
+        inner,
+        extent=extent,
+        half_angle=first.half_angle,
+        points=_boundary(every, axis, first.point, lo, hi, tol),
+    )
+
+
+def _surface_points(assembly: Assembly, name: str, surface: Surface) -> NDArray[np.float64]:
+    mesh = assembly.parts[name].mesh
+    return np.asarray(mesh.vertices[np.unique(mesh.faces[surface.faces])], dtype=np.float64)
+
+
+def find_contacts(
+    assembly: Assembly, tol: Tolerance | None = None, *, only: str | None = None
+) -> list[Contact]:
+    """The contacts between the touching parts of ``assembly``, in part order (module
+    docstring); with ``only``, just the contacts of that part. ``tol`` is a policy that
+    :meth:`Assembly.tolerance` scales to the model."""
+    tol = assembly.tolerance(tol)
+    names = list(assembly.parts)
+    if len(names) < 2:
+        return []
+    stack = _stack(assembly)
+    seg = segment(stack.vertices, stack.faces, tol)
+    part_lo = np.array([p.mesh.bounds[0] for p in assembly.parts.values()])
+    part_hi = np.array([p.mesh.bounds[1] for p in assembly.parts.values()])
+    pairs = candidate_pairs(
+        np.stack([part_lo, part_hi], axis=1),
+        tol.length,
+        None if only is None else names.index(only),
+    )
+    parts_in_pairs = np.unique(pairs)
+    curved_part = np.zeros(len(names), dtype=bool)
+    curved_part[stack.part[np.isin(seg.region, np.flatnonzero(seg.curved))]] = True
+    surfaces: dict[int, tuple[Surface, ...]] = {}
+    excluded = np.zeros(len(stack.faces), dtype=bool)
+    for k in parts_in_pairs:
+        part = assembly.parts[names[k]]
+        if part.surfaces or curved_part[k]:
+            found = tuple(s for s in assembly.surfaces(names[k], tol) if s.kind != "plane")
+            surfaces[int(k)] = found
+            start = stack.face_start[k]
+            excluded[start : start + len(part.mesh.faces)] = faces_on(found, len(part.mesh.faces))
+
+    group_part = stack.part[seg.order[seg.start[:-1]]]
+    usable = seg.flat & (np.bincount(seg.group, weights=excluded, minlength=len(seg.flat)) == 0)
+    g, h = _planar_matches(stack, seg, group_part, usable, part_lo, part_hi, pairs, tol)
+    positive, _ = _overlapping_triangles(stack, seg, g, h, tol)
+    planar: dict[tuple[int, int], list[PlanarPatch]] = {}
+    for m in positive:
+        key = (int(group_part[g[m]]), int(group_part[h[m]]))
+        planar.setdefault(key, []).extend(_patches(stack, seg, int(g[m]), int(h[m]), tol))
+
+    curved: dict[tuple[int, int], list[CurvedPatch]] = {}
+    for a, b in pairs:
+        for sa in surfaces.get(int(a), ()):
+            for sb in surfaces.get(int(b), ()):
+                pts = (
+                    _surface_points(assembly, names[a], sa),
+                    _surface_points(assembly, names[b], sb),
+                )
+                patch = curved_contact(sa, sb, (names[a], names[b]), pts, tol)
+                if patch is not None:
+                    curved.setdefault((int(a), int(b)), []).append(patch)
+
+    return [
+        Contact(names[a], names[b], tuple(planar.get(key, ())), tuple(curved.get(key, ())))
+        for key in sorted(set(planar) | set(curved))
+        for a, b in [key]
+        if planar.get(key) or curved.get(key)
+    ]

@@ -1,0 +1,85 @@
+"""Contacts benchmark: the 527-block dome of compas_assembly, and grids of unit boxes
+showing how the cost grows with the number of parts (near-linear: the broad phase keeps
+only touching pairs, the narrow phase is vectorised over all of them).
+
+Run: python benchmarks/bench_contacts.py
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from assemblykit.geometry.contacts import find_contacts
+from assemblykit.io.compas import load_compas
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.tolerance import Tolerance
+
+DOME = (
+    Path(__file__).resolve().parents[1]
+    / ".."
+    / "shared"
+    / "data"
+    / "compas_assembly"
+    / "dome_assembly.json"
+)
+GRID_SIZES = (1000, 2500, 5000, 10000)
+
+
+def median_time(fn, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def grid(n: int) -> Assembly:
+    """``n`` unit boxes packed face to face in a near-cubic grid."""
+    side = int(np.ceil(n ** (1 / 3)))
+    unit = trimesh.creation.box(extents=[1, 1, 1])
+    parts = []
+    for k, cell in enumerate(np.ndindex(side, side, side)):
+        if k == n:
+            break
+        mesh = trimesh.Trimesh(unit.vertices + np.array(cell), unit.faces, process=False)
+        parts.append(Part(f"b{k}", mesh))
+    return Assembly(parts)
+
+
+def main() -> None:
+    if DOME.is_file():
+        policy = Tolerance(mesh_rel_length=5e-3)  # compas_assembly's tmax for this dome
+        load = median_time(lambda: load_compas(DOME, policy), 3)
+        dome = load_compas(DOME, policy)
+        found = find_contacts(dome)
+        seconds = median_time(lambda: find_contacts(dome), 3)
+        print(
+            f"dome: {len(dome)} blocks, {len(found)} contacts: "
+            f"contacts {seconds:.2f} s (load {load:.2f} s)"
+        )
+    else:
+        print("dome: shared data not present, skipped")
+    rates = []
+    for n in GRID_SIZES:
+        boxes = grid(n)
+        count = len(find_contacts(boxes))
+        seconds = median_time(lambda boxes=boxes: find_contacts(boxes), 3 if n <= 2500 else 1)
+        rates.append(seconds / n)
+        print(
+            f"grid: {n:6d} boxes, {count:6d} contacts: "
+            f"{seconds:6.2f} s ({1e3 * seconds / n:.3f} ms per box)"
+        )
+    print(
+        f"time per box, {GRID_SIZES[-1]} vs {GRID_SIZES[0]} boxes: "
+        f"ratio {rates[-1] / rates[0]:.2f} (1.0 = linear)"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,89 @@
+"""Interference between parts: the volume two solids share, by manifold3d booleans.
+
+Touching parts share faces but no volume; interfering parts share a volume. The volume
+of ``A ∩ B`` is computed exactly on the meshes by manifold3d (DESIGN.md §6: trimesh's
+collision distances are wrong for convex parts, so volumes decide). An overlap counts
+as interference when it is thicker than the length tolerance over the smaller part's
+surface, i.e. when ``volume > tol.length x min(area_a, area_b)``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import manifold3d
+import numpy as np
+import trimesh
+
+from assemblykit.errors import GeometryError
+from assemblykit.geometry.contacts import candidate_pairs
+from assemblykit.tolerance import Tolerance, current
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
+
+
+def solid(mesh: trimesh.Trimesh, name: str | None = None) -> manifold3d.Manifold:
+    """The manifold3d solid of a closed triangle mesh (float64 vertices)."""
+    result = manifold3d.Manifold(
+        manifold3d.Mesh64(
+            vert_properties=np.ascontiguousarray(mesh.vertices, dtype=np.float64),
+            tri_verts=np.ascontiguousarray(mesh.faces, dtype=np.uint64),
+        )
+    )
+    if result.status() != manifold3d.Error.NoError:
+        raise GeometryError(
+            f"mesh is not a closed oriented manifold ({result.status()})", where=name
+        )
+    return result
+
+
+def overlap_volume(mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh) -> float:
+    """Volume of the intersection of two closed meshes, ``vol(A ∩ B)``."""
+    return float((solid(mesh_a) ^ solid(mesh_b)).volume())
+
+
+def interference_threshold(
+    mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh, tol: Tolerance | None = None
+) -> float:
+    """The largest shared volume still counted as touching: the length tolerance times
+    the smaller surface area (module docstring)."""
+    tol = tol or current()
+    return tol.length * min(float(mesh_a.area), float(mesh_b.area))
+
+
+def interferes(
+    mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh, tol: Tolerance | None = None
+) -> bool:
+    """Whether two closed meshes share more than a tolerance-thin volume."""
+    if not _boxes_meet(mesh_a, mesh_b):
+        return False
+    return overlap_volume(mesh_a, mesh_b) > interference_threshold(mesh_a, mesh_b, tol)
+
+
+def _boxes_meet(mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh) -> bool:
+    return bool(
+        np.all(mesh_a.bounds[0] <= mesh_b.bounds[1])
+        and np.all(mesh_b.bounds[0] <= mesh_a.bounds[1])
+    )
+
+
+def interferences(assembly: Assembly, tol: Tolerance | None = None) -> list[tuple[str, str, float]]:
+    """``(a, b, volume)`` for every pair of parts of ``assembly`` that interfere, in part
+    order; only pairs whose bounding boxes overlap are tested (R-tree broad phase)."""
+    tol = assembly.tolerance(tol)
+    names = list(assembly.parts)
+    if len(names) < 2:
+        return []
+    bounds = np.array([p.mesh.bounds for p in assembly.parts.values()])
+    solids = {}
+    found = []
+    for i, j in candidate_pairs(bounds, 0.0):
+        a, b = assembly.parts[names[i]], assembly.parts[names[j]]
+        for k, part in ((i, a), (j, b)):
+            if k not in solids:
+                solids[k] = solid(part.mesh, part.name)
+        volume = float((solids[i] ^ solids[j]).volume())
+        if volume > interference_threshold(a.mesh, b.mesh, tol):
+            found.append((a.name, b.name, volume))
+    return found

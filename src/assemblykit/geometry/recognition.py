@@ -1,0 +1,384 @@
+"""Surface features of a part: planar faces, cylinders, cones and spheres (seed 003 §2,
+oriented primitive features), recognised on triangle meshes or read exactly from CAD.
+
+Method on meshes (all thresholds from the tolerance policy):
+
+1. **Coplanar groups.** Two adjacent triangles are coplanar when each one's unshared
+   vertex lies within the length tolerance of the other's plane and their normals point
+   the same way; groups are the connected components of that relation. A group is
+   *flat* when all its vertices lie within the length tolerance of its area-weighted
+   plane. This length test does not depend on triangle size, so slivers with noisy
+   normals merge into their face.
+2. **Smooth regions.** Adjacent triangles whose normals differ by at most
+   ``smooth_angle`` (30° by default: tessellators keep the angular deflection of curved
+   faces below this, and mechanical edges are sharper) are joined; a region containing
+   a smooth edge that is not coplanar is a candidate curved surface.
+3. **Fits** on each candidate region, accepted when every vertex lies within the length
+   tolerance of the fitted surface:
+
+   * cylinder: faceted normals are perpendicular to the axis, so the axis is the
+     eigenvector of the smallest eigenvalue of ``Σ w n nᵀ``; centre and radius by the
+     linear least-squares circle fit ``x² + y² = 2 c·(x, y) + k`` of the vertices
+     projected on the plane normal to the axis;
+   * cone: normals make a constant angle with the axis, so they lie on a plane whose
+     normal (smallest eigenvector of their centred covariance) is the axis; apex and
+     half-angle by least squares of radial distance against height
+     (``scipy.optimize.least_squares``);
+   * sphere: linear least squares ``|p|² = 2 c·p + k``.
+
+   A surface is convex (shaft, ball, male cone) when the outward normals point away
+   from the axis or centre, concave (hole, socket, female cone) otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from assemblykit.tolerance import Tolerance, current
+
+SurfaceKind = Literal["plane", "cylinder", "cone", "sphere", "torus"]
+SMOOTH_ANGLE = np.radians(30.0)
+MIN_CURVED_FACES = 3
+
+
+@dataclass(frozen=True, eq=False)
+class Surface:
+    """One surface of a part, in world coordinates.
+
+    ``point``: a point of the plane, the axis foot at the start of the surface
+    (cylinder), the apex (cone), the centre (sphere, torus). ``axis``: the outward normal
+    (plane) or the unit axis (cylinder, cone from apex to opening, torus); ``None`` for
+    spheres. ``convex``: the material is inside (shaft, ball, male cone). ``extent``:
+    the interval ``(s0, s1)`` covered along the axis from ``point``. ``faces``: the
+    triangles of the part's mesh on this surface.
+    """
+
+    kind: SurfaceKind
+    point: NDArray[np.float64]
+    axis: NDArray[np.float64] | None
+    faces: NDArray[np.int64]
+    area: float
+    radius: float = 0.0
+    half_angle: float = 0.0
+    minor_radius: float = 0.0
+    convex: bool = True
+    extent: tuple[float, float] = (0.0, 0.0)
+
+    def feature(self) -> Any:
+        """The :mod:`assemblykit.features` primitive of this surface (seed 003 §2)."""
+        from assemblykit.features.primitives import (
+            Ball,
+            Cone,
+            Hole,
+            Plane,
+            Shaft,
+            Socket,
+            Torus,
+        )
+
+        if self.kind == "plane":
+            return Plane(point=self.point, normal=self.axis)
+        if self.kind == "cylinder":
+            cls = Shaft if self.convex else Hole
+            return cls(point=self.point, axis=self.axis, radius=self.radius, directed=False)
+        if self.kind == "sphere":
+            return (Ball if self.convex else Socket)(point=self.point, radius=self.radius)
+        if self.kind == "cone":
+            return Cone(
+                point=self.point, axis=self.axis, half_angle=self.half_angle, male=self.convex
+            )
+        return Torus(
+            point=self.point,
+            axis=self.axis,
+            major_radius=self.radius,
+            minor_radius=self.minor_radius,
+            male=self.convex,
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Segmentation:
+    """Coplanar groups and smooth regions of a triangle mesh (method steps 1 and 2).
+
+    Per face: ``group`` and ``region`` labels, unit ``normals`` and ``areas``. Per group:
+    area-weighted ``normal`` and ``point``, ``area``, bounds ``lo``/``hi`` and ``flat``.
+    ``order``/``start``: faces sorted by group, group ``g`` owning
+    ``order[start[g]:start[g + 1]]``. ``curved``: per region, whether it is a candidate
+    curved surface.
+    """
+
+    group: NDArray[np.int64]
+    region: NDArray[np.int64]
+    normals: NDArray[np.float64]
+    areas: NDArray[np.float64]
+    normal: NDArray[np.float64]
+    point: NDArray[np.float64]
+    area: NDArray[np.float64]
+    lo: NDArray[np.float64]
+    hi: NDArray[np.float64]
+    flat: NDArray[np.bool_]
+    order: NDArray[np.int64]
+    start: NDArray[np.int64]
+    curved: NDArray[np.bool_]
+
+    def faces_of(self, g: int) -> NDArray[np.int64]:
+        """The faces of group ``g``."""
+        return self.order[self.start[g] : self.start[g + 1]]
+
+
+def _components(n: int, pairs: NDArray[np.int64]) -> NDArray[np.int64]:
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    return connected_components(graph, directed=False)[1].astype(np.int64)
+
+
+def segment(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    tol: Tolerance,
+    smooth_angle: float = SMOOTH_ANGLE,
+) -> Segmentation:
+    """Coplanar groups and smooth regions of the mesh ``(vertices, faces)`` (steps 1-2).
+
+    Works on several parts stacked into one array: parts sharing no vertex index never
+    share a group or region."""
+    corners = vertices[faces]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    double_area = np.linalg.norm(cross, axis=1)
+    normals = cross / np.where(double_area > 0, double_area, 1.0)[:, None]
+    areas = double_area / 2
+    adjacency, edges = trimesh.graph.face_adjacency(faces=faces, return_edges=True)
+    adjacency = np.asarray(adjacency, dtype=np.int64).reshape(-1, 2)
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    f0, f1 = adjacency[:, 0], adjacency[:, 1]
+    unshared0 = faces[f0].sum(axis=1) - edges.sum(axis=1)
+    unshared1 = faces[f1].sum(axis=1) - edges.sum(axis=1)
+    on_edge = vertices[edges[:, 0]]
+    dist1 = np.abs(np.einsum("ij,ij->i", normals[f0], vertices[unshared1] - on_edge))
+    dist0 = np.abs(np.einsum("ij,ij->i", normals[f1], vertices[unshared0] - on_edge))
+    cosine = np.einsum("ij,ij->i", normals[f0], normals[f1])
+    coplanar = (dist0 <= tol.length) & (dist1 <= tol.length) & (cosine > 0)
+    smooth = coplanar | (cosine >= np.cos(smooth_angle))
+    n_faces = len(faces)
+    group = _components(n_faces, adjacency[coplanar])
+    region = _components(n_faces, adjacency[smooth])
+    n_regions = int(region.max()) + 1 if n_faces else 0
+    curved = np.zeros(n_regions, dtype=bool)
+    curved[region[f0[smooth & ~coplanar]]] = True
+
+    n_groups = int(group.max()) + 1 if n_faces else 0
+    weighted = np.zeros((n_groups, 3))
+    np.add.at(weighted, group, normals * areas[:, None])
+    area = np.bincount(group, weights=areas, minlength=n_groups)
+    normal = weighted / np.maximum(np.linalg.norm(weighted, axis=1), np.finfo(float).tiny)[:, None]
+    moment = np.zeros((n_groups, 3))
+    np.add.at(moment, group, corners.mean(axis=1) * areas[:, None])
+    point = moment / np.where(area > 0, area, 1.0)[:, None]
+    order = np.argsort(group, kind="stable")
+    start = np.searchsorted(group[order], np.arange(n_groups + 1))
+    heads = start[:-1]
+    lo = np.minimum.reduceat(corners.min(axis=1)[order], heads) if n_groups else np.zeros((0, 3))
+    hi = np.maximum.reduceat(corners.max(axis=1)[order], heads) if n_groups else np.zeros((0, 3))
+    offsets = np.abs(np.einsum("fkj,fj->fk", corners - point[group][:, None], normal[group]))
+    flat = np.maximum.reduceat(offsets.max(axis=1)[order], heads) <= tol.length
+    return Segmentation(
+        group, region, normals, areas, normal, point, area, lo, hi, flat, order, start, curved
+    )
+
+
+def _circle_fit(xy: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+    """Centre and radius of the least-squares circle ``x² + y² = 2 c·(x, y) + k``."""
+    system = np.column_stack([2 * xy, np.ones(len(xy))])
+    solution = np.linalg.lstsq(system, (xy**2).sum(axis=1), rcond=None)[0]
+    centre = solution[:2]
+    return centre, float(np.sqrt(max(solution[2] + centre @ centre, 0.0)))
+
+
+def _basis(axis: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Two unit vectors completing ``axis`` to a right-handed frame (rows)."""
+    helper = np.eye(3)[int(np.argmin(np.abs(axis)))]
+    u = np.cross(helper, axis)
+    u /= np.linalg.norm(u)
+    return np.array([u, np.cross(axis, u)])
+
+
+def _fit_cylinder(
+    points: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    weights: NDArray[np.float64],
+    tol: Tolerance,
+) -> dict[str, Any] | None:
+    scatter = (normals * weights[:, None]).T @ normals / weights.sum()
+    values, vectors = np.linalg.eigh(scatter)
+    if values[0] > tol.angle:
+        return None
+    axis = vectors[:, 0]
+    plane = _basis(axis)
+    centre2, radius = _circle_fit(points @ plane.T)
+    residual = np.abs(np.linalg.norm(points @ plane.T - centre2, axis=1) - radius)
+    if residual.max() > tol.length:
+        return None
+    heights = points @ axis
+    foot = centre2 @ plane + heights.min() * axis
+    return {
+        "kind": "cylinder",
+        "point": foot,
+        "axis": axis,
+        "radius": radius,
+        "extent": (0.0, float(np.ptp(heights))),
+    }
+
+
+def _fit_cone(
+    points: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    weights: NDArray[np.float64],
+    tol: Tolerance,
+) -> dict[str, Any] | None:
+    centred = normals - np.average(normals, axis=0, weights=weights)
+    values, vectors = np.linalg.eigh((centred * weights[:, None]).T @ centred / weights.sum())
+    if values[0] > tol.angle:
+        return None
+    axis = vectors[:, 0]
+    plane = _basis(axis)
+    xy, heights = points @ plane.T, points @ axis
+    centre2, mean_radius = _circle_fit(xy)
+
+    def misfit(p: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.linalg.norm(xy - p[:2], axis=1) - (p[2] + p[3] * heights)
+
+    slope0 = float(np.polyfit(heights, np.linalg.norm(xy - centre2, axis=1), 1)[0])
+    fit = least_squares(misfit, [*centre2, mean_radius - slope0 * heights.mean(), slope0])
+    if np.abs(misfit(fit.x)).max() > tol.length or abs(fit.x[3]) <= tol.angle:
+        return None
+    cx, cy, r0, slope = fit.x
+    apex = np.array([cx, cy]) @ plane + (-r0 / slope) * axis
+    axis = axis * np.sign(slope)  # from the apex towards the opening
+    along = (points - apex) @ axis
+    return {
+        "kind": "cone",
+        "point": apex,
+        "axis": axis,
+        "half_angle": float(np.arctan(abs(slope))),
+        "extent": (float(along.min()), float(along.max())),
+    }
+
+
+def _fit_sphere(
+    points: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    weights: NDArray[np.float64],
+    tol: Tolerance,
+) -> dict[str, Any] | None:
+    system = np.column_stack([2 * points, np.ones(len(points))])
+    solution = np.linalg.lstsq(system, (points**2).sum(axis=1), rcond=None)[0]
+    centre = solution[:3]
+    radius = float(np.sqrt(max(solution[3] + centre @ centre, 0.0)))
+    if np.abs(np.linalg.norm(points - centre, axis=1) - radius).max() > tol.length:
+        return None
+    return {"kind": "sphere", "point": centre, "axis": None, "radius": radius}
+
+
+def fit_surface(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    normals: NDArray[np.float64],
+    areas: NDArray[np.float64],
+    tol: Tolerance,
+    ids: NDArray[np.int64],
+) -> Surface | None:
+    """The cylinder, cone or sphere through the triangles ``faces`` (numbered ``ids`` in
+    their mesh) by method step 3, or ``None`` when none fits within the tolerance."""
+    used = np.unique(faces)
+    points = vertices[used]
+    if len(points) < 4:
+        return None
+    for fit in (_fit_cylinder, _fit_cone, _fit_sphere):
+        found = fit(points, normals, areas, tol)
+        if found is not None:
+            break
+    else:
+        return None
+    convex = is_convex(vertices, faces, found["point"], found["axis"])
+    return Surface(faces=ids, area=float(areas.sum()), convex=convex, **found)
+
+
+def is_convex(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    point: NDArray[np.float64],
+    axis: NDArray[np.float64] | None,
+) -> bool:
+    """Whether the outward normals of the triangles ``faces`` point, on average (area
+    weighted), away from the axis through ``point`` (or from ``point`` if no axis):
+    the material is inside, as in a shaft, a ball or a male cone."""
+    corners = vertices[faces]
+    weighted = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    radial = corners.mean(axis=1) - point
+    if axis is not None:
+        radial -= np.outer(radial @ axis, axis)
+    return bool(np.einsum("ij,ij->", radial, weighted) > 0)
+
+
+def recognise(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surface, ...]:
+    """The surfaces of ``mesh``: its flat coplanar groups outside recognised curved
+    surfaces as planes, then its cylinders, cones and spheres (module docstring)."""
+    tol = tol or current()
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    seg = segment(vertices, faces, tol)
+    curved = curved_surfaces(vertices, faces, seg, tol, np.flatnonzero(seg.curved))
+    return curved + planes(seg, faces_on(curved, len(faces)))
+
+
+def curved_surfaces(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    seg: Segmentation,
+    tol: Tolerance,
+    regions: NDArray[np.int64],
+) -> tuple[Surface, ...]:
+    """The fitted curved surfaces of the candidate ``regions`` of a segmentation."""
+    found = []
+    for r in regions:
+        ids = np.flatnonzero(seg.region == r)
+        if len(ids) < MIN_CURVED_FACES:
+            continue
+        surface = fit_surface(vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, ids)
+        if surface is not None:
+            found.append(surface)
+    return tuple(found)
+
+
+def faces_on(surfaces: tuple[Surface, ...], n_faces: int) -> NDArray[np.bool_]:
+    """Per face of a mesh with ``n_faces`` triangles, whether it lies on one of ``surfaces``."""
+    mask = np.zeros(n_faces, dtype=bool)
+    for surface in surfaces:
+        mask[surface.faces] = True
+    return mask
+
+
+def planes(seg: Segmentation, excluded: NDArray[np.bool_]) -> tuple[Surface, ...]:
+    """The flat coplanar groups (planar faces) not on ``excluded`` faces, as planes."""
+    found = []
+    for g in np.flatnonzero(seg.flat):
+        ids = seg.faces_of(g)
+        if excluded[ids].any():
+            continue
+        found.append(
+            Surface(
+                kind="plane",
+                point=seg.point[g],
+                axis=seg.normal[g],
+                faces=ids,
+                area=float(seg.area[g]),
+            )
+        )
+    return tuple(found)

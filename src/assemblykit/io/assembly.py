@@ -1,0 +1,159 @@
+"""``load_assembly``: read any assembly input of DESIGN.md §5.2, dispatching by kind.
+
+* a folder → mesh folder (:func:`assemblykit.io.meshes.load_mesh_folder`);
+* ``.yaml`` / ``.yml``, or ``.json`` with a top-level ``parts`` list → manifest;
+* ``.step`` / ``.stp`` → STEP (:func:`assemblykit.io.step.load_step`, extra ``cad``);
+* other ``.json`` → COMPAS (:func:`assemblykit.io.compas.load_compas`);
+* a single mesh file → a one-part assembly.
+
+:func:`contact_report` gathers what the ``contacts`` command shows.
+"""
+
+from __future__ import annotations
+
+import json
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from assemblykit.errors import GeometryError, InputError
+from assemblykit.geometry.contacts import Contact
+from assemblykit.geometry.recognition import Surface
+from assemblykit.io.meshes import MESH_SUFFIXES, load_manifest, load_mesh_folder, read_mesh
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.tolerance import Tolerance
+
+
+def _is_manifest_json(path: Path) -> bool:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and isinstance(data.get("parts"), list)
+
+
+def load_assembly(path: str | Path, tol: Tolerance | None = None) -> Assembly:
+    """The assembly stored at ``path`` (module docstring); ``tol`` becomes its policy."""
+    path = Path(path)
+    if path.is_dir():
+        return load_mesh_folder(path, tol)
+    if not path.exists():
+        raise InputError("no such file or folder", source=str(path))
+    suffix = path.suffix.lower()
+    if suffix in (".yaml", ".yml") or (suffix == ".json" and _is_manifest_json(path)):
+        return load_manifest(path, tol)
+    if suffix == ".json":
+        from assemblykit.io.compas import load_compas
+
+        return load_compas(path, tol)
+    if suffix in (".step", ".stp"):
+        from assemblykit.io.step import load_step
+
+        return load_step(path, tol)
+    if suffix in MESH_SUFFIXES:
+        part = Part(path.stem, read_mesh(path), source=str(path))
+        return Assembly([part], source=str(path), policy=tol)
+    raise GeometryError(
+        "unknown assembly kind (expected a mesh folder, .yaml manifest, .step or COMPAS .json)",
+        source=str(path),
+    )
+
+
+def _surface_dict(surface: Surface) -> dict[str, Any]:
+    entry: dict[str, Any] = {"type": surface.feature().type_name, "point": surface.point.tolist()}
+    if surface.kind == "plane":
+        entry["normal"] = surface.axis.tolist() if surface.axis is not None else None
+    elif surface.axis is not None:
+        entry["axis"] = surface.axis.tolist()
+    if surface.kind in ("cylinder", "sphere", "torus"):
+        entry["radius"] = surface.radius
+    if surface.kind == "cone":
+        entry["half_angle"] = surface.half_angle
+    entry["area"] = surface.area
+    return entry
+
+
+def _contact_dict(contact: Contact) -> dict[str, Any]:
+    return {
+        "a": contact.a,
+        "b": contact.b,
+        "area": contact.area,
+        "planar": [
+            {"normal": p.normal.tolist(), "area": p.area, "polygon": p.polygon.tolist()}
+            for p in contact.planar
+        ],
+        "curved": [
+            {
+                "kind": c.kind,
+                "center": c.center.tolist(),
+                "axis": None if c.axis is None else c.axis.tolist(),
+                "radius": c.radius,
+                "inner": c.inner,
+                "extent": None if c.extent is None else list(c.extent),
+                "half_angle": c.half_angle,
+            }
+            for c in contact.curved
+        ],
+    }
+
+
+@dataclass(frozen=True)
+class ContactReport:
+    """What the ``contacts`` command reports: the assembly's parts with their surface
+    features, its contacts and its interferences ``(a, b, volume)``."""
+
+    assembly: Assembly
+    contacts: list[Contact]
+    surfaces: dict[str, tuple[Surface, ...]]
+    interferences: list[tuple[str, str, float]]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: the assembly summary, ``features`` per part, ``contacts`` and
+        ``interferences``."""
+        summary = self.assembly.to_dict()
+        for name, entry in summary["parts"].items():
+            entry["features"] = [_surface_dict(s) for s in self.surfaces[name]]
+        summary["contacts"] = [_contact_dict(c) for c in self.contacts]
+        summary["interferences"] = [{"a": a, "b": b, "volume": v} for a, b, v in self.interferences]
+        return summary
+
+    def render(self) -> Any:
+        """A rich rendering: one table of parts, one of contacts, then interferences."""
+        from rich.console import Group
+        from rich.table import Table
+
+        asm = self.assembly
+        parts = Table(title=f"{asm.source}: {len(asm)} parts ({asm.units}, {asm.units_source})")
+        for column in ("part", "triangles", "volume", "features"):
+            parts.add_column(column)
+        for name, part in asm.parts.items():
+            kinds = Counter(s.feature().type_name for s in self.surfaces[name])
+            listing = ", ".join(f"{n} {k}" for k, n in sorted(kinds.items()))
+            parts.add_row(name, str(len(part.mesh.faces)), f"{part.volume:.6g}", listing)
+        contacts = Table(title=f"{len(self.contacts)} contacts")
+        for column in ("a", "b", "planar area", "normals", "curved"):
+            contacts.add_column(column)
+        for c in self.contacts:
+            normals = "; ".join(
+                "(" + ", ".join(f"{x:.3g}" for x in p.normal) + ")" for p in c.planar
+            )
+            curved = ", ".join(f"{p.kind} r={p.radius:.6g} inner={p.inner}" for p in c.curved)
+            contacts.add_row(c.a, c.b, f"{c.area:.6g}", normals, curved)
+        clashes = (
+            "\n".join(f"interference {a} / {b}: volume {v:.6g}" for a, b, v in self.interferences)
+            or "no interferences"
+        )
+        return Group(parts, contacts, clashes)
+
+
+def contact_report(assembly: Assembly, tol: Tolerance | None = None) -> ContactReport:
+    """Contacts, surface features and interferences of ``assembly``."""
+    from assemblykit.geometry.interference import interferences
+
+    return ContactReport(
+        assembly,
+        assembly.contacts(tol),
+        {name: assembly.surfaces(name, tol) for name in assembly.parts},
+        interferences(assembly, tol),
+    )

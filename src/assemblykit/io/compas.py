@@ -1,0 +1,97 @@
+"""Assemblies from COMPAS JSON (DESIGN.md §5.2): ``compas_assembly`` assemblies and plain
+lists of block meshes.
+
+Accepted layouts (those of the files published with ``compas_assembly``):
+
+* an assembly: ``data.graph.data.node[id].block.data`` (COMPAS 2) or
+  ``value.data.node[id].block.value.data`` (COMPAS 1) holds each block's mesh;
+* a list of meshes: ``[{dtype: compas.datastructures/Mesh, value|data: ...}, ...]``.
+
+A mesh is a ``vertex`` dict ``{key: {x, y, z}}`` and a ``face`` dict
+``{key: [vertex keys]}`` of planar convex polygons (masonry blocks), triangulated as fans.
+Parts are named by node key (assemblies) or list index (lists). COMPAS stores no unit.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import trimesh
+
+from assemblykit.errors import GeometryError, SchemaError
+from assemblykit.io.meshes import DEFAULT_UNITS, repaired
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.tolerance import Tolerance
+
+
+def _payload(obj: Any) -> Any:
+    """Unwrap COMPAS' ``{dtype, data}`` (COMPAS 2) or ``{dtype, value}`` (COMPAS 1)."""
+    while isinstance(obj, Mapping) and "dtype" in obj and ("data" in obj or "value" in obj):
+        obj = obj["data"] if "data" in obj else obj["value"]
+    if isinstance(obj, Mapping) and "vertex" not in obj and "node" not in obj and "data" in obj:
+        return _payload(obj["data"])
+    return obj
+
+
+def mesh_from_compas(data: Mapping[str, Any], source: str, where: str) -> trimesh.Trimesh:
+    """The triangle mesh of a COMPAS mesh payload (``vertex`` and ``face`` dicts)."""
+    vertices = data.get("vertex")
+    faces = data.get("face")
+    if not isinstance(vertices, Mapping) or not isinstance(faces, Mapping) or not faces:
+        raise SchemaError(
+            "a block mesh needs 'vertex' and 'face' dicts", source=source, where=where
+        )
+    keys = {str(k): i for i, k in enumerate(vertices)}
+    try:
+        xyz = np.array(
+            [[float(v["x"]), float(v["y"]), float(v["z"])] for v in vertices.values()],
+            dtype=np.float64,
+        )
+        triangles = [
+            (keys[str(f[0])], keys[str(f[i])], keys[str(f[i + 1])])
+            for f in faces.values()
+            for i in range(1, len(f) - 1)
+        ]
+    except (KeyError, TypeError, ValueError) as bad:
+        raise SchemaError(f"malformed vertex or face: {bad}", source=source, where=where) from None
+    mesh = trimesh.Trimesh(vertices=xyz, faces=np.array(triangles, dtype=np.int64), process=False)
+    return repaired(mesh, f"{source}: {where}")
+
+
+def _blocks(data: Any, source: str) -> list[tuple[str, Any, str]]:
+    """``(name, mesh payload, field path)`` for every block in a COMPAS document."""
+    if isinstance(data, list):
+        return [(str(i), _payload(item), f"[{i}]") for i, item in enumerate(data)]
+    body = _payload(data)
+    graph = _payload(body.get("graph")) if isinstance(body, Mapping) and "graph" in body else body
+    nodes = graph.get("node") if isinstance(graph, Mapping) else None
+    if not isinstance(nodes, Mapping):
+        raise SchemaError("neither a COMPAS assembly nor a list of meshes", source=source)
+    blocks = []
+    for key, node in nodes.items():
+        block = node.get("block") if isinstance(node, Mapping) else None
+        if block is None:
+            raise SchemaError("node has no block", source=source, where=f"node.{key}")
+        blocks.append((str(key), _payload(block), f"node.{key}.block"))
+    return blocks
+
+
+def load_compas(path: str | Path, tol: Tolerance | None = None) -> Assembly:
+    """An assembly of the blocks of a COMPAS JSON file (module docstring)."""
+    path = Path(path)
+    source = str(path)
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError) as bad:
+        raise SchemaError(f"cannot read JSON: {bad}", source=source) from None
+    parts = [
+        Part(name, mesh_from_compas(mesh, source, where), source=source)
+        for name, mesh, where in _blocks(data, source)
+    ]
+    if not parts:
+        raise GeometryError("no blocks", source=source)
+    return Assembly(parts, units=DEFAULT_UNITS, units_source="default", source=source, policy=tol)

@@ -1,0 +1,224 @@
+"""Assemblies from triangle meshes: mesh folders and YAML manifests (DESIGN.md §5.2).
+
+* A **mesh folder** holds one part per file (``*.obj, *.stl, *.ply, *.glb``), named
+  after the file's stem. If the folder has a ``config.json`` with a per-part
+  ``final_state`` ``[x, y, z, rx, ry, rz]`` (the ASAP / Assemble-Them-All convention),
+  the part is placed by the 4x4 transform with that translation and rotation
+  ``Rotation.from_euler('xyz', [rx, ry, rz])`` (radians), applied to the mesh as read:
+  ``p_world = R @ p_file + t``.
+* A **manifest** (YAML or JSON) lists ``parts: [{name, mesh, pose}]``; ``pose`` is a 4x4
+  matrix or ``{translation: [...], rotation_xyz_deg: [...]}`` (same Euler convention, in
+  degrees); mesh paths are relative to the manifest's folder; ``units`` is optional.
+
+Every mesh is checked and repaired with trimesh (merged vertices, degenerate and
+duplicate faces dropped, normals made consistent and outward, holes filled); a mesh
+that is empty, has non-finite vertices or stays open is rejected with a
+:class:`GeometryError` naming the file.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import trimesh
+import yaml
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from assemblykit.errors import GeometryError, SchemaError
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.tolerance import Tolerance, current
+
+MESH_SUFFIXES = (".obj", ".stl", ".ply", ".glb")
+DEFAULT_UNITS = "mm"
+
+
+def read_mesh(path: str | Path) -> trimesh.Trimesh:
+    """Read one mesh file (scenes are flattened into one mesh), repaired and checked.
+
+    Raises :class:`GeometryError` naming the file if it is missing, unreadable, empty,
+    has non-finite vertices, or cannot be made watertight."""
+    path = Path(path)
+    source = str(path)
+    if not path.is_file():
+        raise GeometryError("mesh file not found", source=source)
+    try:
+        loaded = trimesh.load(path, force="mesh", process=False)
+    except Exception as bad:  # trimesh raises many unrelated types on bad files
+        raise GeometryError(f"cannot read mesh: {bad}", source=source) from None
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        raise GeometryError("no triangles in mesh", source=source)
+    return repaired(loaded, source)
+
+
+def repaired(mesh: trimesh.Trimesh, source: str | None = None) -> trimesh.Trimesh:
+    """``mesh`` with trimesh's repairs applied, or :class:`GeometryError` naming ``source``."""
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    if not np.all(np.isfinite(vertices)):
+        bad = int(np.count_nonzero(~np.all(np.isfinite(vertices), axis=1)))
+        raise GeometryError(f"{bad} vertices are NaN or infinite", source=source)
+    fixed = trimesh.Trimesh(vertices=vertices, faces=mesh.faces, process=True)
+    fixed.update_faces(fixed.nondegenerate_faces())
+    fixed.update_faces(fixed.unique_faces())
+    fixed.remove_unreferenced_vertices()
+    if len(fixed.faces) == 0:
+        raise GeometryError("all triangles are degenerate", source=source)
+    if not fixed.is_watertight:
+        trimesh.repair.fill_holes(fixed)
+    if not fixed.is_watertight:
+        raise GeometryError("mesh is not closed (watertight) and cannot be repaired", source=source)
+    trimesh.repair.fix_normals(fixed)
+    return fixed
+
+
+def pose_from_state(state: Sequence[float]) -> NDArray[np.float64]:
+    """The 4x4 pose of an ASAP ``[x, y, z, rx, ry, rz]`` state (translation, then
+    ``Rotation.from_euler('xyz', ...)`` in radians): ``p_world = R @ p + t``."""
+    pose = np.eye(4)
+    pose[:3, :3] = Rotation.from_euler("xyz", np.asarray(state[3:6], dtype=np.float64)).as_matrix()
+    pose[:3, 3] = np.asarray(state[:3], dtype=np.float64)
+    return pose
+
+
+def placed(mesh: trimesh.Trimesh, pose: NDArray[np.float64]) -> trimesh.Trimesh:
+    """A copy of ``mesh`` transformed by ``pose``."""
+    moved = mesh.copy()
+    moved.apply_transform(pose)
+    return moved
+
+
+def _file_units(meshes: Sequence[trimesh.Trimesh]) -> str | None:
+    """The unit the files declare (glTF is metres; OBJ/STL/PLY usually say nothing)."""
+    units = {m.units for m in meshes}
+    if len(units) == 1 and None not in units:
+        return str(units.pop())
+    return None
+
+
+def _assembly(
+    parts: list[Part], units: str | None, declared: bool, source: str, tol: Tolerance | None
+) -> Assembly:
+    file_units = _file_units([p.mesh for p in parts])
+    if units is not None:
+        unit, how = units, "declared" if declared else "file"
+    elif file_units is not None:
+        unit, how = file_units, "file"
+    else:
+        unit, how = DEFAULT_UNITS, "default"
+    return Assembly(parts, units=unit, units_source=how, source=source, policy=tol)
+
+
+def load_mesh_folder(folder: str | Path, tol: Tolerance | None = None) -> Assembly:
+    """An assembly of the mesh files in ``folder`` (sorted by name), placed by the
+    ``final_state`` poses of ``config.json`` when present (module docstring)."""
+    folder = Path(folder)
+    files = sorted(f for f in folder.iterdir() if f.suffix.lower() in MESH_SUFFIXES)
+    if not files:
+        raise GeometryError(
+            f"no mesh files ({', '.join(MESH_SUFFIXES)}) in folder", source=str(folder)
+        )
+    states = _final_states(folder / "config.json")
+    parts = []
+    for file in files:
+        state = states.get(file.stem)
+        pose = np.eye(4) if state is None else pose_from_state(state)
+        mesh = read_mesh(file)
+        parts.append(Part(file.stem, placed(mesh, pose), pose, source=str(file)))
+    return _assembly(parts, None, False, str(folder), tol)
+
+
+def _final_states(config: Path) -> dict[str, list[float]]:
+    if not config.is_file():
+        return {}
+    source = str(config)
+    try:
+        data = json.loads(config.read_text())
+    except (OSError, ValueError) as bad:
+        raise SchemaError(f"cannot read JSON: {bad}", source=source) from None
+    if not isinstance(data, dict):
+        raise SchemaError("expected an object keyed by part name", source=source)
+    states = {}
+    for name, entry in data.items():
+        if not isinstance(entry, dict) or "final_state" not in entry:
+            continue
+        state = entry["final_state"]
+        if not (isinstance(state, list) and len(state) == 6 and _numbers(state)):
+            raise SchemaError(
+                "final_state must be 6 numbers [x, y, z, rx, ry, rz]",
+                source=source,
+                where=f"{name}.final_state",
+            )
+        states[str(name)] = [float(v) for v in state]
+    return states
+
+
+def _numbers(values: Sequence[Any]) -> bool:
+    return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
+
+
+def pose_from_spec(
+    spec: Any, *, source: str | None = None, where: str = "pose", tol: Tolerance | None = None
+) -> NDArray[np.float64]:
+    """The 4x4 pose of a manifest ``pose``: a 4x4 matrix (rigid, last row ``0 0 0 1``,
+    checked with the mesh angle tolerance) or ``{translation, rotation_xyz_deg}``."""
+    tol = tol or current()
+    if spec is None:
+        return np.eye(4)
+    if isinstance(spec, Mapping):
+        unknown = set(spec) - {"translation", "rotation_xyz_deg"}
+        if unknown:
+            raise SchemaError(f"unknown pose keys {sorted(unknown)}", source=source, where=where)
+        pose = np.eye(4)
+        for key in ("translation", "rotation_xyz_deg"):
+            value = spec.get(key, [0.0, 0.0, 0.0])
+            if not (isinstance(value, list) and len(value) == 3 and _numbers(value)):
+                raise SchemaError("expected 3 numbers", source=source, where=f"{where}.{key}")
+        rotation = Rotation.from_euler("xyz", spec.get("rotation_xyz_deg", [0, 0, 0]), degrees=True)
+        pose[:3, :3] = rotation.as_matrix()
+        pose[:3, 3] = spec.get("translation", [0.0, 0.0, 0.0])
+        return pose
+    rows = spec if isinstance(spec, list) else None
+    if not (rows and len(rows) == 4 and all(isinstance(r, list) and len(r) == 4 for r in rows)):
+        raise SchemaError(
+            "expected a 4x4 matrix or {translation, rotation_xyz_deg}", source=source, where=where
+        )
+    if not all(_numbers(r) for r in rows):
+        raise SchemaError("matrix entries must be numbers", source=source, where=where)
+    pose = np.array(rows, dtype=np.float64)
+    rotation = pose[:3, :3]
+    rigid = np.allclose(rotation.T @ rotation, np.eye(3), atol=tol.mesh_angle, rtol=0)
+    if not (rigid and np.linalg.det(rotation) > 0 and np.allclose(pose[3], [0, 0, 0, 1])):
+        raise SchemaError("matrix is not a rigid transform", source=source, where=where)
+    return pose
+
+
+def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
+    """An assembly from a YAML/JSON manifest ``{units?, parts: [{name, mesh, pose?}]}``."""
+    path = Path(path)
+    source = str(path)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError) as bad:
+        raise SchemaError(f"cannot read manifest: {bad}", source=source) from None
+    if not isinstance(data, dict) or not isinstance(data.get("parts"), list) or not data["parts"]:
+        raise SchemaError("expected a non-empty list", source=source, where="parts")
+    units = data.get("units")
+    if units is not None and not isinstance(units, str):
+        raise SchemaError("expected a unit name such as mm", source=source, where="units")
+    parts: list[Part] = []
+    for i, entry in enumerate(data["parts"]):
+        where = f"parts[{i}]"
+        if not isinstance(entry, dict) or not isinstance(entry.get("mesh"), str):
+            raise SchemaError("expected {name, mesh, pose}", source=source, where=where)
+        name = str(entry.get("name", Path(entry["mesh"]).stem))
+        if any(p.name == name for p in parts):
+            raise SchemaError(f"duplicate part name {name!r}", source=source, where=where)
+        pose = pose_from_spec(entry.get("pose"), source=source, where=f"{where}.pose", tol=tol)
+        mesh_path = path.parent / entry["mesh"]
+        mesh = read_mesh(mesh_path)
+        parts.append(Part(name, placed(mesh, pose), pose, source=str(mesh_path)))
+    return _assembly(parts, units, units is not None, source, tol)

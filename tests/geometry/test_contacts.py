@@ -1,0 +1,152 @@
+"""Contacts between parts: planar patches (exact polygons and areas on hand-made boxes),
+curved contacts (a shaft in a hole), and agreement with compas_assembly's interfaces."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+import trimesh
+
+from assemblykit.geometry.contacts import candidate_pairs, find_contacts
+from assemblykit.io.compas import load_compas
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.tolerance import Tolerance
+
+DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "compas_assembly"
+
+
+def box(lo, hi) -> trimesh.Trimesh:
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    return trimesh.creation.box(
+        extents=hi - lo, transform=trimesh.transformations.translation_matrix((lo + hi) / 2)
+    )
+
+
+def assembly(**meshes: trimesh.Trimesh) -> Assembly:
+    return Assembly([Part(name, mesh) for name, mesh in meshes.items()])
+
+
+def test_box_on_box_gives_the_full_square_with_normal_from_a_into_b():
+    found = find_contacts(assembly(a=box([0, 0, 0], [1, 1, 1]), b=box([0, 0, 1], [1, 1, 2])))
+    assert [c.pair for c in found] == [("a", "b")]
+    (patch,) = found[0].planar
+    assert patch.area == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(patch.normal, [0, 0, 1], atol=1e-12)
+    corners = {tuple(np.round(p, 12)) for p in patch.polygon}
+    assert corners == {(0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)}
+    # counter-clockwise seen from the tip of the normal
+    xy = patch.polygon[:, :2]
+    signed = 0.5 * np.sum(xy[:, 0] * np.roll(xy[:, 1], -1) - np.roll(xy[:, 0], -1) * xy[:, 1])
+    assert signed == pytest.approx(1.0)
+
+
+def test_box_offset_by_half_touches_on_half_the_face():
+    found = find_contacts(assembly(a=box([0, 0, 0], [1, 1, 1]), b=box([0.5, 0, 1], [1.5, 1, 2])))
+    (patch,) = found[0].planar
+    assert patch.area == pytest.approx(0.5, abs=1e-12)
+    assert shapely.Polygon(patch.polygon[:, :2]).equals(shapely.box(0.5, 0, 1, 1))
+
+
+def test_normal_points_from_the_first_part_into_the_second():
+    found = find_contacts(assembly(top=box([0, 0, 1], [1, 1, 2]), bottom=box([0, 0, 0], [1, 1, 1])))
+    np.testing.assert_allclose(found[0].planar[0].normal, [0, 0, -1], atol=1e-12)
+    assert found[0].pair == ("top", "bottom")
+
+
+def test_edge_contact_gap_and_same_side_faces_are_not_contacts():
+    parts = assembly(
+        a=box([0, 0, 0], [1, 1, 1]),
+        edge=box([1, 1, 0], [2, 2, 1]),  # shares only an edge line with a
+        gap=box([0, 0, 1.001], [1, 1, 2]),  # a thousandth above a
+        side=box([3, 0, 0], [4, 1, 1]),
+    )
+    assert find_contacts(parts) == []
+
+
+def test_side_by_side_boxes_and_a_t_junction():
+    found = find_contacts(
+        assembly(
+            a=box([0, 0, 0], [2, 1, 1]),
+            b=box([2, 0, 0], [3, 1, 1]),
+            c=box([0.5, 0, 1], [1.5, 1, 2]),
+        )
+    )
+    areas = {c.pair: c.area for c in found}
+    assert areas == pytest.approx({("a", "b"): 1.0, ("a", "c"): 1.0})
+    np.testing.assert_allclose(found[0].planar[0].normal, [1, 0, 0], atol=1e-12)
+
+
+def test_only_restricts_to_the_contacts_of_one_part():
+    parts = assembly(
+        a=box([0, 0, 0], [1, 1, 1]), b=box([0, 0, 1], [1, 1, 2]), c=box([0, 0, 2], [1, 1, 3])
+    )
+    assert [c.pair for c in find_contacts(parts)] == [("a", "b"), ("b", "c")]
+    assert [c.pair for c in find_contacts(parts, only="c")] == [("b", "c")]
+
+
+def test_broad_phase_pairs_boxes_that_overlap_once_inflated():
+    bounds = np.array(
+        [[[0, 0, 0], [1, 1, 1]], [[1, 0, 0], [2, 1, 1]], [[5, 5, 5], [6, 6, 6]]], float
+    )
+    assert candidate_pairs(bounds, 1e-9).tolist() == [[0, 1]]
+    assert candidate_pairs(bounds, 1e-9, only=2).tolist() == []
+
+
+def test_shaft_in_a_hole_from_meshes_is_a_cylindrical_contact():
+    radius, sections = 1.0, 48
+    shaft = trimesh.creation.cylinder(radius=radius, height=6.0, sections=sections)
+    cutter = trimesh.creation.cylinder(radius=radius, height=10.0, sections=sections)
+    plate = box([-3, -3, -1], [3, 3, 1]).difference(cutter, engine="manifold")
+    found = find_contacts(assembly(plate=plate, shaft=shaft))
+    assert [c.pair for c in found] == [("plate", "shaft")]
+    (curved,) = found[0].curved
+    assert curved.kind == "cylindrical"
+    assert curved.inner == "shaft"
+    assert curved.radius == pytest.approx(radius, abs=1e-6)  # boolean output is float32
+    assert abs(curved.axis @ [0, 0, 1]) == pytest.approx(1.0, abs=1e-9)
+    assert curved.extent[1] - curved.extent[0] == pytest.approx(2.0, abs=1e-6)
+    assert found[0].planar == ()
+
+
+def _reference(path: Path) -> dict[frozenset[str], float]:
+    edges = json.loads(path.read_text())["data"]["graph"]["data"]["edge"]
+    ref = {}
+    for i, row in edges.items():
+        for j, edge in row.items():
+            area = 0.0
+            for interface in edge["interfaces"]:
+                pts = np.array([p["data"] for p in interface["data"]["points"]])
+                centred = pts - pts.mean(axis=0)
+                area += (
+                    np.linalg.norm(np.cross(centred, np.roll(centred, -1, axis=0)).sum(axis=0)) / 2
+                )
+            ref[frozenset((i, j))] = area
+    return ref
+
+
+# compas_assembly found these interfaces with its own flatness tolerance ``tmax``: exact
+# for stack and arch, about 1.6e-3 m for the cross vault and 5e-2 m for the dome.
+@pytest.mark.parametrize(
+    "name, rel",
+    [
+        ("stack_assembly.json", None),
+        ("arch_assembly.json", None),
+        ("crossvault_assembly.json", 1e-4),
+        ("dome_assembly.json", 5e-3),
+    ],
+)
+def test_touching_pairs_and_areas_agree_with_compas_assembly(name, rel):
+    path = DATA / name
+    if not path.is_file():
+        pytest.skip("shared data not present")
+    policy = None if rel is None else Tolerance(mesh_rel_length=rel)
+    found = {frozenset(c.pair): c.area for c in load_compas(path, policy).contacts()}
+    ref = _reference(path)
+    jaccard = len(found.keys() & ref.keys()) / len(found.keys() | ref.keys())
+    assert jaccard >= 0.95
+    for pair in found.keys() & ref.keys():
+        assert found[pair] == pytest.approx(ref[pair], rel=0.02)

@@ -1,0 +1,76 @@
+"""Surface recognition on meshes: planes, shafts and holes, balls and sockets, cones."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.features.primitives import Ball, Cone, Hole, Plane, Shaft, Socket
+from assemblykit.geometry.recognition import recognise, segment
+from assemblykit.tolerance import Tolerance
+
+TOL = Tolerance(scale=10.0).for_mesh()
+
+
+def curved(mesh: trimesh.Trimesh):
+    return [s for s in recognise(mesh, TOL) if s.kind != "plane"]
+
+
+def test_box_has_six_planes_with_outward_normals_and_no_curved_surface():
+    surfaces = recognise(trimesh.creation.box(extents=[2, 2, 2]), TOL)
+    assert [s.kind for s in surfaces] == ["plane"] * 6
+    for s in surfaces:
+        assert s.area == pytest.approx(4.0)
+        assert s.axis @ s.point == pytest.approx(1.0)  # outward: the plane is 1 from the centre
+
+
+def test_coplanar_triangles_merge_into_one_group():
+    seg = segment(
+        *(np.asarray(a) for a in (trimesh.creation.box().vertices, trimesh.creation.box().faces)),
+        TOL,
+    )
+    assert len(seg.normal) == 6 and seg.flat.all() and not seg.curved.any()
+
+
+def test_shaft_axis_radius_and_feature():
+    mesh = trimesh.creation.cylinder(radius=1.5, height=4.0, sections=64)
+    mesh.apply_translation([1, 2, 3])
+    (shaft,) = curved(mesh)
+    assert shaft.kind == "cylinder" and shaft.convex
+    assert shaft.radius == pytest.approx(1.5, abs=1e-9)
+    assert abs(shaft.axis @ [0, 0, 1]) == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(shaft.point[:2], [1, 2], atol=1e-9)
+    assert shaft.extent == pytest.approx((0.0, 4.0))
+    feature = shaft.feature()
+    assert isinstance(feature, Shaft) and feature.radius == pytest.approx(1.5, abs=1e-9)
+    assert sum(isinstance(s.feature(), Plane) for s in recognise(mesh, TOL)) == 2
+
+
+def test_hole_in_a_plate_is_concave():
+    cutter = trimesh.creation.cylinder(radius=1.0, height=5.0, sections=48)
+    plate = trimesh.creation.box(extents=[4, 4, 2]).difference(cutter, engine="manifold")
+    (hole,) = curved(plate)
+    assert not hole.convex and isinstance(hole.feature(), Hole)
+    assert hole.radius == pytest.approx(1.0, abs=1e-6)
+
+
+def test_ball_and_socket():
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=2.0)
+    (surface,) = curved(ball)
+    assert surface.kind == "sphere" and surface.convex
+    assert surface.radius == pytest.approx(2.0, abs=1e-9)
+    assert isinstance(surface.feature(), Ball)
+    socket = trimesh.creation.box(extents=[6, 6, 6]).difference(ball, engine="manifold")
+    (inside,) = curved(socket)
+    assert not inside.convex and isinstance(inside.feature(), Socket)
+
+
+def test_cone_apex_axis_and_half_angle():
+    mesh = trimesh.creation.cone(radius=1.0, height=2.0, sections=64)
+    (cone,) = curved(mesh)
+    assert cone.kind == "cone" and cone.convex
+    assert cone.half_angle == pytest.approx(np.arctan(0.5), abs=1e-9)
+    np.testing.assert_allclose(cone.point, [0, 0, 2], atol=1e-9)
+    np.testing.assert_allclose(cone.axis, [0, 0, -1], atol=1e-9)
+    assert isinstance(cone.feature(), Cone)

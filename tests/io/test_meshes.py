@@ -1,0 +1,120 @@
+"""Mesh folders and manifests: poses (ASAP final_state, 4x4, translation + Euler degrees),
+units, repairs and rejection of bad meshes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.errors import GeometryError, SchemaError
+from assemblykit.geometry.interference import interferences, overlap_volume
+from assemblykit.io.assembly import load_assembly
+from assemblykit.io.meshes import load_manifest, pose_from_spec, pose_from_state, read_mesh
+
+ASAP = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "asap_beam_assembly"
+
+
+def unit_box(folder: Path, name: str) -> Path:
+    path = folder / name
+    trimesh.creation.box(extents=[1, 1, 1]).export(path)
+    return path
+
+
+def test_pose_from_state_is_translation_after_xyz_euler_radians():
+    pose = pose_from_state([1, 2, 3, 0, 0, np.pi / 2])
+    np.testing.assert_allclose(pose @ [1, 0, 0, 1], [1, 3, 3, 1], atol=1e-12)
+
+
+def test_folder_applies_config_final_state(tmp_path):
+    unit_box(tmp_path, "a.stl")
+    unit_box(tmp_path, "b.obj")
+    (tmp_path / "config.json").write_text(json.dumps({"b": {"final_state": [0, 0, 1, 0, 0, 0.5]}}))
+    asm = load_assembly(tmp_path)
+    assert asm.names == ["a", "b"]
+    np.testing.assert_allclose(asm["a"].pose, np.eye(4))
+    assert asm["b"].mesh.bounds[0][2] == pytest.approx(0.5)
+    assert asm["b"].mesh.volume == pytest.approx(1.0)
+    assert (asm.units, asm.units_source) == ("mm", "default")
+    assert [c.pair for c in asm.contacts()] == [("a", "b")]
+
+
+def test_manifest_poses_units_and_relative_paths(tmp_path):
+    (tmp_path / "meshes").mkdir()
+    unit_box(tmp_path / "meshes", "cube.ply")
+    (tmp_path / "asm.yaml").write_text(
+        "units: in\n"
+        "parts:\n"
+        "  - {name: base, mesh: meshes/cube.ply}\n"
+        "  - name: lid\n    mesh: meshes/cube.ply\n"
+        "    pose: {translation: [0, 0, 1], rotation_xyz_deg: [0, 0, 90]}\n"
+        "  - name: side\n    mesh: meshes/cube.ply\n"
+        "    pose: [[1, 0, 0, 1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n"
+    )
+    asm = load_manifest(tmp_path / "asm.yaml")
+    assert (asm.units, asm.units_source) == ("in", "declared")
+    np.testing.assert_allclose(
+        asm["lid"].pose[:3, :3], [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-12
+    )
+    assert asm["side"].mesh.bounds[0][0] == pytest.approx(0.5)
+    assert {c.pair for c in asm.contacts()} == {("base", "lid"), ("base", "side")}
+
+
+def test_pose_spec_rejects_non_rigid_matrix():
+    with pytest.raises(SchemaError, match=r"parts\[0\]\.pose"):
+        pose_from_spec(
+            [[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], where="parts[0].pose"
+        )
+
+
+def test_manifest_with_missing_mesh_names_the_file(tmp_path):
+    (tmp_path / "m.yaml").write_text("parts:\n  - {name: a, mesh: nowhere.stl}\n")
+    with pytest.raises(GeometryError, match=r"nowhere\.stl"):
+        load_assembly(tmp_path / "m.yaml")
+
+
+def test_empty_folder_is_rejected(tmp_path):
+    with pytest.raises(GeometryError, match="no mesh files"):
+        load_assembly(tmp_path)
+
+
+def test_nan_vertices_are_rejected_naming_the_file(tmp_path):
+    path = tmp_path / "bad.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv nan 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")
+    with pytest.raises(GeometryError, match=r"bad\.obj.*NaN"):
+        read_mesh(path)
+
+
+def test_duplicate_and_degenerate_faces_are_repaired(tmp_path):
+    cube = trimesh.creation.box(extents=[1, 1, 1])
+    faces = np.vstack([cube.faces, cube.faces[:1], [[0, 0, 1]]])
+    path = tmp_path / "messy.ply"
+    trimesh.Trimesh(cube.vertices, faces, process=False).export(path)
+    mesh = read_mesh(path)
+    assert len(mesh.faces) == 12 and mesh.is_watertight
+    assert mesh.volume == pytest.approx(1.0)
+
+
+def test_open_mesh_that_cannot_be_closed_is_rejected(tmp_path):
+    cube = trimesh.creation.box(extents=[1, 1, 1])
+    path = tmp_path / "open.stl"
+    trimesh.Trimesh(cube.vertices, cube.faces[:6], process=False).export(path)  # half a box
+    with pytest.raises(GeometryError, match=r"open\.stl"):
+        read_mesh(path)
+
+
+def test_asap_beam_touches_without_interfering_with_final_state_poses():
+    if not ASAP.is_dir():
+        pytest.skip("shared data not present")
+    asm = load_assembly(ASAP)
+    assert asm.names == ["0", "1", "2", "3", "6"]
+    # translation after Rotation.from_euler('xyz') of the mesh as read: beams on posts
+    assert {c.pair for c in asm.contacts()} == {("0", "2"), ("1", "3"), ("2", "6"), ("3", "6")}
+    assert interferences(asm) == []
+    # the poses are rounded to 1e-4, leaving layers about 2e-5 thick: < 5e-6 of a part
+    for a, b in [("0", "2"), ("1", "3"), ("2", "6"), ("3", "6")]:
+        volume = overlap_volume(asm[a].mesh, asm[b].mesh)
+        assert volume <= 5e-6 * min(asm[a].volume, asm[b].volume)

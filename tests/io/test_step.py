@@ -1,0 +1,95 @@
+"""STEP round trip built with OCP: a plate with a through hole and a shaft in it, a ball
+in a socket; exact radii and axes, and the curved contacts between them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from assemblykit.errors import GeometryError
+from assemblykit.features.primitives import Ball, Hole, Shaft, Socket
+from assemblykit.io.assembly import load_assembly
+
+pytest.importorskip("OCP")
+
+pytestmark = pytest.mark.cad
+
+
+def write_step(path, *shapes) -> None:
+    from OCP.BRep import BRep_Builder
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TopoDS import TopoDS_Compound
+
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    for shape in shapes:
+        builder.Add(compound, shape)
+    writer = STEPControl_Writer()
+    writer.Transfer(compound, STEPControl_AsIs)
+    writer.Write(str(path))
+
+
+@pytest.fixture(scope="module")
+def step_file(tmp_path_factory):
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.BRepPrimAPI import (
+        BRepPrimAPI_MakeBox,
+        BRepPrimAPI_MakeCylinder,
+        BRepPrimAPI_MakeSphere,
+    )
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+    axis = gp_Ax2(gp_Pnt(0, 0, -10), gp_Dir(0, 0, 1))
+    plate = BRepAlgoAPI_Cut(
+        BRepPrimAPI_MakeBox(gp_Pnt(-20, -20, 0), 40, 40, 10).Shape(),
+        BRepPrimAPI_MakeCylinder(axis, 5.0, 40.0).Shape(),
+    ).Shape()
+    shaft = BRepPrimAPI_MakeCylinder(axis, 5.0, 30.0).Shape()
+    centre = gp_Pnt(60, 0, 0)
+    socket = BRepAlgoAPI_Cut(
+        BRepPrimAPI_MakeBox(gp_Pnt(50, -10, -10), 20, 20, 10).Shape(),
+        BRepPrimAPI_MakeSphere(centre, 4.0).Shape(),
+    ).Shape()
+    ball = BRepPrimAPI_MakeSphere(centre, 4.0).Shape()
+    path = tmp_path_factory.mktemp("step") / "parts.step"
+    write_step(path, plate, shaft, socket, ball)
+    return path
+
+
+def test_solids_become_parts_with_exact_surfaces(step_file):
+    asm = load_assembly(step_file)
+    assert asm.names == ["solid1", "solid2", "solid3", "solid4"]
+    assert (asm.units, asm.units_source, asm.exact) == ("mm", "file", True)
+    assert asm["solid1"].volume == pytest.approx(40 * 40 * 10 - np.pi * 25 * 10, rel=1e-2)
+
+
+def test_recognised_features_have_exact_radii_and_axes(step_file):
+    asm = load_assembly(step_file)
+    (hole,) = [f for f in asm.features("solid1") if isinstance(f, Hole)]
+    (shaft,) = [f for f in asm.features("solid2") if isinstance(f, Shaft)]
+    for feature in (hole, shaft):
+        assert feature.radius == 5.0
+        assert abs(feature.axis @ [0, 0, 1]) == 1.0
+        np.testing.assert_allclose(feature.point[:2], [0, 0], atol=1e-12)
+    (socket,) = [f for f in asm.features("solid3") if isinstance(f, Socket)]
+    (ball,) = [f for f in asm.features("solid4") if isinstance(f, Ball)]
+    assert socket.radius == 4.0 and ball.radius == 4.0
+    np.testing.assert_allclose(ball.point, [60, 0, 0], atol=1e-12)
+
+
+def test_shaft_in_hole_and_ball_in_socket_are_curved_contacts(step_file):
+    contacts = {c.pair: c for c in load_assembly(step_file).contacts()}
+    assert set(contacts) == {("solid1", "solid2"), ("solid3", "solid4")}
+    (cylinder,) = contacts["solid1", "solid2"].curved
+    assert (cylinder.kind, cylinder.inner, cylinder.radius) == ("cylindrical", "solid2", 5.0)
+    assert cylinder.extent == pytest.approx((0.0, 10.0), abs=1e-9)
+    assert contacts["solid1", "solid2"].planar == ()
+    (sphere,) = contacts["solid3", "solid4"].curved
+    assert (sphere.kind, sphere.inner, sphere.radius) == ("spherical", "solid4", 4.0)
+
+
+def test_unreadable_step_names_the_file(tmp_path):
+    path = tmp_path / "junk.step"
+    path.write_text("this is not ISO-10303-21\n")
+    with pytest.raises(GeometryError, match=r"junk\.step"):
+        load_assembly(path)

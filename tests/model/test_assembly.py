@@ -1,0 +1,87 @@
+"""The Assembly model: scale, tolerance, cached contacts, subsets and part changes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.errors import UnknownNameError
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.tolerance import Tolerance, using
+
+
+def box(lo, hi) -> trimesh.Trimesh:
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    return trimesh.creation.box(
+        extents=hi - lo, transform=trimesh.transformations.translation_matrix((lo + hi) / 2)
+    )
+
+
+@pytest.fixture
+def tower() -> Assembly:
+    return Assembly(
+        [
+            Part("a", box([0, 0, 0], [1, 1, 1])),
+            Part("b", box([0, 0, 1], [1, 1, 2])),
+            Part("c", box([0, 0, 2], [1, 1, 3])),
+        ],
+        source="tower",
+    )
+
+
+def test_scale_is_the_bounding_box_diagonal(tower):
+    assert tower.scale == pytest.approx(np.sqrt(11))
+    np.testing.assert_allclose(tower.bounds, [[0, 0, 0], [1, 1, 3]])
+
+
+def test_tolerance_uses_mesh_thresholds_scaled_to_the_model(tower):
+    tol = tower.tolerance()
+    assert tol.length == pytest.approx(1e-6 * np.sqrt(11))
+    with using(Tolerance(mesh_rel_length=1e-3)):
+        assert tower.tolerance().length == pytest.approx(1e-3 * np.sqrt(11))
+    exact = Assembly(tower.parts, exact=True)
+    assert exact.tolerance().length == pytest.approx(1e-9 * np.sqrt(11))
+
+
+def test_contacts_are_cached_per_tolerance(tower):
+    first = tower.contacts()
+    assert [c.pair for c in first] == [("a", "b"), ("b", "c")]
+    assert tower.contacts() is first
+
+
+def test_subset_keeps_scale_and_cached_contacts(tower):
+    tower.contacts()
+    sub = tower.subset(["c", "b"])
+    assert sub.names == ["b", "c"]
+    assert sub.scale == tower.scale
+    assert [c.pair for c in sub.contacts()] == [("b", "c")]
+    assert [c.pair for c in tower.without_part("b").contacts()] == []
+
+
+def test_with_part_adds_only_the_new_contacts(tower):
+    tower.contacts()
+    grown = tower.without_part("c").with_part(Part("c", box([0, 0, 2], [1, 1, 3])))
+    assert sorted(c.pair for c in grown.contacts()) == [("a", "b"), ("b", "c")]
+    outside = tower.with_part(Part("d", box([0, 0, 3], [1, 1, 4])))
+    assert outside.scale == pytest.approx(np.sqrt(18))
+    assert [c.pair for c in outside.contacts()] == [("a", "b"), ("b", "c"), ("c", "d")]
+
+
+def test_unknown_part_is_named(tower):
+    with pytest.raises(UnknownNameError, match="'z'"):
+        tower.part("z")
+
+
+def test_features_of_a_box_are_its_six_faces(tower):
+    features = tower.features("a")
+    assert len(features) == 6
+    normals = sorted(tuple(np.round(f.normal, 12)) for f in features)
+    assert normals == sorted([(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)])
+
+
+def test_to_dict_summarises_parts(tower):
+    summary = tower.to_dict()
+    assert summary["units"] == "mm" and summary["source"] == "tower"
+    assert summary["parts"]["b"]["triangles"] == 12
+    assert summary["parts"]["b"]["volume"] == pytest.approx(1.0)
