@@ -68,3 +68,7 @@ class MissingExtraError(AssemblyKitError):
 
 class NumericError(AssemblyKitError):
     """A numeric procedure failed in a way that is not an answer (e.g. a degenerate frame)."""
+
+
+class GroupError(AssemblyKitError):
+    """Elements given as a symmetry group do not form one (not closed, or not normalising G0)."""

@@ -1,0 +1,431 @@
+"""Right cosets H . x0 of symmetry groups, their intersections and products
+(ALGEBRA.md §2.5, §5.2-§5.3).
+
+A relation between body 1 and body 2 is the set of relative positions X = L1^-1 L2;
+for lower pairs it is a right coset H . x0 with H in body 1's frame. Intersections
+are cosets of the intersected group or empty; products are cosets only when the two
+groups permute (otherwise a :class:`Chain`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from assemblykit.algebra import se3
+from assemblykit.algebra.subgroups import (
+    Kind,
+    SymmetryGroup,
+    _rank_threshold,
+    _scaled,
+    _tr_meet,
+    classify_algebra,
+)
+from assemblykit.errors import GroupError
+from assemblykit.tolerance import Tolerance, current
+
+__all__ = ["Chain", "Coset", "EmptySet", "Mismatch"]
+
+#: Starts of the deterministic multi-start least squares (ALGEBRA.md §2.5 "Numeric fallback").
+NUMERIC_STARTS = 24
+
+#: Lattice steps tried on each side when intersecting a lattice coset.
+LATTICE_SEARCH = 64
+
+#: The documented mismatch kinds.
+MISMATCH_KINDS = frozenset(
+    {"angle", "distance", "radius", "moment", "handedness", "pitch", "sides", "type", "residual"}
+)
+
+_TRANSLATIONS = frozenset({Kind.FIXED, Kind.PRISMATIC, Kind.TRANSLATION2, Kind.TRANSLATION3})
+_CONTAINS_T3 = frozenset({Kind.TRANSLATION3, Kind.SCHOENFLIES, Kind.FREE})
+# Products of connected groups that are groups once the bracket test passes (§5.3 table).
+_PRODUCT_GROUPS = frozenset(
+    frozenset(pair)
+    for pair in (
+        (Kind.REVOLUTE, Kind.PRISMATIC),
+        (Kind.HELICAL, Kind.PRISMATIC),
+        (Kind.REVOLUTE, Kind.HELICAL),
+        (Kind.HELICAL, Kind.HELICAL),
+        (Kind.REVOLUTE, Kind.TRANSLATION2),
+        (Kind.HELICAL, Kind.TRANSLATION2),
+        (Kind.CYLINDRICAL, Kind.TRANSLATION2),
+        (Kind.PLANAR, Kind.PRISMATIC),
+        (Kind.PSEUDO_PLANAR, Kind.PRISMATIC),
+        (Kind.PLANAR, Kind.PSEUDO_PLANAR),
+        (Kind.PLANAR, Kind.CYLINDRICAL),
+        (Kind.PLANAR, Kind.HELICAL),
+        (Kind.PSEUDO_PLANAR, Kind.PSEUDO_PLANAR),
+        (Kind.PSEUDO_PLANAR, Kind.CYLINDRICAL),
+        (Kind.PSEUDO_PLANAR, Kind.HELICAL),
+    )
+)
+
+
+@dataclass(frozen=True)
+class Mismatch:
+    """Why a set is empty: ``kind`` (angle, distance, radius, moment, handedness, pitch,
+    sides, type, residual), its size (radians or model units) and a one-line message."""
+
+    kind: str
+    value: float
+    message: str
+
+
+@dataclass(frozen=True)
+class EmptySet:
+    """The empty relation. ``proven=False`` means only that the numeric search found no
+    solution: "no solution found", never a claim of emptiness (§2.5)."""
+
+    mismatch: Mismatch
+    proven: bool = True
+
+    @property
+    def dof(self) -> int:
+        """Not a manifold: reported as -1."""
+        return -1
+
+    @property
+    def n_components(self) -> int:
+        """No components."""
+        return 0
+
+    def contains(self, x: np.ndarray, tol: Tolerance | None = None) -> bool:
+        """Nothing is in the empty set."""
+        return False
+
+
+@dataclass(frozen=True, eq=False)
+class Coset:
+    """The right coset H . x0 (``group`` H in body 1's frame, ``rep`` x0), ALGEBRA.md §2.2."""
+
+    group: SymmetryGroup
+    rep: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "rep", np.asarray(self.rep, dtype=np.float64))
+
+    # ------------------------------------------------------------------ properties
+
+    @property
+    def dof(self) -> int:
+        """Dimension of the coset (that of H0)."""
+        return self.group.dof
+
+    @property
+    def kind(self) -> Kind:
+        """The Hervé kind of H0."""
+        return self.group.kind
+
+    @property
+    def n_components(self) -> float | int:
+        """Number of components (``math.inf`` for a lattice)."""
+        return self.group.n_components
+
+    @property
+    def is_point(self) -> bool:
+        """A single relative position (dof 0, one component): merge on identity."""
+        return self.dof == 0 and self.n_components == 1
+
+    def points(self) -> list[np.ndarray]:
+        """The finitely many elements of a dof-0 finite coset."""
+        if self.dof != 0 or self.group.lattice:
+            raise GroupError(f"a {self.kind.value} coset is not a finite set of points")
+        return [self.group.element((), i) @ self.rep for i in range(len(self.group.reps))]
+
+    def invariants(self) -> dict[str, Any]:
+        """Invariants of the set in body-1 coordinates (those of H, e.g. the axis line)."""
+        return self.group.invariants
+
+    def sample(self, rng: np.random.Generator, n: int = 1) -> list[np.ndarray]:
+        """``n`` random members."""
+        return [g @ self.rep for g in self.group.sample(rng, n)]
+
+    def describe(self) -> str:
+        """One line: the group and the representative's translation."""
+        return f"{self.group.describe()} . x0 (x0 translation {self.rep[:3, 3].round(9).tolist()})"
+
+    # ------------------------------------------------------------------ set operations
+
+    def contains(self, x: np.ndarray, tol: Tolerance | None = None) -> bool:
+        """Whether ``x`` in H . x0, i.e. x x0^-1 in H."""
+        return self.group.contains(np.asarray(x, float) @ se3.inverse(self.rep), tol)
+
+    def inverse(self) -> Coset:
+        """(H x0)^-1 = (x0^-1 H x0) . x0^-1 (§5.2 reversal)."""
+        ri = se3.inverse(self.rep)
+        return Coset(self.group.conjugate(ri), ri)
+
+    def left(self, t: np.ndarray) -> Coset:
+        """T . (H x0) = (T H T^-1) . T x0."""
+        return Coset(self.group.conjugate(t), t @ self.rep)
+
+    def right(self, t: np.ndarray) -> Coset:
+        """(H x0) . T."""
+        return Coset(self.group, self.rep @ t)
+
+    def conjugate(self, t: np.ndarray) -> Coset:
+        """T (H x0) T^-1."""
+        return Coset(self.group.conjugate(t), t @ self.rep @ se3.inverse(t))
+
+    def intersect(self, other: Coset, tol: Tolerance | None = None) -> Coset | EmptySet:
+        """(A a) ∩ (B b) = (A ∩ B) . c for any common c, or empty (ALGEBRA.md §2.5).
+
+        TR groups: transporter of the characteristic invariants (closed form, with the
+        failed congruence test when empty). Helical groups: the exact group meet and a
+        common point from the numeric fallback. Finite parts: pairs of components.
+        """
+        tol = tol or current()
+        if isinstance(other, Chain):
+            raise GroupError("a chain ∩ coset needs the chain solvers (ALGEBRA.md §5.2 rule 4)")
+        if self.group.lattice or other.group.lattice:
+            return _lattice_coset_meet(self, other, tol)
+        if self.group.is_connected and other.group.is_connected:
+            return _connected_meet(self, other, tol)
+        pieces: list[Coset | EmptySet] = []
+        a0, b0 = self.group.connected_part, other.group.connected_part
+        for alpha, beta in itertools.product(self.group.reps, other.group.reps):
+            pieces.append(
+                _connected_meet(Coset(a0, alpha @ self.rep), Coset(b0, beta @ other.rep), tol)
+            )
+        found = [p for p in pieces if isinstance(p, Coset)]
+        if not found:
+            empties = [p for p in pieces if isinstance(p, EmptySet)]
+            return next((e for e in empties if not e.proven), empties[0])
+        base = found[0]
+        extra = tuple(c.rep @ se3.inverse(base.rep) for c in found[1:])
+        group = base.group.with_discrete(reps=extra, lattice=base.group.lattice, tol=tol)
+        return Coset(group, base.rep)
+
+    def product(self, other: Coset | Chain, tol: Tolerance | None = None) -> Coset | Chain:
+        """(A a)(B b) = A (a B a^-1) . ab: a coset iff A and K = a B a^-1 permute
+        (bracket test to reject, the §5.3 table to accept), else a :class:`Chain`."""
+        tol = tol or current()
+        if isinstance(other, Chain):
+            return Chain((self, *other.factors))
+        a_grp = self.group
+        k_grp = other.group.conjugate(self.rep)
+        rep = self.rep @ other.rep
+        if a_grp.includes(k_grp, tol):
+            return Coset(a_grp, rep)
+        if k_grp.includes(a_grp, tol):
+            return Coset(k_grp, rep)
+        group = _group_product(a_grp, k_grp, tol)
+        return Chain((self, other)) if group is None else Coset(group, rep)
+
+
+def _lattice_steps(bound: int) -> list[int]:
+    """0, 1, -1, 2, -2, ... up to +-bound."""
+    return [0, *(s * k for k in range(1, bound + 1) for s in (1, -1))]
+
+
+def _lattice_coset_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
+    """(G0 <tau> Gamma a) ∩ Q: the group meet, and a common point searched over the
+    lattice steps k = 0, +-1, ... (each step a connected coset intersection). Without a
+    hit within ``LATTICE_SEARCH`` steps the answer is "no solution found"."""
+    lat, other = (p, q) if p.group.lattice else (q, p)
+    if len(lat.group.lattice) != 1 or other.group.lattice:
+        raise GroupError("intersection of cosets of these lattice groups is not supported")
+    group = p.group.intersect(q.group, tol)
+    g0, tau = lat.group.connected_part, lat.group.lattice[0]
+    o0 = other.group.connected_part
+    for k in _lattice_steps(LATTICE_SEARCH):
+        step = lat.group.element(np.zeros(g0.dof), 0, (k,)) @ se3.inverse(lat.group.reps[0])
+        for gamma, beta in itertools.product(lat.group.reps, other.group.reps):
+            piece = _connected_meet(
+                Coset(g0, step @ gamma @ lat.rep), Coset(o0, beta @ other.rep), tol
+            )
+            if isinstance(piece, Coset):
+                return Coset(group, piece.rep)
+    message = f"no lattice element found within {LATTICE_SEARCH} steps of {tau[:3, 3].tolist()}"
+    return EmptySet(Mismatch("residual", math.inf, message), proven=False)
+
+
+def _connected_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
+    from assemblykit.algebra import invariants as inv  # invariants build Coset values
+
+    for point, other in ((p, q), (q, p)):
+        if point.dof == 0:
+            if other.contains(point.rep, tol):
+                return point
+            if not (p.group.is_tr and q.group.is_tr):
+                return EmptySet(Mismatch("residual", 1.0, "the fixed position is not in the set"))
+    if p.group.is_tr and q.group.is_tr:
+        ia = inv.characteristic_invariants(p.group)
+        ib = inv.characteristic_invariants(q.group)
+        ja = tuple(inv.transform_invariant(se3.inverse(p.rep), i) for i in ia)
+        jb = tuple(inv.transform_invariant(se3.inverse(q.rep), i) for i in ib)
+        return inv._directed_transporter(ia + ib, ja + jb, tol, _tr_meet(p.group, q.group, tol))
+    return _numeric_meet(p, q, tol)
+
+
+def _residual_vector(d: np.ndarray, scale: float) -> np.ndarray:
+    """The 12 entries of a difference of transforms, rotation rows scaled to lengths."""
+    return np.concatenate(((d[:3, :3] * scale).ravel(), d[:3, 3]))
+
+
+def _starts(rng: np.random.Generator, angles: np.ndarray, length: float) -> np.ndarray:
+    x = rng.uniform(-1.0, 1.0, angles.size)
+    return x * np.where(angles, math.pi, length)
+
+
+def _numeric_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
+    """A common point from least squares over both parameterisations, from a deterministic
+    multi-start (§2.5 "Numeric fallback"); never claims emptiness."""
+    a, b = p.group, q.group
+    group = a.intersect(b, tol)
+    na = a.dof
+    length = max(tol.scale, se3.norm(p.rep[:3, 3]), se3.norm(q.rep[:3, 3]))
+    angles = np.concatenate((a._angle_params(), b._angle_params()))
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        d = a.element(x[:na]) @ p.rep - b.element(x[na:]) @ q.rep
+        return _residual_vector(d, length)
+
+    rng = np.random.default_rng(0)
+    best = math.inf
+    for i in range(NUMERIC_STARTS):
+        x0 = np.zeros(angles.size) if i == 0 else _starts(rng, angles, length)
+        sol = least_squares(residual, x0, method="lm" if angles.size <= 12 else "trf")
+        best = min(best, float(np.max(np.abs(sol.fun))))
+        c = a.element(sol.x[:na]) @ p.rep
+        if p.contains(c, tol) and q.contains(c, tol):
+            return Coset(group, c)
+    return EmptySet(
+        Mismatch("residual", best, f"no solution found (best residual {best:.3g})"), proven=False
+    )
+
+
+def _bracket(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The Lie bracket of twists (omega; v): (w1 x w2; w1 x v2 - w2 x v1)."""
+    return np.concatenate(
+        (se3.cross(x[:3], y[:3]), se3.cross(x[:3], y[3:]) - se3.cross(y[:3], x[3:]))
+    )
+
+
+def _group_product(a: SymmetryGroup, k: SymmetryGroup, tol: Tolerance) -> SymmetryGroup | None:
+    """The group A K when it is one (§5.3), else ``None``."""
+    if a.lattice or k.lattice:
+        return None
+    basis = np.hstack((a.algebra, k.algebra))
+    scaled = _scaled(basis, tol)
+    u, s, _ = np.linalg.svd(scaled, full_matrices=False)
+    q = u[:, : int(np.sum(s > _rank_threshold(tol)))]
+    for i, j in itertools.combinations(range(basis.shape[1]), 2):
+        br = _scaled(_bracket(basis[:, i], basis[:, j])[:, None], tol)
+        if float(np.max(np.abs(br - q @ (q.T @ br)))) > _rank_threshold(tol):
+            return None
+    kinds = frozenset({a.kind, k.kind})
+    accepted = (
+        kinds <= _TRANSLATIONS
+        or a.kind in _CONTAINS_T3
+        or k.kind in _CONTAINS_T3
+        or kinds in _PRODUCT_GROUPS
+    )
+    if not accepted:
+        return None
+    unscaled = q.copy()
+    unscaled[3:] *= tol.scale
+    g0 = classify_algebra(unscaled, tol)
+    if a.is_connected and k.is_connected:
+        return g0
+    k0 = k.connected_part
+    if not all(k0.conjugate(alpha).equals(k0, tol) for alpha in a.reps):
+        return None
+    reps = tuple(alpha @ kappa for alpha in a.reps for kappa in k.reps)
+    try:
+        return g0.with_discrete(reps=reps, tol=tol)
+    except GroupError:
+        return None
+
+
+@dataclass(frozen=True, eq=False)
+class Chain:
+    """A product of cosets that is not a coset (§5.2 rule 3): the set
+    H1 x1 H2 x2 ... Hn xn of relative positions."""
+
+    factors: tuple[Coset, ...]
+
+    @property
+    def kind(self) -> str:
+        """Always "chain"."""
+        return "chain"
+
+    def product(self, other: Coset | Chain) -> Chain:
+        """The longer chain (self . other)."""
+        more = other.factors if isinstance(other, Chain) else (other,)
+        return Chain((*self.factors, *more))
+
+    def _compose(self, params: np.ndarray, components: tuple[int, ...]) -> np.ndarray:
+        out = np.eye(4)
+        start = 0
+        for f, comp in zip(self.factors, components, strict=True):
+            out = out @ f.group.element(params[start : start + f.dof], comp) @ f.rep
+            start += f.dof
+        return out
+
+    @cached_property
+    def dof(self) -> int:
+        """Dimension of h1 + Ad(g1) h2 + Ad(g1 g2) h3 + ... at generic points (max over a
+        few deterministic samples)."""
+        rng = np.random.default_rng(0)
+        tol = current()
+        best = 0
+        for _ in range(4):
+            cols, prefix = [], np.eye(4)
+            for f in self.factors:
+                cols.append(se3.adjoint(prefix) @ f.group.algebra)
+                prefix = prefix @ f.sample(rng, 1)[0]
+            stacked = _scaled(np.hstack(cols), tol)
+            if stacked.size:
+                s = np.linalg.svd(stacked, compute_uv=False)
+                best = max(best, int(np.sum(s > _rank_threshold(tol) * max(1.0, s[0]))))
+        return best
+
+    def sample(self, rng: np.random.Generator, n: int = 1) -> list[np.ndarray]:
+        """``n`` random members (products of random members of each factor)."""
+        out = []
+        for _ in range(n):
+            g = np.eye(4)
+            for f in self.factors:
+                g = g @ f.sample(rng, 1)[0]
+            out.append(g)
+        return out
+
+    def contains(self, x: np.ndarray, tol: Tolerance | None = None) -> bool:
+        """Whether ``x`` is in the product set, by least squares over the factors'
+        parameters from a deterministic multi-start."""
+        tol = tol or current()
+        x = np.asarray(x, dtype=np.float64)
+        if any(f.group.lattice for f in self.factors):
+            raise GroupError("membership in a chain of lattice cosets is not supported")
+        angles = np.concatenate([f.group._angle_params() for f in self.factors])
+        length = max(tol.scale, se3.norm(x[:3, 3]))
+        length = max([length] + [se3.norm(f.rep[:3, 3]) for f in self.factors])
+        comps = itertools.product(*(range(len(f.group.reps)) for f in self.factors))
+        for components in comps:
+            rng = np.random.default_rng(0)
+
+            def residual(p: np.ndarray, comp: tuple[int, ...] = components) -> np.ndarray:
+                return _residual_vector(self._compose(p, comp) - x, length)
+
+            for i in range(NUMERIC_STARTS):
+                p0 = np.zeros(angles.size) if i == 0 else _starts(rng, angles, length)
+                sol = least_squares(residual, p0, method="lm" if angles.size <= 12 else "trf")
+                d = self._compose(sol.x, components) @ se3.inverse(x)
+                if _close_to_identity(d, tol):
+                    return True
+        return False
+
+
+def _close_to_identity(d: np.ndarray, tol: Tolerance) -> bool:
+    return (
+        float(np.max(np.abs(d[:3, :3] - np.eye(3)))) <= tol.angle
+        and se3.norm(d[:3, 3]) <= tol.length
+    )

@@ -1,0 +1,1132 @@
+"""Symmetry subgroups of SE(3): G = G0 . Gamma (ALGEBRA.md §2).
+
+G0 is one of Hervé's 12 connected families (§2.1) placed by a frame F
+(G0 = F K F^-1 with K canonical: axis/normal +z through the origin); Gamma is a
+finite transversal ``reps`` (always containing I) and optional ``lattice``
+generators of an infinite discrete quotient (helical lattices, §2.2).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import StrEnum
+from fractions import Fraction
+from functools import cached_property
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from assemblykit.algebra import se3
+from assemblykit.errors import GroupError, NumericError
+from assemblykit.tolerance import Tolerance, current
+
+__all__ = ["MAX_LATTICE_DENOMINATOR", "Kind", "Locus", "SymmetryGroup"]
+
+#: Largest denominator accepted when deciding that two lattice periods are commensurate
+#: (ALGEBRA.md §2.4, "Finite parts": bounded-denominator continued fraction).
+MAX_LATTICE_DENOMINATOR = 10_000
+
+#: Largest finite group built by closure (``extended_by``); beyond it the group is not finite.
+MAX_FINITE_ORDER = 1_000
+
+_TWO_PI = 2.0 * math.pi
+# Printed coordinates below this are rounding noise and shown as 0 (display only).
+_DISPLAY_ZERO = 5e-13
+_EYE4 = np.eye(4)
+_EYE4.setflags(write=False)
+
+
+class Kind(StrEnum):
+    """Hervé's 12 families of connected subgroups of SE(3) (ALGEBRA.md §2.1)."""
+
+    FIXED = "fixed"
+    REVOLUTE = "revolute"
+    PRISMATIC = "prismatic"
+    HELICAL = "helical"
+    CYLINDRICAL = "cylindrical"
+    TRANSLATION2 = "translation2"
+    TRANSLATION3 = "translation3"
+    SPHERICAL = "spherical"
+    PLANAR = "planar"
+    PSEUDO_PLANAR = "pseudo-planar"
+    SCHOENFLIES = "schoenflies"
+    FREE = "free"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+_DIM = {
+    Kind.FIXED: 0,
+    Kind.REVOLUTE: 1,
+    Kind.PRISMATIC: 1,
+    Kind.HELICAL: 1,
+    Kind.CYLINDRICAL: 2,
+    Kind.TRANSLATION2: 2,
+    Kind.TRANSLATION3: 3,
+    Kind.SPHERICAL: 3,
+    Kind.PLANAR: 3,
+    Kind.PSEUDO_PLANAR: 3,
+    Kind.SCHOENFLIES: 4,
+    Kind.FREE: 6,
+}
+_HELICAL = frozenset({Kind.HELICAL, Kind.PSEUDO_PLANAR})
+# Rotation part of a TR group (§2.4 characteristic-invariant view): none, about one line
+# direction, or about a point.
+_LINEAR = {
+    Kind.FIXED: "none",
+    Kind.PRISMATIC: "none",
+    Kind.TRANSLATION2: "none",
+    Kind.TRANSLATION3: "none",
+    Kind.REVOLUTE: "line",
+    Kind.CYLINDRICAL: "line",
+    Kind.PLANAR: "line",
+    Kind.SCHOENFLIES: "line",
+    Kind.HELICAL: "line",
+    Kind.PSEUDO_PLANAR: "line",
+    Kind.SPHERICAL: "point",
+    Kind.FREE: "point",
+}
+
+
+# ----------------------------------------------------------------------------- subspaces
+
+
+@dataclass(frozen=True)
+class _Sub:
+    """A linear subspace of R^3 in closed form: dim 1 keeps its direction, dim 2 its normal."""
+
+    dim: int
+    vec: np.ndarray | None = None
+
+    def perp_projector(self) -> np.ndarray:
+        """The orthogonal projector onto the complement of the subspace."""
+        if self.dim == 0:
+            return np.eye(3)
+        if self.dim == 3:
+            return np.zeros((3, 3))
+        assert self.vec is not None
+        outer = np.outer(self.vec, self.vec)
+        return np.eye(3) - outer if self.dim == 1 else outer
+
+    def residual(self, w: np.ndarray) -> float:
+        """Length of the component of ``w`` outside the subspace."""
+        if self.dim == 3:
+            return 0.0
+        if self.dim == 0:
+            return se3.norm(w)
+        assert self.vec is not None
+        if self.dim == 1:
+            return se3.norm(w - (w @ self.vec) * self.vec)
+        return abs(float(w @ self.vec))
+
+    def project(self, w: np.ndarray) -> np.ndarray:
+        """The orthogonal projection of ``w`` onto the subspace."""
+        return w - self.perp_projector() @ w
+
+
+def _parallel(a: np.ndarray, b: np.ndarray, tol: Tolerance) -> bool:
+    return se3.norm(se3.cross(a, b)) <= tol.angle
+
+
+def _sub_meet(a: _Sub, b: _Sub, tol: Tolerance) -> _Sub:
+    """Intersection of two subspaces of R^3."""
+    if a.dim == 0 or b.dim == 3:
+        return a
+    if b.dim == 0 or a.dim == 3:
+        return b
+    assert a.vec is not None and b.vec is not None
+    if a.dim == 1 and b.dim == 1:
+        return a if _parallel(a.vec, b.vec, tol) else _Sub(0)
+    if a.dim == 2 and b.dim == 2:
+        if _parallel(a.vec, b.vec, tol):
+            return a
+        return _Sub(1, se3.unit(se3.cross(a.vec, b.vec)))
+    line, plane = (a, b) if a.dim == 1 else (b, a)
+    assert line.vec is not None and plane.vec is not None
+    return line if abs(float(line.vec @ plane.vec)) <= tol.angle else _Sub(0)
+
+
+def _sub_join(a: _Sub, b: _Sub, tol: Tolerance) -> _Sub:
+    """Sum of two subspaces of R^3."""
+    if a.dim == 0 or b.dim == 3:
+        return b
+    if b.dim == 0 or a.dim == 3:
+        return a
+    assert a.vec is not None and b.vec is not None
+    if a.dim == 1 and b.dim == 1:
+        if _parallel(a.vec, b.vec, tol):
+            return a
+        return _Sub(2, se3.unit(se3.cross(a.vec, b.vec)))
+    if a.dim == 2 and b.dim == 2:
+        return a if _parallel(a.vec, b.vec, tol) else _Sub(3)
+    line, plane = (a, b) if a.dim == 1 else (b, a)
+    assert line.vec is not None and plane.vec is not None
+    return plane if abs(float(line.vec @ plane.vec)) <= tol.angle else _Sub(3)
+
+
+def min_norm_solve(m: np.ndarray, rhs: np.ndarray, tol: Tolerance) -> np.ndarray:
+    """The minimum-norm least-squares solution of ``m x = rhs`` for a symmetric positive
+    semi-definite 3x3 ``m`` (a sum of projectors), in closed form: Cramer's rule when
+    regular, otherwise completed by the null space (rank 2) or the single range
+    direction (rank 1). Plain float arithmetic: this is the hot path of every transporter.
+    """
+    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
+    r0, r1, r2 = rhs.tolist()
+    c0, c1, c2 = e * i - f * h, f * g - d * i, d * h - e * g
+    det = a * c0 + b * c1 + c * c2
+    trace = a + e + i
+    if trace <= tol.angle:
+        return np.zeros(3)
+    if abs(det) > tol.angle * trace**3:
+        # Inverse = adjugate / det; m is symmetric so rows of the adjugate are cofactors.
+        x0 = (c0 * r0 + (c * h - b * i) * r1 + (b * f - c * e) * r2) / det
+        x1 = (c1 * r0 + (a * i - c * g) * r1 + (c * d - a * f) * r2) / det
+        x2 = (c2 * r0 + (b * g - a * h) * r1 + (a * e - b * d) * r2) / det
+        return np.array((x0, x1, x2))
+    rows = (m[0], m[1], m[2])
+    best, null = 0.0, None
+    for p, q in ((0, 1), (0, 2), (1, 2)):
+        w = se3.cross(rows[p], rows[q])
+        size = se3.norm(w)
+        if size > best:
+            best, null = size, w / size
+    if null is not None and best > tol.angle * trace**2:
+        return np.linalg.solve(m + np.outer(null, null), rhs)
+    k = int(np.argmax(np.abs(np.diag(m))))
+    v = se3.unit(m[k])
+    return v * (float(v @ rhs) / trace)
+
+
+def _affine_meet_point(
+    na: np.ndarray, sa: _Sub, nb: np.ndarray, sb: _Sub, tol: Tolerance
+) -> np.ndarray:
+    """A point of (na + sa) ∩ (nb + sb), known to be non-empty: the least-squares
+    point nearest to ``na`` (so a frame origin already valid is kept)."""
+    pa, pb = sa.perp_projector(), sb.perp_projector()
+    return na + min_norm_solve(pa + pb, pb @ (nb - na), tol)
+
+
+# ----------------------------------------------------------------------------- canonical K
+
+
+def _canonical_basis(kind: Kind, pitch: float) -> np.ndarray:
+    """The canonical Lie algebra basis (6 x dim, (omega; v)) of K (ALGEBRA.md §2.1 table)."""
+    e = np.eye(6)
+    rz, tx, ty, tz = e[:, 2], e[:, 3], e[:, 4], e[:, 5]
+    sz = rz + pitch * tz
+    cols: dict[Kind, list[np.ndarray]] = {
+        Kind.FIXED: [],
+        Kind.REVOLUTE: [rz],
+        Kind.PRISMATIC: [tz],
+        Kind.HELICAL: [sz],
+        Kind.CYLINDRICAL: [rz, tz],
+        Kind.TRANSLATION2: [tx, ty],
+        Kind.TRANSLATION3: [tx, ty, tz],
+        Kind.SPHERICAL: [e[:, 0], e[:, 1], rz],
+        Kind.PLANAR: [rz, tx, ty],
+        Kind.PSEUDO_PLANAR: [sz, tx, ty],
+        Kind.SCHOENFLIES: [rz, tx, ty, tz],
+        Kind.FREE: list(e.T),
+    }
+    return np.column_stack(cols[kind]) if cols[kind] else np.zeros((6, 0))
+
+
+def _canonical_element(kind: Kind, pitch: float, params: np.ndarray) -> np.ndarray:
+    """k(params) of the canonical family (ALGEBRA.md §5.1 normal form).
+
+    Parameters: R, H (theta); T (s); C (theta, s); T2 (a, b); T3 (a, b, c);
+    S (rotation vector); G, Y (a, b, theta); X (a, b, c, theta); D (tx, ty, tz, rotvec).
+    """
+    p = [float(x) for x in params]
+    if len(p) != _DIM[kind]:
+        raise GroupError(f"a {kind.value} group takes {_DIM[kind]} parameters, got {len(p)}")
+    z = (0.0, 0.0, 1.0)
+    if kind is Kind.FIXED:
+        return np.eye(4)
+    if kind is Kind.REVOLUTE:
+        return se3.rot_z(p[0])
+    if kind is Kind.PRISMATIC:
+        return se3.translation((0.0, 0.0, p[0]))
+    if kind is Kind.HELICAL:
+        return se3.screw((0.0, 0.0, 0.0), z, pitch, p[0])
+    if kind is Kind.CYLINDRICAL:
+        return se3.rot_z(p[0]) @ se3.translation((0.0, 0.0, p[1]))
+    if kind is Kind.TRANSLATION2:
+        return se3.translation((p[0], p[1], 0.0))
+    if kind is Kind.TRANSLATION3:
+        return se3.translation(p)
+    if kind is Kind.SPHERICAL:
+        out = np.eye(4)
+        out[:3, :3] = Rotation.from_rotvec(p).as_matrix()
+        return out
+    if kind is Kind.PLANAR:
+        return se3.translation((p[0], p[1], 0.0)) @ se3.rot_z(p[2])
+    if kind is Kind.PSEUDO_PLANAR:
+        return se3.translation((p[0], p[1], 0.0)) @ se3.screw((0.0, 0.0, 0.0), z, pitch, p[2])
+    if kind is Kind.SCHOENFLIES:
+        return se3.translation(p[:3]) @ se3.rot_z(p[3])
+    out = se3.translation(p[:3])
+    out[:3, :3] = Rotation.from_rotvec(p[3:]).as_matrix()
+    return out
+
+
+def _helix_residual(pitch: float, tz: float, theta: float) -> float:
+    """Length by which (theta, tz) misses the helix t_z = p (theta + 2 pi k) (§2.3)."""
+    if pitch == 0.0:
+        return abs(tz)
+    d = tz / pitch - theta
+    d -= _TWO_PI * round(d / _TWO_PI)
+    return abs(pitch * d)
+
+
+def _in_canonical(kind: Kind, pitch: float, g: np.ndarray, tol: Tolerance) -> bool:
+    """Membership of a canonical-frame element in K (ALGEBRA.md §2.3 predicate table)."""
+    if kind is Kind.FREE:
+        return True
+    r, t = g[:3, :3], g[:3, 3]
+    ang, length = tol.angle, tol.length
+    if kind is Kind.SPHERICAL:
+        return se3.norm(t) <= length
+    if _LINEAR[kind] == "none":
+        if float(np.max(np.abs(r - np.eye(3)))) > ang:
+            return False
+        if kind is Kind.FIXED:
+            return se3.norm(t) <= length
+        if kind is Kind.PRISMATIC:
+            return math.hypot(t[0], t[1]) <= length
+        if kind is Kind.TRANSLATION2:
+            return abs(t[2]) <= length
+        return True
+    # Rotation about z (R, H, C, G, Y, X): "R ∥ z".
+    if math.sqrt(r[0, 2] ** 2 + r[1, 2] ** 2 + (r[2, 2] - 1.0) ** 2) > ang:
+        return False
+    if kind is Kind.SCHOENFLIES:
+        return True
+    theta = math.atan2(r[1, 0], r[0, 0])
+    if kind is Kind.PLANAR:
+        return abs(t[2]) <= length
+    if kind is Kind.PSEUDO_PLANAR:
+        return _helix_residual(pitch, t[2], theta) <= length
+    if math.hypot(t[0], t[1]) > length:
+        return False
+    if kind is Kind.REVOLUTE:
+        return abs(t[2]) <= length
+    if kind is Kind.HELICAL:
+        return _helix_residual(pitch, t[2], theta) <= length
+    return True
+
+
+# ----------------------------------------------------------------------------- loci
+
+
+@dataclass(frozen=True, eq=False)
+class Locus:
+    """The orbit of a point under a group (ALGEBRA.md §2.3 orbit table).
+
+    ``kind`` is one of "point", "circle", "line", "helix", "cylinder", "plane", "sphere",
+    "space", "union". ``point`` is the point itself (point), the centre (circle, sphere),
+    a point on the axis (line, helix, cylinder: the axis point) or a point of the plane;
+    ``direction`` the axis or normal; ``radius`` for circle/helix/cylinder/sphere;
+    ``pitch`` and ``through`` (a point of the curve) for a helix; ``members`` and
+    ``steps`` (lattice translations) for a union.
+    """
+
+    kind: str
+    point: np.ndarray | None = None
+    direction: np.ndarray | None = None
+    radius: float = 0.0
+    pitch: float = 0.0
+    through: np.ndarray | None = None
+    members: tuple[Locus, ...] = ()
+    steps: tuple[np.ndarray, ...] = ()
+
+    def contains(self, p: np.ndarray, tol: Tolerance | None = None) -> bool:
+        """Whether the point ``p`` lies on the locus."""
+        tol = tol or current()
+        q = np.asarray(p, dtype=np.float64)
+        if self.kind == "space":
+            return True
+        if self.kind == "union":
+            return self._union_contains(q, tol)
+        assert self.point is not None
+        d = q - self.point
+        if self.kind == "point":
+            return se3.norm(d) <= tol.length
+        if self.kind == "sphere":
+            return abs(se3.norm(d) - self.radius) <= tol.length
+        assert self.direction is not None
+        u = self.direction
+        along = float(d @ u)
+        radial = d - along * u
+        if self.kind == "plane":
+            return abs(along) <= tol.length
+        if self.kind == "line":
+            return se3.norm(radial) <= tol.length
+        rho = se3.norm(radial)
+        if self.kind == "cylinder":
+            return abs(rho - self.radius) <= tol.length
+        if self.kind == "circle":
+            return abs(along) <= tol.length and abs(rho - self.radius) <= tol.length
+        return self._helix_contains(d, along, radial, rho, tol)
+
+    def _helix_contains(
+        self, d: np.ndarray, along: float, radial: np.ndarray, rho: float, tol: Tolerance
+    ) -> bool:
+        assert self.through is not None and self.point is not None and self.direction is not None
+        u = self.direction
+        d0 = self.through - self.point
+        along0 = float(d0 @ u)
+        radial0 = d0 - along0 * u
+        if abs(rho - self.radius) > tol.length:
+            return False
+        angle = math.atan2(float(se3.cross(radial0, radial) @ u), float(radial0 @ radial))
+        return _helix_residual(self.pitch, along - along0, angle) <= tol.length
+
+    def _union_contains(self, q: np.ndarray, tol: Tolerance) -> bool:
+        if not self.steps:
+            return any(m.contains(q, tol) for m in self.members)
+        step = self.steps[0]
+        for m in self.members:
+            assert m.point is not None
+            k = round(float((q - m.point) @ step) / float(step @ step))
+            if any(m.contains(q - j * step, tol) for j in (k - 1, k, k + 1)):
+                return True
+        return False
+
+
+# ----------------------------------------------------------------------------- the group
+
+
+def _fmt(v: Any) -> str:
+    vals = np.atleast_1d(np.asarray(v, dtype=np.float64))
+    text = ", ".join(f"{(0.0 if abs(x) < _DISPLAY_ZERO else x):.6g}" for x in vals)
+    return f"({text})" if vals.size > 1 else text
+
+
+@dataclass(frozen=True, eq=False)
+class SymmetryGroup:
+    """A subgroup G = G0 . Gamma of SE(3) (ALGEBRA.md §2.2).
+
+    ``kind``/``frame``/``pitch`` place the connected part G0 = F K F^-1; ``reps`` is a
+    finite transversal of G/G0 (world elements, the first is I) and ``lattice`` the
+    generators of an infinite discrete quotient. Elements are g0 . lambda . gamma.
+    """
+
+    kind: Kind
+    frame: np.ndarray = field(default_factory=lambda: np.eye(4))
+    pitch: float = 0.0
+    reps: tuple[np.ndarray, ...] = (_EYE4,)
+    lattice: tuple[np.ndarray, ...] = ()
+
+    # ------------------------------------------------------------------ constructors
+
+    @classmethod
+    def connected(cls, kind: Kind | str, frame: np.ndarray, pitch: float = 0.0) -> SymmetryGroup:
+        """The connected group F K(kind, pitch) F^-1; a zero pitch gives R or G."""
+        k = Kind(kind)
+        if k in _HELICAL and pitch == 0.0:
+            k = Kind.REVOLUTE if k is Kind.HELICAL else Kind.PLANAR
+        return cls(k, np.asarray(frame, dtype=np.float64), float(pitch) if k in _HELICAL else 0.0)
+
+    @classmethod
+    def identity(cls) -> SymmetryGroup:
+        """The trivial group {I}."""
+        return cls(Kind.FIXED)
+
+    @classmethod
+    def revolute(cls, point: Any, axis: Any) -> SymmetryGroup:
+        """R(N, u): rotations about the line through ``point`` along ``axis``."""
+        return cls.connected(Kind.REVOLUTE, se3.frame(point, axis))
+
+    @classmethod
+    def prismatic(cls, direction: Any) -> SymmetryGroup:
+        """T(u): translations along ``direction``."""
+        return cls.connected(Kind.PRISMATIC, se3.frame((0.0, 0.0, 0.0), direction))
+
+    @classmethod
+    def helical(cls, point: Any, axis: Any, pitch: float) -> SymmetryGroup:
+        """H(N, u, p): screws with signed pitch ``p`` (lead 2 pi p) about the line."""
+        return cls.connected(Kind.HELICAL, se3.frame(point, axis), pitch)
+
+    @classmethod
+    def cylindrical(cls, point: Any, axis: Any) -> SymmetryGroup:
+        """C(N, u): rotations about and translations along the line."""
+        return cls.connected(Kind.CYLINDRICAL, se3.frame(point, axis))
+
+    @classmethod
+    def translation2(cls, normal: Any) -> SymmetryGroup:
+        """T2(n): translations perpendicular to ``normal``."""
+        return cls.connected(Kind.TRANSLATION2, se3.frame((0.0, 0.0, 0.0), normal))
+
+    @classmethod
+    def translation3(cls) -> SymmetryGroup:
+        """T3: all translations."""
+        return cls.connected(Kind.TRANSLATION3, np.eye(4))
+
+    @classmethod
+    def spherical(cls, center: Any) -> SymmetryGroup:
+        """S(N): rotations about the point ``center``."""
+        return cls.connected(Kind.SPHERICAL, se3.translation(center))
+
+    @classmethod
+    def planar(cls, normal: Any) -> SymmetryGroup:
+        """G(n): planar gliding (translations ⊥ n, rotations about lines ∥ n)."""
+        return cls.connected(Kind.PLANAR, se3.frame((0.0, 0.0, 0.0), normal))
+
+    @classmethod
+    def pseudo_planar(cls, normal: Any, pitch: float) -> SymmetryGroup:
+        """Y(n, p): translations ⊥ n and screws of pitch ``p`` along n."""
+        return cls.connected(Kind.PSEUDO_PLANAR, se3.frame((0.0, 0.0, 0.0), normal), pitch)
+
+    @classmethod
+    def schoenflies(cls, direction: Any) -> SymmetryGroup:
+        """X(u): all translations and rotations about lines ∥ u."""
+        return cls.connected(Kind.SCHOENFLIES, se3.frame((0.0, 0.0, 0.0), direction))
+
+    @classmethod
+    def free(cls) -> SymmetryGroup:
+        """D = SE(3)."""
+        return cls(Kind.FREE)
+
+    @classmethod
+    def finite(cls, elements: Any, tol: Tolerance | None = None) -> SymmetryGroup:
+        """The finite group whose elements are ``elements`` (closure is checked)."""
+        return cls.identity().with_discrete(reps=tuple(elements), tol=tol)
+
+    @classmethod
+    def cyclic(cls, point: Any, axis: Any, n: int) -> SymmetryGroup:
+        """C_n: rotations by 2 pi k / n about the line (point, axis)."""
+        if n < 1:
+            raise GroupError(f"a cyclic group needs n >= 1, got {n}")
+        reps = tuple(se3.rotation(axis, _TWO_PI * k / n, point) for k in range(n))
+        return cls(Kind.FIXED, np.eye(4), 0.0, reps)
+
+    @classmethod
+    def lattice_group(cls, generators: Any) -> SymmetryGroup:
+        """The infinite discrete group generated by ``generators`` (translations or screws)."""
+        return cls.identity().with_discrete(lattice=tuple(generators))
+
+    # ------------------------------------------------------------------ properties
+
+    @property
+    def dof(self) -> int:
+        """Dimension of G0 (Hervé dimension)."""
+        return _DIM[self.kind]
+
+    @property
+    def n_components(self) -> float | int:
+        """Number of components: |Gamma|, or ``math.inf`` with a lattice."""
+        return math.inf if self.lattice else len(self.reps)
+
+    @property
+    def is_connected(self) -> bool:
+        """Whether G = G0."""
+        return len(self.reps) == 1 and not self.lattice
+
+    @property
+    def is_tr(self) -> bool:
+        """Whether G0 is a TR group (not helical; ALGEBRA.md §2.4)."""
+        return self.kind not in _HELICAL
+
+    @cached_property
+    def connected_part(self) -> SymmetryGroup:
+        """G0 alone."""
+        if self.is_connected:
+            return self
+        return SymmetryGroup(self.kind, self.frame, self.pitch)
+
+    @cached_property
+    def frame_inverse(self) -> np.ndarray:
+        """F^-1 (cached: every membership test uses it)."""
+        return se3.inverse(self.frame)
+
+    @property
+    def axis(self) -> np.ndarray:
+        """The +z of the frame: axis, direction or normal of G0."""
+        return self.frame[:3, 2]
+
+    @property
+    def origin(self) -> np.ndarray:
+        """The frame origin: a point on the axis, or the centre."""
+        return self.frame[:3, 3]
+
+    @cached_property
+    def algebra(self) -> np.ndarray:
+        """The world Lie algebra basis Ad_F (canonical basis), 6 x dof."""
+        return se3.adjoint(self.frame) @ _canonical_basis(self.kind, self.pitch)
+
+    @cached_property
+    def invariants(self) -> dict[str, Any]:
+        """The geometric invariants of G0 in the frame of the group's body (§2.1 table)."""
+        k = self.kind
+        out: dict[str, Any] = {}
+        if k in (Kind.REVOLUTE, Kind.HELICAL, Kind.CYLINDRICAL, Kind.SPHERICAL):
+            out["point"] = self.origin.copy()
+        if k in (Kind.REVOLUTE, Kind.HELICAL, Kind.CYLINDRICAL):
+            out["axis"] = self.axis.copy()
+        if k in (Kind.PRISMATIC, Kind.SCHOENFLIES):
+            out["direction"] = self.axis.copy()
+        if k in (Kind.TRANSLATION2, Kind.PLANAR, Kind.PSEUDO_PLANAR):
+            out["normal"] = self.axis.copy()
+        if k in _HELICAL:
+            out["pitch"] = self.pitch
+        return out
+
+    @cached_property
+    def _translation_part(self) -> tuple[_Sub, tuple[np.ndarray, float] | None]:
+        """G0 ∩ T3 = {t in V : t.u in c Z} as (V, (u, c) or None) (§2.4, lattice rows)."""
+        k, u = self.kind, self.axis
+        if k in (Kind.FIXED, Kind.REVOLUTE, Kind.SPHERICAL):
+            return _Sub(0), None
+        if k in (Kind.PRISMATIC, Kind.CYLINDRICAL):
+            return _Sub(1, u), None
+        if k in (Kind.TRANSLATION2, Kind.PLANAR):
+            return _Sub(2, u), None
+        if k is Kind.HELICAL:
+            return _Sub(1, u), (u, _TWO_PI * abs(self.pitch))
+        if k is Kind.PSEUDO_PLANAR:
+            return _Sub(3), (u, _TWO_PI * abs(self.pitch))
+        return _Sub(3), None
+
+    @cached_property
+    def _tr_shape(self) -> tuple[str, _Sub]:
+        """Rotation type and translation subspace V of a TR group G0 = T(V) ⋊ Rot."""
+        return _LINEAR[self.kind], self._translation_part[0]
+
+    # ------------------------------------------------------------------ elements
+
+    def element(
+        self, params: Any = (), component: int = 0, steps: tuple[int, ...] = ()
+    ) -> np.ndarray:
+        """F k(params) F^-1 . lambda . reps[component], lambda = prod lattice[i]^steps[i]."""
+        k = _canonical_element(self.kind, self.pitch, np.atleast_1d(np.asarray(params, float)))
+        g = self.frame @ k @ self.frame_inverse
+        for gen, n in zip(self.lattice, steps, strict=False):
+            g = g @ np.linalg.matrix_power(gen if n >= 0 else se3.inverse(gen), abs(n))
+        return g @ self.reps[component]
+
+    def sample(self, rng: np.random.Generator, n: int = 1, scale: float = 10.0) -> list[np.ndarray]:
+        """``n`` random members (angles in [-pi, pi], lengths in [-scale, scale])."""
+        out = []
+        for _ in range(n):
+            params = rng.uniform(-1.0, 1.0, self.dof)
+            params *= np.where(self._angle_params(), math.pi, scale)
+            steps = tuple(int(s) for s in rng.integers(-3, 4, len(self.lattice)))
+            out.append(self.element(params, int(rng.integers(len(self.reps))), steps))
+        return out
+
+    def _angle_params(self) -> np.ndarray:
+        k = self.kind
+        flags = {
+            Kind.REVOLUTE: [1],
+            Kind.HELICAL: [1],
+            Kind.CYLINDRICAL: [1, 0],
+            Kind.SPHERICAL: [1, 1, 1],
+            Kind.PLANAR: [0, 0, 1],
+            Kind.PSEUDO_PLANAR: [0, 0, 1],
+            Kind.SCHOENFLIES: [0, 0, 0, 1],
+            Kind.FREE: [0, 0, 0, 1, 1, 1],
+        }.get(k, [0] * self.dof)
+        return np.asarray(flags, dtype=bool)
+
+    # ------------------------------------------------------------------ membership
+
+    def _in_connected(self, g: np.ndarray, tol: Tolerance) -> bool:
+        if self.kind is Kind.FREE:
+            return True
+        return _in_canonical(self.kind, self.pitch, self.frame_inverse @ g @ self.frame, tol)
+
+    def contains(self, t: np.ndarray, tol: Tolerance | None = None) -> bool:
+        """Whether ``t`` is in G (ALGEBRA.md §2.3, with reps and lattice projection)."""
+        tol = tol or current()
+        for gamma in self.reps:
+            g = t @ se3.inverse(gamma) if gamma is not _EYE4 else t
+            if not self.lattice:
+                if self._in_connected(g, tol):
+                    return True
+            elif self._in_lattice_coset(g, tol):
+                return True
+        return False
+
+    @cached_property
+    def _lattice_projection(self) -> tuple[np.ndarray, np.ndarray]:
+        """Directions W where G0 never translates and each generator's translation is additive,
+        and the generators' coordinates along them (for integer projection, §2.3)."""
+        w = self._quotient_directions()
+        coords = np.column_stack([w.T @ gen[:3, 3] for gen in self.lattice])
+        return w, coords
+
+    def _quotient_directions(self) -> np.ndarray:
+        k = self.kind
+        if k is Kind.FIXED:
+            space = _Sub(3)
+        elif k is Kind.REVOLUTE:
+            space = _Sub(1, self.axis)
+        elif k is Kind.PRISMATIC:
+            space = _Sub(2, self.axis)
+        elif k in (Kind.TRANSLATION2, Kind.PLANAR):
+            space = _Sub(1, self.axis)
+        else:
+            raise GroupError(f"a lattice over a {k.value} group is not supported")
+        tol = current()
+        for gen in self.lattice:
+            if se3.rotation_angle(gen) > tol.angle:
+                axis = se3.unit(Rotation.from_matrix(gen[:3, :3]).as_rotvec())
+                space = _sub_meet(space, _Sub(1, axis), tol)
+        basis = {0: np.zeros((3, 0)), 3: np.eye(3)}.get(space.dim)
+        if basis is None:
+            assert space.vec is not None
+            f = se3.frame((0.0, 0.0, 0.0), space.vec)[:3, :3]
+            basis = f[:, 2:] if space.dim == 1 else f[:, :2]
+        return basis
+
+    def _in_lattice_coset(self, g: np.ndarray, tol: Tolerance) -> bool:
+        w, coords = self._lattice_projection
+        k, *_ = np.linalg.lstsq(coords, w.T @ g[:3, 3], rcond=None)
+        steps = tuple(round(float(x)) for x in k)
+        lam = self.element(np.zeros(self.dof), 0, steps)
+        return self._in_connected(g @ se3.inverse(lam), tol)
+
+    # ------------------------------------------------------------------ comparison
+
+    def _algebra_includes(self, other: SymmetryGroup, tol: Tolerance) -> bool:
+        if other.dof == 0:
+            return True
+        if other.dof > self.dof:
+            return False
+        if self.kind is Kind.FREE:
+            return True
+        q, _ = np.linalg.qr(_scaled(self.algebra, tol))
+        b = _scaled(other.algebra, tol)
+        res = b - q @ (q.T @ b)
+        return float(np.max(np.abs(res))) <= _rank_threshold(tol)
+
+    def includes(self, other: SymmetryGroup, tol: Tolerance | None = None) -> bool:
+        """Whether ``other`` is a subgroup of this group."""
+        tol = tol or current()
+        if not self._algebra_includes(other, tol):
+            return False
+        return all(self.contains(g, tol) for g in (*other.reps, *other.lattice))
+
+    def equals(self, other: SymmetryGroup, tol: Tolerance | None = None) -> bool:
+        """Whether both groups are the same set (kinds, invariants, discrete parts)."""
+        tol = tol or current()
+        return (
+            self.kind is other.kind
+            and self.n_components == other.n_components
+            and self.includes(other, tol)
+            and other.includes(self, tol)
+        )
+
+    # ------------------------------------------------------------------ transforms
+
+    def conjugate(self, t: np.ndarray) -> SymmetryGroup:
+        """T G T^-1 (ALGEBRA.md §2.3 conjugation)."""
+        ti = se3.inverse(t)
+        reps = tuple(_EYE4 if g is _EYE4 else t @ g @ ti for g in self.reps)
+        return SymmetryGroup(
+            self.kind, t @ self.frame, self.pitch, reps, tuple(t @ g @ ti for g in self.lattice)
+        )
+
+    def with_discrete(
+        self,
+        reps: tuple[np.ndarray, ...] = (),
+        lattice: tuple[np.ndarray, ...] = (),
+        tol: Tolerance | None = None,
+    ) -> SymmetryGroup:
+        """G0 . Gamma for the discrete part ``reps``/``lattice`` (closure under G0 checked)."""
+        tol = tol or current()
+        g0 = self.connected_part
+        elements = [np.asarray(g, dtype=np.float64) for g in (*reps, *lattice)]
+        for g in elements:
+            if not se3.is_rigid(g, tol):
+                raise GroupError("a discrete group element is not a rigid transform")
+            if not g0.conjugate(g).equals(g0, tol):
+                raise GroupError(f"an element does not normalise the {g0.kind.value} part")
+        unique = _dedupe(g0, [_EYE4, *elements[: len(reps)]], tol)
+        group = SymmetryGroup(
+            g0.kind, g0.frame, g0.pitch, tuple(unique), tuple(elements[len(reps) :])
+        )
+        if lattice:
+            group._check_lattice(tol)
+        for a in unique:
+            for b in unique:
+                if not group.contains(a @ b, tol):
+                    raise GroupError("the discrete part is not closed under composition")
+        return group
+
+    def _check_lattice(self, tol: Tolerance) -> None:
+        _, coords = self._lattice_projection
+        if coords.shape[0] == 0 or np.linalg.matrix_rank(coords, tol=tol.length) < coords.shape[1]:
+            raise GroupError("lattice generators must move along independent free directions")
+
+    def extended_by(self, elements: Any, tol: Tolerance | None = None) -> SymmetryGroup:
+        """The group generated by G and ``elements`` normalising G0 (flips, swaps, §4.1)."""
+        tol = tol or current()
+        g0 = self.connected_part
+        extra = [np.asarray(g, dtype=np.float64) for g in elements]
+        for g in extra:
+            if not g0.conjugate(g).equals(g0, tol):
+                raise GroupError(f"an element does not normalise the {g0.kind.value} part")
+        found = _dedupe(g0, [*self.reps, *extra], tol)
+        frontier = list(found)
+        gens = [*self.reps[1:], *extra]
+        while frontier:
+            new = []
+            for a in frontier:
+                for b in gens:
+                    c = a @ b
+                    if not any(g0.contains(c @ se3.inverse(f), tol) for f in found):
+                        found.append(c)
+                        new.append(c)
+            if len(found) > MAX_FINITE_ORDER:
+                raise GroupError("the generated discrete group is not finite")
+            frontier = new
+        return SymmetryGroup(g0.kind, g0.frame, g0.pitch, tuple(found), self.lattice)
+
+    # ------------------------------------------------------------------ intersection
+
+    def intersect(self, other: SymmetryGroup, tol: Tolerance | None = None) -> SymmetryGroup:
+        """G ∩ G' (ALGEBRA.md §2.4): connected part, helical residue, finite parts."""
+        tol = tol or current()
+        if self.is_connected and other.is_connected:
+            return _connected_meet(self, other, tol)
+        if self.lattice or other.lattice:
+            return _lattice_meet(self, other, tol)
+        from assemblykit.algebra.cosets import Coset, EmptySet  # cosets build on groups
+
+        c0 = _connected_meet(self.connected_part, other.connected_part, tol)
+        found: list[np.ndarray] = []
+        for a in self.reps:
+            for b in other.reps:
+                met = Coset(self.connected_part, a).intersect(Coset(other.connected_part, b), tol)
+                if isinstance(met, EmptySet):
+                    continue
+                found.append(met.rep)
+        if not found:
+            return c0
+        return c0.with_discrete(reps=tuple(found), lattice=c0.lattice, tol=tol)
+
+    # ------------------------------------------------------------------ orbits
+
+    def orbit(self, point: Any, tol: Tolerance | None = None) -> Locus:
+        """The orbit of ``point`` under G (ALGEBRA.md §2.3 orbit table)."""
+        tol = tol or current()
+        x = np.asarray(point, dtype=np.float64)
+        if any(se3.rotation_angle(g) > tol.angle for g in self.lattice):
+            raise GroupError("the orbit under a discrete screw group is not a supported locus")
+        members = [self._connected_orbit(se3.apply(g, x), tol) for g in self.reps]
+        if len(members) == 1 and not self.lattice:
+            return members[0]
+        return Locus("union", members=tuple(members), steps=tuple(g[:3, 3] for g in self.lattice))
+
+    def _connected_orbit(self, x: np.ndarray, tol: Tolerance) -> Locus:
+        k, u, n = self.kind, self.axis, self.origin
+        d = x - n
+        radial = d - (d @ u) * u
+        rho = se3.norm(radial)
+        foot = n + (d @ u) * u
+        if k is Kind.FIXED:
+            return Locus("point", point=x)
+        if k is Kind.PRISMATIC:
+            return Locus("line", point=x, direction=u)
+        if k in (Kind.TRANSLATION2, Kind.PLANAR):
+            return Locus("plane", point=x, direction=u)
+        if k is Kind.SPHERICAL:
+            return Locus("sphere", point=n.copy(), radius=se3.norm(d))
+        if k in (Kind.TRANSLATION3, Kind.SCHOENFLIES, Kind.FREE, Kind.PSEUDO_PLANAR):
+            return Locus("space")
+        if k is Kind.REVOLUTE:
+            if rho <= tol.length:
+                return Locus("point", point=x)
+            return Locus("circle", point=foot, direction=u, radius=rho)
+        if rho <= tol.length:
+            return Locus("line", point=x, direction=u)
+        if k is Kind.CYLINDRICAL:
+            return Locus("cylinder", point=n.copy(), direction=u, radius=rho)
+        return Locus("helix", point=n.copy(), direction=u, radius=rho, pitch=self.pitch, through=x)
+
+    # ------------------------------------------------------------------ text
+
+    def describe(self) -> str:
+        """One line, e.g. "revolute about line through (0, 0, 1) along (0, 0, 1)"."""
+        k, inv = self.kind, self.invariants
+        if k in (Kind.REVOLUTE, Kind.CYLINDRICAL, Kind.HELICAL):
+            text = f"{k.value} about line through {_fmt(inv['point'])} along {_fmt(inv['axis'])}"
+        elif k is Kind.SPHERICAL:
+            text = f"spherical about {_fmt(inv['point'])}"
+        elif "direction" in inv:
+            text = f"{k.value} along {_fmt(inv['direction'])}"
+        elif "normal" in inv:
+            text = f"{k.value} with normal {_fmt(inv['normal'])}"
+        else:
+            text = k.value
+        if k in _HELICAL:
+            text += f", pitch {_fmt(self.pitch)}"
+        if len(self.reps) > 1:
+            text += f", {len(self.reps)} discrete components"
+        if self.lattice:
+            steps = "; ".join(_fmt(g[:3, 3]) for g in self.lattice)
+            text += f", lattice generated by steps {steps}"
+        return text
+
+    def __repr__(self) -> str:
+        return f"SymmetryGroup<{self.describe()}>"
+
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def _scaled(basis: np.ndarray, tol: Tolerance) -> np.ndarray:
+    """Twists with the v rows in units of the model scale (angles and lengths comparable)."""
+    out = np.array(basis, dtype=np.float64)
+    out[3:] /= tol.scale
+    return out
+
+
+def _rank_threshold(tol: Tolerance) -> float:
+    return max(tol.angle, tol.rel_length)
+
+
+def _dedupe(g0: SymmetryGroup, elements: list[np.ndarray], tol: Tolerance) -> list[np.ndarray]:
+    """One representative per G0-coset, in order of first appearance."""
+    out: list[np.ndarray] = []
+    for g in elements:
+        if not any(g0.contains(g @ se3.inverse(f), tol) for f in out):
+            out.append(g)
+    return out
+
+
+def _null_space(m: np.ndarray, tol: Tolerance) -> np.ndarray:
+    _, s, vt = np.linalg.svd(m)
+    rank = int(np.sum(s > _rank_threshold(tol)))
+    return vt[rank:].T
+
+
+def _tr_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> SymmetryGroup:
+    """Closed-form intersection of two connected TR groups T(V) ⋊ Rot (§2.4, SRC 8 reading).
+
+    The rotation parts meet as linear groups; the centres must agree modulo V_a + V_b
+    (otherwise only translations remain, or, for two points, rotations about their line).
+    """
+    (lin_a, va), (lin_b, vb) = a._tr_shape, b._tr_shape
+    v = _sub_meet(va, vb, tol)
+    u: np.ndarray | None = None
+    if "none" in (lin_a, lin_b):
+        lin = "none"
+    elif lin_a == "line" and lin_b == "line":
+        lin = "line" if _parallel(a.axis, b.axis, tol) else "none"
+        u = a.axis
+    elif lin_a == "line" or lin_b == "line":
+        lin, u = "line", (a.axis if lin_a == "line" else b.axis)
+    else:
+        lin = "point"
+    center = a.origin
+    if lin != "none":
+        w = _sub_join(va, vb, tol)
+        delta = a.origin - b.origin
+        if lin == "line":
+            assert u is not None
+            if w.residual(delta - (delta @ u) * u) > tol.length:
+                lin = "none"
+            else:
+                along = _Sub(1, u)
+                center = _affine_meet_point(
+                    a.origin, _sub_join(va, along, tol), b.origin, _sub_join(vb, along, tol), tol
+                )
+        elif w.residual(delta) > tol.length:
+            # Two centres with no common translation: rotations about the line joining them.
+            lin, u = "line", se3.unit(-delta)
+        else:
+            center = _affine_meet_point(a.origin, va, b.origin, vb, tol)
+    return _tr_group(lin, u, center, v)
+
+
+def _tr_group(lin: str, u: np.ndarray | None, center: np.ndarray, v: _Sub) -> SymmetryGroup:
+    """The TR group with rotation part ``lin`` (about ``u`` through ``center``) and V = ``v``."""
+    origin = np.zeros(3)
+    if lin == "none":
+        if v.dim == 0:
+            return SymmetryGroup.identity()
+        if v.dim == 3:
+            return SymmetryGroup.translation3()
+        assert v.vec is not None
+        kind = Kind.PRISMATIC if v.dim == 1 else Kind.TRANSLATION2
+        return SymmetryGroup(kind, se3.frame(origin, v.vec))
+    if lin == "point":
+        kind = Kind.SPHERICAL if v.dim == 0 else Kind.FREE
+        return SymmetryGroup(kind, se3.translation(center))
+    assert u is not None
+    kind = {0: Kind.REVOLUTE, 1: Kind.CYLINDRICAL, 2: Kind.PLANAR, 3: Kind.SCHOENFLIES}[v.dim]
+    return SymmetryGroup(kind, se3.frame(center, u))
+
+
+def classify_algebra(basis: np.ndarray, tol: Tolerance | None = None) -> SymmetryGroup:
+    """The connected group whose Lie algebra is spanned by ``basis`` (6 x k) (§2.1 steps 1-5)."""
+    tol = tol or current()
+    if basis.shape[1] == 0:
+        return SymmetryGroup.identity()
+    thr = _rank_threshold(tol)
+    q, _ = np.linalg.qr(_scaled(basis, tol))
+    q[3:] *= tol.scale
+    _, s, vt = np.linalg.svd(q[:3])
+    r_w = int(np.sum(s > thr))
+    trans = q[3:] @ vt[r_w:].T if r_w < q.shape[1] else np.zeros((3, 0))
+    tq = np.linalg.qr(trans)[0] if trans.shape[1] else trans
+    r_t = tq.shape[1]
+    zero = np.zeros(3)
+    if r_w == 0:
+        if r_t == 3:
+            return SymmetryGroup.translation3()
+        if r_t == 1:
+            return SymmetryGroup(Kind.PRISMATIC, se3.frame(zero, tq[:, 0]))
+        return SymmetryGroup(Kind.TRANSLATION2, se3.frame(zero, se3.cross(tq[:, 0], tq[:, 1])))
+    if r_w == 1:
+        xi = q @ vt[0]
+        w = xi[:3]
+        xi = xi / se3.norm(w)
+        u, vel = xi[:3], xi[3:]
+        vel = vel - tq @ (tq.T @ vel)
+        pitch = float(u @ vel)
+        foot = se3.cross(u, vel)
+        f = se3.frame(foot, u)
+        helical = abs(pitch) > tol.length
+        if r_t == 0:
+            return SymmetryGroup.connected(Kind.HELICAL if helical else Kind.REVOLUTE, f, pitch)
+        if r_t == 1:
+            return SymmetryGroup(Kind.CYLINDRICAL, f)
+        if r_t == 2:
+            kind = Kind.PSEUDO_PLANAR if helical else Kind.PLANAR
+            return SymmetryGroup.connected(kind, se3.frame(zero, u), pitch)
+        return SymmetryGroup(Kind.SCHOENFLIES, se3.frame(zero, u))
+    if r_w == 3 and r_t == 3:
+        return SymmetryGroup.free()
+    if r_w == 3 and r_t == 0:
+        rows = np.vstack([-se3.skew(q[:3, i]) for i in range(3)])
+        center, *_ = np.linalg.lstsq(rows, q[3:].T.reshape(-1), rcond=None)
+        return SymmetryGroup.spherical(center)
+    raise NumericError(f"not a subalgebra of se(3): rotation rank {r_w}, translation rank {r_t}")
+
+
+def _screw_generator(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> np.ndarray | None:
+    """The discrete screw of H/Y(p) ∩ H/Y(q) about a common axis, p != q (§2.4 table).
+
+    Solving p theta = q (theta + 2 pi m) gives theta in (2 pi q / (p - q)) Z.
+    """
+    if a.kind not in _HELICAL or b.kind not in _HELICAL or not _parallel(a.axis, b.axis, tol):
+        return None
+    if abs(a.pitch - b.pitch) <= tol.length:
+        return None
+    if b.kind is Kind.HELICAL and a.kind is not Kind.HELICAL:
+        a, b = b, a
+    if a.kind is Kind.HELICAL and b.kind is Kind.HELICAL:
+        delta = b.origin - a.origin
+        if se3.norm(delta - (delta @ a.axis) * a.axis) > tol.length:
+            return None
+    # Pitch is intrinsic (H(N, u, p) = H(N, -u, p)), so the axis signs do not matter.
+    q = b.pitch
+    theta = _TWO_PI * q / (a.pitch - q)
+    params = [theta] if a.kind is Kind.HELICAL else [0.0, 0.0, theta]
+    return a.element(params)
+
+
+def _translation_lattice(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> list[np.ndarray]:
+    """Generators of the discrete part of (G0a ∩ T3) ∩ (G0b ∩ T3) (§2.4 lattice rows)."""
+    (va, ca), (vb, cb) = a._translation_part, b._translation_part
+    w = _sub_meet(va, vb, tol)
+    constraints = []
+    for c in (ca, cb):
+        if c is not None:
+            proj = w.project(c[0])
+            if se3.norm(proj) > tol.angle:
+                constraints.append((proj, c[1]))
+    if not constraints:
+        return []
+    if len(constraints) == 1:
+        d, period = constraints[0]
+        return [period * d / float(d @ d)]
+    (da, pa), (db, pb) = constraints
+    if not _parallel(da, db, tol):
+        m = np.vstack((da, db))
+        pinv = np.linalg.pinv(m)
+        return [pinv @ np.array([pa, 0.0]), pinv @ np.array([0.0, pb])]
+    ratio = float(np.linalg.norm(db) / np.linalg.norm(da))
+    # t.da in pa Z and t.da in (pb / ratio) Z: the lcm of the two periods, if commensurate.
+    pb_along = pb / ratio
+    frac = Fraction(pa / pb_along).limit_denominator(MAX_LATTICE_DENOMINATOR)
+    if abs(float(frac) - pa / pb_along) > tol.rel_length * max(1.0, pa / pb_along):
+        return []
+    period = pa * frac.denominator
+    return [period * da / float(da @ da)]
+
+
+def _connected_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> SymmetryGroup:
+    """A0 ∩ B0: closed form for TR groups; otherwise Lie algebra null space plus the
+    helical discrete residue, each generator checked numerically (§2.4)."""
+    if a.is_tr and b.is_tr:
+        return _tr_meet(a, b, tol)
+    if a.includes(b, tol):
+        return b
+    if b.includes(a, tol):
+        return a
+    ka = a.dof
+    null = _null_space(_scaled(np.hstack((a.algebra, -b.algebra)), tol), tol)
+    c0 = classify_algebra(a.algebra @ null[:ka], tol)
+    screw = _screw_generator(a, b, tol)
+    gens = [screw] if screw is not None else []
+    if screw is None:
+        for step in _translation_lattice(a, b, tol):
+            t = se3.translation(step)
+            if not c0.contains(t, tol):
+                gens.append(t)
+    for g in gens:
+        if not (a.contains(g, tol) and b.contains(g, tol)):
+            raise NumericError(f"lattice element check failed for {a.describe()} ∩ {b.describe()}")
+    if not gens:
+        return c0
+    return SymmetryGroup(c0.kind, c0.frame, c0.pitch, (_EYE4,), tuple(gens))
+
+
+def _lattice_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> SymmetryGroup:
+    """G ∩ G' when one side has a lattice over a trivial G0: the sublattice inside the other.
+
+    The first power k = 1..MAX_LATTICE_DENOMINATOR with tau^k in the other group
+    generates it (bounded search, §2.4 "lattice rationality").
+    """
+    if not (a.lattice and a.kind is Kind.FIXED and len(a.reps) == 1 and len(a.lattice) == 1):
+        if b.lattice and b.kind is Kind.FIXED and len(b.reps) == 1 and len(b.lattice) == 1:
+            return _lattice_meet(b, a, tol)
+        raise GroupError("intersection of these discrete groups is not supported")
+    tau = a.lattice[0]
+    if _is_translation_lattice(a, tol) and _is_translation_lattice(b, tol):
+        return _translation_lattice_meet(tau[:3, 3], b.lattice[0][:3, 3], tol)
+    power = np.eye(4)
+    for _ in range(MAX_LATTICE_DENOMINATOR):
+        power = power @ tau
+        if b.contains(power, tol):
+            return SymmetryGroup(Kind.FIXED, np.eye(4), 0.0, (_EYE4,), (power,))
+    return SymmetryGroup.identity()
+
+
+def _is_translation_lattice(g: SymmetryGroup, tol: Tolerance) -> bool:
+    return (
+        g.kind is Kind.FIXED
+        and len(g.reps) == 1
+        and len(g.lattice) == 1
+        and se3.rotation_angle(g.lattice[0]) <= tol.angle
+    )
+
+
+def _translation_lattice_meet(sa: np.ndarray, sb: np.ndarray, tol: Tolerance) -> SymmetryGroup:
+    """aZ.u ∩ bZ.u = lcm(a, b)Z.u when a/b is rational within tolerance, else {0} (§2.4)."""
+    if not _parallel(sa, sb, tol):
+        return SymmetryGroup.identity()
+    ratio = se3.norm(sb) / se3.norm(sa)
+    frac = Fraction(ratio).limit_denominator(MAX_LATTICE_DENOMINATOR)
+    if abs(float(frac) - ratio) > tol.rel_length * max(1.0, ratio):
+        return SymmetryGroup.identity()
+    step = sa * frac.numerator
+    return SymmetryGroup(Kind.FIXED, np.eye(4), 0.0, (_EYE4,), (se3.translation(step),))

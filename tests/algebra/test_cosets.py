@@ -1,0 +1,364 @@
+"""Relation cosets: the worked examples W1-W21 of ALGEBRA.md §6 at the algebra level
+(src/assemblykit/algebra/cosets.py). Relations are built with ``transporter`` as §5.1
+prescribes: 'against' maps the body-2 plane with its normal negated onto the body-1 plane."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from assemblykit.algebra import (
+    Chain,
+    Coset,
+    EmptySet,
+    Kind,
+    LineInvariant,
+    PlaneInvariant,
+    PointInvariant,
+    SymmetryGroup,
+    se3,
+    transform_invariant,
+    transporter,
+)
+
+Z = (0.0, 0.0, 1.0)
+ORIGIN = (0.0, 0.0, 0.0)
+HALF_PI = math.pi / 2
+seeds = st.integers(min_value=0, max_value=2**32 - 1)
+
+
+def tr(x, y, z):
+    return se3.translation((x, y, z))
+
+
+def against(face1, face2):
+    """B2's plane (point, outward normal) against B1's plane."""
+    return transporter([PlaneInvariant(*face1)], [PlaneInvariant(face2[0], -np.asarray(face2[1]))])
+
+
+def fits(axis1, axis2, directed=True):
+    """B2's shaft axis in B1's hole axis (equal radii assumed)."""
+    return transporter(
+        [LineInvariant(*axis1, directed=directed)], [LineInvariant(*axis2, directed=directed)]
+    )
+
+
+def ball(socket, ball_center):
+    return transporter([PointInvariant(socket)], [PointInvariant(ball_center)])
+
+
+def meet(*cosets):
+    out = cosets[0]
+    for c in cosets[1:]:
+        out = out.intersect(c)
+    return out
+
+
+FLOOR = ((0, 0, 0), (0, 0, 1))
+BOTTOM = ((0, 0, 0), (0, 0, -1))
+WALL_X = ((0, 0, 0), (1, 0, 0))
+LEFT = ((0, 0, 0), (-1, 0, 0))
+
+
+def test_w1_single_against_is_planar():
+    c = against(FLOOR, BOTTOM)
+    assert c.kind is Kind.PLANAR and c.dof == 3 and c.n_components == 1
+    assert c.contains(tr(1, 2, 0) @ se3.rot_z(0.3))
+    assert not c.contains(tr(0, 0, 0.1)) and not c.contains(se3.rot_x(0.1))
+
+
+def test_w2_two_perpendicular_against_is_prismatic_along_y():
+    c = meet(against(FLOOR, BOTTOM), against(WALL_X, LEFT))
+    assert c.kind is Kind.PRISMATIC and c.dof == 1
+    np.testing.assert_allclose(abs(c.invariants()["direction"] @ (0, 1, 0)), 1.0)
+    assert c.contains(tr(0, -3, 0)) and c.contains(tr(0, 2.5, 0))
+    assert not c.contains(tr(0.1, 0, 0)) and not c.contains(se3.rot_z(0.1))
+    cube2 = meet(against(FLOOR, ((1, 1, 0), (0, 0, -1))), against(WALL_X, ((0, 1, 1), (-1, 0, 0))))
+    assert cube2.kind is Kind.PRISMATIC and cube2.contains(tr(0, 7, 0))
+
+
+def test_w3_three_against_fix_the_block():
+    c = meet(
+        against(FLOOR, BOTTOM),
+        against(WALL_X, LEFT),
+        against((ORIGIN, (0, 1, 0)), (ORIGIN, (0, -1, 0))),
+    )
+    assert c.is_point
+    np.testing.assert_allclose(c.points()[0], np.eye(4), atol=1e-12)
+    corner = (1, 2, 3)
+    off = meet(
+        against((corner, Z), BOTTOM),
+        against((corner, (1, 0, 0)), LEFT),
+        against((corner, (0, 1, 0)), (ORIGIN, (0, -1, 0))),
+    )
+    assert off.is_point
+    np.testing.assert_allclose(off.rep, tr(1, 2, 3), atol=1e-12)
+
+
+def test_w3b_angle_mismatch_of_10_degrees():
+    s, c = math.sin(math.radians(10)), math.cos(math.radians(10))
+    out = meet(against(FLOOR, BOTTOM), against(WALL_X, (ORIGIN, (-c, 0, s))))
+    assert isinstance(out, EmptySet) and out.proven
+    assert out.mismatch.kind == "angle"
+    assert math.degrees(out.mismatch.value) == pytest.approx(10.0)
+    assert "angle mismatch 10°" in out.mismatch.message
+
+
+def test_w4_pin_in_hole_with_shoulder_is_revolute():
+    down = (0, 0, -1)
+    c = meet(against(FLOOR, BOTTOM), fits((ORIGIN, down), (ORIGIN, down)))
+    assert c.kind is Kind.REVOLUTE and c.dof == 1
+    np.testing.assert_allclose(c.invariants()["point"][:2], (0, 0), atol=1e-12)
+    assert c.contains(se3.rot_z(1.0)) and c.contains(se3.rot_z(-2.0))
+    assert not c.contains(tr(0, 0, 1)) and not c.contains(tr(1, 0, 0))
+
+
+def test_w5_two_parallel_pins_is_prismatic_with_quarter_turn():
+    c = meet(fits((ORIGIN, Z), (ORIGIN, Z)), fits(((10, 0, 0), Z), ((0, 10, 0), Z)))
+    assert c.kind is Kind.PRISMATIC and c.n_components == 1
+    assert c.contains(se3.rot_z(-HALF_PI)) and c.contains(tr(0, 0, 7) @ se3.rot_z(-HALF_PI))
+    assert not c.contains(np.eye(4))
+    undirected = meet(
+        fits((ORIGIN, Z), (ORIGIN, Z), directed=False),
+        fits(((10, 0, 0), Z), ((10, 0, 0), Z), False),
+    )
+    assert undirected.kind is Kind.PRISMATIC and undirected.n_components == 2
+    assert undirected.contains(tr(0, 0, 4)) and undirected.contains(
+        se3.rot_x(math.pi) @ tr(0, 0, 4)
+    )
+    assert not undirected.contains(se3.rot_z(math.pi))
+
+
+def test_w6_unequal_spacing_is_a_distance_mismatch_of_2():
+    out = meet(fits((ORIGIN, Z), (ORIGIN, Z)), fits(((10, 0, 0), Z), ((12, 0, 0), Z)))
+    assert isinstance(out, EmptySet) and out.mismatch.kind == "distance"
+    assert out.mismatch.value == pytest.approx(2.0)
+
+
+def test_w7_shaft_parallel_to_face():
+    x = (1, 0, 0)
+    c = meet(against(FLOOR, BOTTOM), fits(((0, 0, 5), x), ((0, 0, 5), x)))
+    assert c.kind is Kind.PRISMATIC and c.contains(tr(3, 0, 0)) and not c.contains(tr(0, 3, 0))
+    u = meet(against(FLOOR, BOTTOM), fits(((0, 0, 5), x), ((0, 0, 5), x), directed=False))
+    assert u.n_components == 2 and u.contains(se3.rot_z(math.pi) @ tr(-2, 0, 0))
+    bad = meet(against(FLOOR, BOTTOM), fits(((0, 0, 5), x), ((0, 0, 4), x)))
+    assert isinstance(bad, EmptySet) and bad.mismatch.kind == "distance"
+    assert bad.mismatch.value == pytest.approx(1.0)
+
+
+def test_w9_two_balls_is_revolute_about_the_line_of_centres():
+    c = meet(ball(ORIGIN, ORIGIN), ball((0, 0, 10), (0, 0, 10)))
+    assert c.kind is Kind.REVOLUTE and c.contains(se3.rot_z(0.4))
+    v = meet(ball(ORIGIN, ORIGIN), ball((0, 0, 10), (0, 10, 0)))
+    assert v.kind is Kind.REVOLUTE and v.contains(se3.rot_z(0.4) @ se3.rot_x(HALF_PI))
+    assert not v.contains(np.eye(4))
+    bad = meet(ball(ORIGIN, ORIGIN), ball((0, 0, 10), (0, 0, 9)))
+    assert isinstance(bad, EmptySet) and bad.mismatch.kind == "distance"
+    assert bad.mismatch.value == pytest.approx(1.0)
+
+
+def test_w10_three_balls_fix_the_body():
+    c = meet(ball(ORIGIN, ORIGIN), ball((0, 0, 10), (0, 0, 10)), ball((10, 0, 0), (10, 0, 0)))
+    assert c.is_point
+    np.testing.assert_allclose(c.rep, np.eye(4), atol=1e-12)
+
+
+def test_w11_ball_and_sliding_face():
+    c = meet(ball((0, 0, 1), (0, 0, 1)), against(FLOOR, BOTTOM))
+    assert c.kind is Kind.REVOLUTE
+    assert c.group.equals(SymmetryGroup.revolute((0, 0, 1), Z))
+    bad = meet(ball((0, 0, 1), (0, 0, 2)), against(FLOOR, BOTTOM))
+    assert isinstance(bad, EmptySet) and bad.mismatch.value == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize(("n", "count"), [(4, 4), (2, 2), (24, 24)])
+def test_w14_keyed_peg_with_shoulder_has_finitely_many_positions(n, count):
+    turns = tuple(se3.rot_z(2 * math.pi * k / n) for k in range(n))
+    peg = Coset(SymmetryGroup.prismatic(Z).with_discrete(reps=turns), np.eye(4))
+    c = peg.intersect(against(FLOOR, BOTTOM))
+    assert c.dof == 0 and c.n_components == count and not c.is_point
+    points = c.points()
+    assert len(points) == count
+    for k in range(n):
+        assert any(np.allclose(p, turns[k], atol=1e-12) for p in points)
+
+
+def test_w16_thread_and_key_give_a_lattice():
+    p = 1.5 / (2 * math.pi)
+    thread = Coset(SymmetryGroup.helical(ORIGIN, Z, p), np.eye(4))
+    key = Coset(SymmetryGroup.prismatic(Z), np.eye(4))
+    c = thread.intersect(key)
+    assert c.dof == 0 and c.n_components == math.inf and not c.is_point
+    for k in (-2, 1, 3):
+        assert c.contains(tr(0, 0, 1.5 * k))
+    assert not c.contains(tr(0, 0, 1.0))
+
+
+def test_w18a_products_that_are_cosets():
+    rz = Coset(SymmetryGroup.revolute(ORIGIN, Z), np.eye(4))
+    tz = Coset(SymmetryGroup.prismatic(Z), np.eye(4))
+    gz = Coset(SymmetryGroup.planar(Z), np.eye(4))
+    c = rz.product(tz)
+    assert isinstance(c, Coset) and c.group.equals(SymmetryGroup.cylindrical(ORIGIN, Z))
+    x = gz.product(tz)
+    assert isinstance(x, Coset) and x.group.equals(SymmetryGroup.schoenflies(Z))
+
+
+def test_w18b_two_revolutes_through_a_point_are_a_chain():
+    rz = Coset(SymmetryGroup.revolute(ORIGIN, Z), np.eye(4))
+    rx = Coset(SymmetryGroup.revolute(ORIGIN, (1, 0, 0)), np.eye(4))
+    ch = rz.product(rx)
+    assert isinstance(ch, Chain) and ch.dof == 2
+    a, b = se3.rot_z(0.5), se3.rot_x(0.5)
+    assert ch.contains(a) and ch.contains(b)
+    witness = b @ a
+    assert witness[2, 0] == pytest.approx(0.22984884706593015)  # sin^2 0.5
+    assert not ch.contains(witness)
+
+
+def test_w18c_network_products():
+    gz = Coset(SymmetryGroup.planar(Z), np.eye(4))
+    vertical = gz.product(Coset(SymmetryGroup.cylindrical((2, 0, 0), Z), np.eye(4)))
+    assert isinstance(vertical, Coset) and vertical.group.equals(SymmetryGroup.schoenflies(Z))
+    pin = (0, 0, 1), (1, 0, 0)
+    horizontal = gz.product(Coset(SymmetryGroup.cylindrical(*pin), np.eye(4)))
+    assert isinstance(horizontal, Chain) and horizontal.dof == 4
+    a, b = se3.rotation(pin[1], 0.5, pin[0]), se3.rot_z(0.5)
+    assert horizontal.contains(a) and horizontal.contains(b)
+    assert not horizontal.contains(a @ b)
+
+
+def test_w20_slot_is_redundant_or_inconsistent():
+    ceiling = ((0, 0, 10), (0, 0, -1))
+    c = meet(against(FLOOR, BOTTOM), against(ceiling, ((0, 0, 10), Z)))
+    assert c.kind is Kind.PLANAR and c.dof == 3
+    thin = meet(against(FLOOR, BOTTOM), against(ceiling, ((0, 0, 9.9), Z)))
+    assert isinstance(thin, EmptySet) and thin.mismatch.kind == "distance"
+    assert thin.mismatch.value == pytest.approx(0.1)
+
+
+def test_inverse_left_right_and_conjugate():
+    c = against(FLOOR, BOTTOM).right(tr(1, 0, 0))
+    assert c.contains(tr(1, 0, 0)) and c.contains(tr(5, 5, 0) @ se3.rot_z(2))
+    inv = c.inverse()
+    for x in c.sample(np.random.default_rng(0), 5):
+        assert inv.contains(se3.inverse(x))
+    h = se3.rot_x(0.3) @ tr(1, 2, 3)
+    assert c.left(h).contains(h @ tr(1, 0, 0))
+    assert c.conjugate(h).contains(h @ tr(1, 0, 0) @ se3.inverse(h))
+
+
+# ----------------------------------------------------------------------------- equivariance
+
+
+def _w4_relations(b1=None, b2=None):
+    b1 = np.eye(4) if b1 is None else b1
+    b2 = np.eye(4) if b2 is None else b2
+    down = np.array([0.0, 0.0, -1.0])
+
+    def face(t, p, n):
+        inv = transform_invariant(t, PlaneInvariant(p, n))
+        return inv.point, inv.normal
+
+    def axis(t, p, u):
+        inv = transform_invariant(t, LineInvariant(p, u))
+        return inv.point, inv.direction
+
+    return meet(
+        against(face(b1, ORIGIN, Z), face(b2, ORIGIN, down)),
+        fits(axis(b1, ORIGIN, down), axis(b2, ORIGIN, down)),
+        ball(*(transform_invariant(t, PointInvariant((0, 0, -3))).point for t in (b1, b2))),
+    )
+
+
+@settings(max_examples=30, deadline=None)
+@given(seeds)
+def test_equivariance_recipe(seed):
+    rng = np.random.default_rng(seed)
+    base = _w4_relations()
+    assert base.kind is Kind.REVOLUTE
+    g, h = se3.random_transform(rng), se3.random_transform(rng)
+    # B2's features replaced by g^-1(feature): X -> X g, H unchanged.
+    moved2 = _w4_relations(b2=se3.inverse(g))
+    assert moved2.group.equals(base.group)
+    assert moved2.contains(base.rep @ g)
+    # B1's features replaced by h(feature): H -> h H h^-1, X -> h X.
+    moved1 = _w4_relations(b1=h)
+    assert moved1.group.equals(base.group.conjugate(h))
+    assert moved1.contains(h @ base.rep)
+
+
+# ----------------------------------------------------------------------------- properties
+
+
+def _random_relation(rng: np.random.Generator) -> Coset:
+    kind = int(rng.integers(3))
+    p, d = rng.integers(-2, 3, 3).astype(float), np.eye(3)[int(rng.integers(3))]
+    g = se3.random_transform(rng)
+    inv = [PlaneInvariant(p, d), LineInvariant(p, d), PointInvariant(p)][kind]
+    out = transporter([inv], [transform_invariant(se3.inverse(g), inv)])
+    assert isinstance(out, Coset)
+    return out
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_coset_intersection_members_and_equivariance(seed):
+    rng = np.random.default_rng(seed)
+    a, b = _random_relation(rng), _random_relation(rng)
+    m = a.intersect(b)
+    h = se3.random_transform(rng)
+    moved = a.left(h).intersect(b.left(h))
+    if isinstance(m, EmptySet):
+        assert isinstance(moved, EmptySet)
+        return
+    for x in m.sample(rng, 3):
+        assert a.contains(x) and b.contains(x)
+    assert isinstance(moved, Coset)
+    assert moved.group.equals(m.group.conjugate(h)) and moved.contains(h @ m.rep)
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_product_with_inverse_contains_identity(seed):
+    rng = np.random.default_rng(seed)
+    c = _random_relation(rng)
+    prod = c.product(c.inverse())
+    assert isinstance(prod, Coset)
+    assert prod.contains(np.eye(4))
+    np.testing.assert_allclose(prod.rep, np.eye(4), atol=1e-9)
+
+
+@settings(max_examples=15, deadline=None)
+@given(seeds)
+def test_helical_coset_intersection_finds_a_common_point(seed):
+    rng = np.random.default_rng(seed)
+    x = se3.random_transform(rng)
+    pitch = float(rng.uniform(0.2, 1.0))
+    thread = Coset(SymmetryGroup.helical(ORIGIN, Z, pitch), x)
+    other = Coset(
+        [SymmetryGroup.planar(Z), SymmetryGroup.cylindrical((1, 0, 0), Z)][int(rng.integers(2))],
+        x,
+    )
+    m = thread.intersect(other)
+    assert isinstance(m, Coset)
+    assert m.contains(x) and thread.contains(m.rep) and other.contains(m.rep)
+
+
+def test_w16_lattice_meets_a_third_relation():
+    p = 1.5 / (2 * math.pi)
+    w16 = Coset(SymmetryGroup.helical(ORIGIN, Z, p), np.eye(4)).intersect(
+        Coset(SymmetryGroup.prismatic(Z), np.eye(4))
+    )
+    seat = transporter([PlaneInvariant((0, 0, 4.5), Z)], [PlaneInvariant(ORIGIN, Z)])
+    fixed = w16.intersect(seat)
+    assert isinstance(fixed, Coset) and fixed.is_point
+    np.testing.assert_allclose(fixed.rep, tr(0, 0, 4.5), atol=1e-12)
+    off_lattice = transporter([PlaneInvariant((0, 0, 4.0), Z)], [PlaneInvariant(ORIGIN, Z)])
+    missed = w16.intersect(off_lattice)
+    assert isinstance(missed, EmptySet) and not missed.proven
+    assert missed.mismatch.kind == "residual"

@@ -1,0 +1,89 @@
+"""Rigid transforms and twists (src/assemblykit/algebra/se3.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from assemblykit.algebra import se3
+from assemblykit.tolerance import Tolerance
+
+seeds = st.integers(min_value=0, max_value=2**32 - 1)
+
+
+def test_rot_z_quarter_turn_maps_x_to_y():
+    np.testing.assert_allclose(
+        se3.apply(se3.rot_z(math.pi / 2), (1.0, 0.0, 0.0)), (0, 1, 0), atol=1e-15
+    )
+
+
+def test_rotation_about_offset_line_keeps_the_line_fixed():
+    t = se3.rotation((0, 0, 1), math.pi, point=(1.0, 0.0, 0.0))
+    np.testing.assert_allclose(se3.apply(t, (1.0, 0.0, 5.0)), (1, 0, 5), atol=1e-15)
+    np.testing.assert_allclose(se3.apply(t, (0.0, 0.0, 0.0)), (2, 0, 0), atol=1e-15)
+
+
+def test_screw_one_turn_is_a_translation_by_the_lead():
+    # ALGEBRA.md W16: with p = 1/(2 pi), Scr(2 pi k; p) = Tr(0, 0, k).
+    for k in (-2, 1, 3):
+        t = se3.screw((0, 0, 0), (0, 0, 1), 1 / (2 * math.pi), 2 * math.pi * k)
+        np.testing.assert_allclose(t, se3.translation((0, 0, k)), atol=1e-12)
+
+
+def test_frame_is_right_handed_with_requested_z_and_hint():
+    f = se3.frame((1, 2, 3), (0, 0, 2), x_hint=(0, 1, 0))
+    np.testing.assert_allclose(f[:3, :3], [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-15)
+    np.testing.assert_allclose(f[:3, 3], (1, 2, 3))
+    g = se3.frame((0, 0, 0), (1, 1, 0))
+    assert np.isclose(np.linalg.det(g[:3, :3]), 1.0)
+    np.testing.assert_allclose(g[:3, 2], np.array([1, 1, 0]) / math.sqrt(2))
+
+
+def test_hat_vee_and_adjoint_formula():
+    xi = np.array([0.1, -0.2, 0.3, 1.0, 2.0, 3.0])
+    np.testing.assert_allclose(se3.vee(se3.hat(xi)), xi)
+    t = se3.translation((1, 0, 0)) @ se3.rot_z(math.pi / 2)
+    # Ad_g (omega; v) = (R omega; R v + t x R omega)
+    out = se3.adjoint(t) @ np.array([0, 0, 1, 0, 0, 0.0])
+    np.testing.assert_allclose(out, [0, 0, 1, 0, -1, 0], atol=1e-15)
+
+
+def test_exp_of_rotation_twist_about_offset_line():
+    # (u; N x u) with N = (1, 0, 0), u = z, N x u = (0, -1, 0): rotation about that line.
+    xi = np.array([0.0, 0.0, math.pi, 0.0, -math.pi, 0.0])
+    np.testing.assert_allclose(se3.exp(xi), se3.rotation((0, 0, 1), math.pi, (1, 0, 0)), atol=1e-12)
+
+
+def test_is_rigid_rejects_scaling_and_reflection():
+    assert se3.is_rigid(se3.rot_x(0.3))
+    assert not se3.is_rigid(np.diag([1.0, 1.0, -1.0, 1.0]))
+    assert not se3.is_rigid(np.diag([2.0, 1.0, 1.0, 1.0]), Tolerance())
+
+
+def test_rotation_angle_near_pi():
+    assert se3.rotation_angle(se3.rot_x(math.pi)) == pytest.approx(math.pi)
+    assert se3.rotation_angle(se3.rot_y(-0.25)) == pytest.approx(0.25)
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_exp_log_round_trip_and_inverse(seed):
+    rng = np.random.default_rng(seed)
+    t = se3.random_transform(rng)
+    np.testing.assert_allclose(se3.exp(se3.log(t)), t, atol=1e-9)
+    np.testing.assert_allclose(t @ se3.inverse(t), np.eye(4), atol=1e-12)
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_adjoint_is_conjugation_of_twists(seed):
+    rng = np.random.default_rng(seed)
+    t = se3.random_transform(rng)
+    xi = rng.normal(size=6)
+    np.testing.assert_allclose(
+        se3.hat(se3.adjoint(t) @ xi), t @ se3.hat(xi) @ se3.inverse(t), atol=1e-9
+    )

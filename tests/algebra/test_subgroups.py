@@ -1,0 +1,371 @@
+"""Hervé subgroups, membership, intersection, discrete parts and orbits
+(src/assemblykit/algebra/subgroups.py; ALGEBRA.md §2.1-§2.4, W14, W16, W21)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from assemblykit.algebra import Kind, SymmetryGroup, se3
+from assemblykit.algebra.subgroups import _connected_meet, classify_algebra
+from assemblykit.errors import GroupError
+from assemblykit.tolerance import Tolerance
+
+G = SymmetryGroup
+Z = (0.0, 0.0, 1.0)
+ORIGIN = (0.0, 0.0, 0.0)
+seeds = st.integers(min_value=0, max_value=2**32 - 1)
+
+
+def tr(x, y, z):
+    return se3.translation((x, y, z))
+
+
+# ----------------------------------------------------------------------------- kinds
+
+
+def test_kind_values_are_herve_names():
+    assert [k.value for k in Kind] == [
+        "fixed", "revolute", "prismatic", "helical", "cylindrical", "translation2",
+        "translation3", "spherical", "planar", "pseudo-planar", "schoenflies", "free",
+    ]  # fmt: skip
+    assert Kind("pseudo-planar") is Kind.PSEUDO_PLANAR
+
+
+@pytest.mark.parametrize(
+    ("group", "dof"),
+    [
+        (G.identity(), 0),
+        (G.revolute(ORIGIN, Z), 1),
+        (G.prismatic(Z), 1),
+        (G.helical(ORIGIN, Z, 0.5), 1),
+        (G.cylindrical(ORIGIN, Z), 2),
+        (G.translation2(Z), 2),
+        (G.translation3(), 3),
+        (G.spherical(ORIGIN), 3),
+        (G.planar(Z), 3),
+        (G.pseudo_planar(Z, 0.5), 3),
+        (G.schoenflies(Z), 4),
+        (G.free(), 6),
+    ],
+)
+def test_dof_matches_the_table_and_algebra_rank(group, dof):
+    assert group.dof == dof
+    assert group.algebra.shape == (6, dof)
+    if dof:
+        assert np.linalg.matrix_rank(group.algebra) == dof
+    assert group.n_components == 1
+
+
+def test_zero_pitch_helical_is_revolute():
+    assert G.helical(ORIGIN, Z, 0.0).kind is Kind.REVOLUTE
+    assert G.pseudo_planar(Z, 0.0).kind is Kind.PLANAR
+
+
+# ----------------------------------------------------------------------------- membership
+
+
+def test_membership_predicates_of_section_2_3():
+    line = G.revolute((1, 0, 0), Z)
+    assert line.contains(se3.rotation(Z, 0.7, (1, 0, 0)))
+    assert not line.contains(se3.rot_z(0.7))
+    assert G.prismatic(Z).contains(tr(0, 0, -4)) and not G.prismatic(Z).contains(tr(0, 1e-6, 0))
+    helix = G.helical(ORIGIN, Z, 0.5)
+    assert helix.contains(tr(0, 0, 0.5 * 0.3) @ se3.rot_z(0.3))
+    # 2 pi periodicity: the same rotation with the translation of the next turn.
+    assert helix.contains(tr(0, 0, 0.5 * (0.3 + 2 * math.pi)) @ se3.rot_z(0.3))
+    assert not helix.contains(tr(0, 0, 0.5 * 0.3 + 0.1) @ se3.rot_z(0.3))
+    assert G.planar(Z).contains(tr(1, 2, 0) @ se3.rot_z(0.3))
+    assert not G.planar(Z).contains(tr(0, 0, 0.1))
+    assert not G.planar(Z).contains(se3.rot_x(0.1))
+    assert G.spherical((0, 0, 1)).contains(se3.rotation((1, 1, 0), 2.0, (0, 0, 1)))
+    assert not G.spherical((0, 0, 1)).contains(se3.rot_x(1.0))
+    assert G.schoenflies(Z).contains(tr(4, 5, 6) @ se3.rot_z(1))
+    assert not G.schoenflies(Z).contains(se3.rot_y(1))
+    assert G.translation2(Z).contains(tr(3, -1, 0)) and not G.translation2(Z).contains(tr(0, 0, 1))
+    assert G.pseudo_planar(Z, 1.0).contains(tr(5, 6, 0.2) @ se3.rot_z(0.2))
+    assert not G.pseudo_planar(Z, 1.0).contains(tr(5, 6, 0.3) @ se3.rot_z(0.2))
+
+
+def test_length_tolerance_scales_with_the_model():
+    t = tr(0, 0, 1e-7)
+    assert not G.planar(Z).contains(t, Tolerance())
+    assert G.planar(Z).contains(t, Tolerance(scale=1000.0))
+
+
+def test_invariants_and_describe():
+    r = G.revolute((0, 0, 1), Z)
+    assert r.describe() == "revolute about line through (0, 0, 1) along (0, 0, 1)"
+    inv = G.helical((1, 2, 3), (0, 1, 0), 0.25).invariants
+    np.testing.assert_allclose(inv["point"], (1, 2, 3))
+    np.testing.assert_allclose(inv["axis"], (0, 1, 0))
+    assert inv["pitch"] == 0.25
+    np.testing.assert_allclose(G.planar((0, 0, 2)).invariants["normal"], Z)
+    assert set(G.translation3().invariants) == set()
+
+
+def test_element_places_the_canonical_family():
+    c = G.cylindrical((1, 0, 0), Z)
+    np.testing.assert_allclose(
+        c.element((math.pi, 2.0)), tr(0, 0, 2) @ se3.rotation(Z, math.pi, (1, 0, 0)), atol=1e-12
+    )
+
+
+# ----------------------------------------------------------------------------- classification
+
+
+@pytest.mark.parametrize(
+    "group",
+    [
+        G.revolute((1, 2, 0), (0, 1, 1)),
+        G.helical((1, 0, 0), (1, 1, 1), -0.3),
+        G.cylindrical((0, 5, 0), (1, 0, 0)),
+        G.prismatic((1, 2, 3)),
+        G.translation2((0, 1, 0)),
+        G.translation3(),
+        G.spherical((1, -2, 3)),
+        G.planar((1, 0, 1)),
+        G.pseudo_planar((0, 1, 0), 0.7),
+        G.schoenflies((0, 0, 1)),
+        G.free(),
+    ],
+)
+def test_classify_algebra_recovers_the_group(group):
+    found = classify_algebra(group.algebra)
+    assert found.kind is group.kind
+    assert found.equals(group)
+    if group.kind in (Kind.HELICAL, Kind.PSEUDO_PLANAR):
+        assert found.pitch == pytest.approx(group.pitch)
+
+
+# ----------------------------------------------------------------------------- intersections
+
+
+def test_tr_intersection_table():
+    x, y = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)
+    # W2 algebra check: G(z) ∩ G(x) = T(y)
+    t = G.planar(Z).intersect(G.planar(x))
+    assert t.kind is Kind.PRISMATIC and t.equals(G.prismatic(y))
+    assert G.prismatic(x).intersect(G.prismatic(y)).kind is Kind.FIXED
+    assert G.translation2(Z).intersect(G.translation2(x)).equals(G.prismatic(y))
+    assert G.revolute(ORIGIN, Z).intersect(G.revolute((1, 0, 0), Z)).kind is Kind.FIXED
+    assert G.revolute(ORIGIN, Z).intersect(G.spherical((0, 0, 4))).equals(G.revolute(ORIGIN, Z))
+    assert G.revolute(ORIGIN, Z).intersect(G.spherical((1, 0, 4))).kind is Kind.FIXED
+    assert G.cylindrical(ORIGIN, Z).intersect(G.cylindrical((3, 0, 0), Z)).equals(G.prismatic(Z))
+    # W4: C(z) ∩ G(z) = R(z); W7: C(x-axis at height 5) ∩ G(z) = T(x)
+    assert G.cylindrical(ORIGIN, Z).intersect(G.planar(Z)).equals(G.revolute(ORIGIN, Z))
+    assert G.cylindrical((0, 0, 5), x).intersect(G.planar(Z)).equals(G.prismatic(x))
+    assert G.cylindrical(ORIGIN, Z).intersect(G.schoenflies(x)).equals(G.prismatic(Z))
+    # W9: S(N1) ∩ S(N2) = R(line N1 N2); W11: S(N) ∩ G(z) = R(N, z)
+    assert G.spherical(ORIGIN).intersect(G.spherical((0, 0, 10))).equals(G.revolute(ORIGIN, Z))
+    assert G.spherical((0, 0, 1)).intersect(G.planar(Z)).equals(G.revolute((0, 0, 1), Z))
+    assert G.planar(Z).intersect(G.schoenflies(x)).equals(G.translation2(Z))
+    assert G.schoenflies(Z).intersect(G.schoenflies(x)).equals(G.translation3())
+
+
+def test_helical_lattice_rows_of_the_table():
+    p = 1.5 / (2 * math.pi)
+    h = G.helical(ORIGIN, Z, p)
+    # W16: H(z, p) ∩ T(z) = <Tr(0, 0, 2 pi p)> = {Tr(0, 0, 1.5 k)}
+    lat = h.intersect(G.prismatic(Z))
+    assert lat.dof == 0 and lat.n_components == math.inf
+    for k in (-2, 1, 3):
+        assert lat.contains(tr(0, 0, 1.5 * k))
+    assert not lat.contains(tr(0, 0, 1.0))
+    assert not lat.contains(se3.rot_z(0.1))
+    # H ∩ C on a parallel distinct axis and H ∩ G(v), v ⊥ u: the same lattice
+    assert h.intersect(G.cylindrical((1, 0, 0), Z)).equals(lat)
+    assert h.intersect(G.planar((1, 0, 0))).equals(lat)
+    assert h.intersect(G.revolute(ORIGIN, Z)).kind is Kind.FIXED
+    assert h.intersect(G.revolute(ORIGIN, Z)).n_components == 1
+    assert h.intersect(G.cylindrical(ORIGIN, Z)).equals(h)
+    # Y(u, p) ∩ C(N, u) = H(N, u, p); Y ∩ G(u) = T2(u); Y ∩ T3 = T2(u) x <Tr(2 pi p u)>
+    y = G.pseudo_planar(Z, p)
+    assert y.intersect(G.cylindrical((2, 0, 0), Z)).equals(G.helical((2, 0, 0), Z, p))
+    assert y.intersect(G.planar(Z)).equals(G.translation2(Z))
+    yt = y.intersect(G.translation3())
+    assert yt.kind is Kind.TRANSLATION2 and yt.n_components == math.inf
+    assert yt.contains(tr(7, -3, 3.0)) and not yt.contains(tr(7, -3, 2.0))
+
+
+def test_discrete_screw_group_of_two_pitches():
+    # H(p) ∩ H(q), same axis: <Scr(phi; q)> with phi = 2 pi p / (q - p); p=1, q=3: phi = pi.
+    s = G.helical(ORIGIN, Z, 1.0).intersect(G.helical(ORIGIN, Z, 3.0))
+    assert s.dof == 0 and s.n_components == math.inf
+    g = se3.screw(ORIGIN, Z, 3.0, math.pi)
+    assert s.contains(g) and s.contains(g @ g) and s.contains(se3.inverse(g))
+    assert not s.contains(se3.screw(ORIGIN, Z, 3.0, math.pi / 2))
+
+
+def test_lattices_of_incommensurate_periods_meet_trivially():
+    a = G.lattice_group([tr(0, 0, 1.0)])
+    b = G.lattice_group([tr(0, 0, math.sqrt(2))])
+    assert a.intersect(b).n_components == 1
+    c = a.intersect(G.lattice_group([tr(0, 0, 1.5)]))
+    assert c.contains(tr(0, 0, 3.0)) and not c.contains(tr(0, 0, 1.5))
+
+
+def test_finite_parts_w14():
+    c4 = tuple(se3.rot_z(k * math.pi / 2) for k in range(4))
+    peg = G.prismatic(Z).with_discrete(reps=c4)
+    assert peg.n_components == 4 and peg.dof == 1
+    met = peg.intersect(G.planar(Z))
+    assert met.kind is Kind.FIXED and met.n_components == 4
+    assert met.equals(G.cyclic(ORIGIN, Z, 4))
+    assert G.cyclic(ORIGIN, Z, 4).intersect(G.cyclic(ORIGIN, Z, 6)).equals(G.cyclic(ORIGIN, Z, 2))
+
+
+def test_with_discrete_rejects_non_groups():
+    with pytest.raises(GroupError):
+        G.finite([se3.rot_z(math.pi / 2)])  # its square is missing
+    with pytest.raises(GroupError):
+        G.revolute(ORIGIN, Z).with_discrete(reps=(se3.rot_x(0.3),))  # does not normalise R(z)
+
+
+def test_extended_by_generates_the_dihedral_group():
+    d4 = G.cyclic(ORIGIN, Z, 4).extended_by([se3.rot_x(math.pi)])
+    assert d4.n_components == 8
+    assert d4.contains(se3.rot_z(math.pi / 2) @ se3.rot_x(math.pi))
+    flipped = G.cylindrical(ORIGIN, Z).extended_by([se3.rot_x(math.pi)])
+    assert flipped.n_components == 2 and flipped.contains(se3.rot_y(math.pi) @ tr(0, 0, 3))
+
+
+# ----------------------------------------------------------------------------- orbits W21
+
+
+def test_orbits_w21():
+    circle = G.revolute(ORIGIN, Z).orbit((3, 4, 0))
+    assert circle.kind == "circle" and circle.radius == pytest.approx(5.0)
+    assert circle.contains((5, 0, 0)) and not circle.contains((5, 0, 1))
+    plane = G.planar(Z).orbit((3, 4, 0))
+    assert plane.kind == "plane" and plane.contains((-7, 1, 0)) and not plane.contains((0, 0, 1))
+    axis = G.helical(ORIGIN, Z, 0.4).orbit((0, 0, 2))
+    assert axis.kind == "line" and axis.contains((0, 0, -9))
+    assert G.pseudo_planar(Z, 0.4).orbit((3, 4, 0)).kind == "space"
+    sphere = G.spherical(ORIGIN).orbit((1, 0, 0))
+    assert sphere.kind == "sphere" and sphere.radius == 1.0 and sphere.contains((0, 0.6, 0.8))
+    helix = G.helical(ORIGIN, Z, 0.5).orbit((1, 0, 0))
+    assert helix.kind == "helix"
+    assert helix.contains((0, 1, 0.5 * math.pi / 2)) and not helix.contains((0, 1, 0))
+    four = G.cyclic(ORIGIN, Z, 4).orbit((1, 0, 0))
+    assert four.kind == "union" and four.contains((0, -1, 0)) and not four.contains((1, 1, 0))
+
+
+# ----------------------------------------------------------------------------- properties
+
+
+def _random_group(rng: np.random.Generator) -> SymmetryGroup:
+    place = se3.random_transform(rng)
+    canon = [
+        G.revolute(ORIGIN, Z),
+        G.prismatic(Z),
+        G.helical(ORIGIN, Z, float(rng.uniform(0.2, 2.0))),
+        G.cylindrical(ORIGIN, Z),
+        G.translation2(Z),
+        G.spherical(ORIGIN),
+        G.planar(Z),
+        G.pseudo_planar(Z, float(rng.uniform(0.2, 2.0))),
+        G.schoenflies(Z),
+    ]
+    return canon[int(rng.integers(len(canon)))].conjugate(place)
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_group_laws_on_samples(seed):
+    rng = np.random.default_rng(seed)
+    g = _random_group(rng)
+    a, b = g.sample(rng, 2)
+    assert g.contains(a @ b)
+    assert g.contains(se3.inverse(a))
+    assert g.contains(np.eye(4))
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_contains_is_invariant_under_conjugation(seed):
+    rng = np.random.default_rng(seed)
+    g = _random_group(rng)
+    t = se3.random_transform(rng)
+    x = g.sample(rng, 1)[0]
+    assert g.conjugate(t).contains(t @ x @ se3.inverse(t))
+    y = se3.random_transform(rng)
+    assert g.contains(y) == g.conjugate(t).contains(t @ y @ se3.inverse(t))
+
+
+def _tr_group(rng: np.random.Generator) -> SymmetryGroup:
+    # Random TR groups whose invariants sometimes coincide (so meets are non-trivial).
+    pts = [np.zeros(3), np.array([0.0, 0.0, 2.0])]
+    dirs = [np.array(Z), np.array([1.0, 0.0, 0.0])]
+    p, d = pts[int(rng.integers(2))], dirs[int(rng.integers(2))]
+    make = [
+        lambda: G.revolute(p, d),
+        lambda: G.cylindrical(p, d),
+        lambda: G.prismatic(d),
+        lambda: G.spherical(p),
+        lambda: G.planar(d).conjugate(se3.translation(p)),
+        lambda: G.schoenflies(d),
+        lambda: G.translation2(d),
+    ]
+    return make[int(rng.integers(len(make)))]()
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_intersection_members_lie_in_both_and_conjugation_commutes(seed):
+    rng = np.random.default_rng(seed)
+    a, b = _tr_group(rng), _tr_group(rng)
+    m = a.intersect(b)
+    for x in m.sample(rng, 3):
+        assert a.contains(x) and b.contains(x)
+    t = se3.random_transform(rng)
+    assert a.conjugate(t).intersect(b.conjugate(t)).equals(m.conjugate(t))
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_closed_form_tr_meet_agrees_with_the_lie_algebra_route(seed):
+    rng = np.random.default_rng(seed)
+    a, b = _tr_group(rng), _tr_group(rng)
+    from assemblykit.algebra.subgroups import _null_space, _scaled
+
+    tol = Tolerance()
+    null = _null_space(_scaled(np.hstack((a.algebra, -b.algebra)), tol), tol)
+    via_algebra = classify_algebra(a.algebra @ null[: a.dof], tol)
+    assert _connected_meet(a, b, tol).equals(via_algebra)
+
+
+def _any_group(rng: np.random.Generator) -> SymmetryGroup:
+    # All connected families, with axes that often coincide or are parallel.
+    p = [np.zeros(3), np.array([1.0, 0.0, 0.0])][int(rng.integers(2))]
+    d = [np.array(Z), np.array([1.0, 0.0, 0.0])][int(rng.integers(2))]
+    pitch = [0.5, 1.0, 1.5][int(rng.integers(3))]
+    make = [
+        lambda: G.revolute(p, d),
+        lambda: G.prismatic(d),
+        lambda: G.helical(p, d, pitch),
+        lambda: G.cylindrical(p, d),
+        lambda: G.translation2(d),
+        lambda: G.translation3(),
+        lambda: G.spherical(p),
+        lambda: G.planar(d),
+        lambda: G.pseudo_planar(d, pitch),
+        lambda: G.schoenflies(d),
+    ]
+    return make[int(rng.integers(len(make)))]()
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_intersections_with_helical_groups_are_sound_and_equivariant(seed):
+    rng = np.random.default_rng(seed)
+    a, b = _any_group(rng), _any_group(rng)
+    m = a.intersect(b)
+    for x in m.sample(rng, 3):
+        assert a.contains(x) and b.contains(x)
+    t = se3.random_transform(rng)
+    assert a.conjugate(t).intersect(b.conjugate(t)).equals(m.conjugate(t))
