@@ -291,10 +291,10 @@ def test_w16_thread_and_key_leave_a_lattice_of_lead_steps():
 def test_thread_lead_and_hand_mismatches():
     nut = Thread((0, 0, 0), Z, radius=5, lead=1.5, male=False)
     lead = fits(Thread((0, 0, 0), Z, radius=5, lead=1.25), nut)
-    assert isinstance(lead, EmptySet) and lead.mismatch.kind == "lead"
+    assert isinstance(lead, EmptySet) and lead.mismatch.kind == "pitch"
     assert lead.mismatch.value == pytest.approx(0.25)
     hand = fits(Thread((0, 0, 0), Z, radius=5, lead=1.5, hand="left"), nut)
-    assert isinstance(hand, EmptySet) and hand.mismatch.kind == "hand"
+    assert isinstance(hand, EmptySet) and hand.mismatch.kind == "handedness"
 
 
 def test_w20_slot_is_redundant_or_inconsistent():

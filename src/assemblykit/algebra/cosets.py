@@ -40,7 +40,7 @@ LATTICE_SEARCH = 64
 
 #: The documented mismatch kinds.
 MISMATCH_KINDS = frozenset(
-    {"angle", "distance", "radius", "moment", "handedness", "pitch", "sides", "type", "residual"}
+    {"angle", "distance", "radius", "moment", "handedness", "pitch", "sides", "size", "type", "residual"}
 )
 
 _TRANSLATIONS = frozenset({Kind.FIXED, Kind.PRISMATIC, Kind.TRANSLATION2, Kind.TRANSLATION3})

@@ -279,10 +279,10 @@ def _fits_mismatch(first: Feature, second: Feature, tol: Tolerance) -> EmptySet 
             )
         case Thread(), Thread():
             checks.append(("radius", first.radius, second.radius, "radius", tol.length))
-            checks.append(("lead", first.lead, second.lead, "lead", tol.length))
+            checks.append(("pitch", first.lead, second.lead, "lead", tol.length))
             if first.hand != second.hand:
                 return EmptySet(
-                    Mismatch("hand", 2 * first.lead, f"hand {first.hand} vs {second.hand}"),
+                    Mismatch("handedness", 2 * first.lead, f"hand {first.hand} vs {second.hand}"),
                     proven=True,
                 )
         case Prism(), Prism():
