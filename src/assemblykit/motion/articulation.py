@@ -1,0 +1,168 @@
+"""Articulated assemblies: joints and coupled gear trains (seed 003 §4, Figs. 7-9).
+
+Seed 003 represents the gearbox by the motion group of each gear relative to the
+housing, Lᵢ = aᵢ SO(2) aᵢ⁻¹ (a revolute about the gear's shaft, from a cylinder and a
+plane), and the gear pairs by products Lᵢⱼ = Lᵢ Lⱼ "where the relative gear pitch ratio
+is also embedded". Here every part whose motion (:func:`assemblykit.motion.motion`) is
+a revolute is a candidate gear; two of them *mesh* when their axes are parallel and
+their outer cylinders are tangent, |N₁N₂| = R₁ + R₂ (R the largest distance of the
+part's mesh from its axis, i.e. the pitch radius of a gear drawn as its pitch
+cylinder). A mesh couples the angular speeds about the (common) axis direction:
+ω₂ = -(R₁/R₂) ω₁. The gear train's joint speeds are the null space of these coupling
+equations (scipy): its dimension is the train's dof (1 for a simple train, 0 for a
+locked loop), and for one dof the ratios of every gear to the first one.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import networkx as nx
+import numpy as np
+from numpy.typing import NDArray
+from rich.console import Group
+from rich.table import Table
+from scipy.linalg import null_space
+
+from assemblykit.model.assembly import Assembly
+from assemblykit.motion.freedom import Motion, MotionReport, motion
+from assemblykit.tolerance import Tolerance
+
+Vector = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Revolute:
+    """A part turning about the line through ``point`` with unit ``direction``, with
+    ``radius`` the largest distance of its mesh from that line."""
+
+    part: str
+    point: Vector
+    direction: Vector
+    radius: float
+
+
+@dataclass(frozen=True)
+class GearMesh:
+    """Gears ``a`` and ``b`` in mesh: ``ratio`` = ω_b / ω_a about their axis directions."""
+
+    a: str
+    b: str
+    ratio: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """``a``, ``b`` and ``ratio``."""
+        return {"a": self.a, "b": self.b, "ratio": self.ratio}
+
+
+@dataclass(frozen=True)
+class GearTrain:
+    """A connected set of meshing gears: ``dof`` of the coupled motion and, for one dof,
+    the speed ``ratios`` of every gear to the first (``gears[0]``, ratio 1)."""
+
+    gears: tuple[str, ...]
+    meshes: tuple[GearMesh, ...]
+    dof: int
+    ratios: dict[str, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        """``gears``, ``dof``, ``ratios`` and ``meshes``."""
+        return {
+            "gears": list(self.gears),
+            "dof": self.dof,
+            "ratios": dict(self.ratios),
+            "meshes": [m.to_dict() for m in self.meshes],
+        }
+
+
+def revolute_of(assembly: Assembly, moved: Motion) -> Revolute | None:
+    """The revolute joint of a single part whose motion is a revolute, else ``None``."""
+    if moved.kind != "revolute" or len(moved.parts) != 1:
+        return None
+    axis = moved.to_dict()["axis"]
+    point = np.asarray(axis["point"], dtype=np.float64)
+    direction = np.asarray(axis["direction"], dtype=np.float64)
+    offsets = np.asarray(assembly.part(moved.parts[0]).mesh.vertices, dtype=np.float64) - point
+    radial = offsets - np.outer(offsets @ direction, direction)
+    radius = float(np.max(np.linalg.norm(radial, axis=1)))
+    return Revolute(moved.parts[0], point, direction, radius)
+
+
+def gear_meshes(joints: Sequence[Revolute], tol: Tolerance) -> list[GearMesh]:
+    """The pairs of revolutes with parallel axes and tangent outer cylinders."""
+    found = []
+    for first, second in itertools.combinations(joints, 2):
+        if np.linalg.norm(np.cross(first.direction, second.direction)) > tol.angle:
+            continue
+        offset = second.point - first.point
+        distance = float(np.linalg.norm(np.cross(offset, first.direction)))
+        if abs(distance - (first.radius + second.radius)) > tol.length:
+            continue
+        # external mesh: the speeds are opposite about a common axis direction
+        same_way = float(first.direction @ second.direction) > 0
+        ratio = -first.radius / second.radius * (1.0 if same_way else -1.0)
+        found.append(GearMesh(first.part, second.part, ratio))
+    return found
+
+
+def gear_trains(meshes: Iterable[GearMesh], tol: Tolerance) -> list[GearTrain]:
+    """The gear trains (connected components of the meshes) with their coupled motion."""
+    meshes = list(meshes)
+    graph = nx.Graph()
+    for m in meshes:
+        graph.add_edge(m.a, m.b)
+    trains = []
+    for component in nx.connected_components(graph):
+        gears = tuple(n for n in graph.nodes if n in component)
+        index = {g: i for i, g in enumerate(gears)}
+        inside = tuple(m for m in meshes if m.a in component)
+        coupling = np.zeros((len(inside), len(gears)))
+        for row, m in enumerate(inside):
+            coupling[row, index[m.a]] = m.ratio
+            coupling[row, index[m.b]] = -1.0
+        speeds = null_space(coupling, rcond=tol.angle)
+        dof = speeds.shape[1]
+        ratios = {g: float(speeds[index[g], 0] / speeds[0, 0]) for g in gears} if dof == 1 else {}
+        trains.append(GearTrain(gears, inside, dof, ratios))
+    return trains
+
+
+@dataclass(frozen=True, eq=False)
+class Articulation:
+    """The motions of an assembly with its gear trains coupled (seed 003 Fig. 9)."""
+
+    report: MotionReport
+    trains: tuple[GearTrain, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The motion report's ``parts`` and the ``gear_trains``."""
+        return {**self.report.to_dict(), "gear_trains": [t.to_dict() for t in self.trains]}
+
+    def render(self) -> Group:
+        """The motion table followed by one table of gear ratios per train."""
+        tables: list[Table] = [self.report.render()]
+        for number, train in enumerate(self.trains, start=1):
+            table = Table(title=f"Gear train {number}: {train.dof} dof")
+            table.add_column("gear")
+            table.add_column(f"speed / speed of {train.gears[0]}")
+            for gear in train.gears:
+                ratio = train.ratios.get(gear)
+                table.add_row(gear, "locked" if ratio is None else f"{ratio:.6g}")
+            tables.append(table)
+        return Group(*tables)
+
+
+def articulation(
+    assembly: Assembly,
+    subassemblies: Iterable[Sequence[str]] | None = None,
+    tol: Tolerance | None = None,
+) -> Articulation:
+    """Every part's motion (and the given subassemblies'), with the gear trains formed
+    by meshing revolute parts and their coupled motion."""
+    report = motion(assembly, subassemblies, tol)
+    working = assembly.tolerance(tol)
+    joints = [j for m in report.motions.values() if (j := revolute_of(assembly, m)) is not None]
+    return Articulation(report, tuple(gear_trains(gear_meshes(joints, working), working)))

@@ -1,0 +1,443 @@
+"""Motion of a part or subassembly relative to the rest of an assembly (seed 003).
+
+Seed 003 eq. (2): under surface contacts the relative position of a moving set S is
+``l₁⁻¹l₂ ∈ f₁ G f₂⁻¹`` where G is the symmetry group of the *compound feature* formed by
+all the oriented surfaces of S that touch the rest. G tells the motion: the identity
+(fixed), a finite group (finitely many equivalent positions) or a continuous group of
+dimension n (n degrees of freedom), with its invariants (axis, direction, point).
+
+Every contact patch between S and the rest becomes one oriented primitive feature of
+the moving side (seed 003 Def. 2.1.2: the surface with S's outward normals): a planar
+patch a :class:`Plane` with the patch normal pointing out of S, a cylindrical patch a
+:class:`Shaft` (S inside) or :class:`Hole`, a spherical one a :class:`Ball` or
+:class:`Socket`, a conical one a :class:`Cone`. Repeated surfaces (coplanar patches,
+one cylinder split in several patches) are one feature. The group is
+:func:`assemblykit.features.compound_group` (seed 003 Props 3.2.6-3.2.8, 5.0.9).
+
+Next to this *bilateral* reading (contacts are fits), every motion carries the
+*unilateral* reading of :mod:`assemblykit.motion.unilateral` (faces only push): whether
+the set can lift off, and along which directions.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from rich.table import Table
+from scipy.spatial import cKDTree
+
+from assemblykit.algebra import SymmetryGroup, se3
+from assemblykit.errors import UnknownNameError
+from assemblykit.features import compound_group
+from assemblykit.features.primitives import Ball, Cone, Feature, Hole, Plane, Shaft, Socket
+from assemblykit.geometry.contacts import Contact, CurvedPatch
+from assemblykit.model.assembly import Assembly
+from assemblykit.motion.unilateral import UnilateralReading, unilateral_readings
+from assemblykit.tolerance import Tolerance
+
+Vector = NDArray[np.float64]
+
+# samples per circle of a curved patch for the unilateral reading; 8 directions
+# positively span the circle's plane, which is all the linear program needs
+CIRCLE_SAMPLES = 8
+
+
+def subassembly_key(names: Iterable[str]) -> str:
+    """The report key of a moving set: its part names joined by ``+``."""
+    return "+".join(names)
+
+
+@dataclass(frozen=True, eq=False)
+class ContactSamples:
+    """Points on the contact surfaces of a moving set, with unit normals pointing out of
+    the set into the obstacle (the rows of the unilateral linear program)."""
+
+    points: NDArray[np.float64]
+    normals: NDArray[np.float64]
+
+
+def _radial(points: NDArray[np.float64], center: Vector, axis: Vector) -> NDArray:
+    """Unit directions from the axis line (``center``, ``axis``) to each point."""
+    offset = points - center
+    radial = offset - np.outer(offset @ axis, axis)
+    return radial / np.linalg.norm(radial, axis=1, keepdims=True)
+
+
+def _circle(center: Vector, axis: Vector, radius: float, s: float) -> NDArray:
+    """``CIRCLE_SAMPLES`` points of the circle of ``radius`` about the axis at height ``s``."""
+    e1, e2 = se3.frame(center, axis)[:3, :2].T
+    angles = np.linspace(0.0, 2.0 * np.pi, CIRCLE_SAMPLES, endpoint=False)
+    ring = np.outer(np.cos(angles), e1) + np.outer(np.sin(angles), e2)
+    return center + s * axis + radius * ring
+
+
+def _sphere_samples(patch: CurvedPatch, tol: Tolerance) -> NDArray:
+    """Unit directions from the centre covering the spherical patch.
+
+    ``patch.points`` holds the vertices of both spherical surfaces; the contact is where
+    both are, so the vertices that the two surfaces share (within the length tolerance,
+    found with a k-d tree) sample it. Without shared vertices the whole sphere is
+    sampled: the fit is then kept in every direction."""
+    whole = np.vstack([np.eye(3), -np.eye(3)])
+    if patch.points is None:
+        return whole
+    points = np.asarray(patch.points, dtype=np.float64)
+    pairs = cKDTree(points).query_pairs(tol.length, output_type="ndarray")
+    shared = points[np.unique(pairs)] if len(pairs) else np.zeros((0, 3))
+    if len(shared) < 3:
+        return whole
+    directions = shared - patch.center
+    return directions / np.linalg.norm(directions, axis=1, keepdims=True)
+
+
+def _curved_samples(patch: CurvedPatch, inside: bool, tol: Tolerance) -> tuple[NDArray, NDArray]:
+    """Points and normals out of the moving side sampling a curved patch."""
+    sign = 1.0 if inside else -1.0
+    if patch.kind == "spherical":
+        directions = _sphere_samples(patch, tol)
+        return patch.center + patch.radius * directions, sign * directions
+    axis = se3.unit(np.asarray(patch.axis, dtype=np.float64))
+    s0, s1 = patch.extent if patch.extent is not None else (0.0, 0.0)
+    if patch.kind == "cylindrical":
+        points = np.vstack([_circle(patch.center, axis, patch.radius, s) for s in (s0, s1)])
+        return points, sign * _radial(points, patch.center, axis)
+    slope = np.tan(patch.half_angle)
+    points = np.vstack([_circle(patch.center, axis, abs(s) * slope, s) for s in (s0, s1)])
+    radial = _radial(points, patch.center, axis)
+    outward = np.cos(patch.half_angle) * radial - np.sin(patch.half_angle) * axis
+    return points, sign * outward
+
+
+def _patch_feature(patch: CurvedPatch, inside: bool) -> Feature:
+    """The oriented primitive feature of the moving side of a curved patch."""
+    if patch.kind == "spherical":
+        return (Ball if inside else Socket)(point=patch.center, radius=patch.radius)
+    if patch.kind == "cylindrical":
+        cls = Shaft if inside else Hole
+        return cls(point=patch.center, axis=patch.axis, radius=patch.radius, directed=False)
+    return Cone(point=patch.center, axis=patch.axis, half_angle=patch.half_angle, male=inside)
+
+
+def _same_feature(f: Feature, g: Feature, tol: Tolerance) -> bool:
+    """Whether two features are the same oriented surface (so one is kept)."""
+    if type(f) is not type(g):
+        return False
+    if isinstance(f, Plane):
+        return bool(
+            np.linalg.norm(f.normal - g.normal) <= tol.angle
+            and abs(float(f.normal @ (g.point - f.point))) <= tol.length
+        )
+    if isinstance(f, Ball | Socket):
+        return bool(
+            np.linalg.norm(f.point - g.point) <= tol.length
+            and abs(f.radius - g.radius) <= tol.length
+        )
+    on_line = np.linalg.norm(np.cross(g.point - f.point, f.axis)) <= tol.length
+    parallel = np.linalg.norm(np.cross(f.axis, g.axis)) <= tol.angle
+    if isinstance(f, Cone):
+        same_apex = np.linalg.norm(f.point - g.point) <= tol.length
+        return bool(same_apex and f.axis @ g.axis > 0 and parallel)
+    return bool(on_line and parallel and abs(f.radius - g.radius) <= tol.length)
+
+
+def _distinct(features: Iterable[Feature], tol: Tolerance) -> tuple[Feature, ...]:
+    kept: list[Feature] = []
+    for feature in features:
+        if not any(_same_feature(feature, k, tol) for k in kept):
+            kept.append(feature)
+    return tuple(kept)
+
+
+def boundary_contacts(contacts: Iterable[Contact], moving: frozenset[str]) -> list[Contact]:
+    """The contacts between the moving set and the rest."""
+    return [c for c in contacts if (c.a in moving) != (c.b in moving)]
+
+
+def moving_features(
+    contacts: Iterable[Contact], moving: frozenset[str], tol: Tolerance
+) -> tuple[tuple[Feature, ...], ContactSamples]:
+    """The compound feature of ``moving`` (its oriented contact surfaces, seed 003
+    Def. 3.0.1) and the sampled contact points with normals out of ``moving``; contacts
+    inside ``moving`` or inside the rest are skipped."""
+    features: list[Feature] = []
+    points: list[NDArray] = []
+    normals: list[NDArray] = []
+    for contact in boundary_contacts(contacts, moving):
+        sign = 1.0 if contact.a in moving else -1.0
+        for planar in contact.planar:
+            normal = sign * se3.unit(np.asarray(planar.normal, dtype=np.float64))
+            features.append(Plane(point=planar.centroid, normal=normal))
+            points.append(np.asarray(planar.polygon, dtype=np.float64))
+            normals.append(np.tile(normal, (len(planar.polygon), 1)))
+        for curved in contact.curved:
+            inside = curved.inner in moving
+            features.append(_patch_feature(curved, inside))
+            sample_points, sample_normals = _curved_samples(curved, inside, tol)
+            points.append(sample_points)
+            normals.append(sample_normals)
+    samples = ContactSamples(
+        np.vstack(points) if points else np.zeros((0, 3)),
+        np.vstack(normals) if normals else np.zeros((0, 3)),
+    )
+    return _distinct(features, tol), samples
+
+
+def _canonical_direction(u: Vector) -> Vector:
+    """``u`` or ``-u``, whichever has its largest component positive (a line's direction
+    is reported the same way whatever orientation the computation produced)."""
+    u = np.asarray(u, dtype=np.float64)
+    return u if u[int(np.argmax(np.abs(u)))] > 0 else -u
+
+
+def _motion_summary(group: SymmetryGroup | None) -> dict[str, Any]:
+    """``motion`` (the group's kind), ``dof``, ``components`` (``"inf"`` for a lattice),
+    ``description`` and the invariants as plain lists: ``axis`` {point, direction} with
+    the point the axis' foot from the origin, ``center``, ``direction``, ``normal``,
+    ``pitch``. ``None`` (no contact at all) is every rigid motion."""
+    if group is None:
+        return {"motion": "free", "dof": 6, "components": 1, "description": "free"}
+    components = group.n_components
+    out: dict[str, Any] = {
+        "motion": str(group.kind),
+        "dof": group.dof,
+        "components": int(components) if math.isfinite(components) else "inf",
+        "description": group.describe(),
+    }
+    inv = group.invariants
+    if "axis" in inv:
+        u = _canonical_direction(inv["axis"])
+        foot = inv["point"] - (inv["point"] @ u) * u
+        out["axis"] = {"point": foot.tolist(), "direction": u.tolist()}
+    elif "point" in inv:
+        out["center"] = np.asarray(inv["point"], dtype=np.float64).tolist()
+    for key in ("direction", "normal"):
+        if key in inv:
+            out[key] = _canonical_direction(inv[key]).tolist()
+    if "pitch" in inv:
+        out["pitch"] = float(inv["pitch"])
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """The motion of a moving set of parts relative to the rest of its assembly.
+
+    ``group``: the symmetry group of the compound feature of its contact surfaces (seed
+    003 eq. (2)), ``None`` when it touches nothing; ``features``: that compound feature;
+    ``touching``: the parts of the rest it touches; ``unilateral``: the push-only reading.
+    """
+
+    parts: tuple[str, ...]
+    group: SymmetryGroup | None
+    features: tuple[Feature, ...]
+    touching: tuple[str, ...]
+    unilateral: UnilateralReading
+
+    @property
+    def key(self) -> str:
+        """The report key: the part name, or ``a+b`` for a subassembly."""
+        return subassembly_key(self.parts)
+
+    @property
+    def kind(self) -> str:
+        """The motion's name: ``fixed``, ``revolute``, ``prismatic``, ... or ``free``."""
+        return str(_motion_summary(self.group)["motion"])
+
+    @property
+    def dof(self) -> int:
+        """Degrees of freedom of the bilateral motion (the group's dimension)."""
+        return int(_motion_summary(self.group)["dof"])
+
+    @property
+    def separates(self) -> bool:
+        """Whether the bilateral motion carries the set arbitrarily far away: its group
+        is continuous and not only rotations about a line or a point."""
+        return self.kind not in ("fixed", "revolute", "spherical") and self.dof > 0
+
+    def to_dict(self) -> dict[str, Any]:
+        """``dof``, ``motion``, ``components``, the invariants (``axis`` {point,
+        direction}, ``direction``, ``center``, ``normal``, ``pitch`` as they apply),
+        ``touching`` and ``unilateral`` (DESIGN.md §5.3)."""
+        out = _motion_summary(self.group)
+        out["touching"] = list(self.touching)
+        out["unilateral"] = self.unilateral.to_dict()
+        return out
+
+
+def _feature_key(feature: Feature, anchor: Vector, tol: Tolerance) -> tuple[Any, ...]:
+    """The feature seen from ``anchor``, rounded to the tolerance: equal keys mean the
+    same oriented surface up to the translation between the anchors."""
+
+    def lengths(x: Any) -> tuple[int, ...]:
+        return tuple(np.rint(np.atleast_1d(x) / tol.length).astype(np.int64).tolist())
+
+    def angles(x: Any) -> tuple[int, ...]:
+        return tuple(np.rint(np.atleast_1d(x) / tol.angle).astype(np.int64).tolist())
+
+    if isinstance(feature, Plane):
+        return ("plane", angles(feature.normal), lengths(feature.normal @ (feature.point - anchor)))
+    if isinstance(feature, Ball | Socket):
+        return (feature.type_name, lengths(feature.point - anchor), lengths(feature.radius))
+    offset = feature.point - anchor
+    if isinstance(feature, Cone):
+        return (
+            "cone",
+            lengths(offset),
+            angles(feature.axis),
+            angles(feature.half_angle),
+            feature.male,
+        )
+    foot = offset - (offset @ feature.axis) * feature.axis
+    return (feature.type_name, lengths(foot), angles(feature.axis), lengths(feature.radius))
+
+
+class MotionSolver:
+    """Motions of moving sets of one assembly, sharing its contacts and a cache of
+    compound-feature groups.
+
+    Congruent compound features have conjugate groups (ALGEBRA.md §6, equivariance:
+    moving the features by g maps G to g G g⁻¹), so a compound feature that is a
+    translate of one already solved (keys of :func:`_feature_key` seen from the lower
+    corner of the moving set's bounding box) gets that group conjugated by the
+    translation, instead of a new permutation search (seed 003 Props 3.2.6-5.0.9).
+    """
+
+    def __init__(self, assembly: Assembly, tol: Tolerance | None = None) -> None:
+        self.assembly = assembly
+        self.tol = assembly.tolerance(tol)
+        self.contacts = assembly.contacts(tol)
+        self._groups: dict[tuple[Any, ...], tuple[SymmetryGroup, Vector]] = {}
+        self._by_part: dict[str, list[Contact]] = {}
+        for contact in self.contacts:
+            self._by_part.setdefault(contact.a, []).append(contact)
+            self._by_part.setdefault(contact.b, []).append(contact)
+
+    def group(self, features: Sequence[Feature], anchor: Vector) -> SymmetryGroup:
+        """The symmetry group of the compound feature (seed 003 Props 3.2.6-3.2.8, 5.0.9)."""
+        key = tuple(sorted(_feature_key(f, anchor, self.tol) for f in features))
+        if key not in self._groups:
+            self._groups[key] = (compound_group(features, self.tol), anchor)
+            return self._groups[key][0]
+        group, seen_at = self._groups[key]
+        return group.conjugate(se3.translation(anchor - seen_at))
+
+    def connected_group(self, features: Sequence[Feature]) -> SymmetryGroup:
+        """The identity component of the compound feature's group: the swaps of
+        2-congruent features only add discrete components (seed 003 Props 3.2.8,
+        5.0.9), so it is the identity component of G₁ ∩ ... ∩ Gₙ (Prop 3.2.6)."""
+        groups = [f.group().connected_part for f in features]
+        return functools.reduce(lambda g, h: g.intersect(h, tol=self.tol), groups)
+
+    def boundary(self, members: frozenset[str]) -> list[Contact]:
+        """The contacts between ``members`` and the rest (through a per-part index)."""
+        return [
+            c
+            for n in members
+            for c in self._by_part.get(n, ())
+            if (c.a in members) != (c.b in members)
+        ]
+
+    def motions_of(
+        self, sets: Iterable[str | Sequence[str]], components: bool = True
+    ) -> list[Motion]:
+        """The motion of each moving set: one part (a name) or a subassembly (names),
+        relative to the rest. With ``components`` false only the group's identity
+        component is computed (its kind, dof and invariants; one component), which is
+        much faster. The unilateral readings are solved together (one linear program)."""
+        prepared = []
+        for names in sets:
+            moving = (names,) if isinstance(names, str) else tuple(dict.fromkeys(names))
+            if not moving:
+                raise UnknownNameError(
+                    "a moving set needs at least one part", source=self.assembly.source
+                )
+            parts = [self.assembly.part(name) for name in moving]
+            members = frozenset(moving)
+            boundary = self.boundary(members)
+            features, samples = moving_features(boundary, members, self.tol)
+            touching = tuple(sorted({c.b if c.a in members else c.a for c in boundary}))
+            anchor = np.min([p.mesh.bounds[0] for p in parts], axis=0)
+            if not features:
+                group = None
+            elif components:
+                group = self.group(features, anchor)
+            else:
+                group = self.connected_group(features)
+            prepared.append((moving, group, features, touching, samples))
+        readings = unilateral_readings(
+            [(p[4].points, p[4].normals) for p in prepared], self.assembly.scale, self.tol
+        )
+        return [
+            Motion(moving, group, features, touching, reading)
+            for (moving, group, features, touching, _), reading in zip(
+                prepared, readings, strict=True
+            )
+        ]
+
+    def motion_of(self, names: str | Sequence[str], components: bool = True) -> Motion:
+        """The motion of one part (a name) or a subassembly (names) relative to the rest
+        (:meth:`motions_of`)."""
+        return self.motions_of([names], components)[0]
+
+
+def part_motion(
+    assembly: Assembly, names: str | Sequence[str], tol: Tolerance | None = None
+) -> Motion:
+    """The motion of one part (a name) or a subassembly (names) relative to the rest."""
+    return MotionSolver(assembly, tol).motion_of(names)
+
+
+@dataclass(frozen=True, eq=False)
+class MotionReport:
+    """The motion of every part (and of the requested subassemblies) of an assembly."""
+
+    motions: dict[str, Motion]
+    source: str | None = None
+
+    def __getitem__(self, key: str) -> Motion:
+        return self.motions[key]
+
+    def to_dict(self) -> dict[str, Any]:
+        """``parts`` keyed by part name (subassemblies by ``a+b``), DESIGN.md §5.3."""
+        return {"source": self.source, "parts": {k: m.to_dict() for k, m in self.motions.items()}}
+
+    def render(self) -> Table:
+        """A table: moving set, motion with its invariants, dof, components and the
+        unilateral reading."""
+        table = Table(title=f"Motion of each part{f' of {self.source}' if self.source else ''}")
+        for column in ("part", "motion", "dof", "components", "unilateral"):
+            table.add_column(column)
+        for key, moved in self.motions.items():
+            data = _motion_summary(moved.group)
+            reading = moved.unilateral
+            if reading.lift_off:
+                rays = ", ".join(np.array2string(r, precision=3) for r in reading.lift_off)
+                unilateral = f"lifts off along {rays}"
+            elif reading.can_lift_off:
+                unilateral = "lifts off by turning"
+            else:
+                unilateral = "keeps every contact" if reading.free else "held"
+            table.add_row(
+                key, data["description"], str(data["dof"]), str(data["components"]), unilateral
+            )
+        return table
+
+
+def motion(
+    assembly: Assembly,
+    subassemblies: Iterable[Sequence[str]] | None = None,
+    tol: Tolerance | None = None,
+) -> MotionReport:
+    """The motion of every part, and of each given subassembly, relative to the rest
+    (seed 003 eq. (2)): one compound-feature symmetry group per moving set."""
+    solver = MotionSolver(assembly, tol)
+    sets: list[Sequence[str]] = [(name,) for name in assembly.names]
+    sets.extend(subassemblies or ())
+    motions = solver.motions_of(sets)
+    return MotionReport({m.key: m for m in motions}, assembly.source)

@@ -1,0 +1,153 @@
+"""The self-contained HTML view of a motion report (seed 003; DESIGN.md §6).
+
+Every part is drawn as a ``mesh3d`` trace with its bilateral motion on top: the axis of
+a revolute, cylindrical or helical motion as a line with a turning arc, the direction
+of a prismatic motion as a double arrow, the normal of a planar motion with an arc in
+its plane, the centre of a spherical motion with three arcs. The unilateral lift-off
+directions are red arrows from the part's centre. plotly's JavaScript is embedded
+(``include_plotlyjs=True``) so the file opens offline.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import plotly.graph_objects as go
+from numpy.typing import NDArray
+
+from assemblykit.algebra import se3
+from assemblykit.model.assembly import Assembly
+from assemblykit.motion.freedom import Motion, MotionReport
+from assemblykit.viz.viewer import part_colors
+
+GLYPH_FRACTION = 0.12
+"""Size of arcs and arrows, as a fraction of the assembly's bounding-box diagonal."""
+
+ARC_POINTS = 48
+LIFT_OFF_COLOR = "#d62728"
+
+
+def _basis(u: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Two unit vectors completing ``u`` to a right-handed orthonormal frame."""
+    frame = se3.frame(np.zeros(3), u)
+    return frame[:3, 0], frame[:3, 1]
+
+
+def _arc(center: NDArray, axis: NDArray, radius: float, color: str, name: str) -> go.Scatter3d:
+    """Three quarters of a circle about ``axis``: the picture of a rotation."""
+    e1, e2 = _basis(axis)
+    angles = np.linspace(0.0, 1.5 * np.pi, ARC_POINTS)
+    pts = center + radius * (np.outer(np.cos(angles), e1) + np.outer(np.sin(angles), e2))
+    return go.Scatter3d(
+        x=pts[:, 0],
+        y=pts[:, 1],
+        z=pts[:, 2],
+        mode="lines",
+        line={"color": color, "width": 6},
+        name=name,
+        showlegend=False,
+        hoverinfo="name",
+    )
+
+
+def _arrow(start: NDArray, vector: NDArray, color: str, name: str, dash: str) -> list[Any]:
+    """A line from ``start`` along ``vector`` with a cone at its tip."""
+    tip = start + vector
+    line = go.Scatter3d(
+        x=[start[0], tip[0]],
+        y=[start[1], tip[1]],
+        z=[start[2], tip[2]],
+        mode="lines",
+        line={"color": color, "width": 6, "dash": dash},
+        name=name,
+        showlegend=False,
+        hoverinfo="name",
+    )
+    head = go.Cone(
+        x=[tip[0]],
+        y=[tip[1]],
+        z=[tip[2]],
+        u=[vector[0]],
+        v=[vector[1]],
+        w=[vector[2]],
+        sizemode="absolute",
+        sizeref=0.3 * float(np.linalg.norm(vector)),
+        anchor="tip",
+        colorscale=[[0, color], [1, color]],
+        showscale=False,
+        name=name,
+        hoverinfo="name",
+    )
+    return [line, head]
+
+
+def motion_glyphs(motion: Motion, center: NDArray, size: float, color: str) -> list[Any]:
+    """The traces drawing one part's bilateral motion and its lift-off directions."""
+    data = motion.to_dict()
+    name = f"{motion.key}: {data['description']}"
+    traces: list[Any] = []
+    if "axis" in data:
+        point = np.asarray(data["axis"]["point"], dtype=np.float64)
+        u = np.asarray(data["axis"]["direction"], dtype=np.float64)
+        foot = point + ((center - point) @ u) * u
+        traces += _arrow(foot - 1.5 * size * u, 3.0 * size * u, color, name, "solid")
+        traces.append(_arc(foot, u, 0.5 * size, color, name))
+    if "center" in data:
+        point = np.asarray(data["center"], dtype=np.float64)
+        traces += [_arc(point, axis, 0.6 * size, color, name) for axis in np.eye(3)]
+    if "direction" in data:
+        u = np.asarray(data["direction"], dtype=np.float64)
+        traces += _arrow(center, size * u, color, name, "solid")
+        traces += _arrow(center, -size * u, color, name, "solid")
+    if "normal" in data:
+        n = np.asarray(data["normal"], dtype=np.float64)
+        for e in _basis(n):
+            traces += _arrow(center, size * e, color, name, "solid")
+        if data["motion"] == "planar":
+            traces.append(_arc(center, n, 0.5 * size, color, name))
+    for ray in motion.unilateral.lift_off:
+        traces += _arrow(center, size * ray, LIFT_OFF_COLOR, f"{motion.key}: lifts off", "dash")
+    return traces
+
+
+def motion_figure(assembly: Assembly, report: MotionReport) -> go.Figure:
+    """The assembly's parts with each single part's motion drawn on it."""
+    colors = part_colors(assembly.names)
+    size = GLYPH_FRACTION * assembly.scale
+    traces: list[Any] = []
+    for name, part in assembly.parts.items():
+        mesh = part.mesh
+        traces.append(
+            go.Mesh3d(
+                x=mesh.vertices[:, 0],
+                y=mesh.vertices[:, 1],
+                z=mesh.vertices[:, 2],
+                i=mesh.faces[:, 0],
+                j=mesh.faces[:, 1],
+                k=mesh.faces[:, 2],
+                color=colors[name],
+                opacity=0.45,
+                name=name,
+                showlegend=True,
+                flatshading=True,
+            )
+        )
+        if name in report.motions:
+            center = np.asarray(mesh.bounds.mean(axis=0), dtype=np.float64)
+            traces += motion_glyphs(report[name], center, size, colors[name])
+    figure = go.Figure(traces)
+    figure.update_layout(
+        title=f"Motion of each part of {assembly.source or 'the assembly'}",
+        scene={"aspectmode": "data"},
+        margin={"l": 0, "r": 0, "t": 40, "b": 0},
+    )
+    return figure
+
+
+def write_motion_html(assembly: Assembly, report: MotionReport, path: str | Path) -> Path:
+    """Write the self-contained HTML view to ``path`` and return it."""
+    path = Path(path)
+    motion_figure(assembly, report).write_html(path, include_plotlyjs=True, full_html=True)
+    return path
