@@ -1,0 +1,149 @@
+"""Step two of the assembly constraint satisfaction process (seed 002): the laws that
+shrink the goals' domains.
+
+* **Mandatory request law**: a goal with one candidate left claims its non-sharable
+  features; candidates of other goals using them are deleted, until quiescent.
+* **Equivalent feature law**: compound features of a body in the same orbit of the
+  body's symmetry group are equivalent; one representative is kept and the others are
+  counted as copies. It is applied only to bodies in a single goal: for a body in
+  several goals, dismissing orbit members would end the process (seed 002 Example 2).
+* **Arc consistency** (Mackworth 1985; Mohr & Henderson 1986, AC-3): two candidates of
+  different goals are compatible unless they use a common non-sharable feature; a
+  candidate without a compatible one in some other goal is deleted.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Mapping
+
+from assemblykit.features import Relationship, relationship
+from assemblykit.features.compound import feature_transporter
+from assemblykit.mating.graph import Candidate, Domains
+from assemblykit.mating.problem import MatingBody, MatingProblem
+from assemblykit.tolerance import Tolerance
+
+
+def compatible(a: Candidate, b: Candidate) -> bool:
+    """Whether two candidates of different goals can hold together: no non-sharable
+    feature is used by both (seed 002 footnote 3)."""
+    return not (a.uses & b.uses)
+
+
+def mandatory_request(domains: Domains) -> Domains:
+    """The mandatory request law (seed 002 step two), propagated until quiescent."""
+    current = dict(domains)
+    queue = deque(g for g, d in current.items() if len(d) == 1)
+    settled: set[int] = set()
+    while queue:
+        goal = queue.popleft()
+        if goal in settled or len(current[goal]) != 1:
+            continue
+        settled.add(goal)
+        (claim,) = current[goal]
+        for other, domain in current.items():
+            if other == goal:
+                continue
+            kept = tuple(c for c in domain if compatible(c, claim))
+            if len(kept) != len(domain):
+                current[other] = kept
+                if len(kept) == 1:
+                    queue.append(other)
+    return current
+
+
+def _congruent(a: object, b: object, tol: Tolerance) -> bool:
+    return type(a) is type(b) and relationship(a, b, tol) in (  # type: ignore[arg-type]
+        Relationship.ONE_CONGRUENT,
+        Relationship.TWO_CONGRUENT,
+    )
+
+
+def compound_orbits(body: MatingBody, tol: Tolerance) -> dict[str, str]:
+    """The representative (first in file order) of each compound feature's orbit under
+    the body's symmetry group (seed 002 equivalent feature law): ``c ~ c'`` when some
+    discrete element g of the group maps every primitive of ``c`` onto one of ``c'``."""
+    names = list(body.compounds)
+    reps: dict[str, str] = {}
+    elements = body.symmetry.reps[1:]
+    for index, name in enumerate(names):
+        source = body.compounds[name].features
+        reps[name] = name
+        for earlier in names[:index]:
+            if reps[earlier] != earlier:
+                continue
+            target = body.compounds[earlier].features
+            if len(target) == len(source) and any(
+                all(
+                    any(
+                        _congruent(p, q, tol) and feature_transporter(q, p).contains(g, tol)
+                        for q in target
+                    )
+                    for p in source
+                )
+                for g in elements
+            ):
+                reps[name] = earlier
+                break
+    return reps
+
+
+def equivalent_features(problem: MatingProblem, domains: Domains) -> Domains:
+    """The equivalent feature law (seed 002 step two): for each body in exactly one goal,
+    keep the candidates of one compound feature per orbit and count the others as copies.
+    """
+    tol = problem.tolerance
+    involvement: dict[str, int] = {}
+    for goal in problem.goals:
+        for name in (goal.first, goal.second):
+            involvement[name] = involvement.get(name, 0) + 1
+    current = dict(domains)
+    for goal in problem.goals:
+        for side in ("first", "second"):
+            body = problem.bodies[getattr(goal, side)]
+            if involvement[body.name] != 1 or len(body.symmetry.reps) < 2:
+                continue
+            current[goal.number] = _representatives(
+                current[goal.number], side, compound_orbits(body, tol)
+            )
+    return current
+
+
+def _representatives(
+    domain: tuple[Candidate, ...], side: str, orbit: Mapping[str, str]
+) -> tuple[Candidate, ...]:
+    """Candidates grouped by (orbit of this side's compound, other side's compound): the
+    representative's candidates stand for the whole group."""
+    other = "second" if side == "first" else "first"
+    groups: dict[tuple[str, str], list[Candidate]] = {}
+    for c in domain:
+        groups.setdefault((orbit[getattr(c, side)], getattr(c, other)), []).append(c)
+    kept: list[Candidate] = []
+    for (rep, _), members in groups.items():
+        chosen = [c for c in members if getattr(c, side) == rep] or members
+        factor = len({getattr(c, side) for c in members}) if chosen is not members else 1
+        kept.extend(c.with_copies(c.copies * factor) for c in chosen)
+    order = {id(c): i for i, c in enumerate(domain)}
+    return tuple(sorted(kept, key=lambda c: order.get(id(c), len(order))))
+
+
+def arc_consistency(domains: Domains) -> Domains:
+    """AC-3 over the pairwise compatibility of candidates of different goals."""
+    current = {g: tuple(d) for g, d in domains.items()}
+    goals = list(current)
+    neighbours = {
+        g: [h for h in goals if h != g and _constrained(current[g], current[h])] for g in goals
+    }
+    queue = deque((g, h) for g in goals for h in neighbours[g])
+    while queue:
+        g, h = queue.popleft()
+        kept = tuple(c for c in current[g] if any(compatible(c, d) for d in current[h]))
+        if len(kept) != len(current[g]):
+            current[g] = kept
+            queue.extend((k, g) for k in neighbours[g] if k != h)
+    return current
+
+
+def _constrained(a: tuple[Candidate, ...], b: tuple[Candidate, ...]) -> bool:
+    used = frozenset().union(*(c.uses for c in a)) if a else frozenset()
+    return any(c.uses & used for c in b)

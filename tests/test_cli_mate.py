@@ -1,0 +1,62 @@
+"""``assemblykit mate``: the seed's answers on the bundled problems; exit 2 on bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from assemblykit.cli import main
+
+
+def _run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    with pytest.raises(SystemExit) as done:
+        main(["mate", *args])
+        raise SystemExit(0)
+    out, err = capsys.readouterr()
+    return int(done.value.code or 0), out, err
+
+
+def test_example1_json(mating_examples: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = _run(capsys, str(mating_examples / "example1.yaml"), "--json")
+    data = json.loads(out)
+    assert code == 0
+    assert (data["count"], data["representatives"]) == (8, 2)
+    seats = sorted(
+        tuple(p["second"][1] for p in config["pairs"]) for config in data["configurations"]
+    )
+    assert seats == [("comp1", "comp13", "comp12"), ("comp13", "comp1", "comp12")]
+
+
+def test_no_solution_is_an_answer(
+    mating_examples: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, _ = _run(capsys, str(mating_examples / "one_socket.yaml"))
+    assert code == 0
+    assert "** [Or]" in out
+    assert "goal 2: domain emptied by the mandatory request law" in out
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("bodies: {}\n", "p.yaml: missing field 'goals'"),
+        ("bodies: {a: {features: {}}}\ngoals: [[fit, a, b]]\n", "p.yaml: goals[0][2]: no body"),
+        ("goals: [\n", "p.yaml: line"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], text: str, message: str
+) -> None:
+    path = tmp_path / "p.yaml"
+    path.write_text(text)
+    code, out, err = _run(capsys, str(path))
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1
+    assert message in err
+
+
+def test_missing_file_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = _run(capsys, str(tmp_path / "none.yaml"))
+    assert code == 2 and "cannot read the problem" in err
