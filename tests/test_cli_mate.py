@@ -60,3 +60,19 @@ def test_bad_input_exits_2_with_one_line(
 def test_missing_file_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = _run(capsys, str(tmp_path / "none.yaml"))
     assert code == 2 and "cannot read the problem" in err
+
+
+def test_example3_position_up_to_the_peg_symmetry(
+    mating_examples: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, _ = _run(capsys, str(mating_examples / "example3.yaml"), "--json")
+    data = json.loads(out)
+    # The three third-turns of the key are one position of the C3-symmetric peg.
+    assert code == 0 and data["count"] == 1
+    assert data["statistics"]["domains"]["1"] == [1, 1, 1, 1, 1, 1]
+    assert data["configurations"][0]["poses"]["peg"] == [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ]

@@ -19,7 +19,7 @@ _PUBLIC = {
     "motion": "assemblykit.motion.freedom",
     "blocking_graph": "assemblykit.blocking.ndbg",
     "plan": "assemblykit.planning.sequence",
-    "load_problem": "assemblykit.mating.problem",
+    "load_problem": "assemblykit.io.problem",
     "mate": "assemblykit.mating.search",
     "Tolerance": "assemblykit.tolerance",
 }

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 
 import numpy as np
@@ -9,6 +10,7 @@ import pytest
 
 from assemblykit.algebra import Kind, se3
 from assemblykit.features import Hole, Plane, Shaft
+from assemblykit.io.problem import load_problem, parse_problem
 from assemblykit.mating.graph import (
     RARITY,
     build_graph,
@@ -16,8 +18,9 @@ from assemblykit.mating.graph import (
     matable,
     pair_coset,
     pairings,
+    up_to_symmetry,
 )
-from assemblykit.mating.problem import MatingProblem, load_problem
+from assemblykit.mating.problem import MatingProblem
 from assemblykit.tolerance import Tolerance
 
 TOL = Tolerance()
@@ -90,3 +93,76 @@ def test_node_consistency_rejects_the_interfering_seats(example1: MatingProblem)
     assert graph.bottom.number_of_edges() == 4 + 4 + 1
     edge = graph.bottom.get_edge_data(("b3", "comp1"), ("b4", "comp12"))[0]
     assert edge["goal"] == 3 and edge["group"].kind is Kind.FIXED
+
+
+TRIANGLE = {
+    "bodies": {
+        "base": {
+            "features": {
+                "top": {"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]},
+                "slot": {
+                    "type": "prism",
+                    "point": [0, 0, 0],
+                    "axis": [0, 0, -1],
+                    "sides": 3,
+                    "size": 2,
+                    "male": False,
+                },
+            },
+            "compound": {"seat": ["top", "slot"]},
+            "symmetry": "none",
+        },
+        "peg": {
+            "features": {
+                "face": {"type": "plane", "point": [0, 0, 0], "normal": [0, 0, -1]},
+                "key": {"type": "prism", "point": [0, 0, 0], "axis": [0, 0, -1], "sides": 3,
+                        "size": 2},
+            },
+            "compound": {"plug": ["face", "key"]},
+            # A 48-sided cylinder: the third-turns of the features map it onto itself.
+            "mesh": {"add": [{"cylinder": {"point": [0, 0, 0], "axis": [0, 0, 1],
+                                           "radius": 1, "height": 2}}]},
+        },
+    },
+    "goals": [["fit", "peg", "base"]],
+}  # fmt: skip
+
+
+def test_common_group_equal_to_body_symmetry_determines_the_position() -> None:
+    problem = parse_problem(TRIANGLE)
+    peg = problem.bodies["peg"]
+    assert len(peg.symmetry.reps) == 3
+    (candidate,) = build_graph(problem).initial[1]
+    # The common group C3 is the peg's own group: one position, the peg at the origin.
+    assert candidate.determined
+    np.testing.assert_allclose(candidate.coset.rep, np.eye(4), atol=1e-12)
+    assert up_to_symmetry(
+        pair_coset(
+            peg.compounds["plug"].features,
+            problem.bodies["base"].compounds["seat"].features,
+            ((0, 0, "against"), (1, 1, "fits")),
+            problem.tolerance,
+        ),
+        peg,
+        problem.bodies["base"],
+        problem.tolerance,
+    )
+    # Without the peg's symmetry the three third-turns are three candidates.
+    plain = copy.deepcopy(TRIANGLE)
+    plain["bodies"]["peg"]["symmetry"] = "none"
+    assert len(build_graph(parse_problem(plain)).initial[1]) == 3
+
+
+def test_node_consistency_up_to_symmetry_checks_interference() -> None:
+    walled = copy.deepcopy(TRIANGLE)
+    walled["bodies"]["base"]["mesh"] = {
+        "add": [
+            {"box": {"min": [-5, -5, -2], "max": [5, 5, 0]}},
+            {"box": {"min": [0.5, -0.2, 0], "max": [3, 0.2, 3]}},
+        ]
+    }
+    graph = build_graph(parse_problem(walled))
+    assert len(graph.initial[1]) == 1 and graph.domains[1] == ()
+    clear = copy.deepcopy(walled)
+    clear["bodies"]["base"]["mesh"]["add"].pop(1)
+    assert len(build_graph(parse_problem(clear)).domains[1]) == 1

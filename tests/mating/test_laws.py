@@ -1,4 +1,4 @@
-"""Step two: mandatory request law, equivalent feature law (orbits), arc consistency."""
+"""Step two: mandatory request, equivalent features (orbits), arc and path consistency."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from assemblykit.algebra import Coset, SymmetryGroup, se3
+from assemblykit.io.problem import load_problem
 from assemblykit.mating.graph import Candidate, build_graph
 from assemblykit.mating.laws import (
     arc_consistency,
@@ -15,8 +16,9 @@ from assemblykit.mating.laws import (
     compound_orbits,
     equivalent_features,
     mandatory_request,
+    path_consistency,
 )
-from assemblykit.mating.problem import Goal, MatingProblem, load_problem
+from assemblykit.mating.problem import Goal, MatingProblem
 
 GOALS = {n: Goal(n, "fit", f"p{n}", "base") for n in (1, 2, 3)}
 
@@ -106,3 +108,34 @@ def test_equivalent_feature_law_spares_bodies_in_several_goals(mating_examples: 
     }
     domains = build_graph(swapped).domains
     assert _names(equivalent_features(swapped, domains)) == _names(domains)
+
+
+def test_path_consistency_prunes_where_arc_consistency_cannot() -> None:
+    # Three pegs, two holes x, y: every value has a partner in every other goal (AC keeps
+    # all), but no pair of two goals leaves a hole for the third.
+    domains = {g: (_pair(g, "a", "x"), _pair(g, "b", "y")) for g in (1, 2, 3)}
+    assert _names(arc_consistency(domains)) == _names(domains)
+    result = path_consistency(domains, tuple(GOALS.values()))
+    assert _names(result.domains) == {1: [], 2: [], 3: []}
+    # Compatible pairs: (a, b) and (b, a) for each of the three pairs of goals.
+    assert result.pairs_removed == 6
+
+
+def test_path_consistency_keeps_the_supported_values() -> None:
+    domains = {
+        1: (_pair(1, "a", "x"), _pair(1, "b", "z")),
+        2: (_pair(2, "c", "x"), _pair(2, "d", "y")),
+        3: (_pair(3, "e", "x"), _pair(3, "f", "y")),
+    }
+    assert _names(arc_consistency(domains)) == _names(domains)
+    result = path_consistency(domains, tuple(GOALS.values()))
+    # a (hole x) leaves only y for goals 2 and 3 together: a goes; (a, d) and (a, f) go.
+    assert _names(result.domains) == {1: ["b"], 2: ["c", "d"], 3: ["e", "f"]}
+    assert result.pairs_removed == 2
+
+
+def test_path_consistency_ignores_goals_without_a_common_body() -> None:
+    apart = (GOALS[1], Goal(2, "fit", "p2", "other"))
+    domains = {1: (_pair(1, "a", "x"),), 2: (_pair(2, "b", "x"),)}
+    result = path_consistency(domains, apart)
+    assert _names(result.domains) == {1: ["a"], 2: ["b"]} and result.pairs_removed == 0

@@ -1,7 +1,8 @@
-"""Mating problem files: validation with field paths, generated meshes, body symmetry."""
+"""Mating problem values: body symmetry from features and mesh, compounds, model size."""
 
 from __future__ import annotations
 
+import ast
 import math
 from pathlib import Path
 
@@ -9,47 +10,19 @@ import numpy as np
 import pytest
 
 from assemblykit.algebra import se3
-from assemblykit.errors import InputError, SchemaError, UnknownNameError
+from assemblykit.features import Plane, Shaft
 from assemblykit.features.compound import compound_group
-from assemblykit.mating.problem import (
-    CYLINDER_SECTIONS,
-    ShapeModel,
-    generated_mesh,
-    load_problem,
-    parse_problem,
-)
+from assemblykit.geometry.solids import Box, generated_mesh
+from assemblykit.io.problem import load_problem
+from assemblykit.mating.problem import body_symmetry, mating_body, preserves, problem_diagonal
+from assemblykit.tolerance import Tolerance
 
-PEG = {
-    "features": {
-        "face": {"type": "plane", "point": [0, 0, 0], "normal": [0, 0, -1]},
-        "stem": {"type": "shaft", "point": [0, 0, 0], "axis": [0, 0, -1], "radius": 1},
-    },
-    "compound": {"plug": ["face", "stem"]},
+TOL = Tolerance(10.0)
+FEATURES = {
+    "face": Plane((0, 0, 0), (0, 0, -1)),
+    "left": Shaft((-2, 0, 0), (0, 0, -1), 1.0),
+    "right": Shaft((2, 0, 0), (0, 0, -1), 1.0),
 }
-
-
-def _problem(**changes: object) -> dict:
-    data = {"bodies": {"a": PEG, "b": PEG}, "goals": [["fit", "a", "b"]]}
-    data.update(changes)
-    return data
-
-
-def test_example1_is_read_with_compounds_goals_and_symmetry(mating_examples: Path) -> None:
-    problem = load_problem(mating_examples / "example1.yaml")
-    assert list(problem.bodies) == ["b1", "b2", "b3", "b4"]
-    assert [g.describe() for g in problem.goals] == [
-        "goal 1 [fit b1 b4]",
-        "goal 2 [fit b2 b4]",
-        "goal 3 [fit b3 b4]",
-    ]
-    b1 = problem.bodies["b1"]
-    assert b1.members["comp2"] == ("top", "peg_c", "peg_d")
-    # The half-turn about the y axis swaps the two faces of b1 (and keeps its mesh).
-    assert len(b1.symmetry.reps) == 2
-    assert b1.symmetry.contains(se3.rotation((0, 1, 0), math.pi))
-    assert len(problem.bodies["b3"].symmetry.reps) == 1
-    assert problem.bodies["b4"].sharable == frozenset({"top"})
-    assert problem.units == "mm"
 
 
 def test_feature_symmetry_not_kept_by_the_mesh_is_dropped(mating_examples: Path) -> None:
@@ -59,86 +32,42 @@ def test_feature_symmetry_not_kept_by_the_mesh_is_dropped(mating_examples: Path)
     assert len(b3.symmetry.reps) == 1
 
 
-def test_explicit_and_disabled_symmetry() -> None:
-    quarter = [{"axis": [0, 0, 1], "angle": "90 deg"}]
-    body = {**PEG, "symmetry": quarter}
-    problem = parse_problem(_problem(bodies={"a": body, "b": {**PEG, "symmetry": "none"}}))
-    assert len(problem.bodies["a"].symmetry.reps) == 4
-    assert len(problem.bodies["b"].symmetry.reps) == 1
+def test_body_symmetry_from_features_mesh_or_generators() -> None:
+    half = se3.rotation((0, 0, 1), math.pi)
+    assert len(body_symmetry(FEATURES, None, tol=TOL).reps) == 2
+    centred = generated_mesh([Box((-3, -1, 0), (3, 1, 1))])
+    assert len(body_symmetry(FEATURES, centred, tol=TOL).reps) == 2
+    offset = generated_mesh([Box((-3, -1, 0), (4, 1, 1))])
+    assert preserves(centred, half, TOL) and not preserves(offset, half, TOL)
+    assert len(body_symmetry(FEATURES, offset, tol=TOL).reps) == 1
+    assert len(body_symmetry(FEATURES, None, [], TOL).reps) == 1
+    quarter = se3.rotation((0, 0, 1), math.pi / 2)
+    assert len(body_symmetry(FEATURES, None, [quarter], TOL).reps) == 4
 
 
-def test_generated_mesh_is_box_minus_cylinder() -> None:
-    spec = ShapeModel.model_validate(
-        {
-            "add": [{"box": {"min": [-5, -5, 0], "max": [5, 5, 2]}}],
-            "cut": [
-                {"cylinder": {"point": [0, 0, -1], "axis": [0, 0, 1], "radius": 1, "height": 4}}
-            ],
-        }
+def test_mating_body_defaults_and_sharable_planes() -> None:
+    body = mating_body("a", FEATURES, {}, None, body_symmetry(FEATURES, None, [], TOL), ["left"])
+    assert body.members == {"face": ("face",), "left": ("left",), "right": ("right",)}
+    assert body.sharable == {"face", "left"}
+    grouped = mating_body("a", FEATURES, {"plug": ["face", "right"]}, None, body.symmetry)
+    assert grouped.compounds["plug"].features == (FEATURES["face"], FEATURES["right"])
+
+
+def test_problem_diagonal() -> None:
+    mesh = generated_mesh([Box((0, 0, 0), (3, 4, 12))])
+    assert problem_diagonal({"a": FEATURES}, {"a": mesh}) == pytest.approx(
+        float(np.linalg.norm([5, 4, 12]))
     )
-    mesh = generated_mesh(spec)
-    polygon = 0.5 * CYLINDER_SECTIONS * math.sin(2 * math.pi / CYLINDER_SECTIONS)
-    assert mesh.is_watertight
-    assert mesh.volume == pytest.approx(200 - 2 * polygon, rel=1e-9)
+    assert problem_diagonal({"a": {"p": FEATURES["face"]}}, {"a": None}) == 1.0
 
 
-def test_default_compounds_are_the_primitives() -> None:
-    body = {"features": PEG["features"]}
-    problem = parse_problem(_problem(bodies={"a": body, "b": PEG}))
-    assert list(problem.bodies["a"].compounds) == ["face", "stem"]
-
-
-@pytest.mark.parametrize(
-    ("data", "error", "message"),
-    [
-        ({"bodies": {"a": PEG}}, SchemaError, "missing field 'goals'"),
-        (_problem(goals=[["fit", "a", "c"]]), UnknownNameError, "goals[0][2]: no body named 'c'"),
-        (_problem(goals=[["fits", "a", "b"]]), SchemaError, "goals[0][0]"),
-        (_problem(goals=[["fit", "a", "a"]]), SchemaError, "goals[0]: a goal relates two"),
-        (
-            _problem(bodies={"a": {**PEG, "compound": {"plug": ["face", "tip"]}}, "b": PEG}),
-            UnknownNameError,
-            "bodies.a.compound.plug[1]: no feature named 'tip'",
-        ),
-        (
-            _problem(bodies={"a": {**PEG, "sharable": ["rim"]}, "b": PEG}),
-            UnknownNameError,
-            "bodies.a.sharable[0]",
-        ),
-        (
-            _problem(bodies={"a": {**PEG, "mesh": {"add": [{}]}}, "b": PEG}),
-            SchemaError,
-            "bodies.a.mesh",
-        ),
-        (
-            _problem(bodies={"a": {"features": {"f": {"type": "plane"}}}, "b": PEG}),
-            SchemaError,
-            "bodies.a.features.f: a plane needs normal, point",
-        ),
-    ],
-)
-def test_errors_name_the_file_and_field(data: dict, error: type, message: str) -> None:
-    with pytest.raises(error) as caught:
-        parse_problem(data, "p.yaml")
-    assert str(caught.value).startswith("p.yaml: ")
-    assert message in str(caught.value)
-
-
-def test_missing_mesh_file_and_bad_suffix(tmp_path: Path) -> None:
-    path = tmp_path / "p.yaml"
-    path.write_text(
-        "bodies:\n  a: {features: {f: {type: point, point: [0, 0, 0]}}, mesh: gone.obj}\n"
-        "  b: {features: {f: {type: point, point: [0, 0, 0]}}}\ngoals: [[fit, a, b]]\n"
-    )
-    with pytest.raises(InputError, match=r"p\.yaml: bodies\.a\.mesh \(gone\.obj\)"):
-        load_problem(path)
-    other = tmp_path / "p.txt"
-    other.write_text("x")
-    with pytest.raises(InputError, match="unknown problem file type"):
-        load_problem(other)
-
-
-def test_tolerance_is_scaled_to_the_model(mating_examples: Path) -> None:
-    problem = load_problem(mating_examples / "example1.yaml")
-    # Bounding box of features and meshes: [-32, 32] x [-12, 12] x [-6, 4].
-    assert problem.tolerance.scale == pytest.approx(float(np.linalg.norm([64, 24, 10])))
+def test_mating_imports_no_higher_layer() -> None:
+    # DESIGN.md §3: mating sits below io, viz, batch and cli.
+    package = Path(__file__).resolve().parents[2] / "src" / "assemblykit" / "mating"
+    higher = ("assemblykit.io", "assemblykit.viz", "assemblykit.batch", "assemblykit.cli")
+    for source in package.glob("*.py"):
+        tree = ast.parse(source.read_text(encoding="utf-8"))
+        names = [
+            node.module or "" for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
+        ] + [a.name for node in ast.walk(tree) if isinstance(node, ast.Import) for a in node.names]
+        assert not [n for n in names if n.startswith(higher)], source.name

@@ -154,7 +154,7 @@ def parse_task(
     try:
         model = TaskModel.model_validate(data)
     except ValidationError as error:
-        raise _schema_error(error, source, locate) from None
+        raise schema_error(error, source, locate) from None
     try:
         bodies = {
             name: Body(
@@ -174,7 +174,7 @@ def parse_task(
             for index, situation in enumerate(model.situations)
         )
     except InputError as error:
-        raise _with_source(error, source) from None
+        raise with_source(error, source) from None
     return Task(model.units, bodies, situations, source).validate()
 
 
@@ -302,7 +302,7 @@ def _path(loc: tuple[int | str, ...]) -> str:
     return text
 
 
-def _schema_error(error: ValidationError, source: str | None, locate: Locate) -> SchemaError:
+def schema_error(error: ValidationError, source: str | None, locate: Locate) -> SchemaError:
     """The first pydantic error as one line naming the field path."""
     first = error.errors()[0]
     loc = tuple(first["loc"])
@@ -325,7 +325,7 @@ def _schema_error(error: ValidationError, source: str | None, locate: Locate) ->
     return SchemaError(message, source=source, where=locate(path) if path else None)
 
 
-def _with_source(error: InputError, source: str | None) -> InputError:
+def with_source(error: InputError, source: str | None) -> InputError:
     """The same error, naming the file."""
     if error.source or source is None:
         return error

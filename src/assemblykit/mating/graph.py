@@ -10,9 +10,10 @@ constraint graph and node consistency.
   (seed 003 Prop. 3.1.5): their primitives pair up one to one (plane against plane,
   shaft in hole, ball in socket, ...), the intersection of the pairs' relation cosets is
   not empty, and its group is the group of the second compound (conjugate groups).
-* **Node consistency**: when the relative position is determined (identity, or a finite
-  common group: one candidate per position), the two meshes are checked for interference
-  (seed 002: the *intersect* predicate of PADL2; here manifold3d volumes).
+* **Node consistency**: when the relative position is determined (identity; a common
+  group equal to one body's symmetry group, which determines it up to that symmetry; or
+  a finite common group: one candidate per position), the two meshes are checked for
+  interference (seed 002: the *intersect* predicate of PADL2; here manifold3d volumes).
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ from assemblykit.features import (
 )
 from assemblykit.features.compound import compound_group
 from assemblykit.geometry.interference import interferes
-from assemblykit.io.meshes import placed
+from assemblykit.geometry.solids import placed
 from assemblykit.mating.problem import Goal, MatingBody, MatingProblem
 from assemblykit.model.relations import relation_coset
 from assemblykit.tolerance import Tolerance
@@ -104,13 +105,18 @@ def matable(a: Feature, b: Feature, tol: Tolerance) -> str | None:
 
 
 def pairings(
-    first: Sequence[Feature], second: Sequence[Feature], tol: Tolerance
+    first: Sequence[Feature],
+    second: Sequence[Feature],
+    tol: Tolerance,
+    kinds: Sequence[Sequence[str | None]] | None = None,
 ) -> Iterator[tuple[tuple[int, int, str], ...]]:
     """Every one-to-one pairing of two primitive lists in which each pair mates:
-    tuples of (index in first, index in second, relation)."""
+    tuples of (index in first, index in second, relation). ``kinds[i][j]`` may give
+    ``matable(first[i], second[j])`` already known."""
     if len(first) != len(second):
         return
-    kinds = [[matable(a, b, tol) for b in second] for a in first]
+    if kinds is None:
+        kinds = [[matable(a, b, tol) for b in second] for a in first]
     for order in itertools.permutations(range(len(second))):
         if all(kinds[i][j] for i, j in enumerate(order)):
             yield tuple((i, j, kinds[i][j]) for i, j in enumerate(order))  # type: ignore[misc]
@@ -134,9 +140,26 @@ def pair_coset(
     return result
 
 
-def _positions(coset: Coset) -> list[Coset]:
-    """A finite set of positions split into single positions; other cosets as they are."""
+def up_to_symmetry(coset: Coset, first: MatingBody, second: MatingBody, tol: Tolerance) -> bool:
+    """Whether the common group equals the symmetry group of one of the bodies, so that
+    every member of the coset places that body onto the same point set: the relative
+    position is determined up to the body's own symmetry (seed 002 step one, Example
+    Three). X = h·x₀ with h ∈ H in ``second``'s frame, so H must equal sym(second), or
+    x₀⁻¹·H·x₀ (the same motions seen in ``first``'s frame) must equal sym(first)."""
+    group = coset.group
+    return not coset.is_point and (
+        group.equals(second.symmetry, tol)
+        or group.conjugate(coset.rep_inverse).equals(first.symmetry, tol)
+    )
+
+
+def positions(coset: Coset, first: MatingBody, second: MatingBody, tol: Tolerance) -> list[Coset]:
+    """The relative positions a candidate stands for: a finite coset determined up to a
+    body's symmetry is one position (its representative); another finite coset is split
+    into its single positions; any other coset is kept whole."""
     if coset.dof == 0 and not coset.group.lattice and coset.n_components > 1:
+        if up_to_symmetry(coset, first, second, tol):
+            return [Coset(SymmetryGroup.identity(), coset.rep)]
         return [Coset(SymmetryGroup.identity(), p) for p in coset.points()]
     return [coset]
 
@@ -149,8 +172,19 @@ def goal_candidates(
     tol = problem.tolerance
     a, b = problem.bodies[goal.first], problem.bodies[goal.second]
     found: list[Candidate] = []
+    # Compounds share primitives (a face in every seat): each primitive pair is judged once.
+    known: dict[tuple[str, str], str | None] = {}
+
+    def kind(x: str, y: str) -> str | None:
+        if (x, y) not in known:
+            known[(x, y)] = matable(a.features[x], b.features[y], tol)
+        return known[(x, y)]
+
     for (ca, fa), (cb, fb) in itertools.product(a.compounds.items(), b.compounds.items()):
-        for pairing in pairings(fa.features, fb.features, tol):
+        if len(fa.features) != len(fb.features):
+            continue
+        kinds = [[kind(x, y) for y in b.members[cb]] for x in a.members[ca]]
+        for pairing in pairings(fa.features, fb.features, tol, kinds):
             coset = pair_coset(fa.features, fb.features, pairing, tol)
             if isinstance(coset, EmptySet):
                 continue
@@ -166,7 +200,7 @@ def goal_candidates(
             priority = max(RARITY.get(type(f), 0) for f in fa.features)
             found.extend(
                 Candidate(goal, ca, cb, names, position, uses, priority)
-                for position in _positions(coset)
+                for position in positions(coset, a, b, tol)
             )
     found.sort(key=lambda c: -c.priority)
     return found
@@ -184,13 +218,14 @@ def interfering(
 
 def node_consistent(problem: MatingProblem, candidate: Candidate) -> bool:
     """Node consistency (seed 002 step one): a candidate whose relative position is
-    determined is kept only if the two bodies do not interfere there."""
-    if not candidate.determined:
-        return True
+    determined, alone or up to a body's symmetry, is kept only if the two bodies do not
+    interfere at its representative position."""
     g = candidate.goal
-    return not interfering(
-        problem.bodies[g.first], problem.bodies[g.second], candidate.coset.rep, problem.tolerance
-    )
+    first, second = problem.bodies[g.first], problem.bodies[g.second]
+    tol = problem.tolerance
+    if not (candidate.determined or up_to_symmetry(candidate.coset, first, second, tol)):
+        return True
+    return not interfering(first, second, candidate.coset.rep, tol)
 
 
 @dataclass(frozen=True, eq=False)

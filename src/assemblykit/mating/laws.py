@@ -10,17 +10,24 @@ shrink the goals' domains.
 * **Arc consistency** (Mackworth 1985; Mohr & Henderson 1986, AC-3): two candidates of
   different goals are compatible unless they use a common non-sharable feature; a
   candidate without a compatible one in some other goal is deleted.
+* **Path consistency** (Mohr & Henderson 1986; seed 002 step two, "arc/path
+  consistency"): the allowed pairs of candidates of two goals start as the compatible
+  ones; a pair is deleted when some third goal sharing a body with both has no candidate
+  allowed with each of the two; a candidate left in no allowed pair with some
+  neighbouring goal is deleted; repeated until quiescent.
 """
 
 from __future__ import annotations
 
 from collections import deque
 from collections.abc import Mapping
+from dataclasses import dataclass
+from itertools import combinations
 
 from assemblykit.features import Relationship, relationship
 from assemblykit.features.compound import feature_transporter
 from assemblykit.mating.graph import Candidate, Domains
-from assemblykit.mating.problem import MatingBody, MatingProblem
+from assemblykit.mating.problem import Goal, MatingBody, MatingProblem
 from assemblykit.tolerance import Tolerance
 
 
@@ -147,3 +154,68 @@ def arc_consistency(domains: Domains) -> Domains:
 def _constrained(a: tuple[Candidate, ...], b: tuple[Candidate, ...]) -> bool:
     used = frozenset().union(*(c.uses for c in a)) if a else frozenset()
     return any(c.uses & used for c in b)
+
+
+@dataclass(frozen=True)
+class PathResult:
+    """The domains left by :func:`path_consistency` and the number of candidate pairs
+    it deleted (its pruning statistic beyond the domain sizes)."""
+
+    domains: Domains
+    pairs_removed: int
+
+
+def path_consistency(domains: Domains, goals: tuple[Goal, ...]) -> PathResult:
+    """Path consistency over triples of goals sharing bodies (Mohr & Henderson 1986).
+
+    Only goals with a common body constrain each other (a non-sharable feature belongs to
+    one body), so the relations are kept for those pairs and a pair (c, d) of goals g, h
+    needs, for every goal k sharing a body with both, a candidate e of k allowed with c
+    and with d. Relations are sets of index pairs into the given domains."""
+    bodies = {goal.number: {goal.first, goal.second} for goal in goals}
+    linked = [(g, h) for g, h in combinations(sorted(domains), 2) if bodies[g] & bodies[h]]
+    allowed = {
+        (g, h): {
+            (i, j)
+            for i, c in enumerate(domains[g])
+            for j, d in enumerate(domains[h])
+            if compatible(c, d)
+        }
+        for g, h in linked
+    }
+    initial = sum(len(pairs) for pairs in allowed.values())
+    neighbours: dict[int, set[int]] = {g: set() for g in domains}
+    for g, h in linked:
+        neighbours[g].add(h)
+        neighbours[h].add(g)
+
+    def ok(g: int, i: int, h: int, j: int) -> bool:
+        return (i, j) in allowed[(g, h)] if g < h else (j, i) in allowed[(h, g)]
+
+    def supported(g: int, i: int) -> bool:
+        return all(any(ok(g, i, h, j) for j in range(len(domains[h]))) for h in neighbours[g])
+
+    changed = True
+    while changed:
+        changed = False
+        for g, h in linked:
+            for k in sorted(neighbours[g] & neighbours[h]):
+                kept = {
+                    (i, j)
+                    for i, j in allowed[(g, h)]
+                    if any(ok(g, i, k, m) and ok(h, j, k, m) for m in range(len(domains[k])))
+                }
+                if len(kept) != len(allowed[(g, h)]):
+                    allowed[(g, h)] = kept
+                    changed = True
+        alive = {g: {i for i in range(len(domains[g])) if supported(g, i)} for g in domains}
+        for g, h in linked:
+            kept = {(i, j) for i, j in allowed[(g, h)] if i in alive[g] and j in alive[h]}
+            if len(kept) != len(allowed[(g, h)]):
+                allowed[(g, h)] = kept
+                changed = True
+    removed = initial - sum(len(pairs) for pairs in allowed.values())
+    return PathResult(
+        {g: tuple(c for i, c in enumerate(d) if supported(g, i)) for g, d in domains.items()},
+        removed,
+    )

@@ -1,15 +1,17 @@
 """Step three of the assembly constraint satisfaction process (seed 002) and the answer.
 
-``mate(problem)`` sets up the two-layer graph (step one), applies the laws (step two),
-enumerates every consistent assignment of candidate pairs to goals with a CSP library
-(python-constraint2 for small problems, OR-Tools CP-SAT from the ``csp`` extra for
-large ones), then places the bodies globally and checks the spatial constraint:
+``mate(problem)`` sets up the two-layer graph (step one), applies the laws (step two:
+mandatory request, equivalent features, arc and path consistency), enumerates every
+consistent assignment of candidate pairs to goals with a CSP library (python-constraint2
+for small problems, OR-Tools CP-SAT from the ``csp`` extra for large ones), then places
+the bodies globally and checks the spatial constraint:
 
 * **global positions**: one body is fixed and the relative cosets are chained around the
   goal graph; a body reached twice gets the intersection of the two world cosets (seed
-  002 eq. (3)); two revolute world cosets joined by a goal are solved by the
-  representative-point loci of seed 002 Figs 4-5 (the orbits of the coinciding points,
-  circle ∩ circle), each intersection point a configuration;
+  002 eq. (3)); a body rigidly attached to a moving body moves with it; a loop that
+  chaining leaves open is closed by the representative-point loci of seed 002 Figs 4-5
+  or, without a closed form, numerically (:mod:`assemblykit.mating.loci`), each
+  solution a configuration;
 * **interference** between every two placed bodies (manifold3d volumes);
 * **sweeping** (beyond the seed; its Discussion): a body left with a one-parameter group
   is swept over it, sampled finely, the collision-free intervals refined by bisection and
@@ -28,7 +30,7 @@ import numpy as np
 from rich.console import Group
 from rich.text import Text
 
-from assemblykit.algebra import Coset, EmptySet, Kind, Locus, SymmetryGroup, se3
+from assemblykit.algebra import Coset, EmptySet, Kind, SymmetryGroup, se3
 from assemblykit.errors import MissingExtraError
 from assemblykit.mating.graph import Candidate, Domains, build_graph, interfering
 from assemblykit.mating.laws import (
@@ -36,7 +38,9 @@ from assemblykit.mating.laws import (
     compatible,
     equivalent_features,
     mandatory_request,
+    path_consistency,
 )
+from assemblykit.mating.loci import World, loci_branches, numeric_closure
 from assemblykit.mating.problem import MatingProblem
 from assemblykit.tolerance import Tolerance
 
@@ -46,6 +50,7 @@ LAWS = (
     "mandatory request",
     "equivalent feature",
     "arc consistency",
+    "path consistency",
 )
 """The stages whose domain sizes are reported, in order."""
 
@@ -120,13 +125,15 @@ class Emptied:
 class MatingResult:
     """The answer of :func:`mate`: the configurations (representatives), the ``count``
     including equivalent copies, the domain sizes after each law, the goal whose domain
-    emptied (if any), and how many assignments step three rejected."""
+    emptied (if any), how many assignments step three rejected, and how many candidate
+    pairs path consistency deleted."""
 
     configurations: tuple[Configuration, ...]
     statistics: Mapping[int, tuple[int, ...]]
     emptied: Emptied | None
     assignments: int
     rejected: int
+    pairs_removed: int = 0
 
     @property
     def count(self) -> int:
@@ -144,6 +151,7 @@ class MatingResult:
                 "domains": {str(g): list(sizes) for g, sizes in self.statistics.items()},
                 "assignments": self.assignments,
                 "rejected": self.rejected,
+                "path_pairs_removed": self.pairs_removed,
             },
             "emptied": None
             if self.emptied is None
@@ -167,6 +175,7 @@ class MatingResult:
         lines.extend(
             Text(f"  goal {g}: {' -> '.join(map(str, s))}") for g, s in self.statistics.items()
         )
+        lines.append(Text(f"candidate pairs deleted by path consistency: {self.pairs_removed}"))
         return Group(*lines)
 
     def or_and(self) -> str:
@@ -187,11 +196,13 @@ def mate(problem: MatingProblem) -> MatingResult:
     stages.append(mandatory_request(stages[-1]))
     stages.append(equivalent_features(problem, stages[-1]))
     stages.append(arc_consistency(stages[-1]))
+    path = path_consistency(stages[-1], problem.goals)
+    stages.append(path.domains)
     statistics = {g.number: tuple(len(s[g.number]) for s in stages) for g in problem.goals}
     emptied = _emptied(stages, problem)
     domains = stages[-1]
     if emptied is not None:
-        return MatingResult((), statistics, emptied, 0, 0)
+        return MatingResult((), statistics, emptied, 0, 0, path.pairs_removed)
     assignments = solve_csp(domains)
     configurations = [
         config
@@ -199,7 +210,9 @@ def mate(problem: MatingProblem) -> MatingResult:
         for config in place(problem, tuple(assignment[g.number] for g in problem.goals))
     ]
     rejected = len(assignments) - len({tuple(map(id, c.pairs)) for c in configurations})
-    return MatingResult(tuple(configurations), statistics, None, len(assignments), rejected)
+    return MatingResult(
+        tuple(configurations), statistics, None, len(assignments), rejected, path.pairs_removed
+    )
 
 
 def _emptied(stages: Sequence[Domains], problem: MatingProblem) -> Emptied | None:
@@ -283,9 +296,6 @@ def _solve_cp_sat(domains: Domains) -> list[dict[int, Candidate]]:
 
 # ----------------------------------------------------------------------------- placement
 
-World = dict[str, Coset]
-"""The set of possible world poses of each placed body (a right coset)."""
-
 
 def place(problem: MatingProblem, pairs: tuple[Candidate, ...]) -> list[Configuration]:
     """The configurations of one assignment (seed 002 step three): global positions by
@@ -321,31 +331,62 @@ def _root(pairs: Sequence[Candidate], names: Sequence[str]) -> str:
 
 def _positions(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> list[World]:
     """Every consistent set of world cosets reachable from ``world``: chain and intersect
-    until quiescent, then branch on the loci of a revolute loop (seed 002 Figs 4-5)."""
+    until quiescent, then branch on a loop that is not closed yet: representative-point
+    loci (seed 002 Figs 4-5), else the numeric closure. A closed form with no meeting
+    point rejects the assignment; the numeric path never does (module docstring of
+    :mod:`assemblykit.mating.loci`)."""
     settled = _propagate(dict(world), pairs, tol)
     if settled is None:
         return []
     for c in pairs:
         u, v = c.goal.second, c.goal.first
-        if u in settled and v in settled and not (settled[u].is_point and settled[v].is_point):
-            branches = _loci_branches(settled, c, tol)
-            if branches is not None:
-                return [w for b in branches for w in _positions(b, pairs, tol)]
+        if u not in settled or v not in settled or _implied(settled[u], settled[v], c.coset, tol):
+            continue
+        branches = loci_branches(settled, u, v, c.coset, tol)
+        if branches is None:
+            branches = numeric_closure(settled, u, v, c.coset, tol) or None
+        if branches is not None:
+            return [w for b in branches for w in _positions(b, pairs, tol)]
     return [settled]
 
 
+def _implied(second: Coset, first: Coset, relative: Coset, tol: Tolerance) -> bool:
+    """Whether a goal X = L_second⁻¹·L_first ∈ ``relative`` holds for every pose left:
+    both poses fixed (propagation checked it), or one world coset exactly the goal's
+    image of the other (the goal is how that body was reached)."""
+    if second.is_point and first.is_point:
+        return True
+    if second.is_point:
+        reach = relative.left(second.rep)
+        return reach.group.equals(first.group, tol) and reach.contains(first.rep, tol)
+    if first.is_point:
+        reach = relative.inverse().left(first.rep)
+        return reach.group.equals(second.group, tol) and reach.contains(second.rep, tol)
+    if relative.is_point:
+        carried = second.right(relative.rep)
+        return carried.group.equals(first.group, tol) and carried.contains(first.rep, tol)
+    return False
+
+
 def _propagate(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> World | None:
-    """Chain point positions through the goals' relative cosets (X = L_second⁻¹·L_first)
-    and intersect with what is known; ``None`` when an intersection is empty."""
+    """Chain point positions through the goals' relative cosets (X = L_second⁻¹·L_first),
+    carry bodies rigidly attached to a moving body along with it, and intersect with
+    what is known; ``None`` when an intersection is empty."""
     changed = True
     while changed:
         changed = False
         for c in pairs:
             u, v = c.goal.second, c.goal.first
             for known, other, relative in ((u, v, c.coset), (v, u, c.coset.inverse())):
-                if known not in world or not world[known].is_point:
+                if known not in world:
                     continue
-                reach = relative.left(world[known].rep)
+                if world[known].is_point:
+                    reach = relative.left(world[known].rep)
+                elif relative.is_point and other not in world:
+                    # Rigidly attached to a moving body: it moves with it (L_other = L·X).
+                    reach = world[known].right(relative.rep)
+                else:
+                    continue
                 if other not in world:
                     world[other] = reach
                     changed = True
@@ -361,72 +402,6 @@ def _propagate(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> Worl
                     world[other] = met
                     changed = True
     return world
-
-
-def _loci_branches(world: World, c: Candidate, tol: Tolerance) -> list[World] | None:
-    """Representative-point loci (seed 002 Figs 4-5) for a goal whose two bodies each have
-    a revolute world coset: the point of the relation's axis is carried by both bodies;
-    its two orbits (circles) meet in the possible positions of the point. ``None`` when
-    the case is not a pair of revolute cosets and a revolute relation."""
-    u, v = c.goal.second, c.goal.first
-    wu, wv = world[u], world[v]
-    if wu.is_point or wv.is_point:
-        return None
-    if not {wu.kind, wv.kind} <= {Kind.REVOLUTE} or c.coset.kind not in (
-        Kind.REVOLUTE,
-        Kind.SPHERICAL,
-    ):
-        return None
-    p = c.coset.group.origin
-    q = se3.apply(se3.inverse(c.coset.rep), p)
-    locus_u = wu.group.orbit(se3.apply(wu.rep, p), tol)
-    locus_v = wv.group.orbit(se3.apply(wv.rep, q), tol)
-    branches = []
-    for point in locus_meet(locus_u, locus_v, tol):
-        turned = dict(world)
-        turned[u] = Coset(SymmetryGroup.identity(), _turn_to(wu, se3.apply(wu.rep, p), point))
-        branches.append(turned)
-    return branches
-
-
-def _turn_to(coset: Coset, start: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """The member of a revolute coset g·x₀ whose g carries ``start`` to ``target``."""
-    frame_inv = coset.group.frame_inverse
-    a, b = se3.apply(frame_inv, start), se3.apply(frame_inv, target)
-    angle = math.atan2(b[1], b[0]) - math.atan2(a[1], a[0])
-    return coset.group.element([angle]) @ coset.rep
-
-
-def locus_meet(a: Locus, b: Locus, tol: Tolerance) -> list[np.ndarray]:
-    """The common points of two loci that are points or circles with parallel axes
-    (coplanar circles meet in 0, 1 or 2 points; ALGEBRA.md §2.3 orbit table)."""
-    if a.kind == "point":
-        return [a.point] if b.contains(a.point, tol) else []  # type: ignore[list-item]
-    if b.kind == "point":
-        return [b.point] if a.contains(b.point, tol) else []  # type: ignore[list-item]
-    if a.kind != "circle" or b.kind != "circle":
-        return []
-    assert a.point is not None and b.point is not None and a.direction is not None
-    n = a.direction
-    if se3.norm(se3.cross(n, b.direction)) > tol.angle:  # type: ignore[arg-type]
-        return []
-    offset = b.point - a.point
-    if abs(float(offset @ n)) > tol.length:
-        return []
-    d = se3.norm(offset)
-    if d <= tol.length:
-        return []
-    e = offset / d
-    along = (d * d + a.radius**2 - b.radius**2) / (2 * d)
-    height_sq = a.radius**2 - along**2
-    if height_sq < 0 and math.sqrt(-height_sq) > tol.length:
-        return []
-    height = math.sqrt(max(height_sq, 0.0))
-    side = se3.cross(n, e)
-    base = a.point + along * e
-    if height <= tol.length:
-        return [base]
-    return [base + height * side, base - height * side]
 
 
 # ----------------------------------------------------------------------------- space
