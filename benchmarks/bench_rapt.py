@@ -1,0 +1,152 @@
+"""RAPT network reduction: solve times for stacks, trees and grids of N bodies.
+
+Prints, per shape and N, the median solve time; the growth ratio t(10,000)/t(1,000);
+and at N = 100 the ratio of the numeric-only path (the whole network handed to the
+residue solver, the "equation solving" system of seed 000 §III G) to reduction.
+
+Run: python benchmarks/bench_rapt.py [--quick] [--full-numeric]
+
+``--quick`` stops at N = 1,000; the numeric-only path runs one start by default (a lower
+bound of its cost) and the residue solver's full multi-start with ``--full-numeric``
+(several minutes at N = 100).
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+from collections.abc import Callable
+
+from assemblykit.features.primitives import Plane
+from assemblykit.inference.reduction import solve_numeric_only, solve_task
+from assemblykit.model.body import Body
+from assemblykit.model.relations import FeatureRef, Relation
+from assemblykit.model.task import Situation, Task
+
+Z, X, Y = (0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)
+
+
+def _cube(name: str, at: tuple[float, float, float] = (0, 0, 0), fixed: bool = False) -> Body:
+    """A unit cube with its corner at ``at`` in its body frame, its six faces as planes.
+
+    Movable cubes are modelled about their own origin, so their solved poses are
+    translations away from the identity (the numeric path starts at the identity)."""
+    x, y, z = at
+    faces = {
+        "bottom": Plane((x, y, z), (0, 0, -1)),
+        "top": Plane((x, y, z + 1), Z),
+        "left": Plane((x, y, z), (-1, 0, 0)),
+        "right": Plane((x + 1, y, z), X),
+        "front": Plane((x, y, z), (0, -1, 0)),
+        "back": Plane((x, y + 1, z), Y),
+    }
+    return Body(name, faces, fixed)
+
+
+def _rel(kind: str, first: str, second: str) -> Relation:
+    return Relation(kind, (FeatureRef.parse(first), FeatureRef.parse(second)))
+
+
+def _seat_on(child: str, parent: str) -> list[Relation]:
+    """Child on top of parent, flush on the left and front: a fixed relation (3 planes)."""
+    return [
+        _rel("against", f"{child}.bottom", f"{parent}.top"),
+        _rel("coplanar", f"{child}.left", f"{parent}.left"),
+        _rel("coplanar", f"{child}.front", f"{parent}.front"),
+    ]
+
+
+def _beside(child: str, parent: str) -> list[Relation]:
+    """Child right of parent, flush at the bottom and front."""
+    return [
+        _rel("against", f"{child}.left", f"{parent}.right"),
+        _rel("coplanar", f"{child}.bottom", f"{parent}.bottom"),
+        _rel("coplanar", f"{child}.front", f"{parent}.front"),
+    ]
+
+
+def stack(n: int) -> Task:
+    """N cubes stacked on a fixed base."""
+    bodies = [_cube("b0", (0, 0, 0), fixed=True)]
+    relations: list[Relation] = []
+    for i in range(1, n + 1):
+        bodies.append(_cube(f"b{i}"))
+        relations += _seat_on(f"b{i}", f"b{i - 1}")
+    return Task("mm", {b.name: b for b in bodies}, (Situation("s1", tuple(relations)),))
+
+
+def tree(n: int) -> Task:
+    """A binary tree of N cubes: each sits on its parent (left child) or beside it (right)."""
+    bodies = [_cube("b0", (0, 0, 0), fixed=True)]
+    relations: list[Relation] = []
+    for i in range(1, n + 1):
+        parent = (i - 1) // 2
+        attach = _seat_on if i % 2 else _beside
+        relations += attach(f"b{i}", f"b{parent}")
+        bodies.append(_cube(f"b{i}"))
+    return Task("mm", {b.name: b for b in bodies}, (Situation("s1", tuple(relations)),))
+
+
+def grid(n: int) -> Task:
+    """A wall of about N cubes in columns: each on the one below and beside the one left
+    of it (redundant relations that reduction intersects)."""
+    width = max(2, int(n**0.5))
+    bodies = {"base": _cube("base", (0, 0, -1), fixed=True)}
+    relations: list[Relation] = []
+    for k in range(n):
+        row, col = divmod(k, width)
+        name = f"g{row}_{col}"
+        bodies[name] = _cube(name)
+        if row == 0:
+            relations += [
+                _rel("against", f"{name}.bottom", "base.top"),
+                _rel("coplanar", f"{name}.front", "base.front"),
+            ]
+            if col == 0:
+                relations.append(_rel("coplanar", f"{name}.left", "base.left"))
+        else:
+            relations += _seat_on(name, f"g{row - 1}_{col}")
+        if col > 0:
+            relations += _beside(name, f"g{row}_{col - 1}")
+    return Task("mm", bodies, (Situation("s1", tuple(relations)),))
+
+
+def timed(fn: Callable[[], object], repeats: int) -> float:
+    """Median wall time of ``repeats`` calls."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def main() -> None:
+    quick = "--quick" in sys.argv
+    sizes = (10, 100, 1000) if quick else (10, 100, 1000, 10000)
+    print(f"{'shape':8} {'N':>7} {'median s':>10} {'bodies/s':>10}")
+    for name, build in (("stack", stack), ("tree", tree), ("grid", grid)):
+        medians = {}
+        for n in sizes:
+            task = build(n)
+            solution = solve_task(task)
+            assert solution.status == "solved", (name, n, solution.status)
+            medians[n] = timed(lambda task=task: solve_task(task), 3 if n <= 1000 else 1)
+            print(f"{name:8} {n:>7} {medians[n]:>10.4f} {n / medians[n]:>10.0f}")
+        if 10000 in medians:
+            print(f"{name:8} growth t(10000)/t(1000) = {medians[10000] / medians[1000]:.1f}")
+    task = stack(100)
+    reduced = timed(lambda: solve_task(task), 3)
+    starts = 8 if "--full-numeric" in sys.argv else 1
+    start = time.perf_counter()
+    numeric_solution = solve_numeric_only(task, starts=starts)
+    numeric = time.perf_counter() - start
+    print(
+        f"stack N=100: reduction {reduced:.4f} s, numeric only ({starts} start(s))"
+        f" {numeric:.3f} s, status {numeric_solution.status}, ratio {numeric / reduced:.0f}x"
+    )
+
+
+if __name__ == "__main__":
+    main()

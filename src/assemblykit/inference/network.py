@@ -1,0 +1,292 @@
+"""The relational network of a RAPT task (seed 000 §III, ALGEBRA.md §5.2).
+
+Nodes are **body instances** ``(body, situation)``: the pose of one body in one
+situation. Fixed bodies are the world: all their instances are the one node
+:data:`WORLD` (pose = identity). Links carry the set of relative poses
+``X = inv(L_source) @ L_target``:
+
+* a spatial relation ``[kind, first, second]`` within a situation links the second
+  body's instance to the first's with ``relation_coset`` (the set of
+  ``inv(L_second) @ L_first``); relations that are not cosets (point_on_plane, distance,
+  gear, mirror, ...) become general constraints (residual functions);
+* an action between consecutive situations links the body's two instances
+  (seed 000 §III B: "f ** p2 = rel(v) ** f ** p1"): ``move b along f by s`` is the fixed
+  transform F·Tr(0,0,s)·F⁻¹, ``along f`` without ``by`` the prismatic coset F·T(z)·F⁻¹,
+  ``turn b about f by θ`` the fixed F·Rz(θ)·F⁻¹, without ``by`` the revolute coset
+  F·R(z)·F⁻¹; a free ``move b`` adds no link;
+* a body that no action of a transition moves keeps its pose: an identity link.
+
+Every link also has a residual, so the whole network can be handed to the numeric
+residue solver (:mod:`assemblykit.inference.numeric`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
+from typing import Any
+
+import networkx as nx
+import numpy as np
+
+from assemblykit.algebra import Coset, SymmetryGroup, se3
+from assemblykit.errors import SchemaError
+from assemblykit.inference.numeric import Constraint, gear_residual, mirror_residual
+from assemblykit.model.relations import (
+    COUPLED,
+    RELATIONS,
+    Relation,
+    relation_coset,
+    relation_residual,
+)
+from assemblykit.model.task import Action, Situation, Task
+from assemblykit.tolerance import current
+
+Node = tuple[str, str]
+WORLD: Node = ("world", "")
+
+
+@dataclass(frozen=True)
+class Link:
+    """A coset link ``source → target``: ``inv(L_source) @ L_target`` lies in ``value``.
+
+    ``labels`` name the relations or actions it came from; ``make_residual`` builds the
+    same condition as a residual function of ``X``, only when the numeric path needs it.
+    """
+
+    source: Node
+    target: Node
+    value: Any
+    labels: tuple[str, ...]
+    make_residual: Callable[[], Callable[[np.ndarray], np.ndarray]]
+
+
+@dataclass(frozen=True)
+class Network:
+    """Body instances, coset links, general constraints and the situation order."""
+
+    instances: tuple[Node, ...]
+    links: tuple[Link, ...]
+    constraints: tuple[Constraint, ...]
+    situations: tuple[str, ...]
+    bodies: tuple[str, ...]
+    fixed: frozenset[str]
+
+    def node(self, body: str, situation: str) -> Node:
+        """The node of a body instance (the world for a fixed body)."""
+        return WORLD if body in self.fixed else (body, situation)
+
+    def graph(self) -> nx.MultiGraph:
+        """The undirected multigraph of instances and coset links (link index as key)."""
+        graph = nx.MultiGraph()
+        graph.add_node(WORLD)
+        graph.add_nodes_from(self.instances)
+        for index, link in enumerate(self.links):
+            graph.add_edge(link.source, link.target, key=index)
+        return graph
+
+    def link_constraint(self, link: Link) -> Constraint:
+        """The residual of a coset link over the world poses of its two ends."""
+        residual = link.make_residual()
+        return Constraint(
+            (link.source, link.target),
+            lambda poses: residual(se3.inverse(poses[0]) @ poses[1]),
+            link.labels,
+        )
+
+
+def point_coset(pose: np.ndarray) -> Coset:
+    """The single relative pose ``pose`` as a coset of the identity group (a fix link)."""
+    return Coset(SymmetryGroup.identity(), np.asarray(pose, dtype=np.float64))
+
+
+def instance_key(node: Node) -> str:
+    """``"<body>@<situation>"``."""
+    return f"{node[0]}@{node[1]}"
+
+
+def relation_label(relation: Any, situation: str) -> str:
+    """A readable name of a relation: ``"against block.bottom table.top @s1"``."""
+    refs = " ".join(str(r) for r in relation.refs)
+    return f"{relation.kind} {refs} @{situation}"
+
+
+def _fixed_residual(target: np.ndarray, scale: float) -> Callable[[np.ndarray], np.ndarray]:
+    """Residual of ``X == target``: rotation entries (times the length ``scale``, so every
+    entry is a length, as in :func:`relation_residual`) and translation."""
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        rotation = (x[:3, :3] - target[:3, :3]).ravel() * scale
+        return np.concatenate([rotation, x[:3, 3] - target[:3, 3]])
+
+    return residual
+
+
+def _axis_residual(
+    frame: np.ndarray, rotate: bool, scale: float
+) -> Callable[[np.ndarray], np.ndarray]:
+    """Residual of ``X ∈ F·T(z)·F⁻¹`` (``rotate`` False) or ``X ∈ F·R(z)·F⁻¹`` (True):
+    the axis kept (and, turning, its point fixed), or no rotation and no sideways shift."""
+    origin, axis = frame[:3, 3], frame[:3, 2]
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        if rotate:
+            moved = x[:3, :3] @ origin + x[:3, 3] - origin
+            return np.concatenate([(x[:3, :3] @ axis - axis) * scale, moved])
+        t = x[:3, 3]
+        rotation = (x[:3, :3] - np.eye(3)).ravel() * scale
+        return np.concatenate([rotation, t - np.dot(t, axis) * axis])
+
+    return residual
+
+
+def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | None:
+    """The link ``prev → next`` of one action (seed 000 §III B), or None for a free move.
+
+    The feature's frame has +z along its axis or normal (DESIGN.md §4), so moving along it
+    by ``s`` is F·Tr(0,0,s)·F⁻¹ and turning about it by θ is F·Rz(θ)·F⁻¹ in body coordinates.
+    """
+    ref = action.ref
+    if ref is None:
+        return None
+    label = f"{action.kind} {action.body} {ref}"
+    if action.by is not None:
+        label += f" by {action.by:g}"
+    label += f" @{nxt[1]}"
+    frame = np.asarray(task.feature(ref, action.where or label).frame(), dtype=np.float64)
+    rotate = action.kind == "turn"
+    if action.by is None:
+        group = (
+            SymmetryGroup.revolute(frame[:3, 3], frame[:3, 2])
+            if rotate
+            else SymmetryGroup.prismatic(frame[:3, 2])
+        )
+        residual = partial(_axis_residual, frame, rotate, current().scale)
+        return Link(prev, nxt, Coset(group, np.eye(4)), (label,), residual)
+    step = se3.rot_z(action.by) if rotate else se3.translation(np.array([0.0, 0.0, action.by]))
+    target = frame @ step @ se3.inverse(frame)
+    return Link(
+        prev, nxt, point_coset(target), (label,), partial(_fixed_residual, target, current().scale)
+    )
+
+
+def _carrier(situation: Situation, pair: tuple[str, str], node: Callable[[str], Node]) -> Node:
+    """The instance both bodies of a coupled relation are related to (the first in order):
+    the carrier of a gear pair, the palm of a gripper."""
+    related: dict[str, list[Node]] = {pair[0]: [], pair[1]: []}
+    for relation in situation.relations:
+        if relation.kind in COUPLED:
+            continue
+        ends = [r.body for r in relation.refs]
+        for here, there in (ends, ends[::-1]):
+            if here in related and there not in pair:
+                related[here].append(node(there))
+    common = [n for n in related[pair[0]] if n in related[pair[1]]]
+    if not common:
+        raise SchemaError(
+            f"{pair[0]} and {pair[1]} are coupled but no body is related to both"
+            f" in situation {situation.name!r}"
+        )
+    return common[0]
+
+
+def _coupled_constraint(
+    task: Task, situation: Situation, relation: Relation, node: Callable[[str], Node], label: str
+) -> Constraint:
+    """A gear or mirror relation as a general constraint (see :mod:`numeric`)."""
+    where = relation.where or label
+    first, second = (task.feature(r, where) for r in relation.refs)
+    frames = (np.asarray(first.frame(), dtype=float), np.asarray(second.frame(), dtype=float))
+    bodies = tuple(node(r.body) for r in relation.refs)
+    carrier = _carrier(situation, (relation.refs[0].body, relation.refs[1].body), node)
+    if relation.kind == "gear":
+        ratio = float(relation.options["ratio"])
+        residual = gear_residual(*frames, ratio, current().scale)
+        return Constraint((*bodies, carrier), residual, (label,))
+    direction = frames[0][:3, 2]
+    if first.type_name != "plane":
+        offset = frames[1][:3, 3] - frames[0][:3, 3]
+        if not np.linalg.norm(offset) > 0:
+            raise SchemaError(
+                "mirror: the two points coincide, so they give no direction",
+                source=task.source,
+                where=where,
+            )
+        direction = offset / np.linalg.norm(offset)
+    residual = mirror_residual(*frames, direction)
+    return Constraint((*bodies, carrier), residual, (label,))
+
+
+def _relation_part(
+    task: Task,
+    situation: Situation,
+    relation: Relation,
+    node: Callable[[str], Node],
+) -> Link | Constraint:
+    """The link (coset relations) or constraint (all others) of one spatial relation."""
+    label = relation_label(relation, situation.name)
+    if relation.kind in COUPLED:
+        return _coupled_constraint(task, situation, relation, node, label)
+    where = relation.where or label
+    first_ref, second_ref = relation.refs[0], relation.refs[1]
+    first, second = task.feature(first_ref, where), task.feature(second_ref, where)
+    options = dict(relation.options or {})
+    source, target = node(second_ref.body), node(first_ref.body)
+    if not RELATIONS[relation.kind].coset:
+        residual = relation_residual(relation.kind, first, second, options)
+        return Constraint(
+            (source, target),
+            lambda poses: residual(se3.inverse(poses[0]) @ poses[1]),
+            (label,),
+        )
+    value = relation_coset(relation.kind, first, second, options)
+    make = partial(relation_residual, relation.kind, first, second, options, current())
+    return Link(source, target, value, (label,), make)
+
+
+def build_network(task: Task) -> Network:
+    """The relational network of a (validated) task: body instances and links (seed 000 §III)."""
+    fixed = frozenset(name for name, body in task.bodies.items() if body.fixed)
+    situations = tuple(s.name for s in task.situations)
+    instances = tuple((b, s) for s in situations for b in task.bodies if b not in fixed)
+    links: list[Link] = []
+    constraints: list[Constraint] = []
+    for index, situation in enumerate(task.situations):
+
+        def node(body: str, name: str = situation.name) -> Node:
+            return WORLD if body in fixed else (body, name)
+
+        if index > 0:
+            links.extend(_transition(task, situation, situations[index - 1], fixed))
+        for relation in situation.relations:
+            part = _relation_part(task, situation, relation, node)
+            (links if isinstance(part, Link) else constraints).append(part)
+    return Network(
+        instances, tuple(links), tuple(constraints), situations, tuple(task.bodies), fixed
+    )
+
+
+def _transition(
+    task: Task, situation: Situation, previous: str, fixed: frozenset[str]
+) -> list[Link]:
+    """Action links into ``situation`` and identity links for the bodies left in place."""
+    links: list[Link] = []
+    moved = {action.body for action in situation.actions}
+    for action in situation.actions:
+        link = _action_link(task, action, (action.body, previous), (action.body, situation.name))
+        if link is not None:
+            links.append(link)
+    for body in task.bodies:
+        if body in fixed or body in moved:
+            continue
+        links.append(
+            Link(
+                (body, previous),
+                (body, situation.name),
+                point_coset(np.eye(4)),
+                (f"stationary {body} @{situation.name}",),
+                partial(_fixed_residual, np.eye(4), current().scale),
+            )
+        )
+    return links

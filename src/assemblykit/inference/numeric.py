@@ -1,0 +1,305 @@
+"""The residue solver: what network reduction leaves, solved numerically (seed 000 §III G).
+
+Seed 000 hands "the residue" of the cycle finder to "a more powerful inference system".
+Here that system is a least-squares solve over the world poses of the remaining body
+instances (ALGEBRA.md §2.5, "numeric fallback"):
+
+* every unknown pose is parameterised locally by a twist: ``L = [exp(ω) R0 | t0 + v]``;
+* every constraint is a residual vector over the poses of the instances it links;
+* a deterministic (seeded) multi-start of ``scipy.optimize.least_squares`` collects all
+  isolated solutions, deduplicated by pose distance;
+* continuous freedom is measured by the rank of the constraint Jacobian at a solution:
+  the per-instance dof is the rank of that instance's block of the Jacobian's null space;
+* the solver never claims emptiness: it reports "no solution found" with the best residual.
+
+It also defines the two coupled relations that are not relations between two features
+in the coset sense (seed 000 §III G, "the jaws of a gripper ... equal and opposite";
+seed 003 Fig. 9, gear pairs): :func:`gear_residual` and :func:`mirror_residual`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from assemblykit.tolerance import Tolerance, current
+
+Residual = Callable[[Sequence[np.ndarray]], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """A residual over the world poses of ``nodes`` (zero exactly when it holds).
+
+    ``labels`` name the relations or actions it comes from (for conflict reports).
+    """
+
+    nodes: tuple[Hashable, ...]
+    residual: Residual
+    labels: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class ResidueProblem:
+    """Unknown instances with start poses, known instances with poses, and constraints."""
+
+    unknowns: tuple[Hashable, ...]
+    start: Mapping[Hashable, np.ndarray]
+    known: Mapping[Hashable, np.ndarray]
+    constraints: tuple[Constraint, ...]
+
+
+@dataclass(frozen=True)
+class NumericSolution:
+    """One solution: world poses, per-instance dof and the total dof of the residue."""
+
+    poses: Mapping[Hashable, np.ndarray]
+    dof: Mapping[Hashable, int]
+    total_dof: int
+    residual: float
+
+
+@dataclass(frozen=True)
+class ResidueResult:
+    """All solutions found (isolated ones first), or none with the best residual reached."""
+
+    solutions: tuple[NumericSolution, ...]
+    best_residual: float
+    starts: int = field(default=0)
+
+    @property
+    def found(self) -> bool:
+        """Whether at least one solution was found (never a proof of emptiness otherwise)."""
+        return bool(self.solutions)
+
+
+def pose_from_twist(start: np.ndarray, twist: np.ndarray) -> np.ndarray:
+    """The pose ``[exp(ω) R0 | t0 + v]`` for the local coordinates ``twist = (ω; v)``."""
+    pose = np.eye(4)
+    pose[:3, :3] = Rotation.from_rotvec(twist[:3]).as_matrix() @ start[:3, :3]
+    pose[:3, 3] = start[:3, 3] + twist[3:]
+    return pose
+
+
+def _scaled(constraint: Constraint, poses: Mapping[Hashable, np.ndarray]) -> np.ndarray:
+    return np.atleast_1d(
+        np.asarray(constraint.residual([poses[n] for n in constraint.nodes]), dtype=np.float64)
+    )
+
+
+def _residual_vector(
+    problem: ResidueProblem, starts: Mapping[Hashable, np.ndarray], x: np.ndarray
+) -> tuple[np.ndarray, dict[Hashable, np.ndarray]]:
+    poses = dict(problem.known)
+    for i, node in enumerate(problem.unknowns):
+        poses[node] = pose_from_twist(starts[node], x[6 * i : 6 * i + 6])
+    parts = [_scaled(c, poses) for c in problem.constraints]
+    return (np.concatenate(parts) if parts else np.zeros(0)), poses
+
+
+def _local_dof(
+    problem: ResidueProblem, jac: Any, tol: Tolerance
+) -> tuple[dict[Hashable, int], int]:
+    """Per-instance and total dof from the null space of the constraint Jacobian at a
+    solution (ALGEBRA.md §2.5 step 5). The local coordinates of each instance differ
+    from twists at the solution by an invertible map, which keeps every rank."""
+    n = 6 * len(problem.unknowns)
+    dense = jac.toarray() if hasattr(jac, "toarray") else np.asarray(jac, dtype=np.float64)
+    dense = dense * np.tile(np.concatenate([np.ones(3), np.full(3, tol.scale)]), n // 6)
+    if dense.shape[0] == 0:
+        null = np.eye(n)
+    else:
+        _, sv, vt = np.linalg.svd(dense, full_matrices=True)
+        rank = int(np.sum(sv > tol.mesh_angle * max(sv[0], 1.0))) if sv.size else 0
+        null = vt[rank:].T
+    dof = {}
+    for i, node in enumerate(problem.unknowns):
+        block = null[6 * i : 6 * i + 6]
+        sv = np.linalg.svd(block, compute_uv=False) if block.size else np.zeros(0)
+        dof[node] = int(np.sum(sv > tol.mesh_angle))
+    return dof, null.shape[1]
+
+
+def _distance(
+    a: Mapping[Hashable, np.ndarray], b: Mapping[Hashable, np.ndarray], scale: float
+) -> float:
+    """Largest pose difference over instances: rotation entries plus translation / scale."""
+    return max(
+        float(np.abs(a[k][:3, :3] - b[k][:3, :3]).max())
+        + float(np.abs(a[k][:3, 3] - b[k][:3, 3]).max()) / scale
+        for k in a
+    )
+
+
+def _sparsity(problem: ResidueProblem, start: Mapping[Hashable, np.ndarray]) -> np.ndarray:
+    """Which residual rows depend on which unknowns (6 columns per unknown instance), so
+    that finite differences are grouped (a network of N bodies costs O(1) residuals per
+    Jacobian, not O(N))."""
+    column = {node: 6 * i for i, node in enumerate(problem.unknowns)}
+    poses = {**problem.known, **start}
+    rows = []
+    for constraint in problem.constraints:
+        block = np.zeros((_scaled(constraint, poses).size, 6 * len(problem.unknowns)), bool)
+        for node in constraint.nodes:
+            if node in column:
+                block[:, column[node] : column[node] + 6] = True
+        rows.append(block)
+    return np.vstack(rows) if rows else np.zeros((0, 6 * len(problem.unknowns)), bool)
+
+
+def _start_points(problem: ResidueProblem, count: int, seed: int, scale: float) -> list[np.ndarray]:
+    """The deterministic multi-start: the given start, then seeded random twists."""
+    n = 6 * len(problem.unknowns)
+    rng = np.random.default_rng(seed)
+    points = [np.zeros(n)]
+    for _ in range(count - 1):
+        twist = np.empty(n)
+        for i in range(len(problem.unknowns)):
+            twist[6 * i : 6 * i + 3] = Rotation.random(random_state=rng).as_rotvec()
+            twist[6 * i + 3 : 6 * i + 6] = rng.uniform(-scale, scale, 3)
+        points.append(twist)
+    return points
+
+
+def solve_residue(
+    problem: ResidueProblem,
+    tol: Tolerance | None = None,
+    *,
+    starts: int = 8,
+    seed: int = 0,
+) -> ResidueResult:
+    """Solve the residue numerically (ALGEBRA.md §2.5 numeric fallback, steps 1-6).
+
+    Solutions are accepted when every residual entry is within ``tol.mesh_length`` (a
+    numeric solution is approximate geometry, like a mesh). Isolated solutions from
+    different starts are deduplicated by pose distance; the first solution on a
+    continuum (total dof > 0) ends the search and is its representative. ``tol.scale``
+    is the length scale of the start spread.
+    """
+    tol = tol or current()
+    if not problem.unknowns:
+        r, poses = _residual_vector(problem, {}, np.zeros(0))
+        worst = float(np.abs(r).max()) if r.size else 0.0
+        sols = (NumericSolution(dict(poses), {}, 0, worst),) if worst <= tol.mesh_length else ()
+        return ResidueResult(sols, worst, 1)
+    origin = {node: np.asarray(problem.start[node], dtype=np.float64) for node in problem.unknowns}
+    found: list[NumericSolution] = []
+    best = np.inf
+    points = _start_points(problem, starts, seed, tol.scale)
+    sparsity = _sparsity(problem, origin)
+    for x0 in points:
+        moved = {
+            node: pose_from_twist(origin[node], x0[6 * i : 6 * i + 6])
+            for i, node in enumerate(problem.unknowns)
+        }
+        fit = least_squares(
+            lambda x, moved=moved: _residual_vector(problem, moved, x)[0],
+            np.zeros(x0.size),
+            method="trf",
+            jac_sparsity=sparsity,
+            x_scale="jac",
+            xtol=tol.rel_length,
+            ftol=tol.rel_length,
+            gtol=tol.rel_length,
+        )
+        r, poses = _residual_vector(problem, moved, fit.x)
+        worst = float(np.abs(r).max()) if r.size else 0.0
+        best = min(best, worst)
+        if worst > tol.mesh_length:
+            continue
+        poses = {node: poses[node] for node in problem.unknowns}
+        # an angle θ weighs like the arc θ·scale at the model's size, as in the residuals
+        if any(_distance(poses, s.poses, tol.scale) <= tol.mesh_angle for s in found):
+            continue
+        dof, total = _local_dof(problem, fit.jac, tol)
+        found.append(NumericSolution(poses, dof, total, worst))
+        if total > 0:  # a continuum: one representative answers for it
+            break
+    continua = [s for s in found if s.total_dof > 0]
+    isolated = [s for s in found if s.total_dof == 0]
+    return ResidueResult(tuple(isolated or continua[:1]), float(best), len(points))
+
+
+def wrap_angle(angle: float) -> float:
+    """The angle in (-π, π]."""
+    return float(np.pi - np.mod(np.pi - angle, 2 * np.pi))
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of two 3-vectors (np.cross is slow on single small vectors)."""
+    return np.array(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )
+
+
+def signed_angle(a: np.ndarray, b: np.ndarray, axis: np.ndarray) -> float:
+    """The angle from ``a`` to ``b`` measured counter-clockwise about the unit ``axis``."""
+    return float(np.arctan2(np.dot(_cross(a, b), axis), np.dot(a, b)))
+
+
+def rotation_about(rotation: np.ndarray, axis: np.ndarray) -> float:
+    """The angle θ of a rotation matrix about the unit ``axis`` (exact when the rotation is
+    about that axis): the signed angle from a vector perpendicular to the axis to its image."""
+    helper = np.eye(3)[int(np.argmin(np.abs(axis)))]
+    ortho = _cross(axis, helper)
+    ortho /= np.linalg.norm(ortho)
+    return signed_angle(ortho, rotation @ ortho, axis)
+
+
+def gear_residual(
+    first_frame: np.ndarray, second_frame: np.ndarray, ratio: float, scale: float = 1.0
+) -> Residual:
+    """The coupled relation ``gear``: two bodies turning about their axes in a fixed ratio.
+
+    Semantics (seed 003 Fig. 9: gears on a common carrier): each body turns about its
+    feature's axis (+z of ``first_frame`` / ``second_frame``) relative to the carrier (the
+    body both gears are related to; their revolute joints are separate relations). In the
+    reference pose every body frame coincides with the carrier's frame, so the axes in
+    body coordinates are the axes in the carrier. With ``X1``, ``X2`` the gears' poses in
+    the carrier and θi the rotation angle of ``Xi`` about axis i (0 in the reference
+    pose), the relation holds when ``θ2 = ratio·θ1`` (angles in (-π, π]; an external spur
+    pair with n1 and n2 teeth has ``ratio = -n1/n2``). The residual is that angle
+    difference times ``scale`` (a length, like every residual). It takes the world poses
+    ``(L1, L2, L_carrier)``.
+    """
+    axis1, axis2 = first_frame[:3, 2], second_frame[:3, 2]
+
+    def residual(poses: Sequence[np.ndarray]) -> np.ndarray:
+        to_carrier = np.linalg.inv(poses[2])[:3, :3]
+        theta1 = rotation_about(to_carrier @ poses[0][:3, :3], axis1)
+        theta2 = rotation_about(to_carrier @ poses[1][:3, :3], axis2)
+        return np.array([wrap_angle(theta2 - ratio * theta1) * scale])
+
+    return residual
+
+
+def mirror_residual(
+    first_frame: np.ndarray, second_frame: np.ndarray, direction: np.ndarray
+) -> Residual:
+    """The coupled relation ``mirror``: two bodies moving equal and opposite along a direction.
+
+    Semantics (seed 000 §III G: gripper jaws "constrained to move in equal and opposite
+    directions by the same amount"): the jaws move relative to a carrier (the palm, the
+    body both jaws are related to). In the reference pose every body frame coincides with
+    the carrier's frame, so the features' origins ``o1``, ``o2`` (in their bodies) are
+    their reference positions in the carrier. With ``X1``, ``X2`` the jaws' poses in the
+    carrier and ``n`` the unit ``direction`` (in the carrier), the displacements along
+    ``n`` are opposite: ``n·(X1 o1 - o1) + n·(X2 o2 - o2) = 0``, i.e. the midpoint of the
+    two features keeps its reference position along ``n``. Other freedoms of the jaws are
+    left to their own relations (usually a prismatic joint each to the palm). The
+    residual takes the world poses ``(L1, L2, L_carrier)``.
+    """
+    o1, o2 = first_frame[:3, 3], second_frame[:3, 3]
+
+    def residual(poses: Sequence[np.ndarray]) -> np.ndarray:
+        to_carrier = np.linalg.inv(poses[2])
+        moved1 = (to_carrier @ poses[0])[:3] @ np.append(o1, 1.0)
+        moved2 = (to_carrier @ poses[1])[:3] @ np.append(o2, 1.0)
+        return np.array([np.dot(direction, moved1 - o1 + moved2 - o2)])
+
+    return residual

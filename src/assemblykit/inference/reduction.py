@@ -1,0 +1,789 @@
+"""Reduction of the relational network to a fixpoint (seed 000 §III C-F, ALGEBRA.md §5.2).
+
+The rules, in the seed's order:
+
+1. **Intersection** (standard solutions): two links between the same pair of instances
+   are intersected (``Coset.intersect``); an empty result is an inconsistency, recorded
+   with the relations involved and the mismatch (ALGEBRA.md §2.5).
+2. **Merge** on a fixed link (a single point ``X``): the target instance is merged into
+   the source, and every link of the merged instance is re-expressed
+   (``Q ↦ X·Q``, ``P ↦ P·X⁻¹``), which may enable new intersections.
+3. **Branching** on a link of finitely many points: every point is tried (depth first);
+   the answers of the consistent branches are listed together (status ``ambiguous``).
+   A **lattice** (dof 0, infinitely many components) is flagged and not merged.
+4. **Cycles** of length ≤ 4, only when no intersection or merge applies: the links of a
+   cycle but one are chained (``Coset.product``) and intersected with the last; a result
+   with fewer dof replaces it. A revolute-revolute chain closing on a revolute link (the
+   planar four-bar with its crank stopped, two revolutes closing a loop) is solved in
+   closed form by circle-circle intersection (0, 1 or 2 points).
+5. **Termination**: each remaining instance gets its pose set relative to the world:
+   a coset (product along a tree path from the world), a finite set, or, for what the
+   rules cannot express (non-coset relations, unresolved cycles, chains that are not
+   cosets), the residue solved numerically (:mod:`assemblykit.inference.numeric`).
+
+Work is driven by a worklist (insertions and merges), so a network that merges from the
+world outward is reduced in near-linear time; cycles are searched only at a fixpoint.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections import deque
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import networkx as nx
+import numpy as np
+
+from assemblykit.algebra import Coset, EmptySet, se3
+from assemblykit.inference.network import (
+    WORLD,
+    Link,
+    Network,
+    Node,
+    build_network,
+    instance_key,
+    point_coset,
+)
+from assemblykit.inference.numeric import (
+    Constraint,
+    ResidueProblem,
+    signed_angle,
+    solve_residue,
+)
+from assemblykit.inference.solution import (
+    BodyInstanceResult,
+    Conflict,
+    Solution,
+    TraceStep,
+)
+from assemblykit.tolerance import Tolerance, current, using
+
+CYCLE_LENGTH = 4  # seed 000 §III F: "we restrict the size of the cycles ... to four"
+
+
+def _kind_name(value: Any) -> str:
+    """The Hervé family of a coset's group, named as the solve JSON's motions."""
+    return str(value.kind)
+
+
+def _components(value: Any) -> int | None:
+    """Number of components, ``None`` for infinitely many (a lattice)."""
+    n = value.n_components
+    return None if n is None or (isinstance(n, float) and math.isinf(n)) else int(n)
+
+
+def _is_finite_branch(value: Any) -> bool:
+    n = _components(value)
+    return value.dof == 0 and n is not None and n > 1
+
+
+@dataclass
+class _Edge:
+    """A live link between two representative instances: ``inv(L_source) @ L_target``."""
+
+    source: Node
+    target: Node
+    value: Any
+    labels: tuple[str, ...]
+
+    def oriented(self, source: Node) -> Any:
+        """The set of ``inv(L_source) @ L_other`` seen from ``source``."""
+        return self.value if source == self.source else self.value.inverse()
+
+
+@dataclass
+class Reducer:
+    """The state of one reduction: merged instances, live links, conflicts and trace."""
+
+    tol: Tolerance
+    parent: dict[Node, tuple[Node, np.ndarray]] = field(default_factory=dict)
+    edges: dict[frozenset[Node], _Edge] = field(default_factory=dict)
+    adjacency: dict[Node, set[Node]] = field(default_factory=dict)
+    conflicts: list[Conflict] = field(default_factory=list)
+    trace: list[TraceStep] = field(default_factory=list)
+    pending: deque[tuple[Node, Node, Any, tuple[str, ...]]] = field(default_factory=deque)
+    merges: deque[frozenset[Node]] = field(default_factory=deque)
+    loops: list[list[list[tuple[frozenset[Node], Node, np.ndarray]]]] = field(default_factory=list)
+    deferred: set[frozenset[Node]] = field(default_factory=set)
+
+    def copy(self) -> Reducer:
+        """An independent copy for branching (link values are immutable)."""
+        return Reducer(
+            self.tol,
+            dict(self.parent),
+            {k: _Edge(e.source, e.target, e.value, e.labels) for k, e in self.edges.items()},
+            {k: set(v) for k, v in self.adjacency.items()},
+            list(self.conflicts),
+            list(self.trace),
+            deque(self.pending),
+            deque(self.merges),
+            list(self.loops),
+            set(self.deferred),
+        )
+
+    def find(self, node: Node) -> tuple[Node, np.ndarray]:
+        """The representative of ``node`` and ``X`` with ``L_node = L_rep @ X``."""
+        path = []
+        transform = np.eye(4)
+        while node in self.parent:
+            path.append(node)
+            up, step = self.parent[node]
+            transform = step @ transform
+            node = up
+        if len(path) > 1:  # path compression keeps later finds short
+            acc = np.eye(4)
+            for member in reversed(path):
+                acc = acc @ self.parent[member][1]
+                self.parent[member] = (node, acc)
+        return node, transform
+
+    def add(self, link: Link) -> None:
+        """Queue a link of the network (a relation that is empty by itself is a conflict)."""
+        if isinstance(link.value, EmptySet):
+            self._record_conflict(link.labels, link.value)
+            return
+        self.pending.append((link.source, link.target, link.value, link.labels))
+
+    def _record_conflict(self, labels: tuple[str, ...], empty: Any) -> None:
+        mismatch = empty.mismatch
+        self.conflicts.append(
+            Conflict(
+                tuple(dict.fromkeys(labels)),
+                str(mismatch.kind),
+                float(mismatch.value),
+                str(mismatch.message),
+            )
+        )
+
+    def _insert(self, source: Node, target: Node, value: Any, labels: tuple[str, ...]) -> None:
+        rs, a = self.find(source)
+        rt, b = self.find(target)
+        if rs != source:
+            value = value.left(a)
+        if rt != target:
+            value = value.right(se3.inverse(b))
+        if rs == rt:
+            if not value.contains(np.eye(4)):
+                check = value.intersect(point_coset(np.eye(4)))
+                if isinstance(check, EmptySet):
+                    self._record_conflict(labels, check)
+            return
+        key = frozenset((rs, rt))
+        edge = self.edges.get(key)
+        if edge is None:
+            self.edges[key] = _Edge(rs, rt, value, labels)
+            self.adjacency.setdefault(rs, set()).add(rt)
+            self.adjacency.setdefault(rt, set()).add(rs)
+            if value.is_point:
+                self.merges.append(key)
+            return
+        incoming = value if edge.source == rs else value.inverse()
+        if edge.value.group.lattice or incoming.group.lattice:
+            # lattices are flagged, not intersected: the pair is left to the residue
+            self.deferred.add(key)
+            self.trace.append(TraceStep("lattice", self._edge_text(edge, labels), 0, 0, "kept"))
+            return
+        result = edge.value.intersect(incoming)
+        if isinstance(result, EmptySet):
+            self._record_conflict(edge.labels + labels, result)
+            return
+        self.trace.append(
+            TraceStep(
+                "intersect",
+                self._edge_text(edge, labels),
+                min(edge.value.dof, incoming.dof),
+                result.dof,
+                _kind_name(result),
+            )
+        )
+        edge.value = result
+        edge.labels = edge.labels + labels
+        if result.is_point:
+            self.merges.append(key)
+
+    def _edge_text(self, edge: _Edge, extra: tuple[str, ...] = ()) -> str:
+        names = "; ".join(dict.fromkeys(edge.labels + extra))
+        return f"{instance_key(edge.source)} -> {instance_key(edge.target)} [{names}]"
+
+    def _merge(self, key: frozenset[Node]) -> None:
+        edge = self.edges.get(key)
+        if edge is None or not edge.value.is_point:
+            return
+        x = np.asarray(edge.value.points()[0], dtype=np.float64)
+        keep, gone = edge.source, edge.target
+        if gone == WORLD or (
+            keep != WORLD and len(self.adjacency[keep]) < len(self.adjacency[gone])
+        ):
+            keep, gone, x = gone, keep, se3.inverse(x)
+        del self.edges[key]
+        self.adjacency[keep].discard(gone)
+        self.adjacency[gone].discard(keep)
+        self.parent[gone] = (keep, x)
+        self.trace.append(TraceStep("merge", self._edge_text(edge), 0, 0, instance_key(gone)))
+        for other in self.adjacency.pop(gone, set()):
+            moved = self.edges.pop(frozenset((gone, other)))
+            self.adjacency[other].discard(gone)
+            self.pending.appendleft((moved.source, moved.target, moved.value, moved.labels))
+
+    def settle(self) -> None:
+        """Apply intersections and merges until neither applies (rules 1 and 2).
+
+        Merges go first, so later relations meet instances already merged into the world
+        and cost a membership test instead of an intersection."""
+        while self.pending or self.merges:
+            if self.merges:
+                self._merge(self.merges.popleft())
+            else:
+                self._insert(*self.pending.popleft())
+
+    def branch_choice(self) -> list[list[tuple[frozenset[Node], Node, np.ndarray]]] | None:
+        """Alternatives to branch on (rule 3): the points of a finite link, or the
+        assembly modes of a closed loop; each alternative sets links to single points."""
+        if self.loops:
+            return self.loops.pop()
+        for key, edge in self.edges.items():
+            if _is_finite_branch(edge.value):
+                return [[(key, edge.source, np.asarray(p))] for p in edge.value.points()]
+        return None
+
+    def choose(self, alternative: list[tuple[frozenset[Node], Node, np.ndarray]]) -> None:
+        """Set links to single points (one branch of rule 3)."""
+        for key, source, point in alternative:
+            edge = self.edges[key]
+            value = point_coset(point)
+            edge.value = value if source == edge.source else value.inverse()
+            self.trace.append(TraceStep("branch", self._edge_text(edge), 0, 0, "one point"))
+            self.merges.append(key)
+
+    def cycles(self) -> Iterator[list[Node]]:
+        """Cycles of 3 or 4 live links (rule 4)."""
+        graph = nx.Graph(list(self.edges))
+        return (c for c in nx.simple_cycles(graph, length_bound=CYCLE_LENGTH) if len(c) >= 3)
+
+    def reduce_cycle(self, cycle: list[Node]) -> bool:
+        """Chain all links of ``cycle`` but one and intersect with it; True on progress."""
+        n = len(cycle)
+        if any(
+            self.edges[frozenset((cycle[k], cycle[k - 1]))].value.group.lattice for k in range(n)
+        ):
+            return False  # lattices are not chained (rule 3: flagged, left to the residue)
+        for start in range(n):
+            a, b = cycle[start], cycle[(start + 1) % n]
+            closing = self.edges[frozenset((a, b))]
+            path = [cycle[(start - k) % n] for k in range(n)]  # a, then around to b
+            chained = self._chain(path)
+            direct = closing.oriented(a)
+            labels = tuple(
+                label
+                for k in range(n - 1)
+                for label in self.edges[frozenset((path[k], path[k + 1]))].labels
+            )
+            if isinstance(chained, Coset):
+                result = direct.intersect(chained)
+                if isinstance(result, EmptySet):
+                    self._record_conflict(closing.labels + labels, result)
+                    return True
+                if _progress(direct, result):
+                    self._replace(closing, a, result, labels, "chain")
+                    return True
+            elif n == 3:
+                points = revolute_loop(
+                    self.edges[frozenset((path[0], path[1]))].oriented(path[0]),
+                    self.edges[frozenset((path[1], path[2]))].oriented(path[1]),
+                    direct,
+                    self.tol,
+                )
+                if points is not None:
+                    return self._apply_loop(closing, path, points, labels)
+        return False
+
+    def _chain(self, path: list[Node]) -> Any:
+        """The product of the links along ``path`` (a Coset, or a Chain when not a coset)."""
+        value = self.edges[frozenset((path[0], path[1]))].oriented(path[0])
+        for k in range(1, len(path) - 1):
+            if not isinstance(value, Coset):
+                return value
+            value = value.product(self.edges[frozenset((path[k], path[k + 1]))].oriented(path[k]))
+        return value
+
+    def _replace(
+        self, closing: _Edge, source: Node, value: Any, labels: tuple[str, ...], rule: str
+    ) -> None:
+        before = closing.value.dof
+        oriented = value if source == closing.source else value.inverse()
+        closing.value = oriented
+        closing.labels = tuple(dict.fromkeys(closing.labels + labels))
+        self.trace.append(
+            TraceStep(rule, self._edge_text(closing), before, oriented.dof, _kind_name(oriented))
+        )
+        if oriented.is_point:
+            self.merges.append(frozenset((closing.source, closing.target)))
+
+    def _apply_loop(
+        self,
+        closing: _Edge,
+        path: list[Node],
+        points: list[tuple[np.ndarray, np.ndarray]],
+        labels: tuple[str, ...],
+    ) -> bool:
+        """Record the closed-form loop answer: no point is a conflict, one or two points
+        become a branch over the assembly modes (each sets both links to a point)."""
+        if not points:
+            self.conflicts.append(
+                Conflict(
+                    tuple(dict.fromkeys(closing.labels + labels)),
+                    "loop",
+                    0.0,
+                    "the two revolute joints cannot close the loop (the joint circles miss)",
+                )
+            )
+            return True
+        self.trace.append(
+            TraceStep(
+                "loop",
+                self._edge_text(closing, labels),
+                closing.value.dof,
+                0,
+                f"revolute-revolute closure, {len(points)} point(s)",
+            )
+        )
+        first_key = frozenset((path[0], path[1]))
+        close_key = frozenset((path[0], path[-1]))
+        self.loops.append([[(first_key, path[0], p), (close_key, path[0], q)] for p, q in points])
+        return True
+
+    def run(self) -> None:
+        """Rules 1-2 to a fixpoint, then cycles (rule 4) while they make progress."""
+        self.settle()
+        while not self.loops and not self.conflicts and not self._has_finite():
+            if not any(self.reduce_cycle(c) for c in self.cycles()):
+                return
+            self.settle()
+
+    def _has_finite(self) -> bool:
+        return any(_is_finite_branch(e.value) for e in self.edges.values())
+
+
+def _progress(before: Any, after: Any) -> bool:
+    """Whether a chained intersection removed freedom (dof, then number of components)."""
+    if after.dof != before.dof:
+        return after.dof < before.dof
+    b, a = _components(before), _components(after)
+    return a is not None and (b is None or a < b)
+
+
+def _circle_circle(
+    c1: np.ndarray, n1: np.ndarray, r1: float, c2: np.ndarray, n2: np.ndarray, r2: float, tol
+) -> list[np.ndarray] | None:
+    """Common points of two circles in 3D (centre, unit normal, radius); None if they
+    coincide (a continuum). Coplanar circles meet in 0, 1 or 2 points."""
+    if np.linalg.norm(np.cross(n1, n2)) > tol.angle:
+        return None
+    if abs(np.dot(n1, c2 - c1)) > tol.length:
+        return []
+    d = c2 - c1
+    dist = float(np.linalg.norm(d))
+    if dist <= tol.length:
+        return None if abs(r1 - r2) <= tol.length else []
+    along = (dist**2 + r1**2 - r2**2) / (2 * dist)
+    h2 = r1**2 - along**2
+    if h2 < -2 * r1 * tol.length:
+        return []
+    u = d / dist
+    base = c1 + along * u
+    if h2 <= 2 * r1 * tol.length:
+        return [base]
+    side = np.cross(n1, u)
+    h = math.sqrt(h2)
+    return [base + h * side, base - h * side]
+
+
+def _axis(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
+    """Axis point and unit direction of a revolute coset (world of its source)."""
+    if _kind_name(value) != "revolute" or _components(value) != 1:
+        return None
+    return value.group.origin, value.group.axis
+
+
+def _rotation_about(point: np.ndarray, direction: np.ndarray, angle: float) -> np.ndarray:
+    return se3.translation(point) @ se3.rotation(direction, angle) @ se3.translation(-point)
+
+
+def _foot(point: np.ndarray, origin: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    return origin + np.dot(point - origin, direction) * direction
+
+
+def revolute_loop(
+    first: Any, second: Any, closing: Any, tol: Tolerance
+) -> list[tuple[np.ndarray, np.ndarray]] | None:
+    """Closed-form R·R ∩ R (ALGEBRA.md §5.2 rule 4: "the orbit of a point under two
+    revolutes gives circle-circle intersections").
+
+    ``first`` (i→j), ``second`` (j→k) and ``closing`` (i→k) are revolute cosets with
+    parallel axes. The joint point q on the j→k axis traces a circle under ``first``
+    (in i's frame) and, carried by k, a circle under ``closing``; each common point fixes
+    both angles. Returns the pairs ``(X_ij, X_ik)`` (0, 1 or 2), or None when the pattern
+    does not apply (not three revolutes, non-parallel axes, or a continuum).
+    """
+    axes = [_axis(v) for v in (first, second, closing)]
+    if any(a is None for a in axes):
+        return None
+    (p1, u1), (p2, _), (p3, u3) = axes  # the joint axis point p2 is in j's frame
+    x_first, x_close = first.rep, closing.rep
+    q_world = x_first @ np.append(p2, 1.0)  # joint point at the first's representative
+    q_in_k = se3.inverse(x_close) @ x_first @ se3.inverse(second.rep)
+    q_in_k = (q_in_k @ np.append(p2, 1.0))[:3]
+    q0 = q_world[:3]
+    q1 = (x_close @ np.append(q_in_k, 1.0))[:3]
+    c1, c3 = _foot(q0, p1, u1), _foot(q1, p3, u3)
+    if np.dot(u1, u3) < 0:
+        u3 = -u3
+    meets = _circle_circle(
+        c1, u1, float(np.linalg.norm(q0 - c1)), c3, u3, float(np.linalg.norm(q1 - c3)), tol
+    )
+    if meets is None:
+        return None
+    answers = []
+    for point in meets:
+        a1 = signed_angle(q0 - c1, point - c1, u1)
+        a3 = signed_angle(q1 - c3, point - c3, u3)
+        x_ij = _rotation_about(p1, u1, a1) @ x_first
+        x_ik = _rotation_about(p3, u3, a3) @ x_close
+        if second.contains(se3.inverse(x_ij) @ x_ik):
+            answers.append((x_ij, x_ik))
+    return answers
+
+
+@dataclass(frozen=True)
+class _Instance:
+    """What one leaf of the reduction says about one representative instance."""
+
+    pose: np.ndarray
+    dof: int
+    motion: str
+    solutions: int | None = 1
+    alternatives: tuple[np.ndarray, ...] = ()
+    invariants: Mapping[str, Any] = field(default_factory=dict)
+
+
+def _motion(value: Any) -> tuple[str, Mapping[str, Any]]:
+    """Motion name and world invariants of a coset relative to the world (its group is
+    in the world frame): axis ``point`` and ``direction``, ``normal``, ``center``, ``pitch``."""
+    invariants = dict(value.group.invariants)
+    if "axis" in invariants:
+        invariants["direction"] = invariants.pop("axis")
+    if _kind_name(value) == "spherical":
+        invariants["center"] = invariants.pop("point")
+    return _kind_name(value), invariants
+
+
+def explore(reducer: Reducer, max_branches: int) -> list[Reducer]:
+    """Run the reduction, branching depth first on finite alternatives (rule 3).
+
+    At most ``max_branches`` leaves are explored; past that, only the first alternative
+    of a choice is followed.
+    """
+    reducer.run()
+    leaves: list[Reducer] = []
+    stack = [reducer]
+    while stack:
+        state = stack.pop()
+        choice = None if state.conflicts else state.branch_choice()
+        if choice is None:
+            leaves.append(state)
+            continue
+        if len(leaves) + len(stack) + len(choice) > max_branches:
+            choice = choice[:1]
+        children = []
+        for alternative in choice:
+            child = state.copy()
+            child.choose(alternative)
+            child.run()
+            children.append(child)
+        stack.extend(reversed(children))
+    return leaves
+
+
+def _components_of(network: Network, reducer: Reducer) -> list[set[Node]]:
+    """Connected groups of representatives (live links and general constraints)."""
+    graph = nx.Graph()
+    graph.add_node(WORLD)
+    for node in network.instances:
+        graph.add_node(reducer.find(node)[0])
+    graph.add_edges_from(tuple(key) for key in reducer.edges)
+    for constraint in network.constraints:
+        reps = [reducer.find(n)[0] for n in constraint.nodes]
+        graph.add_edges_from(itertools.pairwise(reps))
+    return [set(c) for c in nx.connected_components(graph)]
+
+
+def _tree_sets(
+    reducer: Reducer, component: set[Node], root: Node
+) -> tuple[dict[Node, np.ndarray], dict[Node, Any]]:
+    """Poses along a BFS tree from ``root`` and the chained set of each node relative to it."""
+    poses = {root: np.eye(4)}
+    sets: dict[Node, Any] = {}
+    tree = nx.Graph()
+    tree.add_nodes_from(component)
+    tree.add_edges_from(tuple(k) for k in reducer.edges if k <= component)
+    for parent, child in nx.bfs_edges(tree, root):
+        link = reducer.edges[frozenset((parent, child))].oriented(parent)
+        poses[child] = poses[parent] @ np.asarray(link.rep, dtype=np.float64)
+        above = sets.get(parent)
+        sets[child] = (
+            link if above is None else (above.product(link) if isinstance(above, Coset) else above)
+        )
+    return poses, sets
+
+
+def _residue_constraints(
+    network: Network, reducer: Reducer, component: set[Node]
+) -> tuple[Constraint, ...]:
+    """The original relations of a component, over the poses of the representatives."""
+    out: list[Constraint] = []
+    items = [network.link_constraint(link) for link in network.links]
+    for constraint in (*items, *network.constraints):
+        found = [reducer.find(n) for n in constraint.nodes]
+        if not all(rep in component for rep, _ in found):
+            continue
+        reps = tuple(dict.fromkeys(rep for rep, _ in found))
+        places = [reps.index(rep) for rep, _ in found]
+        offsets = [x for _, x in found]
+
+        def residual(
+            poses: Sequence[np.ndarray],
+            c: Constraint = constraint,
+            places: list[int] = places,
+            offsets: list[np.ndarray] = offsets,
+        ) -> np.ndarray:
+            return c.residual([poses[i] @ x for i, x in zip(places, offsets, strict=True)])
+
+        out.append(Constraint(reps, residual, constraint.labels))
+    return tuple(out)
+
+
+def _solve_component(
+    network: Network, reducer: Reducer, component: set[Node], tol: Tolerance
+) -> tuple[dict[Node, _Instance], list[Conflict]]:
+    """Rule 5 for one connected group of representatives."""
+    if WORLD not in component:
+        root = min(component)
+        poses, _ = _tree_sets(reducer, component, root)
+        return {n: _Instance(poses.get(n, np.eye(4)), 6, "free") for n in component}, []
+    poses, sets = _tree_sets(reducer, component, WORLD)
+    constrained = any(
+        all(reducer.find(n)[0] in component for n in c.nodes) for c in network.constraints
+    )
+    tree_like = (
+        len(poses) == len(component)
+        and sum(1 for k in reducer.edges if k <= component) == len(component) - 1
+        and not any(k <= component for k in reducer.deferred)
+    )
+    if (
+        tree_like and not constrained and all(isinstance(v, Coset) for v in sets.values())
+    ) or reducer.conflicts:
+        # a tree of cosets needs no residue; an inconsistent network is not solved further
+        out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
+        for node in component - {WORLD}:
+            value = sets.get(node)
+            if isinstance(value, Coset):
+                motion, invariants = _motion(value)
+                out[node] = _Instance(
+                    poses[node], value.dof, motion, _components(value), (), invariants
+                )
+            else:
+                out[node] = _Instance(poses.get(node, np.eye(4)), 0, "mechanism")
+        return out, []
+    return _numeric_component(network, reducer, component, poses, tol, candidates=sets)
+
+
+def _numeric_component(
+    network: Network,
+    reducer: Reducer,
+    component: set[Node],
+    start: Mapping[Node, np.ndarray],
+    tol: Tolerance,
+    starts: int = 8,
+    candidates: Mapping[Node, Any] | None = None,
+) -> tuple[dict[Node, _Instance], list[Conflict]]:
+    """The residue of one component, solved numerically (seed 000 §III G).
+
+    An instance's feasible set lies inside its direct link from the world and inside the
+    product along its tree path (``candidates``); when one of those is a coset of the
+    dof measured at the solution, the instance moves in (an open part of) that coset and
+    takes its motion and invariants; otherwise its motion is ``mechanism``.
+    """
+    unknowns = tuple(sorted(n for n in component if n != WORLD))
+    constraints = _residue_constraints(network, reducer, component)
+    problem = ResidueProblem(
+        unknowns,
+        {n: start.get(n, np.eye(4)) for n in unknowns},
+        {WORLD: np.eye(4)},
+        constraints,
+    )
+    result = solve_residue(problem, tol, starts=starts)
+    reducer.trace.append(
+        TraceStep(
+            "residue",
+            ", ".join(instance_key(n) for n in unknowns),
+            None,
+            result.solutions[0].total_dof if result.found else None,
+            f"{len(result.solutions)} solution(s), best residual {result.best_residual:.3g}",
+        )
+    )
+    out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
+    if not result.found:
+        labels = tuple(dict.fromkeys(lb for c in constraints for lb in c.labels))
+        conflict = Conflict(
+            labels,
+            "residual",
+            result.best_residual,
+            f"no solution found numerically (best residual {result.best_residual:.3g});"
+            " this is not a proof that none exists",
+        )
+        for n in unknowns:
+            out[n] = _Instance(np.asarray(problem.start[n]), 0, "mechanism", 0)
+        return out, [conflict]
+    first = result.solutions[0]
+    isolated = first.total_dof == 0
+    for n in unknowns:
+        dof = first.dof[n]
+        motion, invariants = ("fixed", {}) if dof == 0 else ("mechanism", {})
+        link = reducer.edges.get(frozenset((WORLD, n)))
+        options = [link.oriented(WORLD) if link else None, (candidates or {}).get(n)]
+        match = next(
+            (c for c in options if isinstance(c, Coset) and dof > 0 and c.dof == dof), None
+        )
+        if match is not None:
+            motion, invariants = _motion(match)
+        alternatives = tuple(s.poses[n] for s in result.solutions[1:]) if isolated else ()
+        out[n] = _Instance(
+            first.poses[n],
+            dof,
+            motion,
+            len(result.solutions) if isolated else 1,
+            alternatives,
+            invariants,
+        )
+    return out, []
+
+
+def _leaf_report(
+    network: Network, reducer: Reducer, tol: Tolerance
+) -> tuple[dict[Node, _Instance], list[Conflict]]:
+    """Rule 5: every representative's pose set, then every instance through its merge."""
+    reps: dict[Node, _Instance] = {}
+    conflicts = list(reducer.conflicts)
+    for component in _components_of(network, reducer):
+        found, extra = _solve_component(network, reducer, component, tol)
+        reps.update(found)
+        conflicts.extend(extra)
+    out = {}
+    for node in network.instances:
+        rep, x = reducer.find(node)
+        base = reps[rep]
+        out[node] = _Instance(
+            base.pose @ x,
+            base.dof,
+            base.motion,
+            base.solutions,
+            tuple(a @ x for a in base.alternatives),
+            base.invariants,
+        )
+    return out, conflicts
+
+
+def _same_pose(a: np.ndarray, b: np.ndarray, tol: Tolerance) -> bool:
+    return bool(
+        np.abs(a[:3, :3] - b[:3, :3]).max() <= tol.mesh_angle
+        and np.abs(a[:3, 3] - b[:3, 3]).max() <= tol.mesh_length
+    )
+
+
+def _combine(
+    network: Network, reports: list[tuple[dict[Node, _Instance], list[Conflict]]], tol: Tolerance
+) -> tuple[dict[str, BodyInstanceResult], list[Conflict]]:
+    """Merge the answers of the consistent branches: distinct poses become alternatives."""
+    consistent = [r for r in reports if not r[1]] or reports[:1]
+    bodies: dict[str, BodyInstanceResult] = {}
+    for situation in network.situations:
+        for body in network.bodies:
+            node = network.node(body, situation)
+            if node == WORLD:
+                bodies[f"{body}@{situation}"] = BodyInstanceResult(
+                    body, situation, np.eye(4), 0, "fixed"
+                )
+                continue
+            first = consistent[0][0][node]
+            poses: list[np.ndarray] = []
+            for report, _ in consistent:
+                item = report[node]
+                for pose in (item.pose, *item.alternatives):
+                    if not any(_same_pose(pose, p, tol) for p in poses):
+                        poses.append(pose)
+            count = first.solutions
+            if count is not None and first.dof == 0:
+                count = max(len(poses), count)
+            bodies[f"{body}@{situation}"] = BodyInstanceResult(
+                body,
+                situation,
+                first.pose,
+                first.dof,
+                first.motion,
+                count,
+                tuple(poses[1:]) if first.dof == 0 and count is not None else (),
+                first.invariants,
+            )
+    return bodies, consistent[0][1]
+
+
+def solve_network(
+    network: Network, tol: Tolerance | None = None, explain: bool = False, max_branches: int = 64
+) -> Solution:
+    """Reduce a network (rules 1-4), then report every instance (rule 5)."""
+    tol = tol or current()
+    root = Reducer(tol)
+    for link in network.links:
+        root.add(link)
+    leaves = explore(root, max_branches)
+    reports = [_leaf_report(network, leaf, tol) for leaf in leaves]
+    bodies, conflicts = _combine(network, reports, tol)
+    trace = tuple(dict.fromkeys(step for leaf in leaves for step in leaf.trace))
+    return Solution(bodies, tuple(conflicts), trace, explain)
+
+
+def model_scale(task: Any) -> float:
+    """Bounding-box diagonal of all feature origins (the length scale of the tolerances)."""
+    origins = [
+        np.asarray(f.point if hasattr(f, "point") else f.frame()[:3, 3], dtype=np.float64)
+        for body in task.bodies.values()
+        for f in body.features.values()
+    ]
+    if not origins:
+        return 1.0
+    points = np.array(origins)
+    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+    return diagonal if diagonal > 0 else 1.0
+
+
+def solve_task(task: Any, tol: Tolerance | None = None, explain: bool = False) -> Solution:
+    """RAPT inference on a task: poses of every body in every situation (seed 000 §III)."""
+    tol = tol or current().with_scale(model_scale(task))
+    with using(tol):
+        return solve_network(build_network(task.validate()), tol, explain)
+
+
+def solve_numeric_only(task: Any, tol: Tolerance | None = None, starts: int = 8) -> Solution:
+    """The whole network solved by the residue solver alone, without reduction (the
+    "equation solving" system seed 000 §III G compares against; used for benchmarks)."""
+    tol = tol or current().with_scale(model_scale(task))
+    with using(tol):
+        network = build_network(task.validate())
+        reducer = Reducer(tol)
+        component = {WORLD, *network.instances}
+        reps, conflicts = _numeric_component(network, reducer, component, {}, tol, starts)
+        bodies, conflicts = _combine(network, [(reps, conflicts)], tol)
+        return Solution(bodies, tuple(conflicts), tuple(reducer.trace))
