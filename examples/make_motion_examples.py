@@ -3,7 +3,8 @@
 Run ``python examples/make_motion_examples.py`` from the repository root. For every
 example it writes, under ``src/assemblykit/examples/motion/<name>/``, one OBJ mesh per
 part in world coordinates, the manifest ``<name>.yaml`` (DESIGN.md §5.2) and, when OCP
-is installed (extra ``cad``), ``<name>.step`` with one named solid per part.
+is installed (extra ``cad``), ``<name>.step`` with one named solid per part; then the
+picture of the gearbox's motions for the user guide, ``docs/images/motion.png``.
 
 Each part is a small constructive solid (boxes, vertical cylinders, spheres, unions and
 differences) rendered twice: faceted by manifold3d for the meshes and exactly by
@@ -33,6 +34,7 @@ import trimesh
 import yaml
 
 OUT = Path(__file__).resolve().parents[1] / "src" / "assemblykit" / "examples" / "motion"
+PICTURE = Path(__file__).resolve().parents[1] / "docs" / "images" / "motion.png"
 
 ROUND_SEGMENTS = 32
 # cutters overshoot the faces they pierce so that no boolean works on coplanar faces
@@ -325,6 +327,18 @@ def main() -> None:
         if has_ocp:
             write_step(parts, folder / f"{name}.step")
         print(f"{name}: {len(parts)} parts -> {folder}")
+    write_picture(PICTURE)
+    print(f"gearbox motions -> {PICTURE}")
+
+
+def write_picture(path: Path) -> None:
+    """The gearbox with the motion axes of its parts (``docs/motion.md``)."""
+    import assemblykit
+    from assemblykit.viz.motion_view import write_motion_png
+
+    gearbox = assemblykit.load_assembly(OUT / "gearbox" / "gearbox.yaml")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_motion_png(gearbox, assemblykit.motion(gearbox), path)
 
 
 if __name__ == "__main__":

@@ -69,3 +69,39 @@ def test_empty_subassembly_exits_2(capsys: pytest.CaptureFixture[str]) -> None:
     path = str(EXAMPLES / "hinge" / "hinge.yaml")
     code, _, err = _run(["motion", path, "--subassembly", " , "], capsys)
     assert code == 2 and err.count("\n") == 1
+
+
+TASKS = Path(assemblykit.__file__).parent / "examples" / "tasks"
+
+
+@pytest.mark.parametrize("name", ["w4_pin.yaml", "w4_pin.rapt"])
+def test_motion_of_a_task_file(name: str, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = _run(["motion", str(TASKS / name), "--json"], capsys)
+    assert code == 0
+    result = json.loads(out)
+    assert result["status"] == "underconstrained"
+    pin = result["parts"]["pin@s1"]
+    assert (pin["motion"], pin["dof"]) == ("revolute", 1)
+    assert pin["axis"] == {"point": [0.0, 0.0, 0.0], "direction": [0.0, 0.0, 1.0]}
+    assert pin["relations"] == ["fits pin.shaft plate.hole", "against pin.head plate.top"]
+
+
+def test_a_task_takes_no_subassembly(capsys: pytest.CaptureFixture[str]) -> None:
+    path = str(TASKS / "w4_pin.yaml")
+    code, _, err = _run(["motion", path, "--subassembly", "pin,plate"], capsys)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1 and "tasks" in err
+
+
+def test_a_task_file_with_a_bad_relation_exits_2(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(
+        "bodies:\n  a:\n    fixed: true\n"
+        "    features: {p: {type: plane, point: [0,0,0], normal: [0,0,1]}}\n"
+        "situations:\n  - name: s1\n    relations: [[against, a.p, a.q]]\n"
+    )
+    code, _, err = _run(["motion", str(bad)], capsys)
+    assert code == 2
+    assert "bad.yaml" in err and "'q'" in err

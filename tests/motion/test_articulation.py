@@ -71,3 +71,36 @@ def test_hinge_has_no_gear_train() -> None:
     result = articulation(load_assembly(EXAMPLES / "hinge" / "hinge.yaml"))
     assert result.trains == ()
     assert result.to_dict()["gear_trains"] == []
+
+
+def _ring(name: str, x: float, pitch: float, outside: float) -> Revolute:
+    return Revolute(name, np.array([x, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]), outside, pitch)
+
+
+def test_a_gear_inside_a_ring_gear_turns_the_same_way() -> None:
+    # ring: bore (pitch) radius 30 about the origin; gear of radius 10 at x = 20, so
+    # |N1N2| = 30 - 10; equal pitch-line speeds 30 w_ring = 10 w_gear
+    ring, gear = _ring("ring", 0.0, 30.0, 35.0), _revolute("gear", 20.0, 10.0)
+    assert gear_meshes([ring, gear], TOL) == [GearMesh("ring", "gear", 3.0)]
+    assert gear_meshes([gear, ring], TOL) == [GearMesh("gear", "ring", 1.0 / 3.0)]
+    flipped = Revolute("gear", gear.point, -gear.direction, 10.0)
+    assert gear_meshes([ring, flipped], TOL) == [GearMesh("ring", "gear", -3.0)]
+
+
+def test_a_planetary_train_with_the_carrier_held_reverses_the_ring() -> None:
+    sun, planet = _revolute("sun", 0.0, 10.0), _revolute("planet", 20.0, 10.0)
+    ring = _ring("ring", 0.0, 30.0, 35.0)
+    meshes = gear_meshes([sun, planet, ring], TOL)
+    # the coaxial sun and ring do not mesh with each other
+    assert meshes == [GearMesh("sun", "planet", -1.0), GearMesh("planet", "ring", 1.0 / 3.0)]
+    (train,) = gear_trains(meshes, TOL)
+    # fixed carrier: w_ring / w_sun = -z_sun / z_ring = -10 / 30
+    assert train.ratios == pytest.approx({"sun": 1.0, "planet": -1.0, "ring": -1.0 / 3.0})
+
+
+def test_a_gear_off_the_ring_pitch_circle_does_not_mesh() -> None:
+    ring, gear = _ring("ring", 0.0, 30.0, 35.0), _revolute("gear", 19.0, 10.0)
+    assert gear_meshes([ring, gear], TOL) == []
+    # a sleeve turning in a coaxial bore of equal radius is no gear pair
+    sleeve = _revolute("sleeve", 0.0, 30.0)
+    assert gear_meshes([ring, sleeve], TOL) == []

@@ -11,10 +11,13 @@ import trimesh
 import assemblykit
 from assemblykit.algebra import se3
 from assemblykit.errors import UnknownNameError
+from assemblykit.features import compound_group
+from assemblykit.features.primitives import Plane
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.motion.freedom import MotionReport, motion, part_motion
 from assemblykit.motion.separation import contact_graph, separable_subassemblies
+from assemblykit.tolerance import Tolerance
 
 EXAMPLES = Path(assemblykit.__file__).parent / "examples" / "motion"
 GEAR_X = {"gear_1": 0.0, "gear_2": 30.0, "gear_3": 55.0, "gear_4": 85.0}
@@ -215,3 +218,13 @@ def test_public_api_stays_callable_after_the_package_is_imported() -> None:
     first = assemblykit.motion(assembly)
     second = assemblykit.motion(assembly)
     assert first["door"].kind == second["door"].kind == "revolute"
+
+
+def test_a_cube_boxed_in_on_six_sides_has_the_24_rotations_of_the_cube() -> None:
+    faces = [Plane(point=s * axis, normal=s * axis) for axis in np.eye(3) for s in (1.0, -1.0)]
+    group = compound_group(faces, Tolerance().with_scale(4.0))
+    assert (group.dof, group.n_components) == (0, 24)
+    half_turn_x = np.diag([1.0, -1.0, -1.0, 1.0])
+    quarter_turn_z = se3.rot_z(np.pi / 2)
+    assert group.contains(half_turn_x) and group.contains(quarter_turn_z @ half_turn_x)
+    assert not group.contains(se3.translation((0.5, 0.0, 0.0)))

@@ -15,6 +15,9 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 from enum import Enum
 
+import numpy as np
+from numpy.typing import NDArray
+
 from assemblykit.algebra import Coset, EmptySet, SymmetryGroup, se3
 from assemblykit.errors import FeatureError
 from assemblykit.features.primitives import (
@@ -191,28 +194,67 @@ def _congruence_classes(features: Sequence[Feature], tol: Tolerance) -> list[int
     return classes
 
 
+def _plane_invariants(features: Sequence[Feature], tol: Tolerance) -> tuple[NDArray, NDArray]:
+    """Rigid-motion invariants of every pair of planes (NaN where a feature is not a
+    plane): the cosine of the angle of their normals, and for parallel or antiparallel
+    planes the signed offset nᵢ·(pⱼ − pᵢ). A motion mapping Fᵢ, Fⱼ onto F_π(i), F_π(j)
+    keeps both, so a permutation that changes them has an empty transporter."""
+    n = len(features)
+    normals = np.full((n, 3), np.nan)
+    points = np.full((n, 3), np.nan)
+    for i, f in enumerate(features):
+        if isinstance(f, Plane):
+            normals[i], points[i] = f.normal, f.point
+    cosines = normals @ normals.T
+    offsets = np.einsum("ik,ijk->ij", normals, points[None, :, :] - points[:, None, :])
+    offsets[~(np.abs(cosines) >= math.cos(tol.angle))] = np.nan
+    return cosines, offsets
+
+
+def _differ(a: NDArray, b: NDArray, limit: float) -> bool:
+    """Whether two invariant vectors differ by more than ``limit`` where both are known."""
+    known = ~(np.isnan(a) | np.isnan(b))
+    return bool(np.any(np.abs(a[known] - b[known]) > limit))
+
+
 def _transporters(
     features: Sequence[Feature], classes: Sequence[int], tol: Tolerance
 ) -> Iterable[Coset]:
     """The non-empty cosets {g : g(Fᵢ) = F_π(i) ∀i} over class-preserving permutations π.
 
     Depth-first over the assignments π(0), π(1), ...; an empty partial intersection
-    prunes every permutation that extends it (ALGEBRA.md §4.1 steps 2-3)."""
+    prunes every permutation that extends it (ALGEBRA.md §4.1 steps 2-3). Before
+    intersecting, an assignment that changes a pairwise plane invariant
+    (:func:`_plane_invariants`) with an earlier one is pruned at once: its intersection
+    would be empty, and the invariants cost a comparison where the intersection costs
+    a transporter. Once the partial coset is a single motion, each further step is a
+    membership test of that motion."""
+    cosines, offsets = _plane_invariants(features, tol)
 
-    def extend(index: int, used: frozenset[int], partial: Coset | None) -> Iterable[Coset]:
+    def extend(index: int, assigned: tuple[int, ...], partial: Coset | None) -> Iterable[Coset]:
         if index == len(features):
             assert partial is not None
             yield partial
             return
         for target in range(len(features)):
-            if target in used or classes[target] != classes[index]:
+            if target in assigned or classes[target] != classes[index]:
+                continue
+            images = list(assigned)
+            if _differ(cosines[index, :index], cosines[target, images], tol.angle) or _differ(
+                offsets[index, :index], offsets[target, images], tol.length
+            ):
                 continue
             step = feature_transporter(features[index], features[target])
+            if partial is not None and partial.is_point:
+                # a single motion: the intersection is it or nothing, a membership test
+                if step.contains(partial.rep, tol):
+                    yield from extend(index + 1, (*assigned, target), partial)
+                continue
             both = step if partial is None else partial.intersect(step, tol=tol)
             if not isinstance(both, EmptySet):
-                yield from extend(index + 1, used | {target}, both)
+                yield from extend(index + 1, (*assigned, target), both)
 
-    return extend(0, frozenset(), None)
+    return extend(0, (), None)
 
 
 def compound_group(features: Sequence[Feature], tol: Tolerance | None = None) -> SymmetryGroup:
@@ -221,7 +263,9 @@ def compound_group(features: Sequence[Feature], tol: Tolerance | None = None) ->
     ALGEBRA.md §4.1: the union of the non-empty transporters over class-preserving
     permutations. The identity permutation gives G₁ ∩ ... ∩ Gₙ (Props 3.2.6, 3.2.7);
     the others add the swaps g_ij of 2-congruent features and their products (Props
-    3.2.8, 5.0.9), each a coset of that intersection.
+    3.2.8, 5.0.9), each a coset of that intersection. When no two features are the same
+    surface, these cosets are disjoint and already form the group, so their components
+    are listed directly instead of closing them again under composition.
     """
     tol = tol or current()
     if not features:
@@ -229,7 +273,16 @@ def compound_group(features: Sequence[Feature], tol: Tolerance | None = None) ->
     cosets = list(_transporters(features, _congruence_classes(features, tol), tol))
     base = cosets[0].group
     swaps = [coset.rep for coset in cosets[1:]]
-    return base.extended_by(swaps, tol=tol) if swaps else base
+    if not swaps:
+        return base
+    identity = np.eye(4)
+    if base.lattice or any(coset.contains(identity, tol) for coset in cosets[1:]):
+        return base.extended_by(swaps, tol=tol)
+    # Pairwise distinct features: the transporters of distinct permutations are
+    # disjoint, and together they are the whole group, closed already; each is
+    # base · swap, whose components are r · swap for the components r of base.
+    reps = (*base.reps, *(r @ swap for swap in swaps for r in base.reps))
+    return SymmetryGroup(base.kind, base.frame, base.pitch, reps)
 
 
 @dataclass(frozen=True, eq=False)

@@ -5,10 +5,13 @@ housing, Lᵢ = aᵢ SO(2) aᵢ⁻¹ (a revolute about the gear's shaft, from a 
 plane), and the gear pairs by products Lᵢⱼ = Lᵢ Lⱼ "where the relative gear pitch ratio
 is also embedded". Here every part whose motion (:func:`assemblykit.motion.motion`) is
 a revolute is a candidate gear; two of them *mesh* when their axes are parallel and
-their outer cylinders are tangent, |N₁N₂| = R₁ + R₂ (R the largest distance of the
-part's mesh from its axis, i.e. the pitch radius of a gear drawn as its pitch
-cylinder). A mesh couples the angular speeds about the (common) axis direction:
-ω₂ = -(R₁/R₂) ω₁. The gear train's joint speeds are the null space of these coupling
+their pitch circles are tangent. Externally, |N₁N₂| = R₁ + R₂ (R the largest distance
+of the part's mesh from its axis, i.e. the pitch radius of a gear drawn as its pitch
+cylinder), and the gears turn in opposite senses about the common axis direction:
+ω₂ = -(R₁/R₂) ω₁. Internally, a gear inside a ring (internal) gear whose pitch circle
+is its bore (r, the smallest distance of the ring's mesh from its axis):
+|N₁N₂| = r − R > 0, and both turn the same way with equal pitch-line speeds,
+r ω_ring = R ω_gear. The gear train's joint speeds are the null space of these coupling
 equations (scipy): its dimension is the train's dof (1 for a simple train, 0 for a
 locked loop), and for one dof the ratios of every gear to the first one.
 """
@@ -37,12 +40,14 @@ Vector = NDArray[np.float64]
 @dataclass(frozen=True)
 class Revolute:
     """A part turning about the line through ``point`` with unit ``direction``, with
-    ``radius`` the largest distance of its mesh from that line."""
+    ``radius`` the largest and ``inner_radius`` the smallest distance of its mesh from
+    that line (its pitch radii as a gear and as a ring gear)."""
 
     part: str
     point: Vector
     direction: Vector
     radius: float
+    inner_radius: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -87,24 +92,41 @@ def revolute_of(assembly: Assembly, moved: Motion) -> Revolute | None:
     direction = np.asarray(axis["direction"], dtype=np.float64)
     offsets = np.asarray(assembly.part(moved.parts[0]).mesh.vertices, dtype=np.float64) - point
     radial = offsets - np.outer(offsets @ direction, direction)
-    radius = float(np.max(np.linalg.norm(radial, axis=1)))
-    return Revolute(moved.parts[0], point, direction, radius)
+    distances = np.linalg.norm(radial, axis=1)
+    return Revolute(
+        moved.parts[0], point, direction, float(np.max(distances)), float(np.min(distances))
+    )
+
+
+def _mesh_ratio(first: Revolute, second: Revolute, distance: float, tol: Tolerance) -> float | None:
+    """ω_second / ω_first, each about its own axis direction, for two revolutes on
+    parallel axes ``distance`` apart; ``None`` if their pitch circles are not tangent
+    (module docstring: an external mesh, or one gear inside the other's ring)."""
+    if abs(distance - (first.radius + second.radius)) <= tol.length:
+        ratio = -first.radius / second.radius
+    elif distance <= tol.length:
+        return None
+    elif abs(distance - (first.inner_radius - second.radius)) <= tol.length:
+        ratio = first.inner_radius / second.radius
+    elif abs(distance - (second.inner_radius - first.radius)) <= tol.length:
+        ratio = first.radius / second.inner_radius
+    else:
+        return None
+    return ratio if float(first.direction @ second.direction) > 0 else -ratio
 
 
 def gear_meshes(joints: Sequence[Revolute], tol: Tolerance) -> list[GearMesh]:
-    """The pairs of revolutes with parallel axes and tangent outer cylinders."""
+    """The pairs of revolutes with parallel axes and tangent pitch circles, external or
+    internal (a gear in a ring gear)."""
     found = []
     for first, second in itertools.combinations(joints, 2):
         if np.linalg.norm(np.cross(first.direction, second.direction)) > tol.angle:
             continue
         offset = second.point - first.point
         distance = float(np.linalg.norm(np.cross(offset, first.direction)))
-        if abs(distance - (first.radius + second.radius)) > tol.length:
-            continue
-        # external mesh: the speeds are opposite about a common axis direction
-        same_way = float(first.direction @ second.direction) > 0
-        ratio = -first.radius / second.radius * (1.0 if same_way else -1.0)
-        found.append(GearMesh(first.part, second.part, ratio))
+        ratio = _mesh_ratio(first, second, distance, tol)
+        if ratio is not None:
+            found.append(GearMesh(first.part, second.part, ratio))
     return found
 
 

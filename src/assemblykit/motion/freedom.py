@@ -30,7 +30,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from rich.table import Table
-from scipy.spatial import cKDTree
 
 from assemblykit.algebra import SymmetryGroup, se3
 from assemblykit.errors import UnknownNameError
@@ -38,6 +37,7 @@ from assemblykit.features import compound_group
 from assemblykit.features.primitives import Ball, Cone, Feature, Hole, Plane, Shaft, Socket
 from assemblykit.geometry.contacts import Contact, CurvedPatch
 from assemblykit.model.assembly import Assembly
+from assemblykit.motion.spherical import with_sphere_regions
 from assemblykit.motion.unilateral import UnilateralReading, unilateral_readings
 from assemblykit.tolerance import Tolerance
 
@@ -77,30 +77,22 @@ def _circle(center: Vector, axis: Vector, radius: float, s: float) -> NDArray:
     return center + s * axis + radius * ring
 
 
-def _sphere_samples(patch: CurvedPatch, tol: Tolerance) -> NDArray:
-    """Unit directions from the centre covering the spherical patch.
-
-    ``patch.points`` holds the vertices of both spherical surfaces; the contact is where
-    both are, so the vertices that the two surfaces share (within the length tolerance,
-    found with a k-d tree) sample it. Without shared vertices the whole sphere is
-    sampled: the fit is then kept in every direction."""
-    whole = np.vstack([np.eye(3), -np.eye(3)])
-    if patch.points is None:
-        return whole
-    points = np.asarray(patch.points, dtype=np.float64)
-    pairs = cKDTree(points).query_pairs(tol.length, output_type="ndarray")
-    shared = points[np.unique(pairs)] if len(pairs) else np.zeros((0, 3))
-    if len(shared) < 3:
-        return whole
-    directions = shared - patch.center
+def _sphere_samples(patch: CurvedPatch) -> NDArray:
+    """Unit directions from the centre to the points of a spherical patch: the contact
+    region once :func:`assemblykit.motion.spherical.with_sphere_regions` has narrowed
+    them. Without points the whole sphere is sampled: the fit is then kept in every
+    direction."""
+    if patch.points is None or len(patch.points) == 0:
+        return np.vstack([np.eye(3), -np.eye(3)])
+    directions = np.asarray(patch.points, dtype=np.float64) - patch.center
     return directions / np.linalg.norm(directions, axis=1, keepdims=True)
 
 
-def _curved_samples(patch: CurvedPatch, inside: bool, tol: Tolerance) -> tuple[NDArray, NDArray]:
+def _curved_samples(patch: CurvedPatch, inside: bool) -> tuple[NDArray, NDArray]:
     """Points and normals out of the moving side sampling a curved patch."""
     sign = 1.0 if inside else -1.0
     if patch.kind == "spherical":
-        directions = _sphere_samples(patch, tol)
+        directions = _sphere_samples(patch)
         return patch.center + patch.radius * directions, sign * directions
     axis = se3.unit(np.asarray(patch.axis, dtype=np.float64))
     s0, s1 = patch.extent if patch.extent is not None else (0.0, 0.0)
@@ -178,7 +170,7 @@ def moving_features(
         for curved in contact.curved:
             inside = curved.inner in moving
             features.append(_patch_feature(curved, inside))
-            sample_points, sample_normals = _curved_samples(curved, inside, tol)
+            sample_points, sample_normals = _curved_samples(curved, inside)
             points.append(sample_points)
             normals.append(sample_normals)
     samples = ContactSamples(
@@ -195,7 +187,7 @@ def _canonical_direction(u: Vector) -> Vector:
     return u if u[int(np.argmax(np.abs(u)))] > 0 else -u
 
 
-def _motion_summary(group: SymmetryGroup | None) -> dict[str, Any]:
+def motion_summary(group: SymmetryGroup | None) -> dict[str, Any]:
     """``motion`` (the group's kind), ``dof``, ``components`` (``"inf"`` for a lattice),
     ``description`` and the invariants as plain lists: ``axis`` {point, direction} with
     the point the axis' foot from the origin, ``center``, ``direction``, ``normal``,
@@ -247,12 +239,12 @@ class Motion:
     @property
     def kind(self) -> str:
         """The motion's name: ``fixed``, ``revolute``, ``prismatic``, ... or ``free``."""
-        return str(_motion_summary(self.group)["motion"])
+        return str(motion_summary(self.group)["motion"])
 
     @property
     def dof(self) -> int:
         """Degrees of freedom of the bilateral motion (the group's dimension)."""
-        return int(_motion_summary(self.group)["dof"])
+        return int(motion_summary(self.group)["dof"])
 
     @property
     def separates(self) -> bool:
@@ -264,7 +256,7 @@ class Motion:
         """``dof``, ``motion``, ``components``, the invariants (``axis`` {point,
         direction}, ``direction``, ``center``, ``normal``, ``pitch`` as they apply),
         ``touching`` and ``unilateral`` (DESIGN.md §5.3)."""
-        out = _motion_summary(self.group)
+        out = motion_summary(self.group)
         out["touching"] = list(self.touching)
         out["unilateral"] = self.unilateral.to_dict()
         return out
@@ -311,7 +303,8 @@ class MotionSolver:
     def __init__(self, assembly: Assembly, tol: Tolerance | None = None) -> None:
         self.assembly = assembly
         self.tol = assembly.tolerance(tol)
-        self.contacts = assembly.contacts(tol)
+        # a ball is pushed only where its socket is: narrow spherical patches to that
+        self.contacts = with_sphere_regions(assembly, assembly.contacts(tol), self.tol)
         self._groups: dict[tuple[Any, ...], tuple[SymmetryGroup, Vector]] = {}
         self._by_part: dict[str, list[Contact]] = {}
         for contact in self.contacts:
@@ -414,7 +407,7 @@ class MotionReport:
         for column in ("part", "motion", "dof", "components", "unilateral"):
             table.add_column(column)
         for key, moved in self.motions.items():
-            data = _motion_summary(moved.group)
+            data = motion_summary(moved.group)
             reading = moved.unilateral
             if reading.lift_off:
                 rays = ", ".join(np.array2string(r, precision=3) for r in reading.lift_off)

@@ -151,3 +151,53 @@ def write_motion_html(assembly: Assembly, report: MotionReport, path: str | Path
     path = Path(path)
     motion_figure(assembly, report).write_html(path, include_plotlyjs=True, full_html=True)
     return path
+
+
+def write_motion_png(
+    assembly: Assembly, report: MotionReport, path: str | Path, *, dpi: int = 120
+) -> Path:
+    """Write a PNG (matplotlib, Agg canvas) of the parts, each drawn translucent in its
+    colour, with the invariants of its motion: the axis line of a revolute, cylindrical
+    or helical motion (through the part, 3 glyph sizes long) with its label, the double
+    arrow of a prismatic one, the centre of a spherical one. Returns ``path``."""
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    colors = part_colors(assembly.names)
+    size = GLYPH_FRACTION * assembly.scale
+    figure = Figure(figsize=(7.0, 5.5))
+    ax = figure.add_subplot(projection="3d")
+    for name, part in assembly.parts.items():
+        mesh = part.mesh
+        triangles = np.asarray(mesh.vertices, dtype=np.float64)[np.asarray(mesh.faces)]
+        ax.add_collection3d(
+            Poly3DCollection(triangles, facecolor=colors[name], edgecolor="none", alpha=0.25)
+        )
+        if name not in report.motions:
+            continue
+        data = report[name].to_dict()
+        center = np.asarray(mesh.bounds.mean(axis=0), dtype=np.float64)
+        if "axis" in data:
+            point = np.asarray(data["axis"]["point"], dtype=np.float64)
+            u = np.asarray(data["axis"]["direction"], dtype=np.float64)
+            foot = point + ((center - point) @ u) * u
+            line = np.array([foot - 1.5 * size * u, foot + 1.5 * size * u])
+            ax.plot(*line.T, color="black", linewidth=2.0)
+            ax.text(*line[1], f"{name}: {data['motion']}", fontsize=8)
+        elif "direction" in data:
+            u = np.asarray(data["direction"], dtype=np.float64)
+            for sign in (1.0, -1.0):
+                ax.quiver(*center, *(sign * size * u), color="black", linewidth=2.0)
+            ax.text(*(center + size * u), f"{name}: {data['motion']}", fontsize=8)
+        elif "center" in data:
+            ax.scatter(*np.asarray(data["center"], dtype=np.float64), color="black", s=30)
+            ax.text(*center, f"{name}: {data['motion']}", fontsize=8)
+    lo, hi = np.asarray(assembly.bounds, dtype=np.float64)
+    for setter, a, b in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), lo, hi, strict=True):
+        setter(a, b)
+    ax.set_aspect("equal")
+    source = Path(assembly.source).name if assembly.source else "the assembly"
+    ax.set_title(f"Motion of each part of {source}")
+    path = Path(path)
+    figure.savefig(path, dpi=dpi, bbox_inches="tight")
+    return path
