@@ -37,6 +37,10 @@ def test_json_lists_parts_contacts_features_and_interferences(tower, capsys, tmp
     assert contact["area"] == pytest.approx(1.0)
     assert contact["planar"][0]["normal"] == pytest.approx([0, 0, 1])
     assert data["interferences"] == []
+    tolerance = data["tolerance"]
+    assert tolerance["from"] == "policy" and tolerance["relative"] == pytest.approx(1e-6)
+    assert tolerance["length"] == pytest.approx(1e-6 * 6**0.5)  # diagonal of 1 x 1 x 2
+    assert tolerance["measured_from"] == "float32 coordinates"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

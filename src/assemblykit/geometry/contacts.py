@@ -23,13 +23,12 @@ into ``b`` across a planar patch iff ``d . normal > 0`` (seed 004, DBG arcs).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import shapely
 from numpy.typing import NDArray
 from rtree import index
-from shapely.geometry.polygon import orient
 
 from assemblykit.geometry.recognition import Segmentation, Surface, faces_on, segment
 from assemblykit.tolerance import Tolerance
@@ -120,19 +119,21 @@ def candidate_pairs(
     bounds: NDArray[np.float64], margin: float, only: int | None = None
 ) -> NDArray[np.int64]:
     """Pairs ``(i, j)``, ``i < j``, of boxes (``n x 2 x 3``) that overlap once inflated by
-    ``margin`` (an R-tree query per box); with ``only``, just the pairs involving it."""
+    ``margin`` (one bulk R-tree query); with ``only``, just the pairs involving it."""
     lo, hi = bounds[:, 0] - margin, bounds[:, 1] + margin
-    boxes = np.hstack([lo, hi])
     tree = index.Index(
-        ((i, tuple(box), None) for i, box in enumerate(boxes)),
+        ((i, tuple(box), None) for i, box in enumerate(np.hstack([lo, hi]))),
         properties=index.Property(dimension=3),
     )
-    queries = range(len(boxes)) if only is None else [only]
-    found = [(i, j) for i in queries for j in tree.intersection(tuple(boxes[i])) if j != i]
-    if not found:
+    queries = np.arange(len(bounds)) if only is None else np.array([only])
+    if len(bounds) == 0:
         return np.zeros((0, 2), dtype=np.int64)
-    pairs = np.sort(np.array(found, dtype=np.int64), axis=1)
-    return np.unique(pairs, axis=0)
+    found, counts = tree.intersection_v(
+        np.ascontiguousarray(lo[queries]), np.ascontiguousarray(hi[queries])
+    )
+    pairs = np.column_stack([np.repeat(queries, counts.astype(np.int64)), found.astype(np.int64)])
+    pairs = np.sort(pairs[pairs[:, 0] != pairs[:, 1]], axis=1)
+    return np.unique(pairs, axis=0) if len(pairs) else np.zeros((0, 2), dtype=np.int64)
 
 
 def _frames(normals: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -154,8 +155,9 @@ def _boxes_overlap(
 
 
 @dataclass(frozen=True)
-class _Stack:
-    """All parts' triangles in one array (vertex indices offset per part)."""
+class PartStack:
+    """All parts' triangles in one array (vertex indices offset per part): ``part`` is
+    each face's part index, ``face_start`` each part's first face."""
 
     vertices: NDArray[np.float64]
     faces: NDArray[np.int64]
@@ -163,7 +165,8 @@ class _Stack:
     face_start: NDArray[np.int64]
 
 
-def _stack(assembly: Assembly) -> _Stack:
+def stack_parts(assembly: Assembly) -> PartStack:
+    """The triangles of all parts of ``assembly`` in one :class:`PartStack`."""
     meshes = [p.mesh for p in assembly.parts.values()]
     n_vertices = np.array([len(m.vertices) for m in meshes], dtype=np.int64)
     n_faces = np.array([len(m.faces) for m in meshes], dtype=np.int64)
@@ -173,24 +176,21 @@ def _stack(assembly: Assembly) -> _Stack:
     )
     vertices = np.concatenate([np.asarray(m.vertices, dtype=np.float64) for m in meshes])
     part = np.repeat(np.arange(len(meshes), dtype=np.int64), n_faces)
-    return _Stack(vertices, faces, part, np.cumsum(n_faces) - n_faces)
+    return PartStack(vertices, faces, part, np.cumsum(n_faces) - n_faces)
 
 
-def _planar_matches(
-    stack: _Stack,
+def facing_groups(
     seg: Segmentation,
     group_part: NDArray[np.int64],
     usable: NDArray[np.bool_],
     part_lo: NDArray[np.float64],
     part_hi: NDArray[np.float64],
     pairs: NDArray[np.int64],
-    tol: Tolerance,
+    margin: float,
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """Group pairs ``(g, h)``, ``g`` of the first part of a pair and ``h`` of the second,
-    that are flat, face each other (opposite normals), overlap in their boxes, and are
-    coplanar: all vertices of one of them lie within the length tolerance of the
-    other's plane (so the contact region, inside both, is within the tolerance)."""
-    margin = tol.length
+    """Usable group pairs ``(g, h)``, ``g`` of the first part of a pair and ``h`` of the
+    second, whose bounding boxes overlap each other's part and each other (inflated by
+    ``margin``), vectorised over all pairs."""
     candidates = np.flatnonzero(usable)
     candidates = candidates[np.argsort(group_part[candidates], kind="stable")]
     count = np.bincount(group_part[candidates], minlength=len(part_lo))
@@ -210,6 +210,25 @@ def _planar_matches(
     pair_b, groups_b = near(1, 0)
     i, j = _cross_join(pair_a, pair_b, len(pairs))
     g, h = groups_a[i], groups_b[j]
+    keep = _boxes_overlap(seg.lo[g], seg.hi[g], seg.lo[h], seg.hi[h], margin)
+    return g[keep], h[keep]
+
+
+def _planar_matches(
+    stack: PartStack,
+    seg: Segmentation,
+    group_part: NDArray[np.int64],
+    usable: NDArray[np.bool_],
+    part_lo: NDArray[np.float64],
+    part_hi: NDArray[np.float64],
+    pairs: NDArray[np.int64],
+    tol: Tolerance,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Facing group pairs (:func:`facing_groups`) that are flat, have opposite normals
+    and are coplanar: all vertices of one of them lie within the length tolerance of
+    the other's plane (so the contact region, inside both, is within the tolerance)."""
+    margin = tol.length
+    g, h = facing_groups(seg, group_part, usable, part_lo, part_hi, pairs, margin)
     n_g, n_h = seg.normal[g], seg.normal[h]
     gap = seg.point[h] - seg.point[g]
     # a centroid is within the largest vertex distance, so this keeps every true match
@@ -217,14 +236,15 @@ def _planar_matches(
         np.abs(np.einsum("ij,ij->i", n_g, gap)), np.abs(np.einsum("ij,ij->i", n_h, gap))
     )
     ok = (np.einsum("ij,ij->i", n_g, n_h) < 0) & (near_plane <= margin)
-    ok &= _boxes_overlap(seg.lo[g], seg.hi[g], seg.lo[h], seg.hi[h], margin)
     g, h = g[ok], h[ok]
-    close = np.minimum(_deviation(stack, seg, h, g), _deviation(stack, seg, g, h)) <= margin
+    close = (
+        np.minimum(group_deviation(stack, seg, h, g), group_deviation(stack, seg, g, h)) <= margin
+    )
     return g[close], h[close]
 
 
-def _deviation(
-    stack: _Stack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64]
+def group_deviation(
+    stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64]
 ) -> NDArray[np.float64]:
     """Per pair, the largest distance of a vertex of group ``g[k]`` from the plane of
     group ``h[k]``."""
@@ -243,12 +263,13 @@ def _triangles_2d(
     return np.stack([np.einsum("tkj,tj->tk", corners, u), np.einsum("tkj,tj->tk", corners, v)], -1)
 
 
-def _overlapping_triangles(
-    stack: _Stack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], tol: Tolerance
-) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-    """Per matched group pair, the area where its triangles overlap in the common plane
-    (triangle pairs whose 2D boxes overlap by more than the tolerance are clipped by
-    shapely, vectorised); returns the matched pairs with positive area and their areas."""
+def triangle_overlaps(
+    stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], margin: float
+) -> tuple[NDArray[np.int64], NDArray[Any], NDArray[np.float64], NDArray[np.float64]]:
+    """Where the triangles of groups ``g[k]`` and ``h[k]`` overlap, projected on the plane
+    of ``g[k]`` with the frame ``(u[k], v[k])``: the non-empty intersections of triangle
+    pairs whose 2D boxes overlap by more than ``margin`` (shapely, vectorised), each with
+    its ``owner`` ``k``. Returns ``owner, pieces, u, v``."""
     match = np.arange(len(g), dtype=np.int64)
     size_g = seg.start[g + 1] - seg.start[g]
     size_h = seg.start[h + 1] - seg.start[h]
@@ -258,39 +279,59 @@ def _overlapping_triangles(
     faces_b = seg.order[_expand(seg.start[h], size_h)]
     i, j = _cross_join(owner_a, owner_b, len(g))
     owner = owner_a[i]
-    u, v = _frames(seg.normal[g])
+    u, v = _frames(seg.normal[g]) if len(g) else (np.zeros((0, 3)), np.zeros((0, 3)))
     tri_a = _triangles_2d(stack.vertices[stack.faces[faces_a[i]]], u[owner], v[owner])
     tri_b = _triangles_2d(stack.vertices[stack.faces[faces_b[j]]], u[owner], v[owner])
     width = np.minimum(tri_a.max(axis=1), tri_b.max(axis=1)) - np.maximum(
         tri_a.min(axis=1), tri_b.min(axis=1)
     )
-    keep = np.all(width > tol.length, axis=1)
+    keep = np.all(width > margin, axis=1)
     pieces = shapely.intersection(shapely.polygons(tri_a[keep]), shapely.polygons(tri_b[keep]))
-    area = np.bincount(owner[keep], weights=shapely.area(pieces), minlength=len(g))
-    positive = np.flatnonzero(area > 0)
-    return positive, area[positive]
+    owner = owner[keep]
+    solid = shapely.area(pieces) > 0
+    return owner[solid], pieces[solid], u, v
 
 
-def _patches(stack: _Stack, seg: Segmentation, g: int, h: int, tol: Tolerance) -> list[PlanarPatch]:
-    """The contact polygons of groups ``g`` (part a) and ``h`` (part b): the overlap of
-    their triangles' unions in ``g``'s plane, kept where wider than the tolerance."""
+def _planar_patches(
+    stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], tol: Tolerance
+) -> tuple[NDArray[np.int64], list[PlanarPatch]]:
+    """The contact polygons of the matched group pairs ``(g[k], h[k])``: the union of
+    their triangles' overlaps in ``g[k]``'s plane (:func:`triangle_overlaps`), one
+    polygon per connected piece wider than the tolerance, at the mean height of the two
+    planes, counter-clockwise about ``g[k]``'s normal. Returns each patch's ``k``."""
+    owner, pieces, u, v = triangle_overlaps(stack, seg, g, h, tol.length)
+    matched, slot = np.unique(owner, return_inverse=True)
+    rank = np.arange(len(owner)) - np.searchsorted(owner, owner)
+    table = np.full((len(matched), int(rank.max()) + 1 if len(rank) else 0), None, dtype=object)
+    table[slot, rank] = pieces
+    merged = shapely.union_all(table, axis=1) if len(matched) else np.array([], dtype=object)
+    polygons, which = shapely.get_parts(merged, return_index=True)
+    polygons = shapely.simplify(polygons, 0.0)
+    wide = shapely.is_valid(polygons) & (shapely.get_type_id(polygons) == 3)
+    wide &= shapely.area(polygons) > tol.length * shapely.length(polygons) / 2
+    polygons, k = polygons[wide], matched[which[wide]]
+    rings = shapely.get_exterior_ring(shapely.orient_polygons(polygons))
+    coords, ring = shapely.get_coordinates(rings, return_index=True)
+    # each ring repeats its first vertex last
+    last = np.r_[ring[1:] != ring[:-1], True][: len(ring)]
+    coords, ring = coords[~last], ring[~last]
     normal = seg.normal[g]
-    u, v = (w[0] for w in _frames(normal[None]))
-    height = (normal @ seg.point[g] + normal @ seg.point[h]) / 2
-
-    def region(group: int) -> shapely.Geometry:
-        corners = stack.vertices[stack.faces[seg.faces_of(group)]]
-        return shapely.union_all(shapely.polygons(np.stack([corners @ u, corners @ v], -1)))
-
-    overlap = shapely.intersection(region(g), region(h))
-    found = []
-    for poly in shapely.get_parts(overlap):
-        if not isinstance(poly, shapely.Polygon) or poly.area <= tol.length * poly.length / 2:
-            continue
-        ring = np.asarray(orient(poly, 1.0).exterior.coords)[:-1]
-        polygon = ring[:, :1] * u + ring[:, 1:2] * v + height * normal
-        found.append(PlanarPatch(normal=normal.copy(), polygon=polygon, area=float(poly.area)))
-    return found
+    height = (
+        np.einsum("ij,ij->i", normal, seg.point[g]) + np.einsum("ij,ij->i", normal, seg.point[h])
+    ) / 2
+    at = k[ring]
+    world = coords[:, :1] * u[at] + coords[:, 1:] * v[at] + height[at, None] * normal[at]
+    bounds = np.searchsorted(ring, np.arange(len(polygons) + 1))
+    areas = shapely.area(polygons)
+    patches = [
+        PlanarPatch(
+            normal=normal[k[n]].copy(),
+            polygon=world[bounds[n] : bounds[n + 1]],
+            area=float(areas[n]),
+        )
+        for n in range(len(polygons))
+    ]
+    return k, patches
 
 
 def _axial_overlap(
@@ -392,7 +433,7 @@ def find_contacts(
     names = list(assembly.parts)
     if len(names) < 2:
         return []
-    stack = _stack(assembly)
+    stack = stack_parts(assembly)
     seg = segment(stack.vertices, stack.faces, tol)
     part_lo = np.array([p.mesh.bounds[0] for p in assembly.parts.values()])
     part_hi = np.array([p.mesh.bounds[1] for p in assembly.parts.values()])
@@ -417,11 +458,10 @@ def find_contacts(
     group_part = stack.part[seg.order[seg.start[:-1]]]
     usable = seg.flat & (np.bincount(seg.group, weights=excluded, minlength=len(seg.flat)) == 0)
     g, h = _planar_matches(stack, seg, group_part, usable, part_lo, part_hi, pairs, tol)
-    positive, _ = _overlapping_triangles(stack, seg, g, h, tol)
+    k, patches = _planar_patches(stack, seg, g, h, tol)
     planar: dict[tuple[int, int], list[PlanarPatch]] = {}
-    for m in positive:
-        key = (int(group_part[g[m]]), int(group_part[h[m]]))
-        planar.setdefault(key, []).extend(_patches(stack, seg, int(g[m]), int(h[m]), tol))
+    for m, patch in zip(k, patches, strict=True):
+        planar.setdefault((int(group_part[g[m]]), int(group_part[h[m]])), []).append(patch)
 
     curved: dict[tuple[int, int], list[CurvedPatch]] = {}
     for a, b in pairs:

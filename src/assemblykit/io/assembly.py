@@ -19,6 +19,7 @@ from typing import Any
 
 from assemblykit.errors import GeometryError, InputError
 from assemblykit.geometry.contacts import Contact
+from assemblykit.geometry.precision import coordinate_precision
 from assemblykit.geometry.recognition import Surface
 from assemblykit.io.meshes import MESH_SUFFIXES, load_manifest, load_mesh_folder, read_mesh
 from assemblykit.model.assembly import Assembly, Part
@@ -53,7 +54,12 @@ def load_assembly(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         return load_step(path, tol)
     if suffix in MESH_SUFFIXES:
         part = Part(path.stem, read_mesh(path), source=str(path))
-        return Assembly([part], source=str(path), policy=tol)
+        return Assembly(
+            [part],
+            source=str(path),
+            policy=tol,
+            precision=coordinate_precision(part.mesh.vertices),
+        )
     raise GeometryError(
         "unknown assembly kind (expected a mesh folder, .yaml manifest, .step or COMPAS .json)",
         source=str(path),
@@ -101,19 +107,23 @@ def _contact_dict(contact: Contact) -> dict[str, Any]:
 @dataclass(frozen=True)
 class ContactReport:
     """What the ``contacts`` command reports: the assembly's parts with their surface
-    features, its contacts and its interferences ``(a, b, volume)``."""
+    features, its contacts and its interferences ``(a, b, volume)``, found with the
+    tolerance ``policy`` (``None``: the assembly's own) raised to the input's measured
+    precision."""
 
     assembly: Assembly
     contacts: list[Contact]
     surfaces: dict[str, tuple[Surface, ...]]
     interferences: list[tuple[str, str, float]]
+    policy: Tolerance | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: the assembly summary, ``features`` per part, ``contacts`` and
-        ``interferences``."""
+        """JSON form: the assembly summary, ``features`` per part, the ``tolerance`` used
+        and why (:meth:`Assembly.tolerance_summary`), ``contacts`` and ``interferences``."""
         summary = self.assembly.to_dict()
         for name, entry in summary["parts"].items():
             entry["features"] = [_surface_dict(s) for s in self.surfaces[name]]
+        summary["tolerance"] = self.assembly.tolerance_summary(self.policy)
         summary["contacts"] = [_contact_dict(c) for c in self.contacts]
         summary["interferences"] = [{"a": a, "b": b, "volume": v} for a, b, v in self.interferences]
         return summary
@@ -144,7 +154,12 @@ class ContactReport:
             "\n".join(f"interference {a} / {b}: volume {v:.6g}" for a, b, v in self.interferences)
             or "no interferences"
         )
-        return Group(parts, contacts, clashes)
+        used = asm.tolerance_summary(self.policy)
+        measured = f"{used['measured_from'] or 'nothing measured'}: {used['measured'] or 0:.2g}"
+        why = f"input ({measured})" if used["from"] == "measured" else f"policy ({measured})"
+
+        tolerance = f"length tolerance {used['length']:.3g} {asm.units} from the {why}"
+        return Group(tolerance, parts, contacts, clashes)
 
 
 def contact_report(assembly: Assembly, tol: Tolerance | None = None) -> ContactReport:
@@ -156,4 +171,5 @@ def contact_report(assembly: Assembly, tol: Tolerance | None = None) -> ContactR
         assembly.contacts(tol),
         {name: assembly.surfaces(name, tol) for name in assembly.parts},
         interferences(assembly, tol),
+        tol,
     )

@@ -10,6 +10,9 @@ Accepted layouts (those of the files published with ``compas_assembly``):
 A mesh is a ``vertex`` dict ``{key: {x, y, z}}`` and a ``face`` dict
 ``{key: [vertex keys]}`` of planar convex polygons (masonry blocks), triangulated as fans.
 Parts are named by node key (assemblies) or list index (lists). COMPAS stores no unit.
+
+The blocks' joints need not match exactly; the assembly records their largest mismatch
+as its measured precision (:func:`assemblykit.geometry.precision.joint_mismatch`).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import numpy as np
 import trimesh
 
 from assemblykit.errors import GeometryError, SchemaError
+from assemblykit.geometry.precision import joint_mismatch
 from assemblykit.io.meshes import DEFAULT_UNITS, repaired
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance
@@ -94,4 +98,8 @@ def load_compas(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     ]
     if not parts:
         raise GeometryError("no blocks", source=source)
-    return Assembly(parts, units=DEFAULT_UNITS, units_source="default", source=source, policy=tol)
+    assembly = Assembly(
+        parts, units=DEFAULT_UNITS, units_source="default", source=source, policy=tol
+    )
+    assembly.precision = joint_mismatch(assembly, tol)
+    return assembly

@@ -10,6 +10,10 @@
   matrix or ``{translation: [...], rotation_xyz_deg: [...]}`` (same Euler convention, in
   degrees); mesh paths are relative to the manifest's folder; ``units`` is optional.
 
+The assembly records the input's measured precision
+(:mod:`assemblykit.geometry.precision`): the float precision of the coordinates as read,
+and for ``final_state`` poses the displacement their rounding allows.
+
 Every mesh is checked and repaired with trimesh (merged vertices, degenerate and
 duplicate faces dropped, normals made consistent and outward, holes filled); a mesh
 that is empty, has non-finite vertices or stays open is rejected with a
@@ -30,6 +34,13 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from assemblykit.errors import GeometryError, SchemaError
+from assemblykit.geometry.precision import (
+    Precision,
+    combined,
+    coordinate_precision,
+    pose_precision,
+)
+from assemblykit.geometry.solids import placed
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance, current
 
@@ -84,13 +95,6 @@ def pose_from_state(state: Sequence[float]) -> NDArray[np.float64]:
     return pose
 
 
-def placed(mesh: trimesh.Trimesh, pose: NDArray[np.float64]) -> trimesh.Trimesh:
-    """A copy of ``mesh`` transformed by ``pose``."""
-    moved = mesh.copy()
-    moved.apply_transform(pose)
-    return moved
-
-
 def _file_units(meshes: Sequence[trimesh.Trimesh]) -> str | None:
     """The unit the files declare (glTF is metres; OBJ/STL/PLY usually say nothing)."""
     units = {m.units for m in meshes}
@@ -100,7 +104,12 @@ def _file_units(meshes: Sequence[trimesh.Trimesh]) -> str | None:
 
 
 def _assembly(
-    parts: list[Part], units: str | None, declared: bool, source: str, tol: Tolerance | None
+    parts: list[Part],
+    units: str | None,
+    declared: bool,
+    source: str,
+    tol: Tolerance | None,
+    precision: Precision | None,
 ) -> Assembly:
     file_units = _file_units([p.mesh for p in parts])
     if units is not None:
@@ -109,7 +118,9 @@ def _assembly(
         unit, how = file_units, "file"
     else:
         unit, how = DEFAULT_UNITS, "default"
-    return Assembly(parts, units=unit, units_source=how, source=source, policy=tol)
+    return Assembly(
+        parts, units=unit, units_source=how, source=source, policy=tol, precision=precision
+    )
 
 
 def load_mesh_folder(folder: str | Path, tol: Tolerance | None = None) -> Assembly:
@@ -122,13 +133,17 @@ def load_mesh_folder(folder: str | Path, tol: Tolerance | None = None) -> Assemb
             f"no mesh files ({', '.join(MESH_SUFFIXES)}) in folder", source=str(folder)
         )
     states = _final_states(folder / "config.json")
-    parts = []
+    parts, measured = [], []
     for file in files:
         state = states.get(file.stem)
         pose = np.eye(4) if state is None else pose_from_state(state)
         mesh = read_mesh(file)
+        measured.append(coordinate_precision(mesh.vertices))
+        if state is not None:
+            radius = float(np.linalg.norm(mesh.vertices, axis=1).max())
+            measured.append(pose_precision(list(states.values()), radius))
         parts.append(Part(file.stem, placed(mesh, pose), pose, source=str(file)))
-    return _assembly(parts, None, False, str(folder), tol)
+    return _assembly(parts, None, False, str(folder), tol, combined(p for p in measured if p))
 
 
 def _final_states(config: Path) -> dict[str, list[float]]:
@@ -210,6 +225,7 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     if units is not None and not isinstance(units, str):
         raise SchemaError("expected a unit name such as mm", source=source, where="units")
     parts: list[Part] = []
+    measured: list[Precision] = []
     for i, entry in enumerate(data["parts"]):
         where = f"parts[{i}]"
         if not isinstance(entry, dict) or not isinstance(entry.get("mesh"), str):
@@ -220,5 +236,6 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         pose = pose_from_spec(entry.get("pose"), source=source, where=f"{where}.pose", tol=tol)
         mesh_path = path.parent / entry["mesh"]
         mesh = read_mesh(mesh_path)
+        measured.append(coordinate_precision(mesh.vertices))
         parts.append(Part(name, placed(mesh, pose), pose, source=str(mesh_path)))
-    return _assembly(parts, units, units is not None, source, tol)
+    return _assembly(parts, units, units is not None, source, tol, combined(measured))

@@ -25,6 +25,7 @@ from assemblykit.tolerance import Tolerance, current
 
 if TYPE_CHECKING:
     from assemblykit.geometry.contacts import Contact
+    from assemblykit.geometry.precision import Precision
     from assemblykit.geometry.recognition import Surface
 
 
@@ -54,6 +55,8 @@ class Assembly:
     mm of DESIGN.md §4). ``exact`` is true when the geometry comes from exact CAD
     surfaces; otherwise the mesh thresholds of the tolerance policy apply. ``policy``
     is the tolerance policy given when loading (the current one when ``None``).
+    ``precision`` is the input's own precision measured by the loader
+    (:mod:`assemblykit.geometry.precision`); lengths are never compared more finely.
     """
 
     def __init__(
@@ -66,6 +69,7 @@ class Assembly:
         exact: bool = False,
         scale: float | None = None,
         policy: Tolerance | None = None,
+        precision: Precision | None = None,
     ) -> None:
         items = parts.values() if isinstance(parts, Mapping) else parts
         self.parts: dict[str, Part] = {p.name: p for p in items}
@@ -75,6 +79,7 @@ class Assembly:
         self.exact = exact
         self._scale = scale
         self.policy = policy
+        self.precision = precision
         self._contacts: dict[Tolerance, list[Contact]] = {}
         self._surfaces: dict[tuple[str, Tolerance], tuple[Surface, ...]] = {}
 
@@ -121,7 +126,7 @@ class Assembly:
             self._scale = diagonal if diagonal > 0 else 1.0
         return self._scale
 
-    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
+    def policy_tolerance(self, tol: Tolerance | None = None) -> Tolerance:
         """The tolerance policy (``tol``, else the one the assembly was loaded with, else
         the current one) scaled to this model. For mesh input the mesh thresholds are a
         floor (tolerance.py): a looser length or angle asked for still applies."""
@@ -133,6 +138,30 @@ class Assembly:
             rel_length=max(policy.rel_length, policy.mesh_rel_length),
             angle=max(policy.angle, policy.mesh_angle),
         )
+
+    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
+        """The tolerance geometry is compared with: :meth:`policy_tolerance`, with its
+        length raised to the measured :attr:`precision` of the input when that is coarser
+        (``max(policy, measured)``, :mod:`assemblykit.geometry.precision`)."""
+        policy = self.policy_tolerance(tol)
+        if self.precision is None or self.precision.length <= policy.length:
+            return policy
+        return replace(policy, rel_length=self.precision.length / self.scale)
+
+    def tolerance_summary(self, tol: Tolerance | None = None) -> dict[str, Any]:
+        """Which length tolerance applies and why: ``length`` (model units), ``relative``
+        (to the scale), ``angle``, ``from`` (``policy`` or ``measured``), the policy's
+        ``policy_length``, and the ``measured`` precision with what it was ``measured_from``."""
+        policy, used = self.policy_tolerance(tol), self.tolerance(tol)
+        return {
+            "length": used.length,
+            "relative": used.rel_length,
+            "angle": used.angle,
+            "from": "policy" if used == policy else "measured",
+            "policy_length": policy.length,
+            "measured": None if self.precision is None else self.precision.length,
+            "measured_from": None if self.precision is None else self.precision.source,
+        }
 
     def contacts(self, tol: Tolerance | None = None) -> list[Contact]:
         """The contacts between touching parts, computed once per tolerance
@@ -170,6 +199,7 @@ class Assembly:
             exact=self.exact,
             scale=scale,
             policy=self.policy,
+            precision=self.precision,
         )
 
     def subset(self, names: Iterable[str]) -> Assembly:

@@ -1,0 +1,158 @@
+"""The input's own precision, measured from the data (extends the policy of tolerance.py).
+
+The tolerance policy fixes how precisely geometry is *compared*; the data fixes how
+precisely it was *given*. A loader measures the second and records it on the
+:class:`~assemblykit.model.assembly.Assembly`, whose length tolerance is then
+``max(policy, measured)``: a comparison never asks for more precision than the input has.
+
+* **Coordinates.** Vertices that are all exactly representable in float32 carry the
+  precision of float32 (half a float32 spacing at the largest coordinate); float64
+  coordinates carry half a float64 spacing.
+* **Poses** (``final_state`` of a mesh folder's ``config.json``). A number written with
+  ``k >= 1`` decimals is taken as rounded to ``k`` decimals; integers are exact. With
+  ``k_t`` the most decimals among the translations and ``k_r`` among the angles, a
+  vertex at distance ``r`` from its part's origin may be misplaced by up to
+  ``sqrt(3) (0.5 x 10^-k_t + r x 0.5 x 10^-k_r)``.
+* **Block joints** (COMPAS block assemblies). Blocks designed to meet face to face may
+  be given with faces that do not quite match: the dome of ``compas_assembly`` has
+  joints tilted by up to 5.6 degrees and 2.9 cm out of each other's plane. A *joint* is
+  a pair of faces of two blocks, with opposed normals within :data:`MAX_JOINT_TILT`,
+  whose planes cross inside their common outline (the faces touch along a line or
+  coincide); its *mismatch* is the largest distance of the vertices of one face from
+  the other's plane (the smaller of the two ways). Parallel faces with a gap, and faces
+  sunk into each other, do not cross and are not joints. The precision is the largest
+  mismatch, rounded up to two significant digits.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from decimal import Decimal
+from typing import TYPE_CHECKING
+
+import numpy as np
+import shapely
+from numpy.typing import NDArray
+
+from assemblykit.geometry.contacts import (
+    candidate_pairs,
+    facing_groups,
+    group_deviation,
+    stack_parts,
+    triangle_overlaps,
+)
+from assemblykit.geometry.recognition import segment
+from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
+
+MAX_JOINT_TILT = math.radians(10.0)
+
+
+@dataclass(frozen=True)
+class Precision:
+    """A measured precision of the input: ``length`` in model units, and ``source``,
+    what it was measured from (shown by the ``contacts`` command)."""
+
+    length: float
+    source: str
+
+
+def combined(precisions: Iterable[Precision]) -> Precision | None:
+    """The coarsest of ``precisions`` (``None`` when there is none)."""
+    return max(precisions, key=lambda p: p.length, default=None)
+
+
+def round_up(value: float) -> float:
+    """``value`` rounded up to two significant digits (0 stays 0)."""
+    if value <= 0:
+        return 0.0
+    step = 10.0 ** (math.floor(math.log10(value)) - 1)
+    return math.ceil(value / step) * step
+
+
+def coordinate_precision(vertices: NDArray[np.float64]) -> Precision:
+    """Half the float spacing at the largest coordinate: float32 when every coordinate
+    is exactly a float32, float64 otherwise (module docstring)."""
+    values = np.asarray(vertices, dtype=np.float64)
+    largest = float(np.abs(values).max()) if values.size else 0.0
+    single = bool(np.array_equal(values.astype(np.float32).astype(np.float64), values))
+    kind = np.float32 if single else np.float64
+    return Precision(
+        float(np.spacing(kind(largest))) / 2,
+        f"{'float32' if single else 'float64'} coordinates",
+    )
+
+
+def decimals(value: float) -> int:
+    """How many decimals the shortest text of ``value`` has (0 for integers)."""
+    exponent = Decimal(repr(float(value))).normalize().as_tuple().exponent
+    return max(-int(exponent), 0) if isinstance(exponent, int) else 0
+
+
+def pose_precision(states: Sequence[Sequence[float]], radius: float) -> Precision | None:
+    """How far rounding the ``[x, y, z, rx, ry, rz]`` ``states`` to their written decimals
+    may move a vertex at distance ``radius`` from its part's origin (module docstring);
+    ``None`` when every number is an integer."""
+    k_t = max((decimals(v) for s in states for v in s[:3]), default=0)
+    k_r = max((decimals(v) for s in states for v in s[3:6]), default=0)
+    shift = 0.5 * 10.0**-k_t if k_t else 0.0
+    turn = 0.5 * 10.0**-k_r if k_r else 0.0
+    if shift == 0 and turn == 0:
+        return None
+    return Precision(
+        math.sqrt(3) * (shift + radius * turn),
+        f"final_state rounded to {k_t} decimals (translations), {k_r} (angles)",
+    )
+
+
+def joint_mismatch(assembly: Assembly, tol: Tolerance | None = None) -> Precision:
+    """The largest mismatch of the block joints of ``assembly`` (module docstring), with
+    faces and joints judged at the assembly's policy tolerance."""
+    tol = assembly.policy_tolerance(tol)
+    floor = tol.length
+    names = list(assembly.parts)
+    stack = stack_parts(assembly)
+    seg = segment(stack.vertices, stack.faces, tol)
+    part_lo = np.array([p.mesh.bounds[0] for p in assembly.parts.values()])
+    part_hi = np.array([p.mesh.bounds[1] for p in assembly.parts.values()])
+    pairs = candidate_pairs(np.stack([part_lo, part_hi], axis=1), floor)
+    group_part = stack.part[seg.order[seg.start[:-1]]]
+    g, h = facing_groups(seg, group_part, seg.flat, part_lo, part_hi, pairs, floor)
+    opposed = np.einsum("ij,ij->i", seg.normal[g], seg.normal[h]) < -math.cos(MAX_JOINT_TILT)
+    g, h = g[opposed], h[opposed]
+    owner, pieces, u, v = triangle_overlaps(stack, seg, g, h, floor)
+    coords, which = shapely.get_coordinates(pieces, return_index=True)
+    pair = owner[which]
+    n_g, n_h = seg.normal[g][pair], seg.normal[h][pair]
+    points = coords[:, :1] * u[pair] + coords[:, 1:] * v[pair]
+    # height of h's plane above g's plane, along g's normal, at each overlap vertex
+    gap = np.einsum("ij,ij->i", n_h, seg.point[h][pair] - points) / np.einsum(
+        "ij,ij->i", n_h, n_g
+    ) - np.einsum("ij,ij->i", n_g, seg.point[g][pair] - points)
+    lowest = np.full(len(g), np.inf)
+    highest = np.full(len(g), -np.inf)
+    np.minimum.at(lowest, pair, gap)
+    np.maximum.at(highest, pair, gap)
+    mismatch = np.minimum(group_deviation(stack, seg, g, h), group_deviation(stack, seg, h, g))
+    reach, joint = floor, np.zeros(len(g), dtype=bool)
+    while True:
+        within = (lowest <= reach) & (highest >= -reach)
+        if np.array_equal(within, joint):
+            break
+        joint = within
+        reach = max(floor, float(mismatch[joint].max()))
+    if not joint.any():
+        return Precision(0.0, "no block joints")
+    joined = {
+        frozenset((names[a], names[b]))
+        for a, b in zip(group_part[g[joint]], group_part[h[joint]], strict=True)
+    }
+    return Precision(
+        round_up(float(mismatch[joint].max())),
+        f"largest mismatch of the block joints ({len(joined)} block pairs, "
+        f"tilted by at most {math.degrees(MAX_JOINT_TILT):g} deg)",
+    )
