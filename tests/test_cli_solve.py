@@ -206,3 +206,82 @@ def test_readable_output(capsys):
     assert run(["solve", str(EXAMPLES / "w4_pin.rapt")]) == 0
     text = capsys.readouterr().out
     assert "underconstrained" in text and "pin@s1" in text and "revolute" in text
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@pytest.mark.parametrize("suffix", [".yaml", ".rapt"])
+def test_gear_pair_meshed_then_held(suffix: str, capsys):
+    """g1 turned 30 deg by the stop; g2 follows by -30·20/40 = -15 deg about (30, 0)."""
+    out = solve_json(f"gear_pair{suffix}", capsys)
+    assert out["status"] == "underconstrained" and out["conflicts"] == []
+    bodies = out["bodies"]
+    for gear in ("g1@meshed", "g2@meshed"):
+        assert (bodies[gear]["dof"], bodies[gear]["motion"]) == (1, "revolute")
+    np.testing.assert_allclose(bodies["g2@meshed"]["invariants"]["point"][:2], [30, 0], atol=1e-9)
+    assert (bodies["g1@held"]["dof"], bodies["g2@held"]["dof"]) == (0, 0)
+    a, b = math.radians(30), math.radians(-15)
+    g1 = [[math.cos(a), -math.sin(a), 0, 0], [math.sin(a), math.cos(a), 0, 0]]
+    np.testing.assert_allclose(np.asarray(bodies["g1@held"]["pose"])[:2], g1, atol=1e-6)
+    shift = [30 - 30 * math.cos(b), -30 * math.sin(b), 0]
+    rotation = [[math.cos(b), -math.sin(b), 0], [math.sin(b), math.cos(b), 0], [0, 0, 1]]
+    np.testing.assert_allclose(np.asarray(bodies["g2@held"]["pose"])[:3, :3], rotation, atol=1e-6)
+    np.testing.assert_allclose(translation(bodies["g2@held"]), shift, atol=1e-5)
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@pytest.mark.parametrize("suffix", [".yaml", ".rapt"])
+def test_gripper_jaws_open_then_closed_equal_and_opposite(suffix: str, capsys):
+    out = solve_json(f"gripper{suffix}", capsys)
+    assert out["status"] == "underconstrained" and out["conflicts"] == []
+    bodies = out["bodies"]
+    for jaw in ("ja@open", "jb@open"):
+        assert (bodies[jaw]["dof"], bodies[jaw]["motion"]) == (1, "prismatic")
+        direction = np.abs(bodies[jaw]["invariants"]["direction"])
+        np.testing.assert_allclose(direction, [1, 0, 0], atol=1e-9)
+    assert (bodies["ja@closed"]["dof"], bodies["jb@closed"]["dof"]) == (0, 0)
+    np.testing.assert_allclose(bodies["ja@closed"]["pose"][0], [1, 0, 0, 0.5], atol=1e-9)
+    np.testing.assert_allclose(bodies["jb@closed"]["pose"][0], [1, 0, 0, -0.5], atol=1e-9)
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@pytest.mark.parametrize("suffix", [".yaml", ".rapt"])
+def test_box_on_table_with_a_corner_on_the_wall_keeps_two_dof(suffix: str, capsys):
+    out = solve_json(f"higher_pairs{suffix}", capsys)
+    assert out["status"] == "underconstrained" and out["conflicts"] == []
+    box = out["bodies"]["box@s1"]
+    assert box["dof"] == 2
+    pose = np.asarray(box["pose"])
+    assert (pose @ [1, 1, 0, 1])[0] == pytest.approx(5.0, abs=1e-6)  # corner on the wall
+    np.testing.assert_allclose(pose[:3, 2], [0, 0, 1], atol=1e-6)  # upright on the table
+    assert pose[2, 3] == pytest.approx(0.0, abs=1e-6)
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_explain_text_names_rule_link_places_and_dof(capsys, monkeypatch):
+    """The four-bar's trace: each joint's two relations (with their lines) intersect to a
+    revolute, and the loop goes to the residue solver: 4 dof along the chains from the
+    world (crank 1, rocker 1, coupler 2 through the crank), 1 after closing it."""
+    monkeypatch.setenv("COLUMNS", "400")
+    assert run(["solve", str(EXAMPLES / "four_bar.rapt"), "--explain"]) == 0
+    lines = [line for line in capsys.readouterr().out.splitlines() if ": " in line]
+    assert (
+        "intersect: world -> crank@s1 [against crank.bottom ground.top @s1 (line 32);"
+        " fits crank.hole_a ground.pin_a @s1 (line 33)] dof 2 -> 1 (revolute)"
+    ) in lines
+    assert (
+        "intersect: crank@s1 -> coupler@s1 [against coupler.bottom crank.top @s1 (line 36);"
+        " fits coupler.hole_b crank.pin_b @s1 (line 37)] dof 2 -> 1 (revolute)"
+    ) in lines
+    assert any(
+        line.startswith("residue: coupler@s1, crank@s1, rocker@s1 dof 4 -> 1 (1 solution(s)")
+        for line in lines
+    )
+
+
+@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+def test_explain_text_says_where_a_merged_body_ended(capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "400")
+    assert run(["solve", str(EXAMPLES / "stack_and_move.rapt"), "--explain"]) == 0
+    text = capsys.readouterr().out
+    assert "plate@lifted fixed relative to" in text or "fixed relative to plate@lifted" in text
+    assert "offset [0.0, 0.0, 30.0]" in text or "offset [0.0, 0.0, -30.0]" in text

@@ -10,6 +10,7 @@ import pytest
 from assemblykit.inference.numeric import (
     Constraint,
     ResidueProblem,
+    _same_solution,
     gear_residual,
     mirror_residual,
     pose_from_twist,
@@ -223,3 +224,38 @@ def test_known_only_problem_checks_the_residual():
     result = solve_residue(wrong, TOL)
     assert not result.found
     assert result.best_residual == pytest.approx(1.0)
+
+
+def _slide(x: float) -> np.ndarray:
+    pose = np.eye(4)
+    pose[0, 3] = x
+    return pose
+
+
+def test_two_stops_on_one_badly_conditioned_solution_are_one_solution():
+    """x is held only weakly (weight 1e-9): poses at x = 0 and x = 0.3 both satisfy the
+    constraint within the tolerance, and so does every pose between them: one solution."""
+    tol = Tolerance(scale=1.0)
+
+    def weak(poses):
+        return np.concatenate([[1e-9 * poses[0][0, 3]], poses[0][1:3, 3]])
+
+    problem = ResidueProblem(("a",), {"a": np.eye(4)}, {}, (Constraint(("a",), weak),))
+    assert _same_solution(problem, {"a": _slide(0.0)}, {"a": _slide(0.3)}, tol)
+
+
+def test_two_assembly_modes_are_kept_apart():
+    """x² = 1 (no rotation, y = z = 0) has the solutions x = ±1; the pose halfway (x = 0)
+    violates it by 1, so the multi-start keeps both."""
+    tol = Tolerance(scale=1.0)
+
+    def square(poses):
+        pose = poses[0]
+        rotation = (pose[:3, :3] - np.eye(3)).ravel()
+        return np.concatenate([[pose[0, 3] ** 2 - 1.0], pose[1:3, 3], rotation])
+
+    problem = ResidueProblem(("a",), {"a": np.eye(4)}, {}, (Constraint(("a",), square),))
+    assert not _same_solution(problem, {"a": _slide(1.0)}, {"a": _slide(-1.0)}, tol)
+    result = solve_residue(problem, tol, starts=8)
+    xs = sorted(round(s.poses["a"][0, 3], 6) for s in result.solutions)
+    assert xs == [-1.0, 1.0]

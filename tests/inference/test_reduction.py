@@ -830,3 +830,36 @@ def test_numeric_only_path_agrees_with_reduction():
     numeric = solve_numeric_only(task).to_dict()["bodies"]["cube@s1"]
     assert (numeric["dof"], numeric["solutions"]) == (0, 1)
     assert np.allclose(numeric["pose"], shift(1, 2, 3), atol=1e-6)
+
+
+# ---------------------------------------------------------------- repeated geometry
+
+
+def _cube(name: str, fixed: bool = False) -> Body:
+    return body(
+        name,
+        fixed=fixed,
+        bottom=Plane((0, 0, 0), (0, 0, -1)),
+        top=Plane((0, 0, 1), Z),
+        left=Plane((0, 0, 0), (-1, 0, 0)),
+        front=Plane((0, 0, 0), (0, -1, 0)),
+    )
+
+
+def test_a_stack_of_equal_cubes_reuses_one_intersection_and_traces_every_step():
+    """Three equal cubes on a base, each seated by against + 2 coplanar: cube k sits at
+    height k; every seat is traced as planar ∩ planar (3 -> 1) then ∩ planar (1 -> 0)."""
+    names = ["c1", "c2", "c3"]
+    relations = []
+    for child, parent in zip(names, ["base", *names], strict=False):
+        relations += [
+            rel("against", f"{child}.bottom", f"{parent}.top"),
+            rel("coplanar", f"{child}.left", f"{parent}.left"),
+            rel("coplanar", f"{child}.front", f"{parent}.front"),
+        ]
+    out = solve([_cube("base", fixed=True), *map(_cube, names)], *relations, explain=True)
+    assert out["status"] == "solved"
+    for k, name in enumerate(names, start=1):
+        assert np.allclose(out["bodies"][f"{name}@s1"]["pose"], shift(0, 0, k), atol=1e-12)
+    steps = [(s["dof_before"], s["dof_after"]) for s in out["trace"] if s["rule"] == "intersect"]
+    assert steps == [(3, 1), (1, 0)] * 3

@@ -22,7 +22,7 @@ residue solver (:mod:`assemblykit.inference.numeric`).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Hashable, MutableMapping
 from dataclasses import dataclass
 from functools import partial
 from typing import Any
@@ -53,6 +53,9 @@ class Link:
 
     ``labels`` name the relations or actions it came from; ``make_residual`` builds the
     same condition as a residual function of ``X``, only when the numeric path needs it.
+    ``key`` describes the condition in body coordinates (relation kind, the features'
+    geometry and options; or the fixed transform of an action): links with equal keys
+    have equal values, which lets the reduction reuse intersections.
     """
 
     source: Node
@@ -60,6 +63,7 @@ class Link:
     value: Any
     labels: tuple[str, ...]
     make_residual: Callable[[], Callable[[np.ndarray], np.ndarray]]
+    key: Hashable = None
 
 
 @dataclass(frozen=True)
@@ -96,20 +100,43 @@ class Network:
         )
 
 
+def _plain_value(value: Any) -> Hashable:
+    """A hashable copy of a feature field (arrays become their shape and bytes)."""
+    if isinstance(value, np.ndarray):
+        return value.shape, value.tobytes()
+    return value
+
+
+def feature_key(feature: Any) -> Hashable:
+    """The type and geometry of a feature (every field but its name): features with equal
+    keys have equal frames, groups and parameters."""
+    return (
+        type(feature),
+        *(_plain_value(v) for k, v in vars(feature).items() if k != "name"),
+    )
+
+
+def point_key(pose: np.ndarray) -> Hashable:
+    """The key of a fixed link (a single relative pose)."""
+    return "point", _plain_value(np.asarray(pose, dtype=np.float64))
+
+
 def point_coset(pose: np.ndarray) -> Coset:
     """The single relative pose ``pose`` as a coset of the identity group (a fix link)."""
     return Coset(SymmetryGroup.identity(), np.asarray(pose, dtype=np.float64))
 
 
 def instance_key(node: Node) -> str:
-    """``"<body>@<situation>"``."""
-    return f"{node[0]}@{node[1]}"
+    """``"<body>@<situation>"``, or ``"world"`` for the world."""
+    return "world" if node == WORLD else f"{node[0]}@{node[1]}"
 
 
 def relation_label(relation: Any, situation: str) -> str:
-    """A readable name of a relation: ``"against block.bottom table.top @s1"``."""
+    """A readable name of a relation with its place in the task file when known:
+    ``"against block.bottom table.top @s1 (line 14)"``."""
     refs = " ".join(str(r) for r in relation.refs)
-    return f"{relation.kind} {refs} @{situation}"
+    place = f" ({relation.where})" if relation.where else ""
+    return f"{relation.kind} {refs} @{situation}{place}"
 
 
 def _fixed_residual(target: np.ndarray, scale: float) -> Callable[[np.ndarray], np.ndarray]:
@@ -154,6 +181,8 @@ def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | No
     if action.by is not None:
         label += f" by {action.by:g}"
     label += f" @{nxt[1]}"
+    if action.where:
+        label += f" ({action.where})"
     frame = np.asarray(task.feature(ref, action.where or label).frame(), dtype=np.float64)
     rotate = action.kind == "turn"
     if action.by is None:
@@ -163,11 +192,17 @@ def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | No
             else SymmetryGroup.prismatic(frame[:3, 2])
         )
         residual = partial(_axis_residual, frame, rotate, current().scale)
-        return Link(prev, nxt, Coset(group, np.eye(4)), (label,), residual)
+        key = (action.kind, _plain_value(frame))
+        return Link(prev, nxt, Coset(group, np.eye(4)), (label,), residual, key)
     step = se3.rot_z(action.by) if rotate else se3.translation(np.array([0.0, 0.0, action.by]))
     target = frame @ step @ se3.inverse(frame)
     return Link(
-        prev, nxt, point_coset(target), (label,), partial(_fixed_residual, target, current().scale)
+        prev,
+        nxt,
+        point_coset(target),
+        (label,),
+        partial(_fixed_residual, target, current().scale),
+        point_key(target),
     )
 
 
@@ -218,13 +253,26 @@ def _coupled_constraint(
     return Constraint((*bodies, carrier), residual, (label,))
 
 
+def _memo_key(feature: Any, memo: MutableMapping[Hashable, Any]) -> Hashable:
+    """:func:`feature_key`, computed once per feature object of the task being built."""
+    found = memo.get(id(feature))
+    if found is None:
+        found = memo[id(feature)] = feature_key(feature)
+    return found
+
+
 def _relation_part(
     task: Task,
     situation: Situation,
     relation: Relation,
     node: Callable[[str], Node],
+    cosets: MutableMapping[Hashable, Any],
 ) -> Link | Constraint:
-    """The link (coset relations) or constraint (all others) of one spatial relation."""
+    """The link (coset relations) or constraint (all others) of one spatial relation.
+
+    ``cosets`` caches the cosets of identical feature pairs (a stack of equal parts asks
+    for the same coset once) and the keys of the task's features (by object id: the task
+    holds them while the network is built)."""
     label = relation_label(relation, situation.name)
     if relation.kind in COUPLED:
         return _coupled_constraint(task, situation, relation, node, label)
@@ -240,9 +288,17 @@ def _relation_part(
             lambda poses: residual(se3.inverse(poses[0]) @ poses[1]),
             (label,),
         )
-    value = relation_coset(relation.kind, first, second, options)
+    key = (
+        relation.kind,
+        _memo_key(first, cosets),
+        _memo_key(second, cosets),
+        tuple(sorted((k, _plain_value(v)) for k, v in options.items())),
+    )
+    value = cosets.get(key)
+    if value is None:
+        value = cosets[key] = relation_coset(relation.kind, first, second, options)
     make = partial(relation_residual, relation.kind, first, second, options, current())
-    return Link(source, target, value, (label,), make)
+    return Link(source, target, value, (label,), make, key)
 
 
 def build_network(task: Task) -> Network:
@@ -252,6 +308,7 @@ def build_network(task: Task) -> Network:
     instances = tuple((b, s) for s in situations for b in task.bodies if b not in fixed)
     links: list[Link] = []
     constraints: list[Constraint] = []
+    cosets: dict[Hashable, Any] = {}
     for index, situation in enumerate(task.situations):
 
         def node(body: str, name: str = situation.name) -> Node:
@@ -260,7 +317,7 @@ def build_network(task: Task) -> Network:
         if index > 0:
             links.extend(_transition(task, situation, situations[index - 1], fixed))
         for relation in situation.relations:
-            part = _relation_part(task, situation, relation, node)
+            part = _relation_part(task, situation, relation, node, cosets)
             (links if isinstance(part, Link) else constraints).append(part)
     return Network(
         instances, tuple(links), tuple(constraints), situations, tuple(task.bodies), fixed
@@ -287,6 +344,7 @@ def _transition(
                 point_coset(np.eye(4)),
                 (f"stationary {body} @{situation.name}",),
                 partial(_fixed_residual, np.eye(4), current().scale),
+                point_key(np.eye(4)),
             )
         )
     return links

@@ -136,6 +136,30 @@ def _distance(
     )
 
 
+def _midpoint(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The pose halfway from ``a`` to ``b`` in the local coordinates of :func:`pose_from_twist`."""
+    rotvec = Rotation.from_matrix(b[:3, :3] @ a[:3, :3].T).as_rotvec()
+    return pose_from_twist(a, 0.5 * np.concatenate([rotvec, b[:3, 3] - a[:3, 3]]))
+
+
+def _same_solution(
+    problem: ResidueProblem,
+    a: Mapping[Hashable, np.ndarray],
+    b: Mapping[Hashable, np.ndarray],
+    tol: Tolerance,
+) -> bool:
+    """Whether two accepted solutions are one: they are within ``tol.mesh_angle`` (an
+    angle θ weighs like the arc θ·scale, as in the residuals), or the poses halfway
+    between them also satisfy every constraint. Distinct isolated solutions (assembly
+    modes) are separated by violated constraints; two stops of the solver on the same
+    solution are not, however far apart a long, badly conditioned chain lets them be."""
+    if _distance(a, b, tol.scale) <= tol.mesh_angle:
+        return True
+    poses = {**problem.known, **{n: _midpoint(a[n], b[n]) for n in problem.unknowns}}
+    parts = [_scaled(c, poses) for c in problem.constraints]
+    return bool(parts) and float(np.abs(np.concatenate(parts)).max()) <= tol.mesh_length
+
+
 def _sparsity(problem: ResidueProblem, start: Mapping[Hashable, np.ndarray]) -> np.ndarray:
     """Which residual rows depend on which unknowns (6 columns per unknown instance), so
     that finite differences are grouped (a network of N bodies costs O(1) residuals per
@@ -178,7 +202,8 @@ def solve_residue(
     Solutions are accepted when every residual entry is within ``tol.mesh_length`` (a
     numeric solution is approximate geometry, like a mesh). Isolated solutions from
     different starts are deduplicated by pose distance; the first solution on a
-    continuum (total dof > 0) ends the search and is its representative. ``tol.scale``
+    continuum (total dof > 0) ends the search and is its representative. Two solutions
+    are one when the poses halfway between them satisfy the constraints too. ``tol.scale``
     is the length scale of the start spread.
     """
     tol = tol or current()
@@ -213,8 +238,7 @@ def solve_residue(
         if worst > tol.mesh_length:
             continue
         poses = {node: poses[node] for node in problem.unknowns}
-        # an angle θ weighs like the arc θ·scale at the model's size, as in the residuals
-        if any(_distance(poses, s.poses, tol.scale) <= tol.mesh_angle for s in found):
+        if any(_same_solution(problem, poses, s.poses, tol) for s in found):
             continue
         dof, total = _local_dof(problem, fit.jac, tol)
         found.append(NumericSolution(poses, dof, total, worst))

@@ -27,10 +27,12 @@ world outward is reduced in near-linear time; cycles are searched only at a fixp
 
 from __future__ import annotations
 
+import gc
 import itertools
 import math
 from collections import deque
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Hashable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -62,6 +64,14 @@ from assemblykit.inference.solution import (
 from assemblykit.tolerance import Tolerance, current, using
 
 CYCLE_LENGTH = 4  # seed 000 §III F: "we restrict the size of the cycles ... to four"
+
+_EYE = np.eye(4)
+_EYE.flags.writeable = False  # shared by every find() of a representative
+
+GroupEvent = tuple[int, int, int, str] | tuple[int, EmptySet]
+"""One step of intersecting the parallel links of a group: ``(index, dof before, dof
+after, kind)`` for an intersection with link ``index``, ``(index, empty)`` for a
+conflict (the link is then skipped)."""
 
 
 def _kind_name(value: Any) -> str:
@@ -126,8 +136,10 @@ class Reducer:
 
     def find(self, node: Node) -> tuple[Node, np.ndarray]:
         """The representative of ``node`` and ``X`` with ``L_node = L_rep @ X``."""
+        if node not in self.parent:
+            return node, _EYE
         path = []
-        transform = np.eye(4)
+        transform = _EYE
         while node in self.parent:
             path.append(node)
             up, step = self.parent[node]
@@ -146,6 +158,55 @@ class Reducer:
             self._record_conflict(link.labels, link.value)
             return
         self.pending.append((link.source, link.target, link.value, link.labels))
+
+    def add_parallel(
+        self, links: Sequence[Link], cache: dict[Hashable, tuple[Any, list[GroupEvent], int]]
+    ) -> None:
+        """Queue the links between one pair of instances as one link (rule 1 applied on
+        input): their cosets intersected in order, each intersection traced and each
+        empty one recorded as a conflict, as if they were inserted one by one.
+
+        ``cache`` maps the links' keys (their geometry in body coordinates) to the result,
+        so a repeated part (a stack of equal cubes) costs one intersection in all."""
+        valid = [link for link in links if not isinstance(link.value, EmptySet)]
+        for link in links:
+            if isinstance(link.value, EmptySet):
+                self.add(link)
+        if not valid:
+            return
+        head = valid[0]
+        if len(valid) == 1 or any(link.value.group.lattice for link in valid):
+            for link in valid:
+                self.add(link)
+            return
+        forward = [link.source == head.source for link in valid]
+        keys = tuple(zip((link.key for link in valid), forward, strict=True))
+        cached = cache.get(keys) if all(k is not None for k, _ in keys) else None
+        if cached is None:
+            cached = _intersect_parallel(
+                [
+                    link.value if same else link.value.inverse()
+                    for link, same in zip(valid, forward, strict=True)
+                ],
+                self.tol,
+            )
+            if all(k is not None for k, _ in keys):
+                cache[keys] = cached
+        value, events, used = cached
+        labels = head.labels
+        text = f"{instance_key(head.source)} -> {instance_key(head.target)}"
+        for event in events:
+            extra = valid[event[0]].labels
+            if len(event) == 2:
+                self._record_conflict(labels + extra, event[1])
+                continue
+            _, before, after, kind = event
+            names = "; ".join(dict.fromkeys(labels + extra))
+            self.trace.append(TraceStep("intersect", f"{text} [{names}]", before, after, kind))
+            labels = labels + extra
+        self.pending.append((head.source, head.target, value, labels))
+        for link in valid[used:]:
+            self.add(link)
 
     def _record_conflict(self, labels: tuple[str, ...], empty: Any) -> None:
         mismatch = empty.mismatch
@@ -212,7 +273,7 @@ class Reducer:
         edge = self.edges.get(key)
         if edge is None or not edge.value.is_point:
             return
-        x = np.asarray(edge.value.points()[0], dtype=np.float64)
+        x = edge.value.rep  # a point coset is {I}·x0
         keep, gone = edge.source, edge.target
         if gone == WORLD or (
             keep != WORLD and len(self.adjacency[keep]) < len(self.adjacency[gone])
@@ -222,7 +283,16 @@ class Reducer:
         self.adjacency[keep].discard(gone)
         self.adjacency[gone].discard(keep)
         self.parent[gone] = (keep, x)
-        self.trace.append(TraceStep("merge", self._edge_text(edge), 0, 0, instance_key(gone)))
+        offset = np.round(x[:3, 3], 9).tolist()
+        self.trace.append(
+            TraceStep(
+                "merge",
+                self._edge_text(edge),
+                0,
+                0,
+                f"{instance_key(gone)} fixed relative to {instance_key(keep)}, offset {offset}",
+            )
+        )
         for other in self.adjacency.pop(gone, set()):
             moved = self.edges.pop(frozenset((gone, other)))
             self.adjacency[other].discard(gone)
@@ -365,6 +435,32 @@ class Reducer:
 
     def _has_finite(self) -> bool:
         return any(_is_finite_branch(e.value) for e in self.edges.values())
+
+
+def _intersect_parallel(values: list[Any], tol: Tolerance) -> tuple[Any, list[GroupEvent], int]:
+    """Intersect the cosets of parallel links in order (rule 1); an empty intersection is
+    an event and leaves the value as it was (later links still meet it). Stops at a
+    lattice, which is flagged rather than intersected: returns how many values were used."""
+    value = values[0]
+    events: list[GroupEvent] = []
+    for index, incoming in enumerate(values[1:], start=1):
+        if value.group.lattice:
+            return value, events, index
+        result = value.intersect(incoming, tol)
+        if isinstance(result, EmptySet):
+            events.append((index, result))
+            continue
+        events.append((index, min(value.dof, incoming.dof), result.dof, _kind_name(result)))
+        value = result
+    return value, events, len(values)
+
+
+def _parallel_groups(links: Sequence[Link]) -> list[list[Link]]:
+    """The links grouped by their unordered pair of instances, in order of appearance."""
+    groups: dict[frozenset[Node], list[Link]] = {}
+    for link in links:
+        groups.setdefault(frozenset((link.source, link.target)), []).append(link)
+    return list(groups.values())
 
 
 def _progress(before: Any, after: Any) -> bool:
@@ -625,11 +721,13 @@ def _numeric_component(
         constraints,
     )
     result = solve_residue(problem, tol, starts=starts)
+    # before: the freedom each instance has along its chain of links from the world
+    before = sum(getattr((candidates or {}).get(n), "dof", 6) for n in unknowns)
     reducer.trace.append(
         TraceStep(
             "residue",
             ", ".join(instance_key(n) for n in unknowns),
-            None,
+            before,
             result.solutions[0].total_dof if result.found else None,
             f"{len(result.solutions)} solution(s), best residual {result.best_residual:.3g}",
         )
@@ -740,14 +838,32 @@ def _combine(
     return bodies, consistent[0][1]
 
 
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """Pause the cyclic garbage collector for the duration (restoring its state after).
+
+    Building and reducing a network allocates many small objects that all stay alive
+    until the answer is built; every collection the allocations trigger would rescan all
+    of them, which makes a large network cost quadratic time. Nothing here is cyclic
+    garbage, so nothing is lost by collecting once afterwards."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
 def solve_network(
     network: Network, tol: Tolerance | None = None, explain: bool = False, max_branches: int = 64
 ) -> Solution:
     """Reduce a network (rules 1-4), then report every instance (rule 5)."""
     tol = tol or current()
     root = Reducer(tol)
-    for link in network.links:
-        root.add(link)
+    cache: dict[Hashable, tuple[Any, list[GroupEvent], int]] = {}
+    for group in _parallel_groups(network.links):
+        root.add_parallel(group, cache)
     leaves = explore(root, max_branches)
     reports = [_leaf_report(network, leaf, tol) for leaf in leaves]
     bodies, conflicts = _combine(network, reports, tol)
@@ -772,7 +888,7 @@ def model_scale(task: Any) -> float:
 def solve_task(task: Any, tol: Tolerance | None = None, explain: bool = False) -> Solution:
     """RAPT inference on a task: poses of every body in every situation (seed 000 §III)."""
     tol = tol or current().with_scale(model_scale(task))
-    with using(tol):
+    with using(tol), _collector_paused():
         return solve_network(build_network(task.validate()), tol, explain)
 
 
