@@ -5,6 +5,7 @@ prescribes: 'against' maps the body-2 plane with its normal negated onto the bod
 from __future__ import annotations
 
 import math
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ from assemblykit.algebra import (
     PlaneInvariant,
     PointInvariant,
     SymmetryGroup,
+    cosets,
     se3,
     transform_invariant,
     transporter,
@@ -360,5 +362,160 @@ def test_w16_lattice_meets_a_third_relation():
     np.testing.assert_allclose(fixed.rep, tr(0, 0, 4.5), atol=1e-12)
     off_lattice = transporter([PlaneInvariant((0, 0, 4.0), Z)], [PlaneInvariant(ORIGIN, Z)])
     missed = w16.intersect(off_lattice)
-    assert isinstance(missed, EmptySet) and not missed.proven
-    assert missed.mismatch.kind == "residual"
+    # 4.0 lies between the lattice steps 3.0 and 4.5: proven empty, 0.5 from the nearest.
+    assert isinstance(missed, EmptySet) and missed.proven
+    assert missed.mismatch.kind == "distance"
+    assert missed.mismatch.value == pytest.approx(0.5, abs=1e-12)
+
+
+# ----------------------------------------------------------------------------- helical closed forms
+# ALGEBRA.md §2.4 table and §2.5: a thread coset meets a TR coset in a one-parameter
+# problem in the screw angle, solved exactly (no numeric search).
+
+LEAD = 1.5
+PITCH = LEAD / (2 * math.pi)
+
+
+@pytest.fixture
+def no_numeric_search(monkeypatch):
+    """Fail if the numeric fallback runs: the closed forms must decide."""
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the numeric search ran")
+
+    monkeypatch.setattr("assemblykit.algebra.cosets._numeric_meet", refuse)
+
+
+def thread(rep=None):
+    return Coset(SymmetryGroup.helical(ORIGIN, Z, PITCH), np.eye(4) if rep is None else rep)
+
+
+def test_thread_against_a_face_fixes_the_screw_angle(no_numeric_search):
+    # The nut seats 0.75 up: half the lead, so half a turn.
+    seat = against(((0, 0, 0.75), Z), ((0, 0, 0), (0, 0, -1)))
+    c = thread().intersect(seat)
+    assert isinstance(c, Coset) and c.is_point
+    np.testing.assert_allclose(c.rep, tr(0, 0, 0.75) @ se3.rot_z(math.pi), atol=1e-12)
+    # The other order gives the same point.
+    d = seat.intersect(thread())
+    np.testing.assert_allclose(d.rep, c.rep, atol=1e-12)
+
+
+def test_thread_and_key_give_the_lead_lattice_through_the_key_angle(no_numeric_search):
+    key = Coset(SymmetryGroup.prismatic(Z), se3.rot_z(0.3))
+    c = thread().intersect(key)
+    assert isinstance(c, Coset) and c.dof == 0 and c.n_components == math.inf
+    np.testing.assert_allclose(c.rep, se3.screw(ORIGIN, Z, PITCH, 0.3), atol=1e-12)
+    np.testing.assert_allclose(c.group.lattice[0][:3, 3], (0, 0, LEAD), atol=1e-12)
+    assert c.contains(tr(0, 0, 2 * LEAD) @ c.rep)
+
+
+def test_thread_and_revolute_on_the_same_axis_give_one_point(no_numeric_search):
+    shoulder = Coset(SymmetryGroup.revolute(ORIGIN, Z), tr(0, 0, 0.375))
+    c = thread().intersect(shoulder)
+    assert isinstance(c, Coset) and c.is_point
+    np.testing.assert_allclose(c.rep, tr(0, 0, 0.375) @ se3.rot_z(math.pi / 2), atol=1e-12)
+
+
+def test_thread_off_phase_is_proven_empty_with_the_axial_miss(no_numeric_search):
+    # Rotations about the parallel axis through (1, 0, 0) meet the helix only at whole
+    # turns, i.e. at heights 1.5 k; 0.375 is 0.375 from the nearest.
+    other = Coset(SymmetryGroup.revolute((1, 0, 0), Z), tr(0, 0, 0.375))
+    e = thread().intersect(other)
+    assert isinstance(e, EmptySet) and e.proven
+    assert e.mismatch.kind == "distance"
+    assert e.mismatch.value == pytest.approx(0.375, abs=1e-12)
+
+
+def test_thread_in_a_tilted_bore_is_empty_by_the_hull(no_numeric_search):
+    tilted = fits(((0, 0, 0), (1, 0, 0)), ((0, 0, 0), (0, 0, 1)))
+    bore = fits(((0, 0, 0), Z), ((0, 0, 0), Z))
+    assert isinstance(bore, Coset)
+    # C(x-axis) . Ry(pi/2)^-1 ∩ H(z): every element of the hull C(z) keeps z, none maps z to x.
+    e = thread().intersect(tilted)
+    assert isinstance(e, EmptySet) and e.proven and e.mismatch.kind == "angle"
+
+
+def test_pseudo_planar_meets_a_face_and_a_key(no_numeric_search):
+    y = Coset(SymmetryGroup.pseudo_planar(Z, PITCH), tr(1, 2, 3))
+    seat = against(((0, 0, 0.75), Z), ((0, 0, 0), (0, 0, -1)))
+    c = y.intersect(seat)
+    # Y(z) ∩ G(z) = T2(z): the plane at height 0.75 with the angle fixed mod 2 pi.
+    assert isinstance(c, Coset) and c.kind is Kind.TRANSLATION2
+    assert c.rep[2, 3] == pytest.approx(0.75, abs=1e-12)
+    assert y.contains(c.rep) and seat.contains(c.rep)
+    assert c.contains(tr(5, -1, 0) @ c.rep)
+    key = Coset(SymmetryGroup.prismatic(Z), se3.rot_z(0.3))
+    k = y.intersect(key)
+    assert isinstance(k, Coset) and k.dof == 0 and k.n_components == math.inf
+    # Height 3 + 0.3 p: the screw 0.3 on top of the offset 3 = 2 lead turns (3 = 2 x 1.5).
+    np.testing.assert_allclose(k.rep, tr(0, 0, 3 + 0.3 * PITCH) @ se3.rot_z(0.3), atol=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(seeds)
+def test_helical_closed_forms_contain_a_shared_position_and_are_equivariant(seed):
+    """A thread (H) or pseudo-planar (Y) relation and a plane, line or point relation
+    through one random position x: the answer contains x, lies in both, and moving body
+    1 by h moves the answer; the numeric search is never needed."""
+    rng = np.random.default_rng(seed)
+    x = se3.random_transform(rng)
+    pitch = float(rng.uniform(0.05, 1.0)) * (1 if rng.random() < 0.5 else -1)
+    group = (
+        SymmetryGroup.helical(rng.normal(size=3), rng.normal(size=3), pitch)
+        if rng.random() < 0.5
+        else SymmetryGroup.pseudo_planar(rng.normal(size=3), pitch)
+    )
+    helix = Coset(group, x)
+    inv = (
+        PlaneInvariant(rng.normal(size=3), rng.normal(size=3)),
+        LineInvariant(rng.normal(size=3), rng.normal(size=3)),
+        PointInvariant(rng.normal(size=3)),
+    )[rng.integers(3)]
+    other = transporter([inv], [transform_invariant(se3.inverse(x), inv)])
+    assert isinstance(other, Coset) and other.contains(x)
+    h = se3.random_transform(rng)
+    for a, b, point in ((helix, other, x), (helix.left(h), other.left(h), h @ x)):
+        with mock.patch.object(cosets, "_numeric_meet", side_effect=AssertionError("numeric")):
+            m = a.intersect(b)
+        assert isinstance(m, Coset)
+        assert m.contains(point) and a.contains(m.rep) and b.contains(m.rep)
+        assert m.group.equals(a.group.intersect(b.group))
+
+
+# ----------------------------------------------------------------------------- lattice cosets
+
+
+def test_lattice_coset_meets_in_closed_form_far_from_the_origin(no_numeric_search):
+    """W16 seated 900 lead steps up: beyond any bounded step search, found exactly."""
+    w16 = thread().intersect(Coset(SymmetryGroup.prismatic(Z), np.eye(4)))
+    far = against(((0, 0, 900 * LEAD), Z), ((0, 0, 0), (0, 0, -1)))
+    c = w16.intersect(far)
+    assert isinstance(c, Coset) and c.is_point
+    np.testing.assert_allclose(c.rep, tr(0, 0, 1350.0), atol=1e-9)
+
+
+def test_discrete_screw_coset_meets_a_key_every_other_step(no_numeric_search):
+    """H(1) ∩ H(3) = <Scr(-3 pi; 1)>: rotation pi per step, so a key (no rotation)
+    meets the coset through Tr(0, 0, 4 pi) only at even steps, the nearest being
+    Tr(0, 0, 4 pi - 6 pi . 0) ... i.e. heights 4 pi + 6 pi Z."""
+    screws = SymmetryGroup.helical(ORIGIN, Z, 1.0).intersect(SymmetryGroup.helical(ORIGIN, Z, 3.0))
+    lattice = Coset(screws, tr(0, 0, 4 * math.pi))
+    key = Coset(SymmetryGroup.prismatic(Z), np.eye(4))
+    c = lattice.intersect(key)
+    assert isinstance(c, Coset) and c.dof == 0 and c.n_components == math.inf
+    assert np.allclose(c.rep[:3, :3], np.eye(3), atol=1e-12)
+    height = c.rep[2, 3]
+    assert ((height - 4 * math.pi) / (6 * math.pi)) == pytest.approx(
+        round((height - 4 * math.pi) / (6 * math.pi)), abs=1e-12
+    )
+    np.testing.assert_allclose(c.group.lattice[0][:3, 3], (0, 0, -6 * math.pi), atol=1e-9)
+    # A half-turn key only meets the odd steps.
+    flipped = Coset(SymmetryGroup.prismatic(Z), se3.rot_z(math.pi))
+    d = lattice.intersect(flipped)
+    assert isinstance(d, Coset)
+    np.testing.assert_allclose(d.rep[:3, :3], se3.rot_z(math.pi)[:3, :3], atol=1e-12)
+    # A quarter-turn key meets none: proven.
+    quarter = Coset(SymmetryGroup.prismatic(Z), se3.rot_z(math.pi / 2))
+    e = lattice.intersect(quarter)
+    assert isinstance(e, EmptySet) and e.proven

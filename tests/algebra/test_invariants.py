@@ -27,6 +27,7 @@ from assemblykit.algebra import (
     transporter,
 )
 from assemblykit.errors import FeatureError
+from assemblykit.tolerance import Tolerance
 
 Z = (0.0, 0.0, 1.0)
 X = (1.0, 0.0, 0.0)
@@ -155,3 +156,62 @@ def test_stabilizer_is_equivariant(seed):
     h = se3.random_transform(rng)
     moved = [transform_invariant(h, i) for i in invs]
     assert stabilizer(moved).equals(stabilizer(invs).conjugate(h))
+
+
+# ----------------------------------------------------------------------------- float invariants
+
+
+def test_characteristic_flats_follow_the_group_frame():
+    from assemblykit.algebra.invariants import characteristic_flats
+
+    f = se3.frame((1, 2, 3), (0, 0, 1), (1, 0, 0))
+    # Point code 0, line 1, plane 2, direction 3.
+    assert characteristic_flats(Kind.REVOLUTE, f) == (
+        (0, (1.0, 2.0, 3.0), None),
+        (1, (1.0, 2.0, 3.0), (0.0, 0.0, 1.0)),
+    )
+    assert characteristic_flats(Kind.TRANSLATION2, f) == (
+        (2, (1.0, 2.0, 3.0), (0.0, 0.0, 1.0)),
+        (3, None, (1.0, 0.0, 0.0)),
+    )
+    assert characteristic_flats(Kind.FREE, f) == ()
+    with pytest.raises(FeatureError, match="helical"):
+        characteristic_flats(Kind.HELICAL, f)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seeds)
+def test_moved_flats_agree_with_transform_invariant(seed):
+    from assemblykit.algebra.invariants import characteristic_flats, frame_invariants, move_flats
+
+    rng = np.random.default_rng(seed)
+    frame, t = se3.random_transform(rng), se3.random_transform(rng)
+    flats = characteristic_flats(Kind.FIXED, frame)
+    moved = move_flats(t, flats)
+    back = move_flats(t, moved, inverse=True)
+    for (code, p, u), (_, q, w), (_, _, v), inv in zip(
+        moved, back, flats, frame_invariants(Kind.FIXED, frame), strict=True
+    ):
+        ref = transform_invariant(t, inv)
+        np.testing.assert_allclose(p, ref.point, atol=1e-12)
+        np.testing.assert_allclose(q, inv.point, atol=1e-12)
+        if code:
+            np.testing.assert_allclose(u, getattr(ref, "direction", getattr(ref, "normal", None)))
+            np.testing.assert_allclose(w, v, atol=1e-14)
+    assert isinstance(frame_invariants(Kind.FIXED, frame)[1], LineInvariant)
+
+
+def test_flat_transporter_reports_the_congruence_failure():
+    from assemblykit.algebra.invariants import characteristic_flats, flat_transporter
+
+    targets = characteristic_flats(Kind.PLANAR, np.eye(4))
+    # Two floors 1 apart on the body-1 side, 2 apart on the body-2 side.
+    two = targets + characteristic_flats(Kind.PLANAR, se3.translation((0, 0, 1)))
+    other = targets + characteristic_flats(Kind.PLANAR, se3.translation((0, 0, 2)))
+    group = SymmetryGroup.planar((0, 0, 1))
+    e = flat_transporter(two, other, group, Tolerance())
+    assert isinstance(e, EmptySet) and e.mismatch.kind == "distance"
+    assert e.mismatch.value == pytest.approx(1.0)
+    c = flat_transporter(two, two, group, Tolerance())
+    assert isinstance(c, Coset) and c.group is group
+    np.testing.assert_allclose(c.rep, np.eye(4), atol=1e-15)

@@ -87,3 +87,36 @@ def test_adjoint_is_conjugation_of_twists(seed):
     np.testing.assert_allclose(
         se3.hat(se3.adjoint(t) @ xi), t @ se3.hat(xi) @ se3.inverse(t), atol=1e-9
     )
+
+
+def test_frame_default_x_is_the_least_aligned_coordinate_axis():
+    # z = (0.3, 0.4, 0.5): x comes from e1 made perpendicular; ties pick the first axis.
+    f = se3.frame((1, 2, 3), (0.3, 0.4, 0.5))
+    z = np.array((0.3, 0.4, 0.5)) / math.sqrt(0.5)
+    e1 = np.array((1.0, 0.0, 0.0))
+    x = e1 - (e1 @ z) * z
+    np.testing.assert_allclose(f[:3, 0], x / np.linalg.norm(x), atol=1e-15)
+    np.testing.assert_allclose(f[:3, 2], z, atol=1e-15)
+    np.testing.assert_allclose(f[:3, 3], (1, 2, 3))
+    np.testing.assert_array_equal(se3.frame((0, 0, 0), (0, 0, 2.0)), np.eye(4))
+    np.testing.assert_array_equal(se3.frame((0, 0, 0), (1.0, 0, 0))[:3, 0], (0, 1, 0))
+
+
+def test_frame_from_floats_gives_the_columns_of_frame():
+    x, y, z, o = se3.frame_from_floats((1.0, 2.0, 3.0), (0.0, 0.0, 1.0), (1.0, 1.0, 5.0))
+    s = 1 / math.sqrt(2)
+    assert x == pytest.approx((s, s, 0.0)) and y == pytest.approx((-s, s, 0.0))
+    assert z == (0.0, 0.0, 1.0) and o == (1.0, 2.0, 3.0)
+    np.testing.assert_array_equal(
+        se3.matrix_from_columns((x, y, z, o)), se3.frame((1, 2, 3), (0, 0, 1), (1, 1, 5))
+    )
+    assert se3.as_floats(np.array([1, 2, 3])) == (1.0, 2.0, 3.0)
+
+
+@settings(max_examples=50, deadline=None)
+@given(seeds)
+def test_inverse_is_exact_on_rigid_transforms(seed):
+    t = se3.random_transform(np.random.default_rng(seed))
+    np.testing.assert_allclose(se3.inverse(t) @ t, np.eye(4), atol=1e-13)
+    np.testing.assert_allclose(se3.inverse(t), np.linalg.inv(t), atol=1e-12)
+    assert se3.inverse(t)[3].tolist() == [0.0, 0.0, 0.0, 1.0]

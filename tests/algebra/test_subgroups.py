@@ -209,6 +209,64 @@ def test_lattices_of_incommensurate_periods_meet_trivially():
     assert c.contains(tr(0, 0, 3.0)) and not c.contains(tr(0, 0, 1.5))
 
 
+def test_cyclic_lattice_meets_by_the_lcm_rule():
+    """<Tr(0,0,1.5)> ∩ B in closed form (§2.4 "Finite parts"): the lcm of the periods."""
+    a = G.lattice_group([tr(0, 0, 1.5)])
+    steps = {
+        "lead 1": a.intersect(G.helical(ORIGIN, Z, 1.0 / (2 * math.pi))),
+        "lead 0.6": a.intersect(G.helical(ORIGIN, Z, 0.6 / (2 * math.pi))),
+        "lattice 1": a.intersect(G.lattice_group([tr(0, 0, 1.0)])),
+        "lattice 0.5": a.intersect(G.lattice_group([tr(0, 0, -0.5)])),
+    }
+    for name, met in steps.items():
+        assert met.kind is Kind.FIXED and len(met.lattice) == 1, name
+        assert abs(met.lattice[0][2, 3]) == pytest.approx(3.0 if name != "lattice 0.5" else 1.5)
+    assert a.intersect(G.prismatic(Z)).lattice[0][2, 3] == pytest.approx(1.5)
+    # Incommensurate lead, or a direction the lattice never reaches: only I.
+    assert a.intersect(G.helical(ORIGIN, Z, math.sqrt(2) / (2 * math.pi))).n_components == 1
+    assert a.intersect(G.prismatic((1, 0, 0))).n_components == 1
+
+
+def test_discrete_screw_lattice_meets_in_closed_form():
+    """<Scr(-3 pi; 1)> (from H(1) ∩ H(3)) rotates by pi per step."""
+    s = G.helical(ORIGIN, Z, 1.0).intersect(G.helical(ORIGIN, Z, 3.0))
+    # No rotation: every second step, a translation by -6 pi.
+    np.testing.assert_allclose(
+        s.intersect(G.prismatic(Z)).lattice[0], tr(0, 0, -6 * math.pi), atol=1e-12
+    )
+    # No axial motion: only I.
+    assert s.intersect(G.revolute(ORIGIN, Z)).n_components == 1
+    # H(2): -3 pi k = 2 (-3 pi k + 2 pi m) holds for k in 4Z.
+    np.testing.assert_allclose(
+        s.intersect(G.helical(ORIGIN, Z, 2.0)).lattice[0], tr(0, 0, -12 * math.pi), atol=1e-12
+    )
+    # Its own group: all of it.
+    assert s.intersect(G.helical(ORIGIN, Z, 3.0)).equals(s)
+
+
+def test_one_parameter_groups_through_lattice_generators():
+    from assemblykit.algebra.subgroups import lattice_parameter, one_parameter
+
+    t = one_parameter(tr(0, 0, 1.5))
+    assert t is not None and t.kind is Kind.PRISMATIC
+    assert lattice_parameter(t, tr(0, 0, 1.5), tr(0, 0, -4.5)) == pytest.approx(-3.0)
+    tau = se3.screw((1, 0, 0), Z, 0.5, 2.0)
+    h = one_parameter(tau)
+    assert h is not None and h.kind is Kind.HELICAL and h.pitch == pytest.approx(0.5)
+    assert h.contains(tau) and h.contains(tau @ tau @ tau)
+    assert lattice_parameter(h, tau, tau @ tau @ tau) == pytest.approx(3.0)
+    assert one_parameter(se3.rot_z(0.5)) is None
+
+
+def test_with_known_discrete_merges_components_without_closure_checks():
+    half = se3.rot_z(math.pi)
+    # Rz(pi) . Tr(0, 0, 3) is in the same T(z)-coset as Rz(pi): merged.
+    g = G.prismatic(Z).with_known_discrete(reps=(half, half @ tr(0, 0, 3)))
+    assert g.n_components == 2 and g.contains(half @ tr(0, 0, -7)) and g.contains(tr(0, 0, 2))
+    assert not g.contains(se3.rot_z(math.pi / 2))
+    assert g.equals(G.prismatic(Z).with_discrete(reps=(half,)))
+
+
 def test_finite_parts_w14():
     c4 = tuple(se3.rot_z(k * math.pi / 2) for k in range(4))
     peg = G.prismatic(Z).with_discrete(reps=c4)

@@ -12,20 +12,26 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
-from functools import cached_property
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
 
 from assemblykit.algebra import se3
+from assemblykit.algebra.caching import cached
+from assemblykit.algebra.lattices import IntegerPoints, commensurate, integer_points
 from assemblykit.algebra.subgroups import (
     Kind,
     SymmetryGroup,
+    _helix_residual,
     _rank_threshold,
     _scaled,
+    _Sub,
     _tr_meet,
     classify_algebra,
+    lattice_parameter,
+    one_parameter,
 )
 from assemblykit.errors import GroupError
 from assemblykit.tolerance import Tolerance, current
@@ -40,7 +46,18 @@ LATTICE_SEARCH = 64
 
 #: The documented mismatch kinds.
 MISMATCH_KINDS = frozenset(
-    {"angle", "distance", "radius", "moment", "handedness", "pitch", "sides", "size", "type", "residual"}
+    {
+        "angle",
+        "distance",
+        "radius",
+        "moment",
+        "handedness",
+        "pitch",
+        "sides",
+        "size",
+        "type",
+        "residual",
+    }
 )
 
 _TRANSLATIONS = frozenset({Kind.FIXED, Kind.PRISMATIC, Kind.TRANSLATION2, Kind.TRANSLATION3})
@@ -139,6 +156,21 @@ class Coset:
             raise GroupError(f"a {self.kind.value} coset is not a finite set of points")
         return [self.group.element((), i) @ self.rep for i in range(len(self.group.reps))]
 
+    @cached
+    def rep_inverse(self) -> np.ndarray:
+        """x0^-1 (cached: membership and intersections use it)."""
+        return se3.inverse(self.rep)
+
+    @cached
+    def transporter_flats(self) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
+        """The characteristic invariants of a TR group H as floats (§2.4), and the same
+        moved by x0^-1: the objects of body 2 that the relation maps onto them (§2.5
+        transporter; cached for repeated intersections)."""
+        from assemblykit.algebra import invariants as inv  # invariants build Coset values
+
+        body1 = inv.characteristic_flats(self.group.kind, self.group.frame)
+        return body1, inv.move_flats(self.rep, body1, inverse=True)
+
     def invariants(self) -> dict[str, Any]:
         """Invariants of the set in body-1 coordinates (those of H, e.g. the axis line)."""
         return self.group.invariants
@@ -155,7 +187,7 @@ class Coset:
 
     def contains(self, x: np.ndarray, tol: Tolerance | None = None) -> bool:
         """Whether ``x`` in H . x0, i.e. x x0^-1 in H."""
-        return self.group.contains(np.asarray(x, float) @ se3.inverse(self.rep), tol)
+        return self.group.contains(np.asarray(x, float) @ self.rep_inverse, tol)
 
     def inverse(self) -> Coset:
         """(H x0)^-1 = (x0^-1 H x0) . x0^-1 (§5.2 reversal)."""
@@ -200,7 +232,7 @@ class Coset:
             return next((e for e in empties if not e.proven), empties[0])
         base = found[0]
         extra = tuple(c.rep @ se3.inverse(base.rep) for c in found[1:])
-        group = base.group.with_discrete(reps=extra, lattice=base.group.lattice, tol=tol)
+        group = base.group.with_known_discrete(extra, base.group.lattice, tol)
         return Coset(group, base.rep)
 
     def product(self, other: Coset | Chain, tol: Tolerance | None = None) -> Coset | Chain:
@@ -226,13 +258,18 @@ def _lattice_steps(bound: int) -> list[int]:
 
 
 def _lattice_coset_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
-    """(G0 <tau> Gamma a) ∩ Q: the group meet, and a common point searched over the
-    lattice steps k = 0, +-1, ... (each step a connected coset intersection). Without a
-    hit within ``LATTICE_SEARCH`` steps the answer is "no solution found"."""
+    """(G0 <tau> Gamma a) ∩ Q: the group meet, and a common point in closed form for a
+    trivial G0 (:func:`_cyclic_coset_meet`); otherwise searched over the lattice steps
+    k = 0, +-1, ... (each step a connected coset intersection). Without a hit within
+    ``LATTICE_SEARCH`` steps the answer is "no solution found"."""
     lat, other = (p, q) if p.group.lattice else (q, p)
     if len(lat.group.lattice) != 1 or other.group.lattice:
         raise GroupError("intersection of cosets of these lattice groups is not supported")
     group = p.group.intersect(q.group, tol)
+    if lat.group.kind is Kind.FIXED:
+        found = _cyclic_coset_meet(lat, other, group, tol)
+        if found is not None:
+            return found
     g0, tau = lat.group.connected_part, lat.group.lattice[0]
     o0 = other.group.connected_part
     for k in _lattice_steps(LATTICE_SEARCH):
@@ -247,6 +284,58 @@ def _lattice_coset_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
     return EmptySet(Mismatch("residual", math.inf, message), proven=False)
 
 
+def _cyclic_coset_meet(
+    lat: Coset, other: Coset, group: SymmetryGroup, tol: Tolerance
+) -> Coset | EmptySet | None:
+    """(<tau> Gamma a) ∩ Q in closed form (§2.4 "Finite parts", §7), ``group`` being the
+    group meet.
+
+    For each component gamma a, the one-parameter group L through tau gives the hull
+    L gamma a ⊃ {tau^k gamma a}; its intersection with Q is empty or K d with K ⊂ L.
+    Writing d = exp(s0 log tau) gamma a and K = L, {I} or <exp(c log tau)>, the
+    common points are the integers k in s0 + cZ (:func:`integer_points`). ``None``
+    when no closed form applies (no axial translation, an unproven empty hull meet or
+    an incommensurate c): the caller searches.
+    """
+    tau = lat.group.lattice[0]
+    line = one_parameter(tau, tol)
+    if line is None:
+        return None
+    along = float(line.axis @ tau[:3, 3])
+    empty: EmptySet | None = None
+    for gamma in lat.group.reps:
+        base = gamma @ lat.rep
+        hull = Coset(line, base).intersect(other, tol)
+        if isinstance(hull, EmptySet):
+            if not hull.proven:
+                return None
+            empty = empty or hull
+            continue
+        met = hull.group
+        if met.dof > 0:
+            points = IntegerPoints(0, 1)
+        else:
+            s0 = lattice_parameter(line, tau, hull.rep @ se3.inverse(base))
+            period: Fraction | None = Fraction(0)
+            if met.lattice:
+                period = commensurate(lattice_parameter(line, tau, met.lattice[0]), tol)
+            if period is None:
+                return None
+            found = integer_points(s0, period, along, tol)
+            if found is None:
+                miss = abs(s0 - round(s0)) * abs(along)
+                text = f"the lattice steps of {abs(along):.6g} miss the other set"
+                empty = empty or EmptySet(Mismatch("distance", miss, text))
+                continue
+            points = found
+        c = lat.group.element((), 0, (points.start,)) @ base
+        if not (lat.contains(c, tol) and other.contains(c, tol)):
+            return None
+        return Coset(group, c)
+    assert empty is not None
+    return empty
+
+
 def _connected_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
     from assemblykit.algebra import invariants as inv  # invariants build Coset values
 
@@ -257,12 +346,85 @@ def _connected_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
             if not (p.group.is_tr and q.group.is_tr):
                 return EmptySet(Mismatch("residual", 1.0, "the fixed position is not in the set"))
     if p.group.is_tr and q.group.is_tr:
-        ia = inv.characteristic_invariants(p.group)
-        ib = inv.characteristic_invariants(q.group)
-        ja = tuple(inv.transform_invariant(se3.inverse(p.rep), i) for i in ia)
-        jb = tuple(inv.transform_invariant(se3.inverse(q.rep), i) for i in ib)
-        return inv._directed_transporter(ia + ib, ja + jb, tol, _tr_meet(p.group, q.group, tol))
+        (ta, sa), (tb, sb) = p.transporter_flats, q.transporter_flats
+        return inv.flat_transporter(ta + tb, sa + sb, _tr_meet(p.group, q.group, tol), tol)
+    if p.group.is_tr or q.group.is_tr:
+        helical, other = (q, p) if p.group.is_tr else (p, q)
+        found = _helical_meet(helical, other, tol)
+        if found is not None:
+            return found
     return _numeric_meet(p, q, tol)
+
+
+#: The TR hull of each helical family: C(N, u) contains H(N, u, p), X(u) contains Y(u, p).
+_HULL = {Kind.HELICAL: Kind.CYLINDRICAL, Kind.PSEUDO_PLANAR: Kind.SCHOENFLIES}
+
+
+def _screw_coordinates(group: SymmetryGroup, g: np.ndarray) -> tuple[float, float]:
+    """(rotation angle about the axis, translation along it) of ``g`` in the group frame."""
+    c = group.frame_inverse @ g @ group.frame
+    return math.atan2(c[1, 0], c[0, 0]), float(c[2, 3])
+
+
+def _helical_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet | None:
+    """(H a) ∩ (B b) for a helical or pseudo-planar H and a TR group B, in closed form
+    (ALGEBRA.md §2.4 table, §2.5): a one-parameter problem in the screw angle.
+
+    The TR hull C of H (C(N, u) for H(N, u, p), X(u) for Y(u, p)) meets B b a^-1 in a
+    TR coset K d (closed form; empty means empty, as H ⊂ C). Within K d the screw
+    condition t_u = p (theta + 2 pi n) is solved exactly: a rotation of K about u fixes
+    theta (a thread against a face: the angle is fixed by the offset); otherwise a
+    translation of K with a component along u fixes the axial position (a thread and a
+    key: the lead lattice); otherwise d, moved onto the nearest turn, is the only
+    candidate. ``None`` when the membership check of the constructed point fails within
+    rounding (the caller then searches numerically, never claiming emptiness).
+    """
+    h = p.group
+    hull = SymmetryGroup(_HULL[h.kind], h.frame)
+    target = Coset(q.group, q.rep @ p.rep_inverse)
+    found = _connected_meet(Coset(hull, np.eye(4)), target, tol)
+    if isinstance(found, EmptySet):
+        return found
+    k, d = found.group, found.rep
+    theta, shift = _screw_coordinates(h, d)
+    u = h.axis
+    w = _steepest_translation(k._tr_shape[1], u)
+    along = float(w @ u)
+    if k._tr_shape[0] == "line":
+        step = se3.rotation(u, shift / h.pitch - theta, k.origin)
+    elif abs(along) > tol.angle:
+        step = se3.translation(w * ((h.pitch * theta - shift) / along))
+    else:
+        # d is the only candidate up to whole turns: slide it along the axis onto the
+        # nearest turn of the helix and test the other relation by its residual (stable
+        # when d itself is ill-conditioned along the axis, e.g. an axis almost in a face).
+        turns = round((shift / h.pitch - theta) / (2.0 * math.pi))
+        step = se3.translation(u * (h.pitch * (theta + 2.0 * math.pi * turns) - shift))
+        c = step @ d @ p.rep
+        if p.contains(c, tol) and q.contains(c, tol):
+            return Coset(p.group.intersect(q.group, tol), c)
+        miss = _helix_residual(h.pitch, shift, theta)
+        if miss <= tol.length:
+            return None
+        text = f"the positions miss the screw's phase by {miss:.6g} along its axis"
+        return EmptySet(Mismatch("distance", miss, text))
+    c = step @ d @ p.rep
+    if not (p.contains(c, tol) and q.contains(c, tol)):
+        return None
+    return Coset(p.group.intersect(q.group, tol), c)
+
+
+def _steepest_translation(v: _Sub, u: np.ndarray) -> np.ndarray:
+    """The unit vector of the subspace ``v`` with the largest component along ``u``
+    (zero when ``v`` is trivial)."""
+    if v.dim == 0:
+        return np.zeros(3)
+    if v.dim == 3:
+        return u
+    assert v.vec is not None
+    if v.dim == 1:
+        return v.vec
+    return se3.unit(u - float(u @ v.vec) * v.vec)
 
 
 def _residual_vector(d: np.ndarray, scale: float) -> np.ndarray:
@@ -370,7 +532,7 @@ class Chain:
             start += f.dof
         return out
 
-    @cached_property
+    @cached
     def dof(self) -> int:
         """Dimension of h1 + Ad(g1) h2 + Ad(g1 g2) h3 + ... at generic points (max over a
         few deterministic samples)."""

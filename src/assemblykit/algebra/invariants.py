@@ -18,7 +18,7 @@ import numpy as np
 
 from assemblykit.algebra import se3
 from assemblykit.algebra.cosets import Coset, EmptySet, Mismatch
-from assemblykit.algebra.subgroups import Kind, SymmetryGroup, _tr_meet, min_norm_solve
+from assemblykit.algebra.subgroups import Kind, SymmetryGroup, Vec3, _tr_meet, psd_solve
 from assemblykit.errors import FeatureError
 from assemblykit.tolerance import Tolerance, current
 
@@ -236,7 +236,97 @@ def congruence_mismatch(
 # ----------------------------------------------------------------------------- frames
 
 
-def tuple_frame(invariants: tuple[Invariant, ...] | list[Invariant], tol: Tolerance | None = None):
+_POINT, _LINE, _PLANE, _DIRECTION = range(4)
+# An invariant as Python floats: (type code, point or None, direction/normal or None).
+_Flat = tuple[int, Vec3 | None, Vec3 | None]
+
+
+def _flat(inv: Invariant) -> _Flat:
+    """The invariant's coordinates as floats (the frame rule runs in scalar arithmetic),
+    cached on the (immutable) invariant."""
+    cached = inv.__dict__.get("_flat")
+    if cached is None:
+        cached = _flatten(inv)
+        inv.__dict__["_flat"] = cached
+    return cached
+
+
+def _flatten(inv: Invariant) -> _Flat:
+    if isinstance(inv, PointInvariant):
+        return _POINT, se3.as_floats(inv.point), None
+    if isinstance(inv, LineInvariant):
+        return _LINE, se3.as_floats(inv.point), se3.as_floats(inv.direction)
+    if isinstance(inv, PlaneInvariant):
+        return _PLANE, se3.as_floats(inv.point), se3.as_floats(inv.normal)
+    return _DIRECTION, None, se3.as_floats(inv.direction)
+
+
+def _offset(code: int, p: Vec3, u: Vec3 | None, o: Vec3) -> Vec3:
+    """The component of ``p - o`` normal to the object's affine set (projector applied)."""
+    d0, d1, d2 = p[0] - o[0], p[1] - o[1], p[2] - o[2]
+    if code == _POINT:
+        return d0, d1, d2
+    assert u is not None
+    along = u[0] * d0 + u[1] * d1 + u[2] * d2
+    if code == _LINE:
+        return d0 - along * u[0], d1 - along * u[1], d2 - along * u[2]
+    return along * u[0], along * u[1], along * u[2]
+
+
+def _frame_columns(
+    flats: tuple[_Flat, ...], tol: Tolerance
+) -> tuple[Vec3, Vec3, Vec3, Vec3] | tuple[Vec3]:
+    """The columns (x, y, z, origin) of :func:`tuple_frame`, or only (origin,) when the
+    tuple has no direction at all (scalar arithmetic: the hot path of every transporter)."""
+    m00 = m01 = m02 = m11 = m12 = m22 = r0 = r1 = r2 = 0.0
+    dirs: list[Vec3] = []
+    for code, p, u in flats:
+        if u is not None:
+            dirs.append(u)
+        if code == _POINT:
+            assert p is not None
+            m00, m11, m22 = m00 + 1.0, m11 + 1.0, m22 + 1.0
+            r0, r1, r2 = r0 + p[0], r1 + p[1], r2 + p[2]
+        elif code != _DIRECTION:
+            assert p is not None and u is not None
+            u0, u1, u2 = u
+            along = u0 * p[0] + u1 * p[1] + u2 * p[2]
+            # Line: projector I - u u^T; plane: n n^T.
+            sign, base = (-1.0, 1.0) if code == _LINE else (1.0, 0.0)
+            m00 += base + sign * u0 * u0
+            m11 += base + sign * u1 * u1
+            m22 += base + sign * u2 * u2
+            m01 += sign * u0 * u1
+            m02 += sign * u0 * u2
+            m12 += sign * u1 * u2
+            if code == _LINE:
+                r0, r1, r2 = r0 + p[0] - along * u0, r1 + p[1] - along * u1, r2 + p[2] - along * u2
+            else:
+                r0, r1, r2 = r0 + along * u0, r1 + along * u1, r2 + along * u2
+    origin = psd_solve((m00, m01, m02, m11, m12, m22), (r0, r1, r2), tol)
+    length, angle = tol.length, tol.angle
+    for code, p, u in flats:
+        if code != _DIRECTION:
+            assert p is not None
+            w0, w1, w2 = _offset(code, p, u, origin)
+            size = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+            if size > length:
+                dirs.append((w0 / size, w1 / size, w2 / size))
+    if not dirs:
+        return (origin,)
+    z0, z1, z2 = z = dirs[0]
+    hint = None
+    for d0, d1, d2 in dirs[1:]:
+        c0, c1, c2 = z1 * d2 - z2 * d1, z2 * d0 - z0 * d2, z0 * d1 - z1 * d0
+        if math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) > angle:
+            hint = (d0, d1, d2)
+            break
+    return se3.frame_from_floats(origin, z, hint)
+
+
+def tuple_frame(
+    invariants: tuple[Invariant, ...] | list[Invariant], tol: Tolerance | None = None
+) -> np.ndarray:
     """A frame built from the tuple by a rule that commutes with rigid motions up to the
     tuple's stabiliser (§2.5: "the same rule on both sides").
 
@@ -245,43 +335,10 @@ def tuple_frame(invariants: tuple[Invariant, ...] | list[Invariant], tol: Tolera
     direction (line, normal, free direction) or offset from the origin to an object is
     +z; the first one not parallel to it fixes +x.
     """
-    tol = tol or current()
-    m = np.zeros((3, 3))
-    rhs = np.zeros(3)
-    for inv in invariants:
-        p = _projector(inv)
-        if p is not None:
-            m += p
-            rhs += p @ _anchor(inv)
-    origin = min_norm_solve(m, rhs, tol)
-    dirs = [d for d in (_axis_of(inv) for inv in invariants) if d is not None]
-    for inv in invariants:
-        p = _projector(inv)
-        if p is not None:
-            off = p @ (_anchor(inv) - origin)
-            if se3.norm(off) > tol.length:
-                dirs.append(se3.unit(off))
-    if not dirs:
-        return se3.translation(origin)
-    z = dirs[0]
-    hint = next((d for d in dirs[1:] if se3.norm(se3.cross(z, d)) > tol.angle), None)
-    return se3.frame(origin, z, hint)
-
-
-def _projector(inv: Invariant) -> np.ndarray | None:
-    """Projector onto the normal space of the object's affine set (None for directions)."""
-    if isinstance(inv, PointInvariant):
-        return np.eye(3)
-    if isinstance(inv, LineInvariant):
-        return np.eye(3) - np.outer(inv.direction, inv.direction)
-    if isinstance(inv, PlaneInvariant):
-        return np.outer(inv.normal, inv.normal)
-    return None
-
-
-def _anchor(inv: Invariant) -> np.ndarray:
-    assert not isinstance(inv, DirectionInvariant)
-    return inv.point
+    columns = _frame_columns(tuple(_flat(i) for i in invariants), tol or current())
+    if len(columns) == 1:
+        return se3.translation(columns[0])
+    return se3.matrix_from_columns(columns)
 
 
 def pair_frame(first: Invariant, second: Invariant, tol: Tolerance | None = None) -> np.ndarray:
@@ -325,62 +382,155 @@ def stabilizer(
     return result.group
 
 
+# The objects of a group frame (origin o, axes x, y, z) whose directed stabiliser is the
+# connected TR group of each kind (§2.4 characteristic-invariant view), as (type code,
+# frame column): the point o, the line (o, z), the plane through o with normal axis i,
+# the free axis i.
+_CHARACTERISTIC: dict[Kind, tuple[tuple[int, int], ...]] = {
+    Kind.FIXED: ((_POINT, 3), (_LINE, 2), (_PLANE, 0)),
+    Kind.REVOLUTE: ((_POINT, 3), (_LINE, 2)),
+    Kind.PRISMATIC: ((_LINE, 2), (_PLANE, 0)),
+    Kind.CYLINDRICAL: ((_LINE, 2),),
+    Kind.TRANSLATION2: ((_PLANE, 2), (_DIRECTION, 0)),
+    Kind.TRANSLATION3: ((_DIRECTION, 0), (_DIRECTION, 1)),
+    Kind.SPHERICAL: ((_POINT, 3),),
+    Kind.PLANAR: ((_PLANE, 2),),
+    Kind.SCHOENFLIES: ((_DIRECTION, 2),),
+    Kind.FREE: (),
+}
+
+
+def characteristic_flats(kind: Kind, frame: np.ndarray) -> tuple[_Flat, ...]:
+    """The characteristic invariants of the connected TR group of ``kind`` placed by
+    ``frame`` (§2.4) as float tuples (type code, point, direction)."""
+    items = _CHARACTERISTIC.get(kind)
+    if items is None:
+        raise FeatureError(
+            f"a {kind.value} group has no characteristic invariants (not a TR group)"
+        )
+    columns = tuple(map(tuple, frame[:3].T.tolist()))
+    o = columns[3]
+    return tuple(
+        (code, None if code == _DIRECTION else o, None if code == _POINT else columns[i])
+        for code, i in items
+    )
+
+
+def move_flats(t: np.ndarray, flats: tuple[_Flat, ...], inverse: bool = False) -> tuple[_Flat, ...]:
+    """Float invariants moved by the rigid transform ``t`` (by t^-1 when ``inverse``)."""
+    (a, b, c, x), (d, e, f, y), (g, h, i, z) = t[:3].tolist()
+    if inverse:
+        # (R, t)^-1 = (R^T, -R^T t)
+        a, b, c, d, e, f, g, h, i = a, d, g, b, e, h, c, f, i
+        x, y, z = -(a * x + b * y + c * z), -(d * x + e * y + f * z), -(g * x + h * y + i * z)
+    out: list[_Flat] = []
+    for code, p, u in flats:
+        if p is not None:
+            p0, p1, p2 = p
+            p = (
+                a * p0 + b * p1 + c * p2 + x,
+                d * p0 + e * p1 + f * p2 + y,
+                g * p0 + h * p1 + i * p2 + z,
+            )
+        if u is not None:
+            u0, u1, u2 = u
+            u = (a * u0 + b * u1 + c * u2, d * u0 + e * u1 + f * u2, g * u0 + h * u1 + i * u2)
+        out.append((code, p, u))
+    return tuple(out)
+
+
+def _unflatten(flat: _Flat) -> Invariant:
+    """The invariant object of a float invariant (known finite and normalised)."""
+    code, p, u = flat
+    fields: dict[str, Any] = {"_flat": flat}
+    if p is not None:
+        fields["point"] = np.array(p)
+    if code == _LINE:
+        fields.update(direction=np.array(u), directed=True)
+    elif code == _PLANE:
+        fields["normal"] = np.array(u)
+    elif code == _DIRECTION:
+        fields["direction"] = np.array(u)
+    cls = (PointInvariant, LineInvariant, PlaneInvariant, DirectionInvariant)[code]
+    inv = object.__new__(cls)
+    inv.__dict__.update(fields)  # frozen fields filled directly: the data is trusted
+    return inv
+
+
+def frame_invariants(kind: Kind, frame: np.ndarray) -> tuple[Invariant, ...]:
+    """The characteristic invariants of the connected TR group of ``kind`` placed by
+    ``frame`` (§2.4)."""
+    return tuple(_unflatten(f) for f in characteristic_flats(kind, frame))
+
+
 @functools.lru_cache(maxsize=4096)
 def characteristic_invariants(group: SymmetryGroup) -> tuple[Invariant, ...]:
     """A tuple of invariants whose directed stabiliser is the connected TR group (§2.4).
 
     Cached per (immutable) group: every coset intersection asks for it.
     """
-    k, f = group.kind.value, group.frame
-    o, x, y, z = f[:3, 3], f[:3, 0], f[:3, 1], f[:3, 2]
-    point = _trusted(PointInvariant, point=o)
-    axis = _trusted(LineInvariant, point=o, direction=z, directed=True)
-    table: dict[str, tuple[Invariant, ...]] = {
-        "fixed": (point, axis, _trusted(PlaneInvariant, point=o, normal=x)),
-        "revolute": (point, axis),
-        "prismatic": (axis, _trusted(PlaneInvariant, point=o, normal=x)),
-        "cylindrical": (axis,),
-        "translation2": (
-            _trusted(PlaneInvariant, point=o, normal=z),
-            _trusted(DirectionInvariant, direction=x),
-        ),
-        "translation3": (
-            _trusted(DirectionInvariant, direction=x),
-            _trusted(DirectionInvariant, direction=y),
-        ),
-        "spherical": (point,),
-        "planar": (_trusted(PlaneInvariant, point=o, normal=z),),
-        "schoenflies": (_trusted(DirectionInvariant, direction=z),),
-        "free": (),
-    }
-    if k not in table:
-        raise FeatureError(f"a {k} group has no characteristic invariants (not a TR group)")
-    return table[k]
+    return frame_invariants(group.kind, group.frame)
 
 
 # ----------------------------------------------------------------------------- transporter
 
 
-def _maps_onto(x: np.ndarray, source: Invariant, target: Invariant, tol: Tolerance) -> float:
-    """How far ``x . source`` is from ``target`` (0 when it coincides): max of the
-    angular error and the length error divided by the scale."""
-    moved = transform_invariant(x, source)
-    err_a, err_l = 0.0, 0.0
-    if isinstance(moved, PointInvariant):
-        assert isinstance(target, PointInvariant)
-        err_l = se3.norm(moved.point - target.point)
-    elif isinstance(moved, LineInvariant):
-        assert isinstance(target, LineInvariant)
-        err_a = se3.norm(moved.direction - target.direction)
-        err_l = se3.norm(_perp(moved.point - target.point, target.direction))
-    elif isinstance(moved, PlaneInvariant):
-        assert isinstance(target, PlaneInvariant)
-        err_a = se3.norm(moved.normal - target.normal)
-        err_l = abs(float(target.normal @ (moved.point - target.point)))
-    else:
-        assert isinstance(target, DirectionInvariant)
-        err_a = se3.norm(moved.direction - target.direction)
-    return max(err_a / tol.angle, err_l / tol.length)
+_Rows = tuple[Vec3, Vec3, Vec3]
+_IDENTITY_ROWS: _Rows = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+def _miss(
+    rot: _Rows, shift: Vec3, source: _Flat, target: _Flat, angle: float, length: float
+) -> float:
+    """How far ``x . source`` is from ``target`` for x = (rot, shift) (0 when it
+    coincides): max of the angular error over ``angle`` and the length error over
+    ``length`` (the tolerances)."""
+    (a0, a1, a2), (b0, b1, b2), (c0, c1, c2) = rot
+    code, p, u = source
+    _, tp, tu = target
+    err_a = err_l = 0.0
+    if u is not None:
+        assert tu is not None
+        m0 = a0 * u[0] + a1 * u[1] + a2 * u[2]
+        m1 = b0 * u[0] + b1 * u[1] + b2 * u[2]
+        m2 = c0 * u[0] + c1 * u[1] + c2 * u[2]
+        err_a = math.sqrt((m0 - tu[0]) ** 2 + (m1 - tu[1]) ** 2 + (m2 - tu[2]) ** 2)
+    if p is not None:
+        assert tp is not None
+        d0 = a0 * p[0] + a1 * p[1] + a2 * p[2] + shift[0] - tp[0]
+        d1 = b0 * p[0] + b1 * p[1] + b2 * p[2] + shift[1] - tp[1]
+        d2 = c0 * p[0] + c1 * p[1] + c2 * p[2] + shift[2] - tp[2]
+        if code == _PLANE:
+            assert tu is not None
+            err_l = abs(tu[0] * d0 + tu[1] * d1 + tu[2] * d2)
+        else:
+            if code == _LINE:
+                assert tu is not None
+                along = tu[0] * d0 + tu[1] * d1 + tu[2] * d2
+                d0, d1, d2 = d0 - along * tu[0], d1 - along * tu[1], d2 - along * tu[2]
+            err_l = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    return max(err_a / angle, err_l / length)
+
+
+def _frame_rows(columns: tuple[Vec3, ...]) -> tuple[_Rows, Vec3]:
+    """The rotation (as rows) and origin of frame columns; no axes means the identity."""
+    if len(columns) == 1:
+        return _IDENTITY_ROWS, columns[0]
+    (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), origin = columns
+    return ((x0, y0, z0), (x1, y1, z1), (x2, y2, z2)), origin
+
+
+def _relative(target: tuple[Vec3, ...], source: tuple[Vec3, ...]) -> tuple[_Rows, Vec3]:
+    """X0 = F_target . F_source^-1 = (R_t R_s^T, o_t - R_t R_s^T o_s) as (rows, translation)."""
+    rt, ot = _frame_rows(target)
+    ((p0, p1, p2), (q0, q1, q2), (w0, w1, w2)), (s0, s1, s2) = _frame_rows(source)
+    rows: list[Vec3] = []
+    shift: list[float] = []
+    for (x, y, z), o in zip(rt, ot, strict=True):
+        r0, r1, r2 = x * p0 + y * p1 + z * p2, x * q0 + y * q1 + z * q2, x * w0 + y * w1 + z * w2
+        rows.append((r0, r1, r2))
+        shift.append(o - (r0 * s0 + r1 * s1 + r2 * s2))
+    return (rows[0], rows[1], rows[2]), (shift[0], shift[1], shift[2])
 
 
 def _directed_transporter(
@@ -390,12 +540,27 @@ def _directed_transporter(
     group: SymmetryGroup | None = None,
 ) -> Coset | EmptySet:
     """The transporter of directed tuples; ``group`` is Stab(targets) when already known."""
-    x0 = tuple_frame(targets, tol) @ se3.inverse(tuple_frame(sources, tol))
-    worst = max(
-        (_maps_onto(x0, s, t, tol) for s, t in zip(sources, targets, strict=True)), default=0
-    )
+    flat_t = tuple(_flat(i) for i in targets)
+    flat_s = tuple(_flat(i) for i in sources)
+    stab = group if group is not None else _directed_stabilizer(targets, tol)
+    return flat_transporter(flat_t, flat_s, stab, tol)
+
+
+def flat_transporter(
+    targets: tuple[_Flat, ...], sources: tuple[_Flat, ...], group: SymmetryGroup, tol: Tolerance
+) -> Coset | EmptySet:
+    """The transporter of directed float invariants whose targets have stabiliser
+    ``group`` (§2.5 closed form: X0 = Frame(targets) . Frame(sources)^-1, then every
+    source checked to land on its target; the first failing congruence test otherwise)."""
+    rot, shift = _relative(_frame_columns(targets, tol), _frame_columns(sources, tol))
+    angle, length = tol.angle, tol.length
+    worst = 0.0
+    for s, t in zip(sources, targets, strict=True):
+        worst = max(worst, _miss(rot, shift, s, t, angle, length))
     if worst > 1.0:
-        found = congruence_mismatch(targets, sources, tol)
+        found = congruence_mismatch(
+            [_unflatten(f) for f in targets], [_unflatten(f) for f in sources], tol
+        )
         if found is None:
             found = Mismatch(
                 "handedness",
@@ -403,7 +568,9 @@ def _directed_transporter(
                 "the invariants are pairwise congruent but not under a proper rigid motion",
             )
         return EmptySet(found)
-    return Coset(group if group is not None else _directed_stabilizer(targets, tol), x0)
+    (r0, r1, r2), t = rot, shift
+    x0 = np.array(((*r0, t[0]), (*r1, t[1]), (*r2, t[2]), (0.0, 0.0, 0.0, 1.0)))
+    return Coset(group, x0)
 
 
 def _flip(line: LineInvariant) -> LineInvariant:
@@ -448,7 +615,7 @@ def transporter(
         return results[0]
     base = cosets[0]
     reps = tuple(c.rep @ se3.inverse(base.rep) for c in cosets[1:])
-    return Coset(base.group.with_discrete(reps=reps, tol=tol), base.rep)
+    return Coset(base.group.with_known_discrete(reps=reps, tol=tol), base.rep)
 
 
 def _as_directed(inv: Invariant) -> Invariant:

@@ -21,14 +21,17 @@ __all__ = [
     "adjoint",
     "apply",
     "apply_direction",
+    "as_floats",
     "cross",
     "exp",
     "frame",
+    "frame_from_floats",
     "hat",
     "identity",
     "inverse",
     "is_rigid",
     "log",
+    "matrix_from_columns",
     "norm",
     "random_transform",
     "rot_x",
@@ -51,8 +54,8 @@ def identity() -> np.ndarray:
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The cross product of two 3-vectors (plain arithmetic: ``np.cross`` is slow on 3-vectors)."""
-    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
-    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    a0, a1, a2 = as_floats(a)
+    b0, b1, b2 = as_floats(b)
     return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
 
 
@@ -140,9 +143,63 @@ def screw(
 
 
 def inverse(t: np.ndarray) -> np.ndarray:
-    """The inverse of a rigid transform (transpose of the rotation, no general inversion)."""
-    r = t[:3, :3]
-    return _compose(r.T, -(r.T @ t[:3, 3]))
+    """The inverse of a rigid transform (transpose of the rotation, no general inversion;
+    scalar arithmetic, which beats numpy calls on 4x4 matrices)."""
+    (a, b, c, x), (d, e, f, y), (g, h, i, z) = t[:3].tolist()
+    return np.array(
+        (
+            (a, d, g, -(a * x + d * y + g * z)),
+            (b, e, h, -(b * x + e * y + h * z)),
+            (c, f, i, -(c * x + f * y + i * z)),
+            (0.0, 0.0, 0.0, 1.0),
+        )
+    )
+
+
+def as_floats(v: np.ndarray | tuple[float, ...] | list[float]) -> tuple[float, float, float]:
+    """The three coordinates of a 3-vector as Python floats (fast scalar arithmetic)."""
+    a, b, c = v.tolist() if isinstance(v, np.ndarray) else v
+    return float(a), float(b), float(c)
+
+
+def frame_from_floats(
+    origin: tuple[float, float, float],
+    z_axis: tuple[float, float, float],
+    x_hint: tuple[float, float, float] | None = None,
+) -> tuple[tuple[float, float, float], ...]:
+    """The columns (x, y, z, origin) of :func:`frame`, in plain float arithmetic (the
+    frame construction is on the hot path of every transporter)."""
+    zx, zy, zz = z_axis
+    n = math.sqrt(zx * zx + zy * zy + zz * zz)
+    if n > 0.0:
+        zx, zy, zz = zx / n, zy / n, zz / n
+    x: tuple[float, float, float] | None = None
+    if x_hint is not None:
+        hx, hy, hz = x_hint
+        d = hx * zx + hy * zy + hz * zz
+        hx, hy, hz = hx - d * zx, hy - d * zy, hz - d * zz
+        h2 = hx * hx + hy * hy + hz * hz
+        if h2 > 0.0:
+            h = math.sqrt(h2)
+            x = (hx / h, hy / h, hz / h)
+    if x is None:
+        # The coordinate axis least aligned with z (first one on ties), made perpendicular.
+        az, bz, cz = abs(zx), abs(zy), abs(zz)
+        k = 0 if az <= bz and az <= cz else (1 if bz <= cz else 2)
+        ex, ey, ez = (k == 0) * 1.0, (k == 1) * 1.0, (k == 2) * 1.0
+        d = (zx, zy, zz)[k]
+        ex, ey, ez = ex - d * zx, ey - d * zy, ez - d * zz
+        h = math.sqrt(ex * ex + ey * ey + ez * ez)
+        x = (ex / h, ey / h, ez / h) if h > 0.0 else (ex, ey, ez)
+    xx, xy, xz = x
+    y = (zy * xz - zz * xy, zz * xx - zx * xz, zx * xy - zy * xx)
+    return x, y, (zx, zy, zz), origin
+
+
+def matrix_from_columns(columns: tuple[tuple[float, float, float], ...]) -> np.ndarray:
+    """The 4x4 transform with rotation columns x, y, z and translation ``columns[3]``."""
+    (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (o0, o1, o2) = columns
+    return np.array(((x0, y0, z0, o0), (x1, y1, z1, o1), (x2, y2, z2, o2), (0.0, 0.0, 0.0, 1.0)))
 
 
 def frame(
@@ -155,19 +212,8 @@ def frame(
     The x axis is ``x_hint`` made perpendicular to z; without a usable hint it is the
     coordinate axis least aligned with z, made perpendicular (a deterministic choice).
     """
-    z = unit(z_axis)
-    x = None
-    if x_hint is not None:
-        h = np.asarray(x_hint, dtype=np.float64)
-        h = h - (h @ z) * z
-        if float(h @ h) > 0.0:
-            x = unit(h)
-    if x is None:
-        e = np.zeros(3)
-        e[int(np.argmin(np.abs(z)))] = 1.0
-        x = unit(e - (e @ z) * z)
-    y = cross(z, x)
-    return _compose(np.column_stack((x, y, z)), np.asarray(origin, dtype=np.float64))
+    hint = None if x_hint is None else as_floats(x_hint)
+    return matrix_from_columns(frame_from_floats(as_floats(origin), as_floats(z_axis), hint))
 
 
 def apply(t: np.ndarray, points: np.ndarray) -> np.ndarray:

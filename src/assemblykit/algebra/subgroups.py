@@ -11,22 +11,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from enum import StrEnum
-from fractions import Fraction
-from functools import cached_property
 from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from assemblykit.algebra import se3
+from assemblykit.algebra.caching import cached
+from assemblykit.algebra.lattices import MAX_LATTICE_DENOMINATOR, commensurate
 from assemblykit.errors import GroupError, NumericError
 from assemblykit.tolerance import Tolerance, current
 
 __all__ = ["MAX_LATTICE_DENOMINATOR", "Kind", "Locus", "SymmetryGroup"]
-
-#: Largest denominator accepted when deciding that two lattice periods are commensurate
-#: (ALGEBRA.md §2.4, "Finite parts": bounded-denominator continued fraction).
-MAX_LATTICE_DENOMINATOR = 10_000
 
 #: Largest finite group built by closure (``extended_by``); beyond it the group is not finite.
 MAX_FINITE_ORDER = 1_000
@@ -94,6 +90,11 @@ _LINEAR = {
 # ----------------------------------------------------------------------------- subspaces
 
 
+#: A symmetric 3x3 matrix by its upper triangle (m00, m01, m02, m11, m12, m22).
+Sym3 = tuple[float, float, float, float, float, float]
+Vec3 = tuple[float, float, float]
+
+
 @dataclass(frozen=True)
 class _Sub:
     """A linear subspace of R^3 in closed form: dim 1 keeps its direction, dim 2 its normal."""
@@ -126,9 +127,34 @@ class _Sub:
         """The orthogonal projection of ``w`` onto the subspace."""
         return w - self.perp_projector() @ w
 
+    def perp_sym(self) -> Sym3:
+        """:meth:`perp_projector` as the upper triangle (m00, m01, m02, m11, m12, m22)."""
+        if self.dim == 0:
+            return (1.0, 0.0, 0.0, 1.0, 0.0, 1.0)
+        if self.dim == 3:
+            return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        assert self.vec is not None
+        u0, u1, u2 = se3.as_floats(self.vec)
+        outer = (u0 * u0, u0 * u1, u0 * u2, u1 * u1, u1 * u2, u2 * u2)
+        if self.dim == 2:
+            return outer
+        return (1.0 - outer[0], -outer[1], -outer[2], 1.0 - outer[3], -outer[4], 1.0 - outer[5])
+
 
 def _parallel(a: np.ndarray, b: np.ndarray, tol: Tolerance) -> bool:
-    return se3.norm(se3.cross(a, b)) <= tol.angle
+    a0, a1, a2 = se3.as_floats(a)
+    b0, b1, b2 = se3.as_floats(b)
+    c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    return math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) <= tol.angle
+
+
+def _unit_cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The unit vector along a x b (a and b not parallel)."""
+    a0, a1, a2 = se3.as_floats(a)
+    b0, b1, b2 = se3.as_floats(b)
+    c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    size = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+    return np.array((c0 / size, c1 / size, c2 / size))
 
 
 def _sub_meet(a: _Sub, b: _Sub, tol: Tolerance) -> _Sub:
@@ -143,7 +169,7 @@ def _sub_meet(a: _Sub, b: _Sub, tol: Tolerance) -> _Sub:
     if a.dim == 2 and b.dim == 2:
         if _parallel(a.vec, b.vec, tol):
             return a
-        return _Sub(1, se3.unit(se3.cross(a.vec, b.vec)))
+        return _Sub(1, _unit_cross(a.vec, b.vec))
     line, plane = (a, b) if a.dim == 1 else (b, a)
     assert line.vec is not None and plane.vec is not None
     return line if abs(float(line.vec @ plane.vec)) <= tol.angle else _Sub(0)
@@ -159,7 +185,7 @@ def _sub_join(a: _Sub, b: _Sub, tol: Tolerance) -> _Sub:
     if a.dim == 1 and b.dim == 1:
         if _parallel(a.vec, b.vec, tol):
             return a
-        return _Sub(2, se3.unit(se3.cross(a.vec, b.vec)))
+        return _Sub(2, _unit_cross(a.vec, b.vec))
     if a.dim == 2 and b.dim == 2:
         return a if _parallel(a.vec, b.vec, tol) else _Sub(3)
     line, plane = (a, b) if a.dim == 1 else (b, a)
@@ -167,37 +193,55 @@ def _sub_join(a: _Sub, b: _Sub, tol: Tolerance) -> _Sub:
     return plane if abs(float(line.vec @ plane.vec)) <= tol.angle else _Sub(3)
 
 
-def min_norm_solve(m: np.ndarray, rhs: np.ndarray, tol: Tolerance) -> np.ndarray:
+def _cramer(m: Sym3, rhs: Vec3, det: float) -> Vec3:
+    """The solution of ``m x = rhs`` for a regular symmetric ``m`` = (m00, m01, m02, m11,
+    m12, m22) with determinant ``det`` (the adjugate of a symmetric matrix is symmetric)."""
+    a, b, c, e, f, i = m
+    r0, r1, r2 = rhs
+    c00, c01, c02 = e * i - f * f, c * f - b * i, b * f - c * e
+    c11, c12, c22 = a * i - c * c, b * c - a * f, a * e - b * b
+    return (
+        (c00 * r0 + c01 * r1 + c02 * r2) / det,
+        (c01 * r0 + c11 * r1 + c12 * r2) / det,
+        (c02 * r0 + c12 * r1 + c22 * r2) / det,
+    )
+
+
+def psd_solve(m: Sym3, rhs: Vec3, tol: Tolerance) -> Vec3:
     """The minimum-norm least-squares solution of ``m x = rhs`` for a symmetric positive
-    semi-definite 3x3 ``m`` (a sum of projectors), in closed form: Cramer's rule when
-    regular, otherwise completed by the null space (rank 2) or the single range
-    direction (rank 1). Plain float arithmetic: this is the hot path of every transporter.
+    semi-definite 3x3 ``m`` (a sum of projectors) given by its upper triangle (m00, m01,
+    m02, m11, m12, m22), in closed form: Cramer's rule when regular, otherwise completed
+    by the null space (rank 2) or the single range direction (rank 1). Plain float
+    arithmetic: this is the hot path of every transporter.
     """
-    (a, b, c), (d, e, f), (g, h, i) = m.tolist()
-    r0, r1, r2 = rhs.tolist()
-    c0, c1, c2 = e * i - f * h, f * g - d * i, d * h - e * g
-    det = a * c0 + b * c1 + c * c2
+    a, b, c, e, f, i = m
     trace = a + e + i
     if trace <= tol.angle:
-        return np.zeros(3)
+        return (0.0, 0.0, 0.0)
+    det = a * (e * i - f * f) + b * (c * f - b * i) + c * (b * f - c * e)
     if abs(det) > tol.angle * trace**3:
-        # Inverse = adjugate / det; m is symmetric so rows of the adjugate are cofactors.
-        x0 = (c0 * r0 + (c * h - b * i) * r1 + (b * f - c * e) * r2) / det
-        x1 = (c1 * r0 + (a * i - c * g) * r1 + (c * d - a * f) * r2) / det
-        x2 = (c2 * r0 + (b * g - a * h) * r1 + (a * e - b * d) * r2) / det
-        return np.array((x0, x1, x2))
-    rows = (m[0], m[1], m[2])
-    best, null = 0.0, None
+        return _cramer(m, rhs, det)
+    rows = ((a, b, c), (b, e, f), (c, f, i))
+    best, null = 0.0, (0.0, 0.0, 0.0)
     for p, q in ((0, 1), (0, 2), (1, 2)):
-        w = se3.cross(rows[p], rows[q])
-        size = se3.norm(w)
+        (x0, x1, x2), (y0, y1, y2) = rows[p], rows[q]
+        w = (x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0)
+        size = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
         if size > best:
-            best, null = size, w / size
-    if null is not None and best > tol.angle * trace**2:
-        return np.linalg.solve(m + np.outer(null, null), rhs)
-    k = int(np.argmax(np.abs(np.diag(m))))
-    v = se3.unit(m[k])
-    return v * (float(v @ rhs) / trace)
+            best, null = size, (w[0] / size, w[1] / size, w[2] / size)
+    if best > tol.angle * trace**2:
+        # m + n n^T is regular and maps n to n, so the solution has no null component.
+        n0, n1, n2 = null
+        full = (a + n0 * n0, b + n0 * n1, c + n0 * n2, e + n1 * n1, f + n1 * n2, i + n2 * n2)
+        fa, fb, fc, fe, ff, fi = full
+        det = fa * (fe * fi - ff * ff) + fb * (fc * ff - fb * fi) + fc * (fb * ff - fc * fe)
+        return _cramer(full, rhs, det)
+    k = 0 if a >= e and a >= i else (1 if e >= i else 2)
+    v0, v1, v2 = rows[k]
+    size = math.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+    v0, v1, v2 = v0 / size, v1 / size, v2 / size
+    along = (v0 * rhs[0] + v1 * rhs[1] + v2 * rhs[2]) / trace
+    return (v0 * along, v1 * along, v2 * along)
 
 
 def _affine_meet_point(
@@ -205,8 +249,17 @@ def _affine_meet_point(
 ) -> np.ndarray:
     """A point of (na + sa) ∩ (nb + sb), known to be non-empty: the least-squares
     point nearest to ``na`` (so a frame origin already valid is kept)."""
-    pa, pb = sa.perp_projector(), sb.perp_projector()
-    return na + min_norm_solve(pa + pb, pb @ (nb - na), tol)
+    pa, (b00, b01, b02, b11, b12, b22) = sa.perp_sym(), sb.perp_sym()
+    a0, a1, a2 = se3.as_floats(na)
+    d0, d1, d2 = (y - x for x, y in zip((a0, a1, a2), se3.as_floats(nb), strict=True))
+    rhs = (
+        b00 * d0 + b01 * d1 + b02 * d2,
+        b01 * d0 + b11 * d1 + b12 * d2,
+        b02 * d0 + b12 * d1 + b22 * d2,
+    )
+    m = (pa[0] + b00, pa[1] + b01, pa[2] + b02, pa[3] + b11, pa[4] + b12, pa[5] + b22)
+    x0, x1, x2 = psd_solve(m, rhs, tol)
+    return np.array((a0 + x0, a1 + x1, a2 + x2))
 
 
 # ----------------------------------------------------------------------------- canonical K
@@ -433,8 +486,8 @@ class SymmetryGroup:
 
     @classmethod
     def identity(cls) -> SymmetryGroup:
-        """The trivial group {I}."""
-        return cls(Kind.FIXED)
+        """The trivial group {I} (one shared immutable value)."""
+        return _IDENTITY
 
     @classmethod
     def revolute(cls, point: Any, axis: Any) -> SymmetryGroup:
@@ -531,14 +584,14 @@ class SymmetryGroup:
         """Whether G0 is a TR group (not helical; ALGEBRA.md §2.4)."""
         return self.kind not in _HELICAL
 
-    @cached_property
+    @cached
     def connected_part(self) -> SymmetryGroup:
         """G0 alone."""
         if self.is_connected:
             return self
         return SymmetryGroup(self.kind, self.frame, self.pitch)
 
-    @cached_property
+    @cached
     def frame_inverse(self) -> np.ndarray:
         """F^-1 (cached: every membership test uses it)."""
         return se3.inverse(self.frame)
@@ -553,12 +606,12 @@ class SymmetryGroup:
         """The frame origin: a point on the axis, or the centre."""
         return self.frame[:3, 3]
 
-    @cached_property
+    @cached
     def algebra(self) -> np.ndarray:
         """The world Lie algebra basis Ad_F (canonical basis), 6 x dof."""
         return se3.adjoint(self.frame) @ _canonical_basis(self.kind, self.pitch)
 
-    @cached_property
+    @cached
     def invariants(self) -> dict[str, Any]:
         """The geometric invariants of G0 in the frame of the group's body (§2.1 table)."""
         k = self.kind
@@ -575,7 +628,7 @@ class SymmetryGroup:
             out["pitch"] = self.pitch
         return out
 
-    @cached_property
+    @cached
     def _translation_part(self) -> tuple[_Sub, tuple[np.ndarray, float] | None]:
         """G0 ∩ T3 = {t in V : t.u in c Z} as (V, (u, c) or None) (§2.4, lattice rows)."""
         k, u = self.kind, self.axis
@@ -591,7 +644,7 @@ class SymmetryGroup:
             return _Sub(3), (u, _TWO_PI * abs(self.pitch))
         return _Sub(3), None
 
-    @cached_property
+    @cached
     def _tr_shape(self) -> tuple[str, _Sub]:
         """Rotation type and translation subspace V of a TR group G0 = T(V) ⋊ Rot."""
         return _LINEAR[self.kind], self._translation_part[0]
@@ -651,7 +704,7 @@ class SymmetryGroup:
                 return True
         return False
 
-    @cached_property
+    @cached
     def _lattice_projection(self) -> tuple[np.ndarray, np.ndarray]:
         """Directions W where G0 never translates and each generator's translation is additive,
         and the generators' coordinates along them (for integer projection, §2.3)."""
@@ -758,6 +811,20 @@ class SymmetryGroup:
                     raise GroupError("the discrete part is not closed under composition")
         return group
 
+    def with_known_discrete(
+        self,
+        reps: tuple[np.ndarray, ...] = (),
+        lattice: tuple[np.ndarray, ...] = (),
+        tol: Tolerance | None = None,
+    ) -> SymmetryGroup:
+        """G0 . Gamma for a discrete part known to form a group with G0 (components of an
+        intersection of groups, flips of a stabiliser): duplicates are merged, the
+        rigidity, normaliser and closure checks of :meth:`with_discrete` are skipped
+        (they cost O(n^3) membership tests for n components)."""
+        g0 = self.connected_part
+        unique = _dedupe(g0, [_EYE4, *reps], tol or current())
+        return SymmetryGroup(g0.kind, g0.frame, g0.pitch, tuple(unique), tuple(lattice))
+
     def _check_lattice(self, tol: Tolerance) -> None:
         _, coords = self._lattice_projection
         if coords.shape[0] == 0 or np.linalg.matrix_rank(coords, tol=tol.length) < coords.shape[1]:
@@ -808,7 +875,7 @@ class SymmetryGroup:
                 found.append(met.rep)
         if not found:
             return c0
-        return c0.with_discrete(reps=tuple(found), lattice=c0.lattice, tol=tol)
+        return c0.with_known_discrete(reps=tuple(found), lattice=c0.lattice, tol=tol)
 
     # ------------------------------------------------------------------ orbits
 
@@ -876,6 +943,8 @@ class SymmetryGroup:
     def __repr__(self) -> str:
         return f"SymmetryGroup<{self.describe()}>"
 
+
+_IDENTITY = SymmetryGroup(Kind.FIXED, _EYE4)
 
 # ----------------------------------------------------------------------------- helpers
 
@@ -947,7 +1016,7 @@ def _tr_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> SymmetryGrou
 
 def _tr_group(lin: str, u: np.ndarray | None, center: np.ndarray, v: _Sub) -> SymmetryGroup:
     """The TR group with rotation part ``lin`` (about ``u`` through ``center``) and V = ``v``."""
-    origin = np.zeros(3)
+    origin = (0.0, 0.0, 0.0)
     if lin == "none":
         if v.dim == 0:
             return SymmetryGroup.identity()
@@ -1055,9 +1124,8 @@ def _translation_lattice(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> 
         return [pinv @ np.array([pa, 0.0]), pinv @ np.array([0.0, pb])]
     ratio = float(np.linalg.norm(db) / np.linalg.norm(da))
     # t.da in pa Z and t.da in (pb / ratio) Z: the lcm of the two periods, if commensurate.
-    pb_along = pb / ratio
-    frac = Fraction(pa / pb_along).limit_denominator(MAX_LATTICE_DENOMINATOR)
-    if abs(float(frac) - pa / pb_along) > tol.rel_length * max(1.0, pa / pb_along):
+    frac = commensurate(pa / (pb / ratio), tol)
+    if frac is None:
         return []
     period = pa * frac.denominator
     return [period * da / float(da @ da)]
@@ -1091,18 +1159,22 @@ def _connected_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> Symme
 
 
 def _lattice_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> SymmetryGroup:
-    """G ∩ G' when one side has a lattice over a trivial G0: the sublattice inside the other.
+    """G ∩ G' when one side is a cyclic lattice <tau> (trivial G0): the sublattice
+    <tau^m> inside the other group (§2.4 "Finite parts").
 
-    The first power k = 1..MAX_LATTICE_DENOMINATOR with tau^k in the other group
-    generates it (bounded search, §2.4 "lattice rationality").
+    Closed form when the other group is connected or cyclic: m comes from the rational
+    test on the one-parameter group through tau (:func:`_cyclic_meet`). Otherwise the
+    first power k = 1..MAX_LATTICE_DENOMINATOR with tau^k in the other group generates it.
     """
-    if not (a.lattice and a.kind is Kind.FIXED and len(a.reps) == 1 and len(a.lattice) == 1):
-        if b.lattice and b.kind is Kind.FIXED and len(b.reps) == 1 and len(b.lattice) == 1:
+    if not _is_cyclic(a):
+        if _is_cyclic(b):
             return _lattice_meet(b, a, tol)
         raise GroupError("intersection of these discrete groups is not supported")
     tau = a.lattice[0]
-    if _is_translation_lattice(a, tol) and _is_translation_lattice(b, tol):
-        return _translation_lattice_meet(tau[:3, 3], b.lattice[0][:3, 3], tol)
+    if b.is_connected or _is_cyclic(b):
+        found = _cyclic_meet(tau, b, tol)
+        if found is not None:
+            return found
     power = np.eye(4)
     for _ in range(MAX_LATTICE_DENOMINATOR):
         power = power @ tau
@@ -1111,22 +1183,51 @@ def _lattice_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> Symmetr
     return SymmetryGroup.identity()
 
 
-def _is_translation_lattice(g: SymmetryGroup, tol: Tolerance) -> bool:
-    return (
-        g.kind is Kind.FIXED
-        and len(g.reps) == 1
-        and len(g.lattice) == 1
-        and se3.rotation_angle(g.lattice[0]) <= tol.angle
-    )
+def _is_cyclic(g: SymmetryGroup) -> bool:
+    """Whether G = <tau> is an infinite cyclic group (one lattice generator, trivial G0)."""
+    return g.kind is Kind.FIXED and len(g.reps) == 1 and len(g.lattice) == 1
 
 
-def _translation_lattice_meet(sa: np.ndarray, sb: np.ndarray, tol: Tolerance) -> SymmetryGroup:
-    """aZ.u ∩ bZ.u = lcm(a, b)Z.u when a/b is rational within tolerance, else {0} (§2.4)."""
-    if not _parallel(sa, sb, tol):
+def one_parameter(tau: np.ndarray, tol: Tolerance | None = None) -> SymmetryGroup | None:
+    """The connected one-parameter group {exp(s log tau)} through a lattice generator
+    that translates along its axis (a translation: T; a screw: H), else ``None``.
+
+    Its elements are exp(s log tau), with s the ratio of their translation along the
+    axis to that of tau (:func:`lattice_parameter`).
+    """
+    tol = tol or current()
+    group = classify_algebra(se3.log(tau)[:, None], tol)
+    if group.kind not in (Kind.PRISMATIC, Kind.HELICAL):
+        return None
+    if abs(float(group.axis @ tau[:3, 3])) <= tol.length:
+        return None
+    return group
+
+
+def lattice_parameter(line: SymmetryGroup, tau: np.ndarray, g: np.ndarray) -> float:
+    """s with g = exp(s log tau), for g in the one-parameter group ``line`` through tau:
+    rotations about the axis leave the translation along it additive."""
+    u = line.axis
+    return float(u @ g[:3, 3]) / float(u @ tau[:3, 3])
+
+
+def _cyclic_meet(tau: np.ndarray, b: SymmetryGroup, tol: Tolerance) -> SymmetryGroup | None:
+    """<tau> ∩ B in closed form: with L the one-parameter group through tau, L ∩ B is L
+    (every power), {I} (none but I) or <exp(c log tau)>, and tau^k is in B iff k is in
+    cZ; for c = r/n in lowest terms that is rZ (the lcm rule of §2.4), and an
+    incommensurate c leaves only I (§7). ``None`` when no closed form applies."""
+    line = one_parameter(tau, tol)
+    if line is None:
+        return None
+    met = b.intersect(line, tol)
+    if met.dof > 0:
+        return SymmetryGroup(Kind.FIXED, np.eye(4), 0.0, (_EYE4,), (tau,))
+    if not met.lattice:
         return SymmetryGroup.identity()
-    ratio = se3.norm(sb) / se3.norm(sa)
-    frac = Fraction(ratio).limit_denominator(MAX_LATTICE_DENOMINATOR)
-    if abs(float(frac) - ratio) > tol.rel_length * max(1.0, ratio):
+    frac = commensurate(lattice_parameter(line, tau, met.lattice[0]), tol)
+    if frac is None:
         return SymmetryGroup.identity()
-    step = sa * frac.numerator
-    return SymmetryGroup(Kind.FIXED, np.eye(4), 0.0, (_EYE4,), (se3.translation(step),))
+    power = np.linalg.matrix_power(tau, abs(frac.numerator))
+    if not b.contains(power, tol):
+        return None
+    return SymmetryGroup(Kind.FIXED, np.eye(4), 0.0, (_EYE4,), (power,))

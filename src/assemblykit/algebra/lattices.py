@@ -1,0 +1,69 @@
+"""Arithmetic of one-dimensional lattices: commensurability and integer points of
+arithmetic progressions (ALGEBRA.md §2.4 "Finite parts", §7 "Lattice rationality").
+
+A discrete one-parameter family {tau^k} meets another set in the k of a progression
+``offset + period * Z``; the answer is decided in closed form when ``period`` is
+rational within tolerance (bounded-denominator continued fraction) and treated as
+incommensurate otherwise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+from assemblykit.tolerance import Tolerance, current
+
+__all__ = ["MAX_LATTICE_DENOMINATOR", "IntegerPoints", "commensurate", "integer_points"]
+
+#: Largest denominator accepted when deciding that two lattice periods are commensurate
+#: (ALGEBRA.md §2.4, "Finite parts": bounded-denominator continued fraction).
+MAX_LATTICE_DENOMINATOR = 10_000
+
+
+def commensurate(ratio: float, tol: Tolerance | None = None) -> Fraction | None:
+    """The fraction r/n (n <= ``MAX_LATTICE_DENOMINATOR``) equal to ``ratio`` within the
+    relative length tolerance, or ``None`` when the ratio is incommensurate (§7)."""
+    tol = tol or current()
+    if not math.isfinite(ratio):
+        return None
+    frac = Fraction(ratio).limit_denominator(MAX_LATTICE_DENOMINATOR)
+    if abs(float(frac) - ratio) > tol.rel_length * max(1.0, abs(ratio)):
+        return None
+    return frac
+
+
+@dataclass(frozen=True)
+class IntegerPoints:
+    """The integers ``start + step * Z`` (``step`` 0: the single integer ``start``)."""
+
+    start: int
+    step: int
+
+
+def integer_points(
+    offset: float, period: Fraction, unit: float, tol: Tolerance | None = None
+) -> IntegerPoints | None:
+    """The integers k in ``offset + period * Z`` (``period`` 0: k = ``offset``), or
+    ``None`` when there are none.
+
+    ``unit`` is the length of one step of k, so that ``offset`` counts as an integer
+    when it is one within the length tolerance. With period r/n in lowest terms,
+    k = offset + j r / n is an integer iff n * offset is one, and then j is fixed
+    modulo n by j r = -n offset (mod n): the solutions are spaced |r| apart.
+    """
+    tol = tol or current()
+    slack = tol.length / abs(unit)
+    r, n = period.numerator, period.denominator
+    scaled = n * offset
+    whole = round(scaled)
+    if abs(scaled - whole) > n * slack:
+        return None
+    if r == 0:
+        return IntegerPoints(whole, 0)
+    # gcd(r, n) = 1, so r has an inverse modulo n.
+    j = (-whole * pow(r, -1, n)) % n if n > 1 else 0
+    start = (whole + j * r) // n
+    step = abs(r)
+    return IntegerPoints(start % step, step)
