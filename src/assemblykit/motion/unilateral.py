@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import sparse
 from scipy.optimize import linprog
-from scipy.spatial import cKDTree
+from scipy.spatial import ConvexHull, cKDTree
 
 from assemblykit.errors import NumericError
 from assemblykit.tolerance import Tolerance, current
@@ -113,26 +113,32 @@ def translation_cone(
 
     ``sliding`` is an orthonormal basis of the lineality space (directions keeping every
     contact) and ``rays`` the unit extreme rays of the cone's pointed part, which lies in
-    the orthogonal complement of ``sliding``. An extreme ray is orthogonal to the
-    lineality space and to enough active normals to leave one direction: it is the cross
-    product of two of {sliding basis, normals}, checked against every constraint.
+    the orthogonal complement of ``sliding``. The pointed part is the polar of the cone
+    spanned by the normals; its extreme rays are the outward normals of the facets of
+    conv({0} ∪ normals) that pass through the origin (scipy ``ConvexHull``, so the cost
+    is O(m log m) in the number of contact normals).
     """
     tol = current() if tol is None else tol
     normals = _unique_directions(normals, tol)
     sliding = _null_space(normals, tol.angle, 3)
     if len(sliding) == 3:
         return tuple(sliding), ()
-    generators = np.vstack([sliding, normals])
-    first, second = np.triu_indices(len(generators), k=1)
-    cross = np.cross(generators[first], generators[second])
-    norms = np.linalg.norm(cross, axis=1)
-    unit = cross[norms > tol.angle] / norms[norms > tol.angle, None]
-    candidates = np.vstack([unit, -unit])
-    feasible = np.all(candidates @ normals.T <= tol.angle, axis=1)
-    if len(sliding):
-        feasible &= np.all(np.abs(candidates @ sliding.T) <= tol.angle, axis=1)
-    rays = _unique_directions(candidates[feasible], tol)
-    return tuple(sliding), tuple(rays)
+    basis = _null_space(sliding, tol.angle, 3) if len(sliding) else np.eye(3)
+    rays = _polar_rays(normals @ basis.T, tol) @ basis
+    return tuple(sliding), tuple(_unique_directions(rays, tol))
+
+
+def _polar_rays(coords: NDArray[np.float64], tol: Tolerance) -> NDArray[np.float64]:
+    """Unit extreme rays of {d : c · d ≤ 0 for every row c} when the rows span the space
+    (``coords`` is m x k, k = 1, 2 or 3)."""
+    k = coords.shape[1]
+    if k == 1:
+        signs = np.sign(coords[:, 0])
+        return -signs[:1, None] if np.all(signs == signs[0]) else np.zeros((0, 1))
+    hull = ConvexHull(np.vstack([np.zeros(k), coords]))
+    # hull.equations rows (a, b): a · x + b ≤ 0 inside, a the unit outward normal
+    through_origin = np.abs(hull.equations[:, -1]) <= tol.angle
+    return hull.equations[through_origin, :-1]
 
 
 def lift_off_witnesses(
