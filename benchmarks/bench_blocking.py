@@ -1,0 +1,166 @@
+"""Benchmark of the blocking graphs (seed 004): run ``python benchmarks/bench_blocking.py``.
+
+Prints
+* Γ_t for synthetic assemblies of n = 50 parts with c = 50, 100, 200, 400 distinct
+  contact planes: arrangement size, time to build the arrangement, time of the crossing
+  rule over every region, and the time to recompute every region's DBG from scratch,
+  vectorised over regions and one region at a time (both measured on a sample of
+  regions and scaled), with the growth between sizes;
+* removable-part queries on the COMPAS dome (527 blocks), extended and infinitesimal
+  translations (skipped when ../shared/data is absent);
+* incremental removal / addition of a part against rebuilding the NDBG.
+
+CPU times (``time.process_time``) are reported next to wall times: the machine is shared.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from assemblykit.blocking.arrangement import sphere_arrangement
+from assemblykit.blocking.constraints import infinitesimal_terms
+from assemblykit.blocking.ndbg import ConstraintTable, build_ndbg, crossing_rule
+from assemblykit.geometry.contacts import Contact, PlanarPatch
+from assemblykit.tolerance import Tolerance
+
+N_PARTS = 50
+PLANES = (50, 100, 200, 400)
+DIRECT_SAMPLE = 20_000
+PER_REGION_SAMPLE = 2_000
+REPEATS = 3
+DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "compas_assembly"
+TOL = Tolerance()
+
+
+def synthetic(c: int, seed: int = 0) -> tuple[tuple[str, ...], list[Contact]]:
+    """``c`` contacts with distinct random planes between random pairs of a chain of
+    N_PARTS parts (each part touches its neighbours and a few others)."""
+    rng = np.random.default_rng(seed)
+    names = tuple(f"p{i}" for i in range(N_PARTS))
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float)
+    contacts = []
+    for k in range(c):
+        a = k % N_PARTS
+        b = (a + 1 + rng.integers(3)) % N_PARTS
+        n = rng.normal(size=3)
+        contacts.append(
+            Contact(names[a], names[b], planar=(PlanarPatch(n / np.linalg.norm(n), square, 1.0),))
+        )
+    return names, contacts
+
+
+def timed(fn, *args, repeats: int = REPEATS):
+    """Result of ``fn(*args)`` and the medians of its wall and CPU times."""
+    walls, cpus, out = [], [], None
+    for _ in range(repeats):
+        w, p = time.perf_counter(), time.process_time()
+        out = fn(*args)
+        walls.append(time.perf_counter() - w)
+        cpus.append(time.process_time() - p)
+    return out, statistics.median(walls), statistics.median(cpus)
+
+
+def per_region(table: ConstraintTable, directions: np.ndarray) -> list[np.ndarray]:
+    """Each region's DBG recomputed on its own (seed 004: inner products with every
+    contact normal, then the arcs), one direction at a time."""
+    return [table.direct_arcs(d[None, :], TOL) for d in directions]
+
+
+def bench_gamma_t() -> None:
+    print(f"Γ_t, n = {N_PARTS} parts (median of {REPEATS}; CPU seconds)")
+    print(
+        f"{'c':>5} {'regions':>9} {'slots':>6} {'arrangement':>12} {'crossing':>10} "
+        f"{'direct (all)':>13} {'direct/crossing':>16} {'one by one':>11} {'ratio':>6} "
+        f"{'per c² n² (ns)':>15}"
+    )
+    previous = None
+    for c in PLANES:
+        names, contacts = synthetic(c)
+        terms = infinitesimal_terms(contacts)
+        table = ConstraintTable.build(names, terms, TOL)
+        arr, _, t_arr = timed(sphere_arrangement, table.normals, repeats=1)
+        packed, _, t_cross = timed(crossing_rule, arr, table, repeats=1 if c >= 400 else REPEATS)
+        rng = np.random.default_rng(1)
+        sample = rng.choice(len(arr), size=min(DIRECT_SAMPLE, len(arr)), replace=False)
+        direct, _, t_sample = timed(
+            table.direct_arcs, arr.directions[sample], TOL, repeats=1 if c >= 400 else REPEATS
+        )
+        t_direct = t_sample * len(arr) / len(sample)
+        one_by_one = sample[:PER_REGION_SAMPLE]
+        _, _, t_each = timed(per_region, table, arr.directions[one_by_one], repeats=1)
+        t_each *= len(arr) / len(one_by_one)
+        slots = np.unpackbits(packed[sample], axis=1, count=len(table.starts)).astype(bool)
+        assert np.array_equal(slots, direct), "crossing rule differs from direct DBGs"
+        total = t_arr + t_cross
+        per = 1e9 * total / (c * c * N_PARTS**2)
+        print(
+            f"{c:>5} {len(arr):>9} {len(table.starts):>6} {t_arr:>12.3f} {t_cross:>10.3f} "
+            f"{t_direct:>13.3f} {t_direct / t_cross:>16.1f} {t_each:>11.2f} "
+            f"{t_each / t_cross:>6.0f} {per:>15.2f}"
+        )
+        if previous is not None:
+            print(f"      growth x{total / previous:.2f} for c x2 (c² predicts x4)")
+        previous = total
+
+
+def bench_dome() -> None:
+    path = DATA / "dome_assembly.json"
+    if not path.is_file():
+        print("dome: ../shared/data absent, skipped")
+        return
+    from assemblykit import load_assembly
+    from assemblykit.blocking.queries import removable_parts
+
+    dome, _, c_load = timed(load_assembly, path, repeats=1)
+    _, _, c_con = timed(dome.contacts, repeats=1)
+    print(
+        f"\ndome: {len(dome.names)} blocks, {len(dome.contacts())} contacts "
+        f"(load {c_load:.2f} s, contacts {c_con:.2f} s CPU)"
+    )
+    for motion in ("extended", "infinitesimal"):
+        found, wall, cpu = timed(removable_parts, dome, motion, repeats=1)
+        print(
+            f"  removable parts, {motion:>13}: {len(found)} parts in {cpu:.2f} s CPU "
+            f"({wall:.2f} s wall)"
+        )
+
+
+def bench_incremental() -> None:
+    names, contacts = synthetic(200, seed=3)
+    terms = infinitesimal_terms(contacts)
+    full = build_ndbg(names, "infinitesimal", terms, len(contacts), TOL)
+    gone = "p7"
+    _, _, t_remove = timed(full.without_parts, [gone])
+    rest = tuple(n for n in names if n != gone)
+    rest_terms = [t for t in terms if gone not in (t.moving, t.blocker)]
+    _, _, t_rebuild = timed(build_ndbg, rest, "infinitesimal", rest_terms, 0, TOL)
+    smaller = full.without_parts([gone])
+    # a new part touching two others on planes already in the arrangement
+    rng = np.random.default_rng(4)
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype=float)
+    picks = rng.choice(len(full.table.normals), 3, replace=False)
+    others = rng.choice(rest, 3, replace=False)
+    new = [
+        Contact("new", str(o), planar=(PlanarPatch(full.table.normals[k], square, 1.0),))
+        for k, o in zip(picks, others, strict=True)
+    ]
+    new_terms = infinitesimal_terms(new)
+    _, _, t_add = timed(smaller.with_terms, ["new"], new_terms, len(new))
+    _, _, t_add_full = timed(
+        build_ndbg, (*rest, "new"), "infinitesimal", [*rest_terms, *new_terms], 0, TOL
+    )
+    print(f"\nincremental, c = 200, {len(full.arrangement)} regions (CPU seconds)")
+    print(
+        f"  remove a part: {t_remove:.4f} vs rebuild {t_rebuild:.3f}  (x{t_rebuild / t_remove:.0f})"
+    )
+    print(f"  add a part:    {t_add:.4f} vs rebuild {t_add_full:.3f}  (x{t_add_full / t_add:.0f})")
+
+
+if __name__ == "__main__":
+    bench_gamma_t()
+    bench_dome()
+    bench_incremental()

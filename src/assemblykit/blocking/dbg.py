@@ -1,0 +1,105 @@
+"""The directional blocking graph G(d, A) (seed 004, "Directional Blocking Graph").
+
+Nodes are the parts; an arc ``i -> j`` means that part ``j`` blocks the motion of part
+``i`` along the direction ``d``. A subassembly ``S`` is locally free along ``d`` iff no
+arc leaves ``S``; the strongly connected components of the graph tell which such
+subassemblies exist (a sink component always does unless the graph is strongly
+connected).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import networkx as nx
+import numpy as np
+from numpy.typing import NDArray
+
+
+@dataclass(frozen=True, eq=False)
+class DirectionalBlockingGraph:
+    """G(d, A): ``parts`` in order, the motion ``direction`` (a unit 2-, 3- or 6-vector)
+    and ``arcs`` ``(i, j)`` meaning ``j`` blocks ``i`` along ``direction``."""
+
+    parts: tuple[str, ...]
+    direction: NDArray[np.float64]
+    arcs: frozenset[tuple[str, str]] = field(default_factory=frozenset)
+
+    @cached_property
+    def graph(self) -> nx.DiGraph:
+        """The graph as a networkx DiGraph over every part."""
+        g = nx.DiGraph()
+        g.add_nodes_from(self.parts)
+        g.add_edges_from(self.arcs)
+        return g
+
+    def blocks(self, blocker: str, moving: str) -> bool:
+        """Whether ``blocker`` blocks ``moving`` along the direction."""
+        return (moving, blocker) in self.arcs
+
+    def sccs(self) -> list[frozenset[str]]:
+        """The strongly connected components (networkx), largest first."""
+        comps = [frozenset(c) for c in nx.strongly_connected_components(self.graph)]
+        return sorted(comps, key=lambda c: (-len(c), sorted(c)))
+
+    @cached_property
+    def condensation(self) -> nx.DiGraph:
+        """The acyclic graph of the components; node attribute ``members`` (networkx)."""
+        return nx.condensation(self.graph)
+
+    def is_free(self, subassembly: frozenset[str] | set[str]) -> bool:
+        """Whether ``subassembly`` is locally free: no arc from it to the rest (seed 004)."""
+        inside = set(subassembly)
+        return not any(i in inside and j not in inside for i, j in self.arcs)
+
+    def free_subassemblies(self) -> list[frozenset[str]]:
+        """The proper subassemblies that are locally free and closed under blocking.
+
+        Every locally free subassembly is a union of these: for each component, the set
+        of parts reachable from it (everything it pushes against must come along). The
+        whole assembly is left out; sinks of the condensation give the smallest sets.
+        """
+        cond = self.condensation
+        members = nx.get_node_attributes(cond, "members")
+        everything = frozenset(self.parts)
+        found: set[frozenset[str]] = set()
+        for node in cond.nodes:
+            reach = {node} | nx.descendants(cond, node)
+            closed = frozenset().union(*(members[r] for r in reach))
+            if closed != everything:
+                found.add(closed)
+        return sorted(found, key=lambda s: (len(s), sorted(s)))
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON form: the direction and the sorted arcs."""
+        return {
+            "direction": [float(x) for x in self.direction],
+            "arcs": [list(a) for a in sorted(self.arcs)],
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class Region:
+    """A regular region of an NDBG: a unit ``direction`` inside it, its ``dimension``
+    (0 vertex/point, 1 edge/arc, 2 face) and its ``dbg`` (seed 004, G(R, A))."""
+
+    direction: NDArray[np.float64]
+    dimension: int
+    dbg: DirectionalBlockingGraph
+
+
+@dataclass(frozen=True, eq=False)
+class Removal:
+    """A subassembly ``parts`` and unit ``directions`` (translations, or twists
+    ``(omega; v)`` for rigid motions) along which it is free of the rest."""
+
+    parts: frozenset[str]
+    directions: tuple[NDArray[np.float64], ...]
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON form (DESIGN.md §5.3): sorted part names and direction lists."""
+        return {
+            "parts": sorted(self.parts),
+            "directions": [[float(x) for x in d] for d in self.directions],
+        }

@@ -1,0 +1,179 @@
+"""Planar assemblies of polygonal parts (seed 004, "2D case").
+
+Parts are simple polygons in the plane z = 0, in assembled position: read from a small
+YAML file (``parts: {name: [[x, y], ...]}``) or cut from 3D meshes by a plane (trimesh
+``section``). Two parts are in contact along a segment where an edge of one lies on an
+edge of the other with opposite outward normals and the two overlap with positive
+length. Each contact segment becomes a :class:`PlanarPatch` with its in-plane normal
+(from part ``a`` into part ``b``), its two endpoints (z = 0) and its length as area, so
+that the NDBG machinery treats the planar case on the circle of directions S¹.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import trimesh
+import yaml
+from numpy.typing import NDArray
+from shapely.geometry import Polygon
+from shapely.geometry.polygon import orient
+
+from assemblykit.errors import GeometryError, SchemaError, UnknownNameError
+from assemblykit.geometry.contacts import Contact, PlanarPatch
+from assemblykit.tolerance import Tolerance, current
+
+
+@dataclass(eq=False)
+class PolygonAssembly:
+    """Named counter-clockwise polygons (k x 2) in the plane, in assembled position."""
+
+    polygons: dict[str, NDArray[np.float64]]
+    source: str | None = None
+    dimension: int = 2
+    _contacts: dict[Tolerance, list[Contact]] = field(default_factory=dict, repr=False)
+
+    @property
+    def names(self) -> list[str]:
+        """Part names in order."""
+        return list(self.polygons)
+
+    @property
+    def scale(self) -> float:
+        """Diagonal of the bounding box of all polygons (1 when empty)."""
+        if not self.polygons:
+            return 1.0
+        pts = np.concatenate(list(self.polygons.values()))
+        diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+        return diag if diag > 0 else 1.0
+
+    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
+        """The tolerance policy scaled to this drawing."""
+        return (tol or current()).with_scale(self.scale)
+
+    def contacts(self, tol: Tolerance | None = None) -> list[Contact]:
+        """Contact segments between every two polygons (computed once per tolerance)."""
+        tol = self.tolerance(tol)
+        if tol not in self._contacts:
+            self._contacts[tol] = edge_contacts(self.polygons, tol)
+        return self._contacts[tol]
+
+    def subset(self, names: list[str]) -> PolygonAssembly:
+        """The polygons named."""
+        missing = set(names) - set(self.polygons)
+        if missing:
+            raise UnknownNameError(f"no part named {sorted(missing)[0]!r}", source=self.source)
+        return PolygonAssembly(
+            {n: self.polygons[n] for n in self.polygons if n in names}, self.source
+        )
+
+
+def _ccw(points: NDArray[np.float64], name: str, source: str | None) -> NDArray[np.float64]:
+    poly = Polygon(points)
+    if not poly.is_valid or poly.area <= 0:
+        raise GeometryError(
+            "not a simple polygon of positive area", source=source, where=f"parts.{name}"
+        )
+    return np.asarray(orient(poly, 1.0).exterior.coords, dtype=np.float64)[:-1]
+
+
+def load_polygons(path: str | Path) -> PolygonAssembly:
+    """Read ``parts: {name: [[x, y], ...]}`` from a YAML file."""
+    path = Path(path)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError) as bad:
+        raise GeometryError(f"cannot read polygons: {bad}", source=str(path)) from None
+    if not isinstance(data, dict) or not isinstance(data.get("parts"), dict):
+        raise SchemaError(
+            "expected a mapping 'parts: {name: [[x, y], ...]}'", source=str(path), where="parts"
+        )
+    polygons = {}
+    for name, pts in data["parts"].items():
+        arr = np.asarray(pts, dtype=np.float64) if isinstance(pts, list) else np.zeros(0)
+        if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3:
+            raise SchemaError(
+                "a polygon is a list of at least three [x, y] points",
+                source=str(path),
+                where=f"parts.{name}",
+            )
+        polygons[str(name)] = _ccw(arr, str(name), str(path))
+    return PolygonAssembly(polygons, str(path))
+
+
+def section_polygons(
+    meshes: dict[str, trimesh.Trimesh],
+    origin: NDArray[np.float64],
+    normal: NDArray[np.float64],
+) -> PolygonAssembly:
+    """Cross-sections of meshes by the plane through ``origin`` with ``normal``, as
+    polygons in one frame of that plane (the largest region of each part)."""
+    n = np.asarray(normal, dtype=np.float64)
+    n = n / np.linalg.norm(n)
+    e1 = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
+    e1 /= np.linalg.norm(e1)
+    to_2d = np.eye(4)
+    to_2d[:3, :3] = np.vstack([e1, np.cross(n, e1), n])
+    to_2d[:3, 3] = -to_2d[:3, :3] @ np.asarray(origin, dtype=np.float64)
+    polygons = {}
+    for name, mesh in meshes.items():
+        cut = mesh.section(plane_origin=origin, plane_normal=n)
+        if cut is None:
+            continue
+        planar, _ = cut.to_2D(to_2D=to_2d, check=False)
+        regions = planar.polygons_full
+        if regions:
+            # the triangulation leaves collinear vertices on the section's edges
+            biggest = max(regions, key=lambda p: p.area).simplify(0)
+            polygons[name] = _ccw(np.asarray(biggest.exterior.coords)[:-1], name, None)
+    return PolygonAssembly(polygons)
+
+
+def _edges(poly: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    return poly, np.roll(poly, -1, axis=0)
+
+
+def edge_contacts(polygons: dict[str, NDArray[np.float64]], tol: Tolerance) -> list[Contact]:
+    """Contact segments between every two counter-clockwise polygons (module docstring)."""
+    contacts = []
+    boxes = {
+        n: (p.min(axis=0) - tol.length, p.max(axis=0) + tol.length) for n, p in polygons.items()
+    }
+    for a, b in itertools.combinations(polygons, 2):
+        (alo, ahi), (blo, bhi) = boxes[a], boxes[b]
+        if np.any(alo > bhi) or np.any(blo > ahi):
+            continue
+        patches = []
+        for p, q in zip(*_edges(polygons[a]), strict=True):
+            u = (q - p) / np.linalg.norm(q - p)
+            normal = np.array([u[1], -u[0]])  # outward for a counter-clockwise polygon
+            for r, s in zip(*_edges(polygons[b]), strict=True):
+                w = (s - r) / np.linalg.norm(s - r)
+                if u @ w > 0 or abs(u[0] * w[1] - u[1] * w[0]) > tol.angle:
+                    continue
+                if abs(normal @ (r - p)) > tol.length or abs(normal @ (s - p)) > tol.length:
+                    continue
+                lo = max(0.0, min(u @ (r - p), u @ (s - p)))
+                hi = min(float(u @ (q - p)), max(u @ (r - p), u @ (s - p)))
+                if hi - lo > tol.length:
+                    seg = np.array([[*(p + lo * u), 0.0], [*(p + hi * u), 0.0]])
+                    patches.append(PlanarPatch(np.array([*normal, 0.0]), seg, hi - lo))
+        if patches:
+            contacts.append(Contact(a, b, planar=tuple(patches)))
+    return contacts
+
+
+def is_polygon_file(path: str | Path) -> bool:
+    """Whether ``path`` is a YAML file of polygons (``parts`` a mapping of point lists,
+    where an assembly manifest has a list)."""
+    path = Path(path)
+    if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
+        return False
+    try:
+        data = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError):
+        return False
+    return isinstance(data, dict) and isinstance(data.get("parts"), dict)

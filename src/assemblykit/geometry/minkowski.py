@@ -1,0 +1,86 @@
+"""Configuration obstacles of translating parts (seed 004, "Extended translations").
+
+Part ``j`` blocks the extended translation of part ``i`` along ``d`` iff the volume that
+``i`` sweeps meets the interior of ``j``, i.e. iff the ray ``{t d, t > 0}`` enters the
+interior of the grown obstacle ``P_j ⊕ (−P_i) = {a − b | a ∈ P_j, b ∈ P_i}`` (the
+seed's "Minkowski difference P_j ⊖ P_i", Lozano-Pérez 1983). For convex pieces the
+obstacle is the convex hull of the vertex differences (scipy ``ConvexHull``) and the
+blocked directions form an open polyhedral cone, bounded by the obstacle's facets
+through the origin once the origin is added to the hull.
+
+Non-convex parts are split into their connected bodies; a body that is not convex is
+decomposed with ``coacd`` when it is installed (extra ``decompose``) and replaced by
+its convex hull otherwise. Both only enlarge the obstacles, so a direction found free
+stays free: the sufficient condition of Γ_e holds. (manifold3d's ``minkowski_sum`` of
+two non-convex meshes took minutes on a 576-triangle torus, too slow to use here.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+from scipy.spatial import ConvexHull, QhullError
+
+from assemblykit.errors import GeometryError
+from assemblykit.tolerance import Tolerance, current
+
+COACD_THRESHOLD = 0.05
+
+
+def _decompose(body: trimesh.Trimesh) -> list[NDArray[np.float64]]:
+    try:
+        import coacd
+    except ImportError:
+        return [np.asarray(body.convex_hull.vertices, dtype=np.float64)]
+    coacd.set_log_level("error")
+    pieces = coacd.run_coacd(coacd.Mesh(body.vertices, body.faces), threshold=COACD_THRESHOLD)
+    return [np.asarray(v, dtype=np.float64) for v, _ in pieces]
+
+
+def convex_pieces(mesh: trimesh.Trimesh) -> list[NDArray[np.float64]]:
+    """Vertex sets of convex pieces whose union contains the mesh (module docstring)."""
+    if mesh.is_convex:
+        return [np.asarray(mesh.vertices, dtype=np.float64)]
+    pieces: list[NDArray[np.float64]] = []
+    for body in mesh.split(only_watertight=False) or [mesh]:
+        if body.is_convex:
+            pieces.append(np.asarray(body.vertices, dtype=np.float64))
+        else:
+            pieces.extend(_decompose(body))
+    return pieces
+
+
+def obstacle_hull(obstacle: NDArray[np.float64], moving: NDArray[np.float64]) -> ConvexHull:
+    """Hull of ``{a − b}`` for the vertices ``a`` of the obstacle and ``b`` of the moving
+    piece, with the origin added (module docstring)."""
+    diffs = (obstacle[:, None, :] - moving[None, :, :]).reshape(-1, 3)
+    try:
+        return ConvexHull(np.vstack([diffs, np.zeros(3)]))
+    except QhullError as bad:
+        raise GeometryError(
+            f"degenerate convex piece ({len(obstacle)} and {len(moving)} vertices): {bad}"
+        ) from None
+
+
+def blocking_cone(
+    obstacle: NDArray[np.float64], moving: NDArray[np.float64], tol: Tolerance | None = None
+) -> NDArray[np.float64]:
+    """Normals ``n`` (m x 3) such that translating the convex piece ``moving`` along ``d``
+    to infinity enters the interior of the convex piece ``obstacle`` iff ``n . d > 0`` for
+    all of them. An empty array means every direction (the pieces overlap)."""
+    tol = tol or current()
+    hull = obstacle_hull(
+        np.asarray(obstacle, dtype=np.float64), np.asarray(moving, dtype=np.float64)
+    )
+    through = np.abs(hull.equations[:, 3]) <= tol.length
+    normals = -hull.equations[through, :3]
+    # qhull triangulates facets: keep one normal per plane (first of each repeat)
+    same = normals @ normals.T >= np.cos(tol.angle)
+    first = ~np.any(np.triu(same, 1), axis=0)
+    return np.ascontiguousarray(normals[first], dtype=np.float64).reshape(-1, 3)
+
+
+def blocks_along(cone: NDArray[np.float64], directions: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Whether each direction (rows) lies in the open blocking cone."""
+    return np.all(np.atleast_2d(directions) @ cone.T > 0, axis=1)

@@ -1,0 +1,93 @@
+"""Hand-built assemblies for the blocking-graph tests: contacts given as value types."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.geometry.contacts import Contact, CurvedPatch, PlanarPatch
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.tolerance import Tolerance, current
+
+DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
+
+
+@dataclass(eq=False)
+class ContactAssembly:
+    """Just what the blocking graphs read: part names and contacts."""
+
+    names: list[str]
+    given: list[Contact]
+    dimension: int = 3
+    calls: list[int] = field(default_factory=list)
+
+    def contacts(self, tol: Tolerance | None = None) -> list[Contact]:
+        self.calls.append(1)
+        return self.given
+
+    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
+        return tol or current()
+
+
+def square(normal, center=(0.0, 0.0, 0.0), half=0.5) -> PlanarPatch:
+    """A square patch of side 2*half centred at ``center`` with the given normal."""
+    n = np.asarray(normal, dtype=np.float64)
+    n = n / np.linalg.norm(n)
+    e1 = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    c = np.asarray(center, dtype=np.float64)
+    poly = np.array(
+        [c + half * (sx * e1 + sy * e2) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    )
+    return PlanarPatch(n, poly, (2 * half) ** 2)
+
+
+def cylinder(axis, inner: str) -> CurvedPatch:
+    return CurvedPatch(
+        "cylindrical",
+        np.zeros(3),
+        np.asarray(axis, dtype=np.float64),
+        1.0,
+        inner,
+        extent=(-1.0, 0.0),
+    )
+
+
+def box(lo, hi) -> trimesh.Trimesh:
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    return trimesh.creation.box(
+        extents=hi - lo, transform=trimesh.transformations.translation_matrix((lo + hi) / 2)
+    )
+
+
+def mesh_assembly(meshes: dict[str, trimesh.Trimesh]) -> Assembly:
+    return Assembly([Part(name, mesh) for name, mesh in meshes.items()])
+
+
+def random_box_contacts(rng: np.random.Generator, n: int, c: int) -> ContactAssembly:
+    """Boxes of random orientations: ``c`` contacts between random pairs of ``n`` parts,
+    normals drawn from a few rotated box frames so that planes repeat."""
+    frames = [
+        trimesh.transformations.random_rotation_matrix(rng.random(3))[:3, :3] for _ in range(3)
+    ]
+    names = [f"p{i}" for i in range(n)]
+    contacts = []
+    for _ in range(c):
+        a, b = rng.choice(n, 2, replace=False)
+        frame = frames[rng.integers(len(frames))]
+        normal = frame[:, rng.integers(3)] * rng.choice([-1.0, 1.0])
+        contacts.append(Contact(names[a], names[b], planar=(square(normal),)))
+    return ContactAssembly(names, contacts)
+
+
+def compas_folder() -> Path:
+    """The COMPAS assemblies of the shared data; skips the test when absent."""
+    folder = DATA / "compas_assembly"
+    if not folder.is_dir():
+        pytest.skip("shared data (../shared/data) not available")
+    return folder

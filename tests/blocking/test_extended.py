@@ -1,0 +1,63 @@
+"""Γ_e: blocking for extended translations (seed 004, "Extended translations")."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+from blocking_helpers import box, mesh_assembly
+
+from assemblykit.blocking.extended import extended_dbg
+from assemblykit.blocking.ndbg import blocking_graph
+
+
+def ring(center, plane: str) -> trimesh.Trimesh:
+    """A square ring of four bars (convex pieces): outer half-size 1.5, bar width 0.5,
+    thickness 0.5, in the plane 'xy' or 'xz' around ``center``."""
+    c = np.asarray(center, dtype=float)
+    bars = []
+    for lo, hi in (
+        ([-1.5, -1.5], [-1.0, 1.5]),
+        ([1.0, -1.5], [1.5, 1.5]),
+        ([-1.0, -1.5], [1.0, -1.0]),
+        ([-1.0, 1.0], [1.0, 1.5]),
+    ):
+        if plane == "xy":
+            bars.append(
+                box(c + np.array([lo[0], lo[1], -0.25]), c + np.array([hi[0], hi[1], 0.25]))
+            )
+        else:
+            bars.append(
+                box(c + np.array([lo[0], -0.25, lo[1]]), c + np.array([hi[0], 0.25, hi[1]]))
+            )
+    return trimesh.util.concatenate(bars)
+
+
+def test_locally_free_but_blocked_farther_along():
+    asm = mesh_assembly(
+        {
+            "table": box([-2, -2, -1], [2, 2, 0]),
+            "block": box([0, 0, 0], [1, 1, 1]),
+            "lamp": box([0, 0, 3], [1, 1, 4]),  # hangs above the block, not touching it
+        }
+    )
+    up = np.array([0.0, 0.0, 1.0])
+    local = blocking_graph(asm, "infinitesimal")
+    assert local.dbg(up).is_free({"block"})
+    extended = blocking_graph(asm, "extended")
+    assert not extended.dbg(up).is_free({"block"})
+    assert extended.dbg(up).blocks("lamp", "block")
+    assert extended_dbg(asm, up, tuple(asm.names), asm.tolerance()).arcs == extended.dbg(up).arcs
+    sideways = extended.dbg([1.0, 0.0, 0.0])
+    assert sideways.is_free({"block"})
+    for region in extended.regions():
+        assert region.dbg.arcs == extended.dbg(region.direction).arcs
+
+
+def test_interlocked_rings_have_no_removable_subassembly():
+    asm = mesh_assembly({"r1": ring([0, 0, 0], "xy"), "r2": ring([1.25, 0, 0], "xz")})
+    assert asm.contacts() == []
+    g = blocking_graph(asm, "extended")
+    assert g.removable() == []
+    # without the interlock (second ring moved away) they separate
+    apart = mesh_assembly({"r1": ring([0, 0, 0], "xy"), "r2": ring([5, 0, 0], "xz")})
+    assert blocking_graph(apart, "extended").removable() != []

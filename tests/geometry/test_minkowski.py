@@ -1,0 +1,66 @@
+"""Configuration obstacles of translating convex pieces (seed 004, extended translations)."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from assemblykit.geometry.minkowski import blocking_cone, blocks_along, convex_pieces
+from assemblykit.tolerance import Tolerance
+
+TOL = Tolerance()
+
+
+def corners(lo, hi) -> np.ndarray:
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    return np.array(
+        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+    )
+
+
+def as_set(normals) -> set[tuple[float, ...]]:
+    return {tuple(np.round(n, 9)) for n in normals}
+
+
+def test_touching_cube_blocks_the_open_half_space():
+    below, above = corners([0, 0, 0], [1, 1, 1]), corners([0, 0, 1], [1, 1, 2])
+    cone = blocking_cone(above, below, TOL)  # 'above' blocks 'below'
+    assert as_set(cone) == {(0.0, 0.0, 1.0)}
+    assert blocks_along(cone, np.array([[0.1, 0, 1], [1, 0, 0], [0, 0, -1]])).tolist() == [
+        True,
+        False,
+        False,
+    ]
+
+
+def test_distant_cube_blocks_a_pyramid_of_directions():
+    moving, obstacle = (
+        corners([-0.5, -0.5, -0.5], [0.5, 0.5, 0.5]),
+        corners([2.5, -0.5, -0.5], [3.5, 0.5, 0.5]),
+    )
+    # grown obstacle [2, 4] x [-1, 1]^2: rays enter it iff |d_y|, |d_z| < d_x / 2
+    cone = blocking_cone(obstacle, moving, TOL)
+    expected = {
+        tuple(np.round(np.array(v) / np.sqrt(5), 9))
+        for v in ([1, 2, 0], [1, -2, 0], [1, 0, 2], [1, 0, -2])
+    }
+    assert as_set(cone) == expected
+    assert blocks_along(cone, np.array([1.0, 0.49, 0.0]))[0]
+    assert not blocks_along(cone, np.array([1.0, 0.51, 0.0]))[0]
+    assert not blocks_along(cone, np.array([-1.0, 0.0, 0.0]))[0]
+
+
+def test_overlapping_pieces_block_everything():
+    cone = blocking_cone(corners([0, 0, 0], [2, 2, 2]), corners([1, 1, 1], [3, 3, 3]), TOL)
+    assert cone.shape == (0, 3)
+    assert blocks_along(cone, np.array([[1.0, 0, 0], [0, 0, -1.0]])).all()
+
+
+def test_convex_pieces_split_bodies():
+    a = trimesh.creation.box(extents=(1, 1, 1))
+    b = trimesh.creation.box(
+        extents=(1, 1, 1), transform=trimesh.transformations.translation_matrix([3, 0, 0])
+    )
+    pieces = convex_pieces(trimesh.util.concatenate([a, b]))
+    assert len(pieces) == 2
+    assert sorted(round(float(p[:, 0].mean()), 9) for p in pieces) == [0.0, 3.0]
