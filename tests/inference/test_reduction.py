@@ -744,12 +744,21 @@ def test_box_against_table_with_corner_on_wall_has_two_dof():
         [WORLD_BODY, BOX],
         rel("against", "box.bottom", "world.table"),
         rel("point_on_plane", "box.corner", "world.wall"),
+        explain=True,
     )
     b = out["bodies"]["box@s1"]
     assert (b["dof"], b["motion"]) == (2, "mechanism")
     pose = np.asarray(b["pose"])
     assert pose[:3, :3] @ [1, 1, 0] @ [1, 0, 0] + pose[0, 3] == pytest.approx(5.0)
     assert member_of_plane(pose, (0, 0, 0), (0, 0, -1), (0, 0, 0), Z)
+    # closed form: the nearest pose moves the corner (1,1,0) straight onto the wall x = 5;
+    # the box slides along y and turns about the vertical through the corner
+    np.testing.assert_allclose(pose, shift(4.0), atol=1e-9)
+    inv = b["invariants"]
+    assert parallel(inv["normal"], Z) and parallel(inv["direction"], (0, 1, 0))
+    np.testing.assert_allclose(inv["point"], [5, 1, 0], atol=1e-9)
+    assert "chain-solve point-on-plane" in [step["rule"] for step in out["trace"]]
+    assert "residue" not in [step["rule"] for step in out["trace"]]
 
 
 def test_non_coset_relations_that_cannot_hold_report_no_solution_found():
@@ -760,10 +769,8 @@ def test_non_coset_relations_that_cannot_hold_report_no_solution_found():
     )
     assert out["status"] == "inconsistent"
     conflict = out["conflicts"][0]
-    assert conflict["kind"] == "residual"
-    assert "no solution found" in conflict["message"]
-    # the corner must rise 5 while the bottom stays down: least squares shares the gap
-    assert 2.0 < conflict["value"] <= 5.0
+    # the corner moves in the table's plane z = 0, parallel to the roof 5 above it
+    assert (conflict["kind"], conflict["value"]) == ("distance", pytest.approx(5.0, abs=1e-9))
     assert "point_on_plane box.corner world.roof @s1" in conflict["relations"]
 
 

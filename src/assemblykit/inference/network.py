@@ -253,6 +253,32 @@ def _coupled_constraint(
     return Constraint((*bodies, carrier), residual, (label,))
 
 
+@dataclass(frozen=True)
+class PointOnPlane:
+    """A ``point_on_plane`` relation: the point (in its instance's body frame) lies on the
+    plane through ``origin`` with unit ``normal`` (in the plane instance's body frame)."""
+
+    point_node: Node
+    point: np.ndarray
+    plane_node: Node
+    origin: np.ndarray
+    normal: np.ndarray
+
+
+def _point_on_plane(
+    kind: str, first: tuple[Node, Any], second: tuple[Node, Any]
+) -> PointOnPlane | None:
+    """The geometry of a ``point_on_plane`` relation (either order), None for other kinds."""
+    if kind != "point_on_plane":
+        return None
+    (point_node, point), (plane_node, plane) = (
+        (first, second) if second[1].type_name == "plane" else (second, first)
+    )
+    frame = np.asarray(plane.frame(), dtype=np.float64)
+    where = np.asarray(point.frame(), dtype=np.float64)[:3, 3]
+    return PointOnPlane(point_node, where, plane_node, frame[:3, 3], frame[:3, 2])
+
+
 def _memo_key(feature: Any, memo: MutableMapping[Hashable, Any]) -> Hashable:
     """:func:`feature_key`, computed once per feature object of the task being built."""
     found = memo.get(id(feature))
@@ -287,6 +313,7 @@ def _relation_part(
             (source, target),
             lambda poses: residual(se3.inverse(poses[0]) @ poses[1]),
             (label,),
+            _point_on_plane(relation.kind, (target, first), (source, second)),
         )
     key = (
         relation.kind,

@@ -36,12 +36,14 @@ Residual = Callable[[Sequence[np.ndarray]], np.ndarray]
 class Constraint:
     """A residual over the world poses of ``nodes`` (zero exactly when it holds).
 
-    ``labels`` name the relations or actions it comes from (for conflict reports).
+    ``labels`` name the relations or actions it comes from (for conflict reports);
+    ``geometry`` describes the relation when the reduction has a closed form for it.
     """
 
     nodes: tuple[Hashable, ...]
     residual: Residual
     labels: tuple[str, ...] = ()
+    geometry: Any = None
 
 
 @dataclass(frozen=True)

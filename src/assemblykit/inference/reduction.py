@@ -40,6 +40,14 @@ import networkx as nx
 import numpy as np
 
 from assemblykit.algebra import Coset, EmptySet, se3
+from assemblykit.inference.loops import (
+    Circle,
+    LoopPoses,
+    circle_circle,
+    foot,
+    point_loop,
+    rotation_about,
+)
 from assemblykit.inference.network import (
     WORLD,
     Link,
@@ -368,6 +376,15 @@ class Reducer:
                 )
                 if points is not None:
                     return self._apply_loop(closing, path, points, labels)
+                for way in (path, path[::-1]):  # the revolute may come first either way
+                    solved = point_loop(
+                        self.edges[frozenset((way[0], way[1]))].oriented(way[0]),
+                        self.edges[frozenset((way[1], way[2]))].oriented(way[1]),
+                        closing.oriented(way[0]),
+                        self.tol,
+                    )
+                    if solved is not None:
+                        return self._apply_point_loop(closing, way, solved, labels)
         return False
 
     def _chain(self, path: list[Node]) -> Any:
@@ -425,6 +442,37 @@ class Reducer:
         self.loops.append([[(first_key, path[0], p), (close_key, path[0], q)] for p, q in points])
         return True
 
+    def _apply_point_loop(
+        self, closing: _Edge, path: list[Node], solved: LoopPoses, labels: tuple[str, ...]
+    ) -> bool:
+        """Record a point-orbit loop answer (:func:`point_loop`): no pose is a conflict;
+        otherwise a branch over the poses of the first link, whose merge leaves the rest of
+        the loop to rule 1."""
+        first_key = frozenset((path[0], path[1]))
+        names = tuple(dict.fromkeys(closing.labels + labels))
+        if not solved.poses:
+            self.conflicts.append(
+                Conflict(
+                    names,
+                    "loop",
+                    0.0,
+                    f"the loop cannot close ({solved.pattern}: the joint point's circle"
+                    " misses its orbit under the closing link)",
+                )
+            )
+            return True
+        self.trace.append(
+            TraceStep(
+                f"chain-solve {solved.pattern}",
+                self._edge_text(self.edges[first_key], labels + closing.labels),
+                self.edges[first_key].value.dof,
+                0,
+                f"{len(solved.poses)} point(s)",
+            )
+        )
+        self.loops.append([[(first_key, path[0], p)] for p in solved.poses])
+        return True
+
     def run(self) -> None:
         """Rules 1-2 to a fixpoint, then cycles (rule 4) while they make progress."""
         self.settle()
@@ -471,45 +519,11 @@ def _progress(before: Any, after: Any) -> bool:
     return a is not None and (b is None or a < b)
 
 
-def _circle_circle(
-    c1: np.ndarray, n1: np.ndarray, r1: float, c2: np.ndarray, n2: np.ndarray, r2: float, tol
-) -> list[np.ndarray] | None:
-    """Common points of two circles in 3D (centre, unit normal, radius); None if they
-    coincide (a continuum). Coplanar circles meet in 0, 1 or 2 points."""
-    if np.linalg.norm(np.cross(n1, n2)) > tol.angle:
-        return None
-    if abs(np.dot(n1, c2 - c1)) > tol.length:
-        return []
-    d = c2 - c1
-    dist = float(np.linalg.norm(d))
-    if dist <= tol.length:
-        return None if abs(r1 - r2) <= tol.length else []
-    along = (dist**2 + r1**2 - r2**2) / (2 * dist)
-    h2 = r1**2 - along**2
-    if h2 < -2 * r1 * tol.length:
-        return []
-    u = d / dist
-    base = c1 + along * u
-    if h2 <= 2 * r1 * tol.length:
-        return [base]
-    side = np.cross(n1, u)
-    h = math.sqrt(h2)
-    return [base + h * side, base - h * side]
-
-
 def _axis(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
     """Axis point and unit direction of a revolute coset (world of its source)."""
     if _kind_name(value) != "revolute" or _components(value) != 1:
         return None
     return value.group.origin, value.group.axis
-
-
-def _rotation_about(point: np.ndarray, direction: np.ndarray, angle: float) -> np.ndarray:
-    return se3.translation(point) @ se3.rotation(direction, angle) @ se3.translation(-point)
-
-
-def _foot(point: np.ndarray, origin: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    return origin + np.dot(point - origin, direction) * direction
 
 
 def revolute_loop(
@@ -534,11 +548,13 @@ def revolute_loop(
     q_in_k = (q_in_k @ np.append(p2, 1.0))[:3]
     q0 = q_world[:3]
     q1 = (x_close @ np.append(q_in_k, 1.0))[:3]
-    c1, c3 = _foot(q0, p1, u1), _foot(q1, p3, u3)
+    c1, c3 = foot(q0, p1, u1), foot(q1, p3, u3)
     if np.dot(u1, u3) < 0:
         u3 = -u3
-    meets = _circle_circle(
-        c1, u1, float(np.linalg.norm(q0 - c1)), c3, u3, float(np.linalg.norm(q1 - c3)), tol
+    meets = circle_circle(
+        Circle(c1, u1, float(np.linalg.norm(q0 - c1))),
+        Circle(c3, u3, float(np.linalg.norm(q1 - c3))),
+        tol,
     )
     if meets is None:
         return None
@@ -546,8 +562,8 @@ def revolute_loop(
     for point in meets:
         a1 = signed_angle(q0 - c1, point - c1, u1)
         a3 = signed_angle(q1 - c3, point - c3, u3)
-        x_ij = _rotation_about(p1, u1, a1) @ x_first
-        x_ik = _rotation_about(p3, u3, a3) @ x_close
+        x_ij = rotation_about(p1, u1, a1) @ x_first
+        x_ik = rotation_about(p3, u3, a3) @ x_close
         if second.contains(se3.inverse(x_ij) @ x_ik):
             answers.append((x_ij, x_ik))
     return answers
@@ -693,7 +709,70 @@ def _solve_component(
             else:
                 out[node] = _Instance(poses.get(node, np.eye(4)), 0, "mechanism")
         return out, []
+    closed = _planar_point_on_plane(network, reducer, component, tol)
+    if closed is not None:
+        return closed
     return _numeric_component(network, reducer, component, poses, tol, candidates=sets)
+
+
+def _planar_point_on_plane(
+    network: Network, reducer: Reducer, component: set[Node], tol: Tolerance
+) -> tuple[dict[Node, _Instance], list[Conflict]] | None:
+    """A higher pair in closed form (ALGEBRA.md §3, §5.3): one instance on a planar coset
+    G(m)·x0 from the world with one of its points c on a world plane (p, n).
+
+    The orbit of c is the plane through x0·c normal to m. If n ∥ m the relation holds
+    everywhere on the coset or nowhere (a distance mismatch). Otherwise the poses are
+    T(d)·R(L)·x1 = a 2-dof subset of G(m) that is not a coset (§5.3: R(N,u)·T(v) is not a
+    group): x1 is x0 translated by the shortest step along n's part ⊥ m that puts c on the
+    plane (the pose nearest the reference), d = m × n⊥ the slide along the plane and L the
+    line through the placed point along m. None when the pattern does not apply."""
+    nodes = component - {WORLD}
+    edge = reducer.edges.get(frozenset((WORLD, *nodes)))
+    own = [c for c in network.constraints if all(reducer.find(n)[0] in component for n in c.nodes)]
+    if len(nodes) != 1 or edge is None or len(own) != 1 or len(reducer.edges) < 1:
+        return None
+    (node,) = nodes
+    geometry, value = own[0].geometry, edge.oriented(WORLD)
+    if geometry is None or value.group.kind != "planar" or _components(value) != 1:
+        return None
+    point_rep, point_x = reducer.find(geometry.point_node)
+    plane_rep, plane_x = reducer.find(geometry.plane_node)
+    if (point_rep, plane_rep) != (node, WORLD) or any(k <= component for k in reducer.deferred):
+        return None
+    corner = se3.apply(point_x, geometry.point)
+    origin = se3.apply(plane_x, geometry.origin)
+    normal = plane_x[:3, :3] @ geometry.normal
+    base = _EYE if value.contains(_EYE, tol) else np.asarray(value.rep, dtype=np.float64)
+    m = value.group.axis
+    offset = float(normal @ (se3.apply(base, corner) - origin))
+    across = normal - (normal @ m) * m
+    reach = float(np.linalg.norm(across))
+    out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
+    if reach <= tol.angle:
+        if abs(offset) > tol.length:
+            out[node] = _Instance(base, 0, "mechanism", 0)
+            return out, [Conflict(own[0].labels, "distance", abs(offset), _PARALLEL_MISS)]
+        motion, invariants = _motion(value)
+        out[node] = _Instance(base, value.dof, motion, 1, (), invariants)
+        return out, []
+    pose = se3.translation(-offset / reach**2 * across) @ base
+    slide = np.cross(m, across) / reach
+    invariants = {"normal": m, "direction": slide, "point": se3.apply(pose, corner)}
+    out[node] = _Instance(pose, value.dof - 1, "mechanism", 1, (), invariants)
+    reducer.trace.append(
+        TraceStep(
+            "chain-solve point-on-plane",
+            f"world -> {instance_key(node)} [{'; '.join(edge.labels + own[0].labels)}]",
+            value.dof,
+            value.dof - 1,
+            "slide along the plane and turn about its normal through the point",
+        )
+    )
+    return out, []
+
+
+_PARALLEL_MISS = "the point moves parallel to the plane at a distance from it"
 
 
 def _numeric_component(

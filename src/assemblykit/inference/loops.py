@@ -1,0 +1,215 @@
+"""Closed-form chain solvers for short loops (ALGEBRA.md §5.2 rule 4, §5.4).
+
+A loop i→j→k closing on i→k, whose first link is a revolute and whose second link fixes
+a point ``Q`` (a revolute or spherical joint), is solved by intersecting two orbits of
+``Q`` in i's frame (ALGEBRA.md §2.3 orbit table; Kramer's locus-intersection plan
+fragments, §5.4): the circle ``Q`` sweeps under the first revolute and the orbit of ``Q``
+under the closing coset (a point, circle, line, plane or sphere). Each common point fixes
+the first joint's angle; what remains of the loop is then a coset intersection (rule 1).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from assemblykit.algebra import Kind, Locus, se3
+from assemblykit.inference.numeric import signed_angle
+from assemblykit.tolerance import Tolerance
+
+
+@dataclass(frozen=True)
+class Circle:
+    """A circle in space: centre, unit normal and radius."""
+
+    center: np.ndarray
+    normal: np.ndarray
+    radius: float
+
+
+@dataclass(frozen=True)
+class LoopPoses:
+    """The answer of a point-orbit loop solver: the pattern solved (``"circle-sphere"``,
+    ``"circle-plane"``, ``"circle-line"``, ...) and the poses of the first link (0, 1, 2)."""
+
+    pattern: str
+    poses: tuple[np.ndarray, ...]
+
+
+def foot(point: np.ndarray, origin: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """The foot of ``point`` on the line through ``origin`` with unit ``direction``."""
+    return origin + np.dot(point - origin, direction) * direction
+
+
+def rotation_about(point: np.ndarray, direction: np.ndarray, angle: float) -> np.ndarray:
+    """The rotation by ``angle`` about the line through ``point`` with unit ``direction``."""
+    return se3.translation(point) @ se3.rotation(direction, angle) @ se3.translation(-point)
+
+
+def circle_circle(first: Circle, second: Circle, tol: Tolerance) -> list[np.ndarray] | None:
+    """Common points of two coplanar circles (0, 1 or 2); None if they coincide (a
+    continuum) or are not parallel (use :func:`circle_meets` with a circle locus)."""
+    c1, n1, r1 = first.center, first.normal, first.radius
+    c2, r2 = second.center, second.radius
+    if np.linalg.norm(np.cross(n1, second.normal)) > tol.angle:
+        return None
+    if abs(np.dot(n1, c2 - c1)) > tol.length:
+        return []
+    d = c2 - c1
+    dist = float(np.linalg.norm(d))
+    if dist <= tol.length:
+        return None if abs(r1 - r2) <= tol.length else []
+    along = (dist**2 + r1**2 - r2**2) / (2 * dist)
+    h2 = r1**2 - along**2
+    if h2 < -2 * r1 * tol.length:
+        return []
+    u = d / dist
+    base = c1 + along * u
+    if h2 <= 2 * r1 * tol.length:
+        return [base]
+    side = np.cross(n1, u)
+    h = math.sqrt(h2)
+    return [base + h * side, base - h * side]
+
+
+def _on_circle(circle: Circle, point: np.ndarray, tol: Tolerance) -> bool:
+    d = point - circle.center
+    along = float(np.dot(d, circle.normal))
+    radial = float(np.linalg.norm(d - along * circle.normal))
+    return abs(along) <= tol.length and abs(radial - circle.radius) <= tol.length
+
+
+def circle_plane(
+    circle: Circle, point: np.ndarray, normal: np.ndarray, tol: Tolerance
+) -> list[np.ndarray] | None:
+    """Points of a circle on the plane through ``point`` with unit ``normal``: 0, 1 or 2,
+    None when the circle lies in the plane. With ``e1`` the in-plane direction of the
+    normal (|m⊥| = s), a circle point ``c + r(cos φ e1 + sin φ e2)`` is on the plane iff
+    ``cos φ = −m·(c − p) / (r s)``."""
+    c, n, r = circle.center, circle.normal, circle.radius
+    offset = float(np.dot(normal, c - point))
+    tangential = normal - np.dot(normal, n) * n
+    s = float(np.linalg.norm(tangential))
+    if s <= tol.angle:
+        return None if abs(offset) <= tol.length else []
+    e1 = tangential / s
+    e2 = np.cross(n, e1)
+    # the plane's distance from the circle's nearest and farthest points, in lengths
+    reach = r * s
+    if abs(offset) > reach + tol.length:
+        return []
+    cos_phi = max(-1.0, min(1.0, -offset / reach))
+    base = c + r * cos_phi * e1
+    half = r * math.sqrt(max(0.0, 1.0 - cos_phi**2))
+    if half <= tol.length:
+        return [base]
+    return [base + half * e2, base - half * e2]
+
+
+def circle_line(
+    circle: Circle, point: np.ndarray, direction: np.ndarray, tol: Tolerance
+) -> list[np.ndarray] | None:
+    """Points of a circle on the line through ``point`` with unit ``direction``: 0, 1
+    or 2. A line across the circle's plane meets it once at most; a line in the plane
+    meets it where its foot from the centre is within the radius."""
+    c, n, r = circle.center, circle.normal, circle.radius
+    slope = float(np.dot(direction, n))
+    if abs(slope) > tol.angle:
+        hit = point + (float(np.dot(n, c - point)) / slope) * direction
+        return [hit] if _on_circle(circle, hit, tol) else []
+    if abs(float(np.dot(n, point - c))) > tol.length:
+        return []
+    base = foot(c, point, direction)
+    h2 = r**2 - float(np.dot(base - c, base - c))
+    if h2 < -2 * r * tol.length:
+        return []
+    if h2 <= 2 * r * tol.length:
+        return [base]
+    h = math.sqrt(h2)
+    return [base + h * direction, base - h * direction]
+
+
+def circle_sphere(
+    circle: Circle, center: np.ndarray, radius: float, tol: Tolerance
+) -> list[np.ndarray] | None:
+    """Points of a circle on a sphere: the sphere cuts the circle's plane in a circle
+    (radius² = R² − h², h the centre's height over the plane), then circle-circle."""
+    height = float(np.dot(circle.normal, center - circle.center))
+    r2 = radius**2 - height**2
+    if r2 < -2 * radius * tol.length:
+        return []
+    cut = Circle(center - height * circle.normal, circle.normal, math.sqrt(max(0.0, r2)))
+    return circle_circle(circle, cut, tol)
+
+
+def circle_meets(circle: Circle, locus: Locus, tol: Tolerance) -> list[np.ndarray] | None:
+    """Common points of a circle and an orbit (ALGEBRA.md §2.3): a point, circle, line,
+    plane or sphere. None for a continuum or a locus without a closed form here."""
+    if locus.kind == "point":
+        assert locus.point is not None
+        return [locus.point] if _on_circle(circle, locus.point, tol) else []
+    if locus.kind == "sphere":
+        assert locus.point is not None
+        return circle_sphere(circle, locus.point, locus.radius, tol)
+    if locus.kind == "line":
+        assert locus.point is not None and locus.direction is not None
+        return circle_line(circle, locus.point, locus.direction, tol)
+    if locus.kind == "plane":
+        assert locus.point is not None and locus.direction is not None
+        return circle_plane(circle, locus.point, locus.direction, tol)
+    if locus.kind == "circle":
+        assert locus.point is not None and locus.direction is not None
+        other = Circle(locus.point, locus.direction, locus.radius)
+        met = circle_plane(circle, locus.point, locus.direction, tol)
+        if met is None:
+            return circle_circle(circle, other, tol)
+        return [p for p in met if _on_circle(other, p, tol)]
+    return None
+
+
+def _single(value: Any, kinds: tuple[Kind, ...]) -> bool:
+    """Whether a coset is connected (one component) with a group of one of ``kinds``."""
+    return value.group.kind in kinds and value.n_components == 1
+
+
+def point_loop(first: Any, second: Any, closing: Any, tol: Tolerance) -> LoopPoses | None:
+    """Closed-form R·(R or S) ∩ coset (ALGEBRA.md §5.2 rule 4): circle against the
+    closing orbit.
+
+    ``first`` (i→j) is a revolute coset, ``second`` (j→k) fixes a point ``Q`` of j (on
+    its axis or its centre), ``closing`` (i→k) any coset. In i's frame ``Q`` sweeps a
+    circle under ``first`` and the orbit of ``Q``'s point of k under ``closing``; each
+    common point fixes ``X_ij``. Both axis points of a revolute second link are tried
+    (a point whose circle lies inside the orbit says nothing). Returns the poses
+    ``X_ij`` (possibly none: the loop cannot close), or None when the pattern does not
+    apply (other kinds, a point on the first axis, a continuum, an orbit without a
+    closed form)."""
+    if not _single(first, (Kind.REVOLUTE,)):
+        return None
+    if not _single(second, (Kind.REVOLUTE, Kind.SPHERICAL)) or closing.group.lattice:
+        return None
+    p1, u1 = first.group.origin, first.group.axis
+    origin = second.group.origin
+    points = [origin]
+    if second.group.kind is Kind.REVOLUTE:
+        points.append(origin + second.group.axis * tol.scale)
+    for q_j in points:
+        q0 = se3.apply(first.rep, q_j)
+        center = foot(q0, p1, u1)
+        radius = float(np.linalg.norm(q0 - center))
+        if radius <= tol.length:
+            continue
+        q_k = se3.apply(se3.inverse(second.rep), q_j)
+        locus = closing.group.orbit(se3.apply(closing.rep, q_k), tol)
+        meets = circle_meets(Circle(center, u1, radius), locus, tol)
+        if meets is None:
+            continue
+        poses = tuple(
+            rotation_about(p1, u1, signed_angle(q0 - center, p - center, u1)) @ first.rep
+            for p in meets
+        )
+        return LoopPoses(f"circle-{locus.kind}", poses)
+    return None
