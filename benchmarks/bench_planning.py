@@ -1,0 +1,81 @@
+"""Planning times: the bundled gearbox, the shared ASAP beam, arch and crossvault, and
+synthetic stacks of growing size.
+
+Run ``python benchmarks/bench_planning.py``. Each figure is the median wall time of
+``REPEATS`` runs on a freshly loaded assembly (contacts and blocking graphs included);
+the beam and the crossvault (184 blocks) run once. Shared assemblies are skipped when
+``../shared/data`` is absent.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import trimesh
+
+from assemblykit.io.assembly import load_assembly
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning.sequence import Plan, plan
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT.parent / "shared" / "data"
+REPEATS = 3
+STACK_SIZES = (5, 10, 20, 40, 80)
+
+
+def stack(n: int) -> Assembly:
+    """``n`` unit cubes stacked along z, each resting on the one below."""
+    parts = []
+    for level in range(n):
+        cube = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+        cube.apply_translation((0.0, 0.0, level + 0.5))
+        parts.append(Part(f"block_{level}", cube))
+    return Assembly(parts)
+
+
+def timed(make: Callable[[], Assembly], repeats: int) -> tuple[float, Plan]:
+    """Median seconds of ``plan(make())`` over ``repeats`` runs, and the last plan."""
+    seconds, result = [], None
+    for _ in range(repeats):
+        assembly = make()
+        start = time.perf_counter()
+        result = plan(assembly)
+        seconds.append(time.perf_counter() - start)
+    assert result is not None
+    return statistics.median(seconds), result
+
+
+def row(name: str, parts: int, seconds: float, result: Plan) -> None:
+    verdict = "feasible" if result.feasible else "infeasible"
+    print(
+        f"{name:<28} {parts:>5} parts {seconds:>8.3f} s  {len(result.steps):>4} steps  "
+        f"{result.directions:>6} directions  {verdict}  {parts / seconds:>8.1f} parts/s"
+    )
+
+
+def main() -> None:
+    print("planning (median wall time; loading excluded, contacts and blocking included)")
+    demo = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
+    cases = [("gearbox demo", demo, REPEATS)]
+    cases += [
+        ("asap beam", DATA / "asap_beam_assembly", 1),
+        ("compas stack", DATA / "compas_assembly" / "stack_assembly.json", REPEATS),
+        ("compas arch", DATA / "compas_assembly" / "arch_assembly.json", REPEATS),
+        ("compas crossvault", DATA / "compas_assembly" / "crossvault_assembly.json", 1),
+    ]
+    for name, path, repeats in cases:
+        if not path.exists():
+            print(f"{name:<28} skipped ({path} is absent)")
+            continue
+        seconds, result = timed(lambda p=path: load_assembly(p), repeats)
+        row(name, len(result.parts), seconds, result)
+    for n in STACK_SIZES:
+        seconds, result = timed(lambda n=n: stack(n), REPEATS)
+        row(f"synthetic stack of {n}", n, seconds, result)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,237 @@
+"""Many assemblies in parallel: ``assemblykit batch`` (DESIGN.md §5.3).
+
+Every assembly runs in its own child process (``python -m assemblykit.batch INPUT``), so
+a per-assembly timeout really stops the work and a crash is recorded instead of ending
+the batch. The children are driven either locally (a pool of ``workers`` threads, each
+waiting on one child at a time) or by Dask (``dask.distributed``; a local cluster when no
+scheduler address is given), whose tasks start the same child. Both engines therefore
+give the same answers.
+
+The output is JSON Lines, one line per assembly, appended as soon as it is known:
+``input``, ``status`` (``ok``, ``error`` or ``timeout``), ``result`` (the command's JSON)
+or ``error`` (one line), and ``seconds``. A rerun reads the file first and skips the
+inputs already finished (``ok`` or ``error``); timed-out inputs are tried again.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from collections import Counter
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal, cast
+
+from rich.table import Table
+
+from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
+
+Engine = Literal["local", "dask"]
+Command = Literal["plan", "motion"]
+Status = Literal["ok", "error", "timeout"]
+FINISHED: frozenset[str] = frozenset({"ok", "error"})
+
+
+@dataclass(frozen=True)
+class Job:
+    """One assembly to process: its path, the command, and the relative tolerance."""
+
+    input: str
+    command: Command
+    timeout: float | None = None
+    rel_tolerance: float | None = None
+
+
+@dataclass(frozen=True)
+class BatchSummary:
+    """What a batch run did: the output file, how many inputs it skipped and the count
+    of each status among the inputs it ran."""
+
+    out: str
+    total: int
+    skipped: int
+    statuses: dict[str, int]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``out``, ``total``, ``skipped``, ``ran`` and the status counts."""
+        return {
+            "out": self.out,
+            "total": self.total,
+            "skipped": self.skipped,
+            "ran": sum(self.statuses.values()),
+            **{status: self.statuses.get(status, 0) for status in ("ok", "error", "timeout")},
+        }
+
+    def render(self) -> Table:
+        """A one-row rich table of the counts."""
+        data = self.to_dict()
+        table = Table(title=f"batch -> {self.out}")
+        for key in ("total", "skipped", "ok", "error", "timeout"):
+            table.add_column(key)
+        table.add_row(*(str(data[key]) for key in ("total", "skipped", "ok", "error", "timeout")))
+        return table
+
+
+def compute(command: Command, path: str, rel_tolerance: float | None = None) -> dict[str, Any]:
+    """The JSON result of ``command`` (``plan`` or ``motion``) on the assembly at ``path``."""
+    from assemblykit.io.assembly import load_assembly
+    from assemblykit.io.report import jsonable
+    from assemblykit.tolerance import Tolerance
+
+    tol = None if rel_tolerance is None else Tolerance(rel_length=rel_tolerance)
+    assembly = load_assembly(path, tol=tol)
+    if command == "plan":
+        from assemblykit.planning.sequence import plan
+
+        result = plan(assembly, tol=tol)
+    else:
+        from assemblykit.motion.freedom import motion
+
+        result = motion(assembly)
+    return cast(dict[str, Any], jsonable(result.to_dict(), assembly.tolerance(tol)))
+
+
+def run_job(job: Job) -> dict[str, Any]:
+    """Run one job in a child process and return its JSON line (as a dict).
+
+    The child prints ``{"status": ..., "result"|"error": ...}``; a child that exceeds
+    ``job.timeout`` seconds is killed (status ``timeout``); one that dies without an
+    answer is an ``error`` carrying the last line of its stderr.
+    """
+    command = [sys.executable, "-m", "assemblykit.batch", job.command, job.input]
+    if job.rel_tolerance is not None:
+        command.append(repr(job.rel_tolerance))
+    start = time.perf_counter()
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=job.timeout)
+    except subprocess.TimeoutExpired:
+        return _line(job, {"status": "timeout", "error": f"over {job.timeout} s"}, start)
+    lines = done.stdout.strip().splitlines()
+    if done.returncode == 0 and lines:
+        return _line(job, json.loads(lines[-1]), start)
+    reason = (done.stderr.strip().splitlines() or [f"exit code {done.returncode}"])[-1]
+    return _line(job, {"status": "error", "error": f"worker died: {reason}"}, start)
+
+
+def _line(job: Job, outcome: dict[str, Any], start: float) -> dict[str, Any]:
+    return {"input": job.input, **outcome, "seconds": round(time.perf_counter() - start, 3)}
+
+
+def finished_inputs(out: Path) -> set[str]:
+    """Inputs already finished (``ok`` or ``error``) in an existing JSON Lines file, as
+    resolved paths; a truncated last line (an interrupted run) is ignored."""
+    if not out.exists():
+        return set()
+    done = set()
+    lines = out.read_text(encoding="utf-8").splitlines()
+    for number, text in enumerate(lines, start=1):
+        if not text.strip():
+            continue
+        try:
+            record = json.loads(text)
+        except json.JSONDecodeError:
+            if number == len(lines):
+                continue
+            raise InputError("not a JSON line", source=str(out), where=f"line {number}") from None
+        if record.get("status") in FINISHED:
+            done.add(_key(record["input"]))
+    return done
+
+
+def _key(path: str) -> str:
+    return str(Path(path).resolve())
+
+
+def _local(jobs: Sequence[Job], workers: int) -> Iterator[dict[str, Any]]:
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        futures = [pool.submit(run_job, job) for job in jobs]
+        for future in as_completed(futures):
+            yield future.result()
+
+
+def _dask(jobs: Sequence[Job], workers: int, scheduler: str | None) -> Iterator[dict[str, Any]]:
+    try:
+        from dask.distributed import Client, LocalCluster
+        from dask.distributed import as_completed as dask_completed
+    except ImportError:
+        raise MissingExtraError("dask[distributed]", "dist", "batch --engine dask") from None
+    if scheduler is None:
+        # the work happens in child processes, so thread workers are enough here
+        cluster = LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=False, dashboard_address=None
+        )
+        client = Client(cluster)
+    else:
+        cluster = None
+        client = Client(scheduler)
+    try:
+        futures = [client.submit(run_job, job, pure=False) for job in jobs]
+        for future in dask_completed(futures):
+            yield future.result()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def run_batch(
+    inputs: Iterable[str | Path],
+    out: str | Path,
+    *,
+    engine: Engine = "local",
+    command: Command = "plan",
+    timeout: float | None = None,
+    workers: int = 2,
+    scheduler: str | None = None,
+    rel_tolerance: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> BatchSummary:
+    """Run ``command`` over ``inputs`` and append one JSON line per assembly to ``out``.
+
+    Inputs already finished in ``out`` are skipped; ``progress(done, total)`` is called
+    after each assembly.
+    """
+    if engine not in ("local", "dask"):
+        raise InputError(f"unknown engine {engine!r} (use local or dask)", where="--engine")
+    if workers < 1:
+        raise InputError(f"workers must be at least 1, got {workers}", where="--workers")
+    target = Path(out)
+    names = [str(path) for path in inputs]
+    done = finished_inputs(target)
+    todo = [Job(name, command, timeout, rel_tolerance) for name in names if _key(name) not in done]
+    target.parent.mkdir(parents=True, exist_ok=True)
+    lines = _local(todo, workers) if engine == "local" else _dask(todo, workers, scheduler)
+    statuses: Counter[str] = Counter()
+    with target.open("a", encoding="utf-8") as sink:
+        for record in lines:
+            sink.write(json.dumps(record) + "\n")
+            sink.flush()
+            statuses[record["status"]] += 1
+            if progress is not None:
+                progress(sum(statuses.values()), len(todo))
+    return BatchSummary(str(target), len(names), len(names) - len(todo), dict(statuses))
+
+
+def _child(argv: Sequence[str]) -> int:
+    """The child process: print one JSON object with ``status`` and ``result``/``error``."""
+    command, path, *rest = argv
+    rel_tolerance = float(rest[0]) if rest else None
+    try:
+        outcome: dict[str, Any] = {
+            "status": "ok",
+            "result": compute(command, path, rel_tolerance),  # type: ignore[arg-type]
+        }
+    except AssemblyKitError as failure:
+        outcome = {"status": "error", "error": str(failure)}
+    except Exception as bug:  # recorded, never fatal to the batch
+        outcome = {"status": "error", "error": f"{type(bug).__name__}: {bug}"}
+    sys.stdout.write(json.dumps(outcome) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(_child(sys.argv[1:]))

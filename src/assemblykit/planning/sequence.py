@@ -1,0 +1,654 @@
+"""Assembly planning by disassembly on non-directional blocking graphs (seed 004).
+
+The planner answers the questions seed 004 lists for an NDBG: which subassemblies can
+be removed, in what order, and which parts are interlocked. It uses three NDBGs:
+
+* Γ_t (infinitesimal translations) is *necessary*: a set that is not locally free
+  along ``d`` cannot be removed along ``d``. Γ_t is cheap (it only needs the contacts),
+  so its regular regions supply the candidate directions (one per region, the vertices
+  and edges included: free directions are often isolated, e.g. a pin's axis) and, per
+  direction, how many parts it lets leave one by one: a bound that orders the
+  candidates and stops the search early.
+* Γ_e (extended translations) is *sufficient*: a set with no arc leaving it in the DBG
+  of Γ_e along ``d`` is taken out by one straight translation ("Extended
+  translations"). Only such removals are accepted as steps. Its DBG along a candidate
+  direction is computed from swept volumes (:mod:`assemblykit.planning.sweep`, exact
+  for parts with holes and slots) pair by pair, only when needed, and kept.
+* Γ_g (infinitesimal rigid motions), also *necessary*, tells for a set left interlocked
+  whether a motion with rotation might still free it.
+
+Blocking is pairwise (whether P_j blocks P_i along d does not depend on the other
+parts), so the DBG of a subassembly is the induced subgraph of the assembly's DBG, and
+one DBG per direction serves every node of the search.
+
+The chosen plan removes, at each step, every minimal free set (sink strong component,
+"Directional Blocking Graph") of one direction at once: parts that can go in parallel
+share a step. The previous step's direction is kept while it frees anything (fewer
+direction changes, shallower trees); otherwise the direction freeing the most parts
+wins, then directions along a coordinate axis, then lifting (+z). Removing parts never
+makes the rest harder to take apart (a partition of a set restricts to a partition of
+any subset), so the greedy search only stops on a set that no candidate direction
+separates. For assemblies of at most ``max_and_or_parts`` parts the AND/OR graph of
+every two-handed partition accepted by Γ_e is built too, and its plans are counted.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from functools import cache
+from typing import TYPE_CHECKING, Any, Literal
+
+import networkx as nx
+import numpy as np
+import trimesh
+from numpy.typing import ArrayLike, NDArray
+from rich.table import Table
+
+from assemblykit.geometry.interference import interferes
+from assemblykit.planning.sweep import swept_volume
+from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
+
+Progress = Callable[[str, int, int], None]
+MotionKind = Literal["translation", "rigid"]
+
+
+@dataclass(frozen=True, eq=False)
+class DirectionTable:
+    """DBGs of one NDBG along a list of directions, over a fixed list of parts.
+
+    ``directions[k]`` is the k-th direction (a region's representative). The
+    possible arcs are *slots*, sorted by moving part: slot ``s`` is the arc
+    ``moving[s] → blocker[s]`` ("``blocker[s]`` blocks ``moving[s]``"), present along
+    direction ``k`` when ``slots[k, s]``. Sets of parts are bit masks over ``names``.
+    """
+
+    names: tuple[str, ...]
+    directions: NDArray[np.float64]
+    slots: NDArray[np.bool_]
+    moving: NDArray[np.int64]
+    blocker: NDArray[np.int64]
+
+    @classmethod
+    def from_arcs(
+        cls,
+        names: Sequence[str],
+        directions: ArrayLike,
+        arcs: Sequence[Iterable[tuple[int, int]]],
+    ) -> DirectionTable:
+        """A table from the arcs ``(i, j)`` ("j blocks i") of each direction."""
+        pairs = sorted({arc for per_direction in arcs for arc in per_direction})
+        column = {pair: s for s, pair in enumerate(pairs)}
+        slots = np.zeros((len(arcs), len(pairs)), dtype=bool)
+        for k, per_direction in enumerate(arcs):
+            slots[k, [column[arc] for arc in per_direction]] = True
+        ends = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+        return cls(tuple(names), np.asarray(directions, dtype=np.float64), slots, *ends.T)
+
+    def vector(self, members: int) -> NDArray[np.bool_]:
+        """The set ``members`` as a boolean vector over ``names``."""
+        return np.array([bool(members >> i & 1) for i in range(len(self.names))], dtype=bool)
+
+    def _active(self, members: int) -> NDArray[np.int64]:
+        inside = self.vector(members)
+        return np.flatnonzero(inside[self.moving] & inside[self.blocker])
+
+    def free_parts(self, members: int) -> NDArray[np.bool_]:
+        """``free[k, i]``: part i of ``members`` has no blocker in ``members`` along k."""
+        inside = self.vector(members)
+        blocked = np.zeros((len(self.directions), len(self.names)), dtype=bool)
+        columns = self._active(members)
+        if len(columns):
+            movers = self.moving[columns]
+            starts = np.flatnonzero(np.r_[True, movers[1:] != movers[:-1]])
+            blocked[:, movers[starts]] = np.logical_or.reduceat(
+                self.slots[:, columns], starts, axis=1
+            )
+        return ~blocked & inside
+
+    def graph(self, k: int, members: int) -> nx.DiGraph:
+        """The DBG of direction ``k`` induced on ``members``: arc i→j when j blocks i."""
+        columns = self._active(members)
+        columns = columns[self.slots[k, columns]]
+        graph = nx.DiGraph()
+        graph.add_nodes_from(_bits(members))
+        graph.add_edges_from(
+            zip(self.moving[columns].tolist(), self.blocker[columns].tolist(), strict=True)
+        )
+        return graph
+
+    def masks(self, k: int) -> tuple[int, ...]:
+        """Per part, the bit mask of its blockers along direction ``k``."""
+        masks = [0] * len(self.names)
+        for s in np.flatnonzero(self.slots[k]):
+            masks[self.moving[s]] |= 1 << int(self.blocker[s])
+        return tuple(masks)
+
+
+class ExtendedDirections:
+    """The DBGs of Γ_e along fixed candidate directions, evaluated pair by pair on first
+    use with the swept volumes of :mod:`assemblykit.planning.sweep`."""
+
+    def __init__(self, assembly: Assembly, directions: NDArray[np.float64], tol: Tolerance) -> None:
+        self.assembly = assembly
+        self.names = tuple(assembly.names)
+        self.directions = directions
+        self.tol = tol
+        self._sweeps: dict[tuple[int, int], trimesh.Trimesh] = {}
+        self._pairs: dict[tuple[int, int, int], bool] = {}
+
+    def _sweep(self, i: int, k: int) -> trimesh.Trimesh:
+        key = (i, k)
+        if key not in self._sweeps:
+            mesh = self.assembly.parts[self.names[i]].mesh
+            self._sweeps[key] = swept_volume(
+                mesh, self.directions[k], self.assembly.scale, self.tol
+            )
+        return self._sweeps[key]
+
+    def _blocks(self, i: int, j: int, k: int) -> bool:
+        key = (i, j, k)
+        if key not in self._pairs:
+            blocker = self.assembly.parts[self.names[j]].mesh
+            self._pairs[key] = interferes(self._sweep(i, k), blocker, self.tol)
+        return self._pairs[key]
+
+    def graph(self, k: int, members: int) -> nx.DiGraph:
+        """The Γ_e DBG along direction ``k`` induced on ``members`` (pairs are tested
+        once and remembered: blocking is pairwise)."""
+        inside = list(_bits(members))
+        graph = nx.DiGraph()
+        graph.add_nodes_from(inside)
+        graph.add_edges_from(
+            (i, j) for i in inside for j in inside if i != j and self._blocks(i, j, k)
+        )
+        return graph
+
+    @property
+    def evaluated(self) -> set[int]:
+        """The directions along which some sweep has been computed."""
+        return {k for _, k in self._sweeps}
+
+    def table(self, indices: Iterable[int]) -> DirectionTable:
+        """The DBGs over all parts along the directions ``indices``, as a table."""
+        chosen = sorted(set(indices))
+        everything = _mask(range(len(self.names)))
+        arcs = [list(self.graph(k, everything).edges) for k in chosen]
+        return DirectionTable.from_arcs(self.names, self.directions[chosen], arcs)
+
+
+@dataclass(frozen=True, eq=False)
+class Step:
+    """One disassembly step: ``parts`` translate along unit ``direction`` away from
+    ``rest`` (the other parts of the subassembly they leave). ``blocking`` lists the
+    arcs (i, j), "j blocks i", of the DBG along ``direction`` within that subassembly."""
+
+    parts: tuple[str, ...]
+    direction: NDArray[np.float64]
+    rest: tuple[str, ...]
+    blocking: tuple[tuple[str, str], ...]
+    motion: MotionKind = "translation"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form (DESIGN.md §5.3): ``parts``, ``direction``, ``motion`` and ``rest``."""
+        return {
+            "parts": list(self.parts),
+            "direction": [float(x) + 0.0 for x in self.direction],
+            "motion": self.motion,
+            "rest": list(self.rest),
+            "blocking": [list(arc) for arc in self.blocking],
+        }
+
+
+@dataclass(frozen=True)
+class Interlock:
+    """A minimal interlocked set: no extended translation separates any part of it.
+
+    ``translation_locked`` is true when even infinitesimal translations cannot start
+    (its DBGs are strongly connected over all of Γ_t); ``rigid_may_free`` when some DBG
+    of Γ_g is not strongly connected, i.e. a motion with rotation is not excluded.
+    """
+
+    parts: tuple[str, ...]
+    translation_locked: bool
+    rigid_may_free: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form."""
+        return {
+            "parts": list(self.parts),
+            "translation_locked": self.translation_locked,
+            "rigid_may_free": self.rigid_may_free,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class AndOrGraph:
+    """The AND/OR graph of all feasible two-handed partitions (seed 004, "order").
+
+    OR nodes are subassemblies (frozensets of names); an AND node
+    ``("split", left, right)`` has arcs to its two halves and an arc from the
+    subassembly it splits. ``plans`` counts distinct disassembly trees of the whole.
+    """
+
+    graph: nx.DiGraph
+    plans: int
+
+    @property
+    def subassemblies(self) -> int:
+        """Number of OR nodes."""
+        return sum(1 for _, kind in self.graph.nodes(data="kind") if kind == "or")
+
+    @property
+    def partitions(self) -> int:
+        """Number of AND nodes (feasible partitions)."""
+        return sum(1 for _, kind in self.graph.nodes(data="kind") if kind == "and")
+
+    def to_dict(self) -> dict[str, int]:
+        """Counts: subassemblies, partitions, plans."""
+        return {
+            "subassemblies": self.subassemblies,
+            "partitions": self.partitions,
+            "plans": self.plans,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """A disassembly plan; reversed, it is the assembly plan (``order``). ``directions``
+    is the number of candidate directions (regions of Γ_t) the search could use."""
+
+    parts: tuple[str, ...]
+    steps: tuple[Step, ...]
+    interlocked: tuple[Interlock, ...]
+    and_or: AndOrGraph | None
+    directions: int
+
+    @property
+    def feasible(self) -> bool:
+        """True when every part is separated by the steps."""
+        return not self.interlocked
+
+    @property
+    def stuck(self) -> tuple[str, ...]:
+        """All interlocked parts (empty when feasible)."""
+        return tuple(sorted({name for lock in self.interlocked for name in lock.parts}))
+
+    @property
+    def order(self) -> tuple[tuple[str, ...], ...]:
+        """Assembly order: the moved sets of the steps, last removed first inserted."""
+        return tuple(step.parts for step in reversed(self.steps))
+
+    def exploded(self, distance: float) -> tuple[dict[str, NDArray[np.float64]], ...]:
+        """Offsets of an exploded view, one mapping per frame (frame 0 is the assembly,
+        frame k follows step k): a part moved at step s sits ``(k - s + 1) x distance``
+        along that step's direction, so parts removed earlier stay further out."""
+        frames = []
+        for k in range(len(self.steps) + 1):
+            offsets = {name: np.zeros(3) for name in self.parts}
+            for s, step in enumerate(self.steps[:k], start=1):
+                for name in step.parts:
+                    offsets[name] = offsets[name] + (k - s + 1) * distance * step.direction
+            frames.append(offsets)
+        return tuple(frames)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form (DESIGN.md §5.3): ``feasible``, ``steps``, ``stuck``, plus
+        ``interlocked``, ``order``, ``parts``, ``directions`` and ``and_or``."""
+        return {
+            "feasible": self.feasible,
+            "steps": [step.to_dict() for step in self.steps],
+            "stuck": list(self.stuck),
+            "interlocked": [lock.to_dict() for lock in self.interlocked],
+            "order": [list(parts) for parts in self.order],
+            "parts": list(self.parts),
+            "directions": self.directions,
+            "and_or": None if self.and_or is None else self.and_or.to_dict(),
+        }
+
+    def render(self) -> Table:
+        """A rich table of the steps (and the interlocked sets when infeasible)."""
+        title = "feasible" if self.feasible else "infeasible"
+        if self.and_or is not None:
+            title += f", {self.and_or.plans} plan(s) in the AND/OR graph"
+        table = Table(title=f"Disassembly plan ({title})")
+        for column in ("step", "move", "direction", "motion", "away from"):
+            table.add_column(column)
+        for number, step in enumerate(self.steps, start=1):
+            table.add_row(
+                str(number),
+                ", ".join(step.parts),
+                format_direction(step.direction),
+                step.motion,
+                _abbreviate(step.rest),
+            )
+        for lock in self.interlocked:
+            freed = "rigid motion may free" if lock.rigid_may_free else "locked"
+            table.add_row("-", ", ".join(lock.parts), "-", f"interlocked ({freed})", "-")
+        return table
+
+
+def format_direction(direction: Sequence[float]) -> str:
+    """A direction as ``(x, y, z)`` with 3 decimals (``-0.000`` printed as ``0.000``)."""
+    return "(" + ", ".join(f"{float(x) + 0.0:.3f}" for x in np.round(direction, 3)) + ")"
+
+
+def _abbreviate(names: Sequence[str], limit: int = 4) -> str:
+    shown = ", ".join(names[:limit])
+    return shown if len(names) <= limit else f"{shown}, ... ({len(names)} parts)"
+
+
+def _bits(mask: int) -> Iterable[int]:
+    index = 0
+    while mask:
+        if mask & 1:
+            yield index
+        mask >>= 1
+        index += 1
+
+
+def _mask(indices: Iterable[int]) -> int:
+    total = 0
+    for i in indices:
+        total |= 1 << i
+    return total
+
+
+def _union(masks: Iterable[int]) -> int:
+    total = 0
+    for mask in masks:
+        total |= mask
+    return total
+
+
+def _count(mask: int) -> int:
+    return bin(mask).count("1")
+
+
+def _several(mask: int) -> bool:
+    return (mask & (mask - 1)) != 0
+
+
+def direction_table(ndbg: Any) -> DirectionTable:
+    """The DBG of every region of ``ndbg`` (Γ_t or Γ_e of :mod:`assemblykit.blocking.ndbg`)
+    with the region's representative direction.
+
+    Every region counts, vertices and edges included (free directions of extended
+    translations are often isolated, e.g. a pin's axis), and regions with the same DBG
+    are kept apart: Γ_e may free a set along one of them and not another. The NDBG's
+    bit-packed slots are read as they are; expanding every region into a graph would
+    cost more than planning on large assemblies.
+    """
+    count = len(ndbg.table.starts)
+    slots = np.unpackbits(ndbg.packed, axis=1, count=count).astype(bool)
+    return DirectionTable(
+        tuple(ndbg.parts),
+        np.asarray(ndbg.arrangement.directions, dtype=np.float64),
+        slots.reshape(len(slots), count),
+        np.asarray(ndbg.table.slot_moving, dtype=np.int64),
+        np.asarray(ndbg.table.slot_blocker, dtype=np.int64),
+    )
+
+
+def distinct_directions(table: DirectionTable) -> list[int]:
+    """One direction per distinct DBG of ``table``: the one closest to a coordinate axis."""
+    _, inverse = np.unique(table.slots, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    order = np.lexsort((-np.abs(table.directions).max(axis=1), inverse))
+    return sorted(order[np.r_[True, inverse[order][1:] != inverse[order][:-1]]].tolist())
+
+
+def separable(table: DirectionTable, members: int) -> bool:
+    """True when some direction of ``table`` frees a proper, non-empty part of ``members``
+    (a DBG that is not strongly connected, seed 004)."""
+    if not _several(members):
+        return False
+    if table.free_parts(members).any():
+        return True
+    return not all(
+        nx.is_strongly_connected(table.graph(k, members)) for k in range(len(table.directions))
+    )
+
+
+def _sinks(source: DirectionTable | ExtendedDirections, k: int, members: int) -> list[int]:
+    """The minimal free sets of ``members`` along direction ``k``: the sink strong
+    components of its DBG, as bit masks (seed 004, "Directional Blocking Graph")."""
+    condensed = nx.condensation(source.graph(k, members))
+    return [
+        _mask(condensed.nodes[c]["members"])
+        for c in condensed.nodes
+        if condensed.out_degree(c) == 0
+    ]
+
+
+def _base(members: int, volumes: Sequence[float]) -> int:
+    """The heaviest part of ``members``: it stays, everything else leaves it."""
+    return max(_bits(members), key=lambda i: (volumes[i], -i))
+
+
+def _removal(sinks: list[int], members: int, volumes: Sequence[float]) -> list[int]:
+    """The free sets to move: all but the one holding the base (:func:`_base`). Keeping
+    the base still is no loss: the other side of a partition along ``d`` is free along
+    ``-d``, which is also a candidate (the arrangement is symmetric)."""
+    base = 1 << _base(members, volumes)
+    return [s for s in sinks if not s & base]
+
+
+def _bounds(translations: DirectionTable, members: int, volumes: Sequence[float]) -> dict[int, int]:
+    """Per candidate direction, how many parts Γ_t lets leave ``members`` on their own
+    (a bound for Γ_e on single parts). They are counted for all directions at once;
+    only when no direction frees a single part are the DBGs condensed, so that groups
+    that must leave together count too."""
+    free = translations.free_parts(members)
+    free[:, _base(members, volumes)] = False
+    counts = free.sum(axis=1)
+    if counts.max(initial=0) > 0:
+        return {int(k): int(counts[k]) for k in np.flatnonzero(counts)}
+    bounds = {
+        k: _count(_union(_removal(_sinks(translations, k, members), members, volumes)))
+        for k in range(len(translations.directions))
+    }
+    return {k: v for k, v in bounds.items() if v}
+
+
+def _choose_removal(
+    translations: DirectionTable,
+    extended: DirectionTable | ExtendedDirections,
+    members: int,
+    volumes: Sequence[float],
+    previous: int | None,
+) -> tuple[int, list[int]] | None:
+    """The direction index and the free sets of Γ_e it removes from ``members``.
+
+    The previous step's direction is tried first and kept if it frees anything. Other
+    candidates are visited best Γ_t bound first (most parts, closest to a coordinate
+    axis, then +z); the search stops as soon as a bound cannot beat the best removal
+    that Γ_e accepted.
+    """
+    if previous is not None:
+        sinks = _removal(_sinks(extended, previous, members), members, volumes)
+        if sinks:
+            return previous, sinks
+
+    def rank(k: int, moved: int) -> tuple[float, ...]:
+        direction = translations.directions[k]
+        return (moved, float(np.abs(direction).max()), float(direction[2]), -k)
+
+    bounds = _bounds(translations, members, volumes)
+    best: tuple[tuple[float, ...], int, list[int]] | None = None
+    for k in sorted(bounds, key=lambda k: rank(k, bounds[k]), reverse=True):
+        if best is not None and rank(k, bounds[k]) <= best[0]:
+            break
+        sinks = _removal(_sinks(extended, k, members), members, volumes)
+        if sinks and (best is None or rank(k, _count(_union(sinks))) > best[0]):
+            best = (rank(k, _count(_union(sinks))), k, sinks)
+    return None if best is None else (best[1], best[2])
+
+
+@dataclass
+class _Search:
+    translations: DirectionTable
+    extended: DirectionTable | ExtendedDirections
+    volumes: tuple[float, ...]
+    progress: Progress
+    steps: list[Step]
+    locked: list[int]
+
+    def disassemble(self, members: int) -> None:
+        """Append the steps that take ``members`` apart, or record it as interlocked."""
+        previous: int | None = None
+        pending = [members]
+        while pending:
+            current = pending.pop()
+            while _several(current):
+                choice = _choose_removal(
+                    self.translations, self.extended, current, self.volumes, previous
+                )
+                if choice is None:
+                    self.locked.append(current)
+                    break
+                k, sinks = choice
+                moved = _union(sinks)
+                self._record(k, moved, current)
+                previous = k
+                pending.extend(s for s in sinks if _several(s))
+                current &= ~moved
+
+    def _record(self, k: int, moved: int, members: int) -> None:
+        names = self.translations.names
+        graph = self.extended.graph(k, members)
+        self.steps.append(
+            Step(
+                parts=tuple(names[i] for i in _bits(moved)),
+                direction=self.translations.directions[k],
+                rest=tuple(names[i] for i in _bits(members & ~moved)),
+                blocking=tuple((names[i], names[j]) for i, j in sorted(graph.edges)),
+            )
+        )
+        self.progress("planning", len(self.steps), len(names))
+
+
+def minimal_interlocked(table: DirectionTable, members: int) -> int:
+    """A minimal subset of ``members`` that no direction of ``table`` separates: parts are
+    dropped one at a time while the rest stays interlocked."""
+    for i in list(_bits(members)):
+        smaller = members & ~(1 << i)
+        if _several(smaller) and not separable(table, smaller):
+            return minimal_interlocked(table, smaller)
+    return members
+
+
+def and_or_graph(table: DirectionTable) -> AndOrGraph:
+    """The AND/OR graph of every two-handed partition of the whole set that ``table``
+    (Γ_e) accepts, and the number of disassembly trees it holds (seed 004, "order").
+    :func:`plan` gives it one direction per distinct DBG of Γ_t plus those its search
+    used, so the count is a lower bound when Γ_e differs within a region of Γ_t."""
+    names = table.names
+    masks = [table.masks(k) for k in range(len(table.directions))]
+    graph = nx.DiGraph()
+
+    def label(mask: int) -> frozenset[str]:
+        return frozenset(names[i] for i in _bits(mask))
+
+    def free(part: int, members: int) -> bool:
+        # part is free along k when none of its blockers inside members lies outside it
+        outside = members & ~part
+        return any(all((blockers[i] & outside) == 0 for i in _bits(part)) for blockers in masks)
+
+    @cache
+    def count(members: int) -> int:
+        graph.add_node(label(members), kind="or")
+        if not _several(members):
+            return 1
+        total = 0
+        lowest = members & -members
+        rest = members & ~lowest
+        sub = rest
+        while True:
+            part = sub | lowest
+            if part != members and free(part, members):
+                other = members & ~part
+                node = ("split", label(part), label(other))
+                graph.add_node(node, kind="and")
+                graph.add_edge(label(members), node)
+                graph.add_edge(node, label(part))
+                graph.add_edge(node, label(other))
+                total += count(part) * count(other)
+            if sub == 0:
+                break
+            sub = (sub - 1) & rest
+        return total
+
+    plans = count(_mask(range(len(names))))
+    return AndOrGraph(graph, plans)
+
+
+def _table(assembly: Assembly, motion: str, tol: Tolerance) -> DirectionTable:
+    from assemblykit.blocking.ndbg import blocking_graph
+
+    return direction_table(blocking_graph(assembly, motion=motion, tol=tol))
+
+
+def rigid_may_free(assembly: Assembly, parts: Iterable[str], tol: Tolerance | None = None) -> bool:
+    """Whether some DBG of Γ_g (infinitesimal rigid motions) of the sub-assembly
+    ``parts`` frees a proper part of it: the necessary condition of seed 004 ("a
+    necessary condition for a subassembly S to be directly removable")."""
+    from assemblykit.blocking.ndbg import blocking_graph
+
+    return bool(blocking_graph(assembly, motion="rigid", parts=parts, tol=tol).removable())
+
+
+def plan(
+    assembly: Assembly,
+    tol: Tolerance | None = None,
+    max_and_or_parts: int = 8,
+    progress: Progress | None = None,
+) -> Plan:
+    """Plan the disassembly of ``assembly`` by extended translations (seed 004).
+
+    ``progress(stage, done, total)`` is called as the work advances. The result is
+    feasible when every part is separated; otherwise ``interlocked`` holds the minimal
+    sets that no candidate direction separates, each classified with Γ_t and Γ_g
+    (module doc).
+    """
+    tol = assembly.tolerance(tol)
+    names = tuple(assembly.names)
+    report: Progress = progress or (lambda stage, done, total: None)
+    report("blocking graph (infinitesimal translations)", 0, len(names))
+    translations = _table(assembly, "infinitesimal", tol)
+    extended = ExtendedDirections(assembly, translations.directions, tol)
+    volumes = tuple(assembly.parts[name].volume for name in names)
+    search = _Search(translations, extended, volumes, report, [], [])
+    search.disassemble(_mask(range(len(names))))
+    interlocks: tuple[Interlock, ...] = ()
+    if search.locked:
+        complete = extended.table(range(len(translations.directions)))
+        interlocks = tuple(
+            _interlock(assembly, names, minimal_interlocked(complete, members), translations, tol)
+            for members in search.locked
+        )
+    and_or = None
+    if 1 < len(names) <= max_and_or_parts:
+        # one direction per distinct DBG of Γ_t, and those the search already swept
+        directions = set(distinct_directions(translations)) | extended.evaluated
+        and_or = and_or_graph(extended.table(directions))
+    report("done", len(names), len(names))
+    return Plan(names, tuple(search.steps), interlocks, and_or, len(translations.directions))
+
+
+def _interlock(
+    assembly: Assembly,
+    names: Sequence[str],
+    members: int,
+    translations: DirectionTable,
+    tol: Tolerance,
+) -> Interlock:
+    parts = tuple(names[i] for i in _bits(members))
+    return Interlock(
+        parts=parts,
+        translation_locked=not separable(translations, members),
+        rigid_may_free=rigid_may_free(assembly, parts, tol),
+    )

@@ -1,0 +1,242 @@
+"""Tests of the disassembly planner (seed 004) on hand-made blocking tables and on
+real assemblies (the bundled gearbox and the shared data, skipped when absent)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.blocking.extended import extended_dbg
+from assemblykit.geometry.interference import interferes
+from assemblykit.io.assembly import load_assembly
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning.sequence import (
+    DirectionTable,
+    Plan,
+    _Search,
+    and_or_graph,
+    minimal_interlocked,
+    plan,
+    separable,
+)
+from assemblykit.planning.sweep import swept_volume
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = ROOT.parent / "shared" / "data"
+DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
+UP, DOWN = np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, -1.0])
+
+
+def table(names: str, arcs_per_direction: dict[tuple[float, ...], str]) -> DirectionTable:
+    """A table from arcs written ``"ab bc"`` (a blocked by b, b blocked by c)."""
+    arcs = [
+        [(names.index(arc[0]), names.index(arc[1])) for arc in text.split()]
+        for text in arcs_per_direction.values()
+    ]
+    return DirectionTable.from_arcs(tuple(names), list(arcs_per_direction), arcs)
+
+
+# a stack: a at the bottom, b on a, c on b; only vertical motions considered
+STACK = table("abc", {(0.0, 0.0, 1.0): "ab bc", (0.0, 0.0, -1.0): "ba cb"})
+# two parts that block each other both ways
+LOCKED = table("pq", {(0.0, 0.0, 1.0): "pq qp", (1.0, 0.0, 0.0): "pq qp"})
+
+
+def run(
+    tab: DirectionTable, volumes: tuple[float, ...], extended: DirectionTable | None = None
+) -> _Search:
+    """The greedy search with ``tab`` as Γ_t and ``extended`` (default: the same) as Γ_e."""
+    search = _Search(tab, extended or tab, volumes, lambda *_: None, [], [])
+    search.disassemble((1 << len(tab.names)) - 1)
+    return search
+
+
+def test_stack_is_taken_apart_from_the_top_keeping_the_direction():
+    search = run(STACK, (1.0, 1.0, 1.0))
+    # c and a are both free; +z wins the tie, then b stays on +z (no direction change)
+    assert [s.parts for s in search.steps] == [("c",), ("b",)]
+    assert [tuple(s.direction) for s in search.steps] == [(0, 0, 1), (0, 0, 1)]
+    assert search.steps[0].rest == ("a", "b")
+    assert search.steps[0].blocking == (("a", "b"), ("b", "c"))
+    assert search.locked == []
+
+
+def test_and_or_graph_of_the_stack_has_two_plans():
+    graph = and_or_graph(STACK)
+    # {c | ab} then {b | a}, or {a | bc} then {c | b}; b alone is never free
+    assert graph.plans == 2
+    assert graph.partitions == 4
+    assert graph.subassemblies == 6
+    assert graph.to_dict() == {"subassemblies": 6, "partitions": 4, "plans": 2}
+
+
+def test_parallel_free_parts_share_a_step_and_the_heaviest_stays():
+    free = table("abc", {(0.0, 0.0, 1.0): "", (1.0, 0.0, 0.0): "ab"})
+    search = run(free, (1.0, 5.0, 2.0))
+    assert [s.parts for s in search.steps] == [("a", "c")]
+    assert search.steps[0].rest == ("b",)
+    # any partition of 3 unblocked parts is feasible: 3 splits, each child 1 plan
+    assert and_or_graph(free).plans == 3
+
+
+def test_subassembly_moved_as_a_unit_is_taken_apart_later():
+    # along +z, a and b block each other and leave the heavy c together; along ±y all
+    # three are strongly connected, but once c is gone b leaves a (the base) along -y
+    tab = table(
+        "abc",
+        {
+            (0.0, 0.0, 1.0): "ab ba ca cb",
+            (0.0, 0.0, -1.0): "ab ba ac bc",
+            (0.0, 1.0, 0.0): "ac ca cb ba",
+            (0.0, -1.0, 0.0): "ac ca bc ab",
+        },
+    )
+    search = run(tab, (1.0, 1.0, 9.0))
+    assert [s.parts for s in search.steps] == [("a", "b"), ("b",)]
+    assert search.steps[0].rest == ("c",)
+    assert search.steps[1].rest == ("a",)
+    assert tuple(search.steps[1].direction) == (0.0, -1.0, 0.0)
+
+
+def test_extended_blocking_overrides_the_infinitesimal_bound():
+    # Γ_t lets a and c leave the heavy x upwards, but along +z a sweeps into an overhang
+    # of x (Γ_e): only c leaves, and a is then found stuck under x
+    infinitesimal = table("acx", {(0.0, 0.0, 1.0): "", (1.0, 0.0, 0.0): "ax cx"})
+    extended = table("acx", {(0.0, 0.0, 1.0): "ax", (1.0, 0.0, 0.0): "ax cx"})
+    search = run(infinitesimal, (1.0, 1.0, 9.0), extended)
+    assert [s.parts for s in search.steps] == [("c",)]
+    assert search.steps[0].rest == ("a", "x")
+    assert search.steps[0].blocking == (("a", "x"),)
+    assert search.locked == [0b101]
+
+
+def test_interlocked_pair_is_reported():
+    search = run(LOCKED, (1.0, 1.0))
+    assert search.steps == []
+    assert search.locked == [0b11]
+    assert not separable(LOCKED, 0b11)
+    assert separable(STACK, 0b111)
+    assert and_or_graph(LOCKED).plans == 0
+
+
+def test_minimal_interlocked_drops_free_parts():
+    # p and q interlock; r rests on q and is free upwards
+    tab = table("pqr", {(0.0, 0.0, 1.0): "pq qp qr", (1.0, 0.0, 0.0): "pq qp rq"})
+    assert not separable(tab, 0b011)
+    assert minimal_interlocked(tab, 0b011) == 0b011
+    assert separable(tab, 0b111)
+    # p-q and q-r both interlock: dropping p leaves the interlocked pair q, r
+    chain = table("pqr", {(0.0, 0.0, 1.0): "pq qp qr rq", (1.0, 0.0, 0.0): "pq qp rq qr"})
+    assert minimal_interlocked(chain, 0b111) == 0b110
+
+
+def test_exploded_offsets_push_earlier_parts_further():
+    search = run(STACK, (1.0, 1.0, 1.0))
+    result = Plan(("a", "b", "c"), tuple(search.steps), (), None, 2)
+    frames = result.exploded(10.0)
+    assert len(frames) == 3
+    assert np.allclose(frames[0]["c"], 0)
+    assert np.allclose(frames[1]["c"], [0, 0, 10])
+    assert np.allclose(frames[2]["c"], [0, 0, 20])
+    assert np.allclose(frames[2]["b"], [0, 0, 10])
+    assert np.allclose(frames[2]["a"], 0)
+    assert result.order == (("b",), ("c",))
+    data = result.to_dict()
+    assert data["feasible"] is True
+    assert data["stuck"] == []
+    assert data["steps"][0] == {
+        "parts": ["c"],
+        "direction": [0.0, 0.0, 1.0],
+        "motion": "translation",
+        "rest": ["a", "b"],
+        "blocking": [["a", "b"], ["b", "c"]],
+    }
+
+
+def assert_every_step_free(assembly: Assembly, result: Plan) -> None:
+    """Each step checked on its own: every moved part's swept volume misses every part
+    it leaves (extended translation, seed 004)."""
+    assert result.feasible, result.stuck
+    # every part but the first base moves at some step (a moved group may split later)
+    moved = set().union(*(step.parts for step in result.steps))
+    assert len(moved) == len(assembly.names) - 1
+    tol = assembly.tolerance()
+    for step in result.steps:
+        assert np.isclose(np.linalg.norm(step.direction), 1.0)
+        for moving in step.parts:
+            sweep = swept_volume(assembly.parts[moving].mesh, step.direction, assembly.scale, tol)
+            for rest in step.rest:
+                assert not interferes(sweep, assembly.parts[rest].mesh, tol), (moving, rest)
+
+
+def assert_free_by_cones(assembly: Assembly, result: Plan) -> None:
+    """For convex parts, the cone test of :mod:`assemblykit.blocking.extended` is exact:
+    an independent check of every step."""
+    tol = assembly.tolerance()
+    for step in result.steps:
+        members = (*step.parts, *step.rest)
+        dbg = extended_dbg(assembly, step.direction, members, tol)
+        assert dbg.is_free(frozenset(step.parts)), step
+
+
+def test_gearbox_plan_lifts_pins_and_cover_first():
+    assembly = load_assembly(DEMO)
+    result = plan(assembly)
+    assert_every_step_free(assembly, result)
+    first = result.steps[0]
+    assert set(first.parts) == {"cover", "pin_1", "pin_2", "pin_3", "pin_4"}
+    assert np.allclose(first.direction, UP)
+    assert result.and_or is None
+
+
+def shared(path: str) -> Path:
+    target = DATA / path
+    if not target.exists():
+        pytest.skip(f"shared data {target} is absent")
+    return target
+
+
+@pytest.mark.parametrize(
+    "path", ["compas_assembly/stack_assembly.json", "compas_assembly/arch_assembly.json"]
+)
+def test_masonry_plans_are_free_by_extended_translation(path):
+    assembly = load_assembly(shared(path))
+    result = plan(assembly)
+    assert_every_step_free(assembly, result)
+    assert_free_by_cones(assembly, result)
+
+
+@pytest.mark.slow
+def test_asap_beam_plan_is_free_by_extended_translation():
+    assembly = load_assembly(shared("asap_beam_assembly"))
+    result = plan(assembly)
+    assert_every_step_free(assembly, result)
+    assert result.and_or is not None and result.and_or.plans >= 1
+
+
+def ring(radius: float, tube: float, transform: np.ndarray) -> trimesh.Trimesh:
+    mesh = trimesh.creation.torus(radius, tube, major_sections=48, minor_sections=12)
+    mesh.apply_transform(transform)
+    return mesh
+
+
+def test_interlocked_rings_are_stuck():
+    # two chain links: the second ring is turned into the xz plane and threaded through
+    first = ring(10.0, 2.0, np.eye(4))
+    turn = trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0])
+    turn[:3, 3] = [10.0, 0.0, 0.0]
+    second = ring(10.0, 2.0, turn)
+    assembly = Assembly([Part("ring_a", first), Part("ring_b", second)])
+    result = plan(assembly)
+    data = result.to_dict()
+    assert data["feasible"] is False
+    assert data["stuck"] == ["ring_a", "ring_b"]
+    assert data["steps"] == []
+    lock = result.interlocked[0]
+    # the rings do not touch: nothing blocks infinitesimal motions
+    assert lock.translation_locked is False
+    assert lock.rigid_may_free is True
+    assert result.and_or is not None and result.and_or.plans == 0

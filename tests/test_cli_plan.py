@@ -1,0 +1,81 @@
+"""End-to-end tests of ``assemblykit plan``, ``demo`` and ``batch`` on the bundled gearbox."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import pytest
+
+from assemblykit.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    try:
+        main(list(argv))
+        code = 0
+    except SystemExit as done:
+        code = int(done.code or 0)
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_plan_json_html_and_png(capsys, tmp_path):
+    html, png = tmp_path / "report.html", tmp_path / "exploded.png"
+    code, out, err = run(
+        capsys, "plan", str(DEMO), "--json", "--html", str(html), "--png", str(png)
+    )
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["feasible"] is True
+    assert data["stuck"] == []
+    assert {"parts", "direction", "motion"} <= set(data["steps"][0])
+    moved = {name for step in data["steps"] for name in step["parts"]}
+    assert len(moved) == 13 and "base" not in moved  # the heaviest part stays
+    assert html.stat().st_size > 3_000_000
+    assert png.read_bytes()[:8] == PNG_SIGNATURE
+    assert f"wrote {html}" in err and f"wrote {png}" in err
+
+
+def test_plan_table_output(capsys):
+    code, out, _ = run(capsys, "plan", str(DEMO))
+    assert code == 0
+    assert "Disassembly plan (feasible)" in out
+    assert "pin_1" in out
+
+
+def test_plan_of_a_missing_file_is_one_line_and_exit_2(capsys, tmp_path):
+    code, out, err = run(capsys, "plan", str(tmp_path / "nothing.yaml"))
+    assert code == 2
+    assert out == ""
+    assert err.count("\n") == 1 and "nothing.yaml" in err and "Traceback" not in err
+
+
+def test_demo_writes_its_report_quickly(capsys, tmp_path):
+    start = time.perf_counter()
+    code, out, err = run(capsys, "demo", "--out", str(tmp_path / "demo"))
+    assert code == 0, err
+    assert time.perf_counter() - start < 60
+    report = tmp_path / "demo" / "gearbox_report.html"
+    assert report.stat().st_size > 3_000_000
+    assert "Report written to" in out and "gearbox_report.html" in out
+    code, out, _ = run(capsys, "demo", "--out", str(tmp_path / "again"), "--json")
+    data = json.loads(out)
+    assert data["report"] == str((tmp_path / "again" / "gearbox_report.html").resolve())
+    assert data["plan"]["feasible"] is True
+
+
+def test_batch_command(capsys, tmp_path):
+    out_file = tmp_path / "r.jsonl"
+    code, out, err = run(capsys, "batch", str(DEMO), "--out", str(out_file), "--json")
+    assert code == 0, err
+    assert json.loads(out)["ok"] == 1
+    record = json.loads(out_file.read_text())
+    assert record["input"] == str(DEMO) and record["status"] == "ok"
+    code, _, err = run(capsys, "batch", str(DEMO), "--command", "solve")
+    assert code == 2 and "unknown command 'solve'" in err
