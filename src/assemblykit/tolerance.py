@@ -62,8 +62,10 @@ class Tolerance:
         return replace(self, rel_length=self.mesh_rel_length, angle=self.mesh_angle)
 
 
+DEFAULT = Tolerance()
+
 _current: contextvars.ContextVar[Tolerance] = contextvars.ContextVar(
-    "assemblykit_tolerance", default=Tolerance()
+    "assemblykit_tolerance", default=DEFAULT
 )
 
 
