@@ -19,6 +19,8 @@ except ImportError as missing:  # the engine is a separate layer; only its answe
 else:
     ENGINE = ""
 
+needs_engine = pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+
 EXAMPLES = Path(assemblykit.__file__).parent / "examples" / "tasks"
 
 GOOD = """\
@@ -110,16 +112,21 @@ def solve_json(name: str, capsys: pytest.CaptureFixture[str], *extra: str) -> di
     return out
 
 
+def underconstrained_bodies(name: str, capsys: pytest.CaptureFixture[str]) -> dict:
+    """The bodies of an example solved as underconstrained without conflicts."""
+    out = solve_json(name, capsys)
+    assert out["status"] == "underconstrained" and out["conflicts"] == []
+    return out["bodies"]
+
+
 def translation(body: dict) -> np.ndarray:
     return np.asarray(body["pose"])[:3, 3]
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 @pytest.mark.parametrize("suffix", [".yaml", ".rapt"])
 def test_peg_in_block_is_cylindrical_then_revolute(suffix: str, capsys):
-    out = solve_json(f"peg_in_block{suffix}", capsys)
-    assert out["status"] == "underconstrained" and out["conflicts"] == []
-    bodies = out["bodies"]
+    bodies = underconstrained_bodies(f"peg_in_block{suffix}", capsys)
     assert (bodies["block@s1"]["dof"], bodies["block@s1"]["motion"]) == (0, "fixed")
     np.testing.assert_allclose(bodies["block@s1"]["pose"], np.eye(4), atol=1e-9)
     assert (bodies["peg@s1"]["dof"], bodies["peg@s1"]["motion"]) == (2, "cylindrical")
@@ -134,7 +141,7 @@ ONE_DOF = {
 }
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 @pytest.mark.parametrize("name", sorted(ONE_DOF))
 def test_one_dof_examples(name: str, capsys):
     out = solve_json(f"{name}.yaml", capsys)
@@ -143,11 +150,9 @@ def test_one_dof_examples(name: str, capsys):
         assert (out["bodies"][body]["dof"], out["bodies"][body]["motion"]) == (dof, motion)
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_four_bar_is_a_one_dof_mechanism(capsys):
-    out = solve_json("four_bar.rapt", capsys)
-    assert out["status"] == "underconstrained" and out["conflicts"] == []
-    bodies = out["bodies"]
+    bodies = underconstrained_bodies("four_bar.rapt", capsys)
     assert (bodies["crank@s1"]["dof"], bodies["crank@s1"]["motion"]) == (1, "revolute")
     assert (bodies["rocker@s1"]["dof"], bodies["rocker@s1"]["motion"]) == (1, "revolute")
     assert (bodies["coupler@s1"]["dof"], bodies["coupler@s1"]["motion"]) == (1, "mechanism")
@@ -155,7 +160,7 @@ def test_four_bar_is_a_one_dof_mechanism(capsys):
     np.testing.assert_allclose(bodies["rocker@s1"]["invariants"]["point"][:2], [40, 0], atol=1e-9)
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_slide_direction_and_triangle_offset(capsys):
     cube = solve_json("w2_slide.rapt", capsys)["bodies"]["cube@s1"]
     direction = np.asarray(cube["invariants"]["direction"])
@@ -165,7 +170,7 @@ def test_slide_direction_and_triangle_offset(capsys):
     assert translation(b)[2] == pytest.approx(0.0, abs=1e-9)
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_square_peg_has_four_poses(capsys):
     out = solve_json("w14_square_peg.rapt", capsys)
     peg = out["bodies"]["peg@s1"]
@@ -173,7 +178,7 @@ def test_square_peg_has_four_poses(capsys):
     assert (peg["dof"], peg["solutions"]) == (0, 4)
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_unequal_pins_are_inconsistent_by_2(capsys):
     out = solve_json("w6_unequal_pins.rapt", capsys)
     assert out["status"] == "inconsistent"
@@ -182,7 +187,7 @@ def test_unequal_pins_are_inconsistent_by_2(capsys):
     assert conflict["value"] == pytest.approx(2.0, abs=1e-9)
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_actions_lift_then_turn_the_plate(capsys):
     bodies = solve_json("stack_and_move.rapt", capsys)["bodies"]
     np.testing.assert_allclose(bodies["plate@stacked"]["pose"], np.eye(4), atol=1e-9)
@@ -195,26 +200,24 @@ def test_actions_lift_then_turn_the_plate(capsys):
     assert all(b["dof"] == 0 for b in bodies.values())
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_explain_adds_the_trace(capsys):
     out = solve_json("w4_pin.yaml", capsys, "--explain")
     assert out["trace"] and {"rule", "link"} <= set(out["trace"][0])
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_readable_output(capsys):
     assert run(["solve", str(EXAMPLES / "w4_pin.rapt")]) == 0
     text = capsys.readouterr().out
     assert "underconstrained" in text and "pin@s1" in text and "revolute" in text
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 @pytest.mark.parametrize("suffix", [".yaml", ".rapt"])
 def test_gear_pair_meshed_then_held(suffix: str, capsys):
     """g1 turned 30 deg by the stop; g2 follows by -30·20/40 = -15 deg about (30, 0)."""
-    out = solve_json(f"gear_pair{suffix}", capsys)
-    assert out["status"] == "underconstrained" and out["conflicts"] == []
-    bodies = out["bodies"]
+    bodies = underconstrained_bodies(f"gear_pair{suffix}", capsys)
     for gear in ("g1@meshed", "g2@meshed"):
         assert (bodies[gear]["dof"], bodies[gear]["motion"]) == (1, "revolute")
     np.testing.assert_allclose(bodies["g2@meshed"]["invariants"]["point"][:2], [30, 0], atol=1e-9)
@@ -228,12 +231,10 @@ def test_gear_pair_meshed_then_held(suffix: str, capsys):
     np.testing.assert_allclose(translation(bodies["g2@held"]), shift, atol=1e-5)
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 @pytest.mark.parametrize("suffix", [".yaml", ".rapt"])
 def test_gripper_jaws_open_then_closed_equal_and_opposite(suffix: str, capsys):
-    out = solve_json(f"gripper{suffix}", capsys)
-    assert out["status"] == "underconstrained" and out["conflicts"] == []
-    bodies = out["bodies"]
+    bodies = underconstrained_bodies(f"gripper{suffix}", capsys)
     for jaw in ("ja@open", "jb@open"):
         assert (bodies[jaw]["dof"], bodies[jaw]["motion"]) == (1, "prismatic")
         direction = np.abs(bodies[jaw]["invariants"]["direction"])
@@ -243,12 +244,10 @@ def test_gripper_jaws_open_then_closed_equal_and_opposite(suffix: str, capsys):
     np.testing.assert_allclose(bodies["jb@closed"]["pose"][0], [1, 0, 0, -0.5], atol=1e-9)
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 @pytest.mark.parametrize("suffix", [".yaml", ".rapt"])
 def test_box_on_table_with_a_corner_on_the_wall_keeps_two_dof(suffix: str, capsys):
-    out = solve_json(f"higher_pairs{suffix}", capsys)
-    assert out["status"] == "underconstrained" and out["conflicts"] == []
-    box = out["bodies"]["box@s1"]
+    box = underconstrained_bodies(f"higher_pairs{suffix}", capsys)["box@s1"]
     assert box["dof"] == 2
     pose = np.asarray(box["pose"])
     assert (pose @ [1, 1, 0, 1])[0] == pytest.approx(5.0, abs=1e-6)  # corner on the wall
@@ -256,7 +255,7 @@ def test_box_on_table_with_a_corner_on_the_wall_keeps_two_dof(suffix: str, capsy
     assert pose[2, 3] == pytest.approx(0.0, abs=1e-6)
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_explain_text_names_rule_link_places_and_dof(capsys, monkeypatch):
     """The four-bar's trace: each joint's two relations (with their lines) intersect to a
     revolute, and the loop goes to the residue solver: 4 dof along the chains from the
@@ -278,7 +277,7 @@ def test_explain_text_names_rule_link_places_and_dof(capsys, monkeypatch):
     )
 
 
-@pytest.mark.skipif(bool(ENGINE), reason=ENGINE or "engine present")
+@needs_engine
 def test_explain_text_says_where_a_merged_body_ended(capsys, monkeypatch):
     monkeypatch.setenv("COLUMNS", "400")
     assert run(["solve", str(EXAMPLES / "stack_and_move.rapt"), "--explain"]) == 0

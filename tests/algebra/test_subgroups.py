@@ -355,6 +355,17 @@ def test_contains_is_invariant_under_conjugation(seed):
     assert g.contains(y) == g.conjugate(t).contains(t @ y @ se3.inverse(t))
 
 
+def assert_meet_sound_and_equivariant(
+    rng: np.random.Generator, a: SymmetryGroup, b: SymmetryGroup
+) -> None:
+    """Sampled members of a ∩ b lie in both, and the meet commutes with conjugation."""
+    m = a.intersect(b)
+    for x in m.sample(rng, 3):
+        assert a.contains(x) and b.contains(x)
+    t = se3.random_transform(rng)
+    assert a.conjugate(t).intersect(b.conjugate(t)).equals(m.conjugate(t))
+
+
 def _tr_group(rng: np.random.Generator) -> SymmetryGroup:
     # Random TR groups whose invariants sometimes coincide (so meets are non-trivial).
     pts = [np.zeros(3), np.array([0.0, 0.0, 2.0])]
@@ -376,12 +387,7 @@ def _tr_group(rng: np.random.Generator) -> SymmetryGroup:
 @given(seeds)
 def test_intersection_members_lie_in_both_and_conjugation_commutes(seed):
     rng = np.random.default_rng(seed)
-    a, b = _tr_group(rng), _tr_group(rng)
-    m = a.intersect(b)
-    for x in m.sample(rng, 3):
-        assert a.contains(x) and b.contains(x)
-    t = se3.random_transform(rng)
-    assert a.conjugate(t).intersect(b.conjugate(t)).equals(m.conjugate(t))
+    assert_meet_sound_and_equivariant(rng, _tr_group(rng), _tr_group(rng))
 
 
 @settings(max_examples=50, deadline=None)
@@ -421,9 +427,4 @@ def _any_group(rng: np.random.Generator) -> SymmetryGroup:
 @given(seeds)
 def test_intersections_with_helical_groups_are_sound_and_equivariant(seed):
     rng = np.random.default_rng(seed)
-    a, b = _any_group(rng), _any_group(rng)
-    m = a.intersect(b)
-    for x in m.sample(rng, 3):
-        assert a.contains(x) and b.contains(x)
-    t = se3.random_transform(rng)
-    assert a.conjugate(t).intersect(b.conjugate(t)).equals(m.conjugate(t))
+    assert_meet_sound_and_equivariant(rng, _any_group(rng), _any_group(rng))

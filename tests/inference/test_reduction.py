@@ -307,19 +307,21 @@ def test_w14_square_peg_has_four_positions():
     assert angles == pytest.approx([0.0, math.pi / 2, math.pi, 3 * math.pi / 2])
 
 
+def threaded_and_keyed(name: str, male: bool, fixed: bool = False, **extra) -> Body:
+    """W16's nut (female) or bolt (male): a thread of radius 3 and lead 1.5 about z and a
+    square key at (5, 0, 0), plus the ``extra`` features."""
+    return body(
+        name,
+        fixed,
+        thread=Thread((0, 0, 0), Z, 3.0, 1.5, male=male),
+        key=Prism((5, 0, 0), Z, 4, 0.5, male=male),
+        **extra,
+    )
+
+
 def test_w16_thread_and_key_is_a_lattice_not_merged():
-    lead = 1.5
-    nut = body(
-        "nut",
-        fixed=True,
-        thread=Thread((0, 0, 0), Z, 3.0, lead, male=False),
-        key=Prism((5, 0, 0), Z, 4, 0.5, male=False),
-    )
-    bolt = body(
-        "bolt",
-        thread=Thread((0, 0, 0), Z, 3.0, lead, male=True),
-        key=Prism((5, 0, 0), Z, 4, 0.5, male=True),
-    )
+    nut = threaded_and_keyed("nut", male=False, fixed=True)
+    bolt = threaded_and_keyed("bolt", male=True)
     out = solve(
         [nut, bolt], rel("fits", "bolt.thread", "nut.thread"), rel("fits", "bolt.key", "nut.key")
     )
@@ -804,20 +806,8 @@ def test_equivariance_of_the_answer(angles, offset):
 def test_lattice_with_a_further_relation_goes_to_the_residue():
     """Thread + key between nut and bolt is a lattice; a collar against the nut face picks
     the bolt's height: left to the residue solver, which finds the pose at height 0."""
-    lead = 1.5
-    nut = body(
-        "nut",
-        fixed=True,
-        thread=Thread((0, 0, 0), Z, 3.0, lead, male=False),
-        key=Prism((5, 0, 0), Z, 4, 0.5, male=False),
-        face=Plane((0, 0, 0), Z),
-    )
-    bolt = body(
-        "bolt",
-        thread=Thread((0, 0, 0), Z, 3.0, lead, male=True),
-        key=Prism((5, 0, 0), Z, 4, 0.5, male=True),
-        collar=Plane((0, 0, 0), (0, 0, -1)),
-    )
+    nut = threaded_and_keyed("nut", male=False, fixed=True, face=Plane((0, 0, 0), Z))
+    bolt = threaded_and_keyed("bolt", male=True, collar=Plane((0, 0, 0), (0, 0, -1)))
     out = solve(
         [nut, bolt],
         rel("fits", "bolt.thread", "nut.thread"),

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import re
 from abc import ABC, abstractmethod
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import MISSING, dataclass, fields, replace
 from typing import Any, ClassVar, Self
 
@@ -123,6 +123,14 @@ class Feature(ABC):
         """The feature's name, or its type when unnamed (used in error messages)."""
         return self.name or self.type_name
 
+    def _validate(self, check: Callable[[Any, str, str], Any], *names: str) -> None:
+        """Replace each named field by ``check(value, name, label)``, in order (the frozen
+        dataclass is still being built, hence ``object.__setattr__``)."""
+        for field_name in names:
+            object.__setattr__(
+                self, field_name, check(getattr(self, field_name), field_name, self.label)
+            )
+
     @abstractmethod
     def frame(self) -> Matrix:
         """The 4x4 feature frame in body coordinates (DESIGN §4)."""
@@ -159,6 +167,10 @@ class _Axial(Feature):
     point: Vector
     axis: Vector
 
+    def __post_init__(self) -> None:
+        self._validate(_vector, "point")
+        self._validate(_direction, "axis")
+
     def frame(self) -> Matrix:
         return se3.frame(self.point, self.axis)
 
@@ -168,6 +180,26 @@ class _Axial(Feature):
             "axis": se3.apply_direction(transform, self.axis),
             **changes,
         }
+
+    def transformed(self, transform: Matrix) -> Self:
+        return replace(self, **self._moved(transform))
+
+
+class _Line(_Axial):
+    """Shared behaviour of the axial features with a ``directed`` flag: the axis line is
+    their invariant, and the half-turn about the frame's x axis joins their group when
+    undirected (ALGEBRA.md §4). By default the group is the line's own, C(z)."""
+
+    directed: bool
+
+    def _flipped_unless_directed(self, base: SymmetryGroup) -> SymmetryGroup:
+        return base if self.directed else base.with_discrete(reps=(_flip(self.frame()),))
+
+    def group(self) -> SymmetryGroup:
+        return self._flipped_unless_directed(SymmetryGroup.cylindrical(self.point, self.axis))
+
+    def invariants(self) -> tuple[Invariant, ...]:
+        return (LineInvariant(self.point, self.axis, directed=self.directed),)
 
 
 @dataclass(frozen=True, eq=False)
@@ -182,8 +214,8 @@ class Plane(Feature):
     type_name: ClassVar[str] = "plane"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-        object.__setattr__(self, "normal", _direction(self.normal, "normal", self.label))
+        self._validate(_vector, "point")
+        self._validate(_direction, "normal")
 
     def frame(self) -> Matrix:
         return se3.frame(self.point, self.normal)
@@ -203,7 +235,7 @@ class Plane(Feature):
 
 
 @dataclass(frozen=True, eq=False)
-class _Cylinder(_Axial):
+class _Cylinder(_Line):
     """A cylinder of ``radius`` about the axis line: Sym = C(z), or C(z)⋊⟨Rx(π)⟩ undirected."""
 
     radius: float
@@ -211,20 +243,9 @@ class _Cylinder(_Axial):
     name: str | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-        object.__setattr__(self, "axis", _direction(self.axis, "axis", self.label))
-        object.__setattr__(self, "radius", _positive(self.radius, "radius", self.label))
-        object.__setattr__(self, "directed", _flag(self.directed, "directed", self.label))
-
-    def group(self) -> SymmetryGroup:
-        base = SymmetryGroup.cylindrical(self.point, self.axis)
-        return base if self.directed else base.with_discrete(reps=(_flip(self.frame()),))
-
-    def invariants(self) -> tuple[Invariant, ...]:
-        return (LineInvariant(self.point, self.axis, directed=self.directed),)
-
-    def transformed(self, transform: Matrix) -> Self:
-        return replace(self, **self._moved(transform))
+        super().__post_init__()
+        self._validate(_positive, "radius")
+        self._validate(_flag, "directed")
 
 
 @dataclass(frozen=True, eq=False)
@@ -242,16 +263,13 @@ class Hole(_Cylinder):
 
 
 @dataclass(frozen=True, eq=False)
-class _Sphere(Feature):
-    """A sphere of ``radius`` about ``point``: Sym = S(point), 3 dof."""
+class _Centred(Feature):
+    """Shared behaviour of the features centred at ``point``: Sym = S(point), 3 dof."""
 
     point: Vector
-    radius: float
-    name: str | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-        object.__setattr__(self, "radius", _positive(self.radius, "radius", self.label))
+        self._validate(_vector, "point")
 
     def frame(self) -> Matrix:
         return se3.translation(self.point)
@@ -264,6 +282,18 @@ class _Sphere(Feature):
 
     def transformed(self, transform: Matrix) -> Self:
         return replace(self, point=se3.apply(transform, self.point))
+
+
+@dataclass(frozen=True, eq=False)
+class _Sphere(_Centred):
+    """A sphere of ``radius`` about ``point``: Sym = S(point), 3 dof."""
+
+    radius: float
+    name: str | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self._validate(_positive, "radius")
 
 
 @dataclass(frozen=True, eq=False)
@@ -292,24 +322,20 @@ class Cone(_Axial):
     type_name: ClassVar[str] = "cone"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-        object.__setattr__(self, "axis", _direction(self.axis, "axis", self.label))
+        super().__post_init__()
         angle = _positive(self.half_angle, "half_angle", self.label)
         if not angle < math.pi / 2:
             raise FeatureError(
                 f"half_angle must lie in (0, π/2), got {self.half_angle!r}", where=self.label
             )
         object.__setattr__(self, "half_angle", angle)
-        object.__setattr__(self, "male", _flag(self.male, "male", self.label))
+        self._validate(_flag, "male")
 
     def group(self) -> SymmetryGroup:
         return SymmetryGroup.revolute(self.point, self.axis)
 
     def invariants(self) -> tuple[Invariant, ...]:
         return (LineInvariant(self.point, self.axis, directed=True), PointInvariant(self.point))
-
-    def transformed(self, transform: Matrix) -> Cone:
-        return replace(self, **self._moved(transform))
 
 
 @dataclass(frozen=True, eq=False)
@@ -325,13 +351,9 @@ class Torus(_Axial):
     type_name: ClassVar[str] = "torus"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-        object.__setattr__(self, "axis", _direction(self.axis, "axis", self.label))
-        major = _positive(self.major_radius, "major_radius", self.label)
-        minor = _positive(self.minor_radius, "minor_radius", self.label)
-        object.__setattr__(self, "major_radius", major)
-        object.__setattr__(self, "minor_radius", minor)
-        object.__setattr__(self, "male", _flag(self.male, "male", self.label))
+        super().__post_init__()
+        self._validate(_positive, "major_radius", "minor_radius")
+        self._validate(_flag, "male")
 
     def group(self) -> SymmetryGroup:
         base = SymmetryGroup.revolute(self.point, self.axis)
@@ -339,9 +361,6 @@ class Torus(_Axial):
 
     def invariants(self) -> tuple[Invariant, ...]:
         return (LineInvariant(self.point, self.axis, directed=False), PointInvariant(self.point))
-
-    def transformed(self, transform: Matrix) -> Torus:
-        return replace(self, **self._moved(transform))
 
 
 def _phase_after(frame: Matrix, transform: Matrix) -> float:
@@ -355,13 +374,14 @@ def _phase_after(frame: Matrix, transform: Matrix) -> float:
 
 
 @dataclass(frozen=True, eq=False)
-class Thread(_Axial):
+class Thread(_Line):
     """A helical thread of ``radius`` and ``lead`` (axial advance per turn) about the axis.
 
     Sym = H(z, p) with pitch p = ±lead/2π (+ for a right hand, ALGEBRA.md §1 and §7), or
     H(z, p)⋊⟨Rx(π)⟩ undirected. ``phase`` is the angle of the thread start about the axis
     from the default frame's x axis; the frame's x axis points at the thread start, so the
-    flip axis of an undirected thread is that perpendicular (ALGEBRA.md §4)."""
+    flip axis of an undirected thread is that perpendicular (ALGEBRA.md §4). The helical
+    part is not a TR invariant (ALGEBRA.md §2.4): the invariant is the axis line alone."""
 
     radius: float
     lead: float
@@ -373,16 +393,13 @@ class Thread(_Axial):
     type_name: ClassVar[str] = "thread"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-        object.__setattr__(self, "axis", _direction(self.axis, "axis", self.label))
-        object.__setattr__(self, "radius", _positive(self.radius, "radius", self.label))
-        object.__setattr__(self, "lead", _positive(self.lead, "lead", self.label))
+        super().__post_init__()
+        self._validate(_positive, "radius", "lead")
         if self.hand not in ("right", "left"):
             raise FeatureError(
                 f"hand must be 'right' or 'left', got {self.hand!r}", where=self.label
             )
-        object.__setattr__(self, "male", _flag(self.male, "male", self.label))
-        object.__setattr__(self, "directed", _flag(self.directed, "directed", self.label))
+        self._validate(_flag, "male", "directed")
         phase = parse_angle(self.phase, self.label)
         object.__setattr__(self, "phase", math.remainder(phase, 2 * math.pi))
 
@@ -397,18 +414,14 @@ class Thread(_Axial):
 
     def group(self) -> SymmetryGroup:
         base = SymmetryGroup.helical(self.point, self.axis, self.pitch)
-        return base if self.directed else base.with_discrete(reps=(_flip(self.frame()),))
-
-    def invariants(self) -> tuple[Invariant, ...]:
-        # The helical part is not a TR invariant (ALGEBRA.md §2.4); only the axis is.
-        return (LineInvariant(self.point, self.axis, directed=self.directed),)
+        return self._flipped_unless_directed(base)
 
     def transformed(self, transform: Matrix) -> Thread:
         return replace(self, **self._moved(transform, phase=_phase_after(self.frame(), transform)))
 
 
 @dataclass(frozen=True, eq=False)
-class Prism(_Axial):
+class Prism(_Line):
     """A prism of regular ``sides``-gon section along the axis (a spline, a square peg).
 
     ``size`` is the circumradius (axis to vertex) and ``ref`` the direction from the axis
@@ -425,16 +438,14 @@ class Prism(_Axial):
     type_name: ClassVar[str] = "prism"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-        object.__setattr__(self, "axis", _direction(self.axis, "axis", self.label))
+        super().__post_init__()
         if isinstance(self.sides, bool) or not isinstance(self.sides, int | np.integer):
             raise FeatureError(f"sides must be an integer, got {self.sides!r}", where=self.label)
         if self.sides < 2:
             raise FeatureError(f"sides must be at least 2, got {self.sides}", where=self.label)
         object.__setattr__(self, "sides", int(self.sides))
-        object.__setattr__(self, "size", _positive(self.size, "size", self.label))
-        object.__setattr__(self, "male", _flag(self.male, "male", self.label))
-        object.__setattr__(self, "directed", _flag(self.directed, "directed", self.label))
+        self._validate(_positive, "size")
+        self._validate(_flag, "male", "directed")
         if self.ref is not None:
             ref = _vector(self.ref, "ref", self.label)
             across = ref - (ref @ self.axis) * self.axis
@@ -455,40 +466,21 @@ class Prism(_Axial):
         # The transversal is known in closed form: no closure search needed.
         return SymmetryGroup(Kind.PRISMATIC, frame, 0.0, (np.eye(4), *turns))
 
-    def invariants(self) -> tuple[Invariant, ...]:
-        return (LineInvariant(self.point, self.axis, directed=self.directed),)
-
     def transformed(self, transform: Matrix) -> Prism:
         ref = se3.apply_direction(transform, self.frame()[:3, 0])
         return replace(self, **self._moved(transform, ref=ref))
 
 
 @dataclass(frozen=True, eq=False)
-class Point(Feature):
+class Point(_Centred):
     """A datum point: Sym = S(point)."""
 
-    point: Vector
     name: str | None = None
     type_name: ClassVar[str] = "point"
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-
-    def frame(self) -> Matrix:
-        return se3.translation(self.point)
-
-    def group(self) -> SymmetryGroup:
-        return SymmetryGroup.spherical(self.point)
-
-    def invariants(self) -> tuple[Invariant, ...]:
-        return (PointInvariant(self.point),)
-
-    def transformed(self, transform: Matrix) -> Point:
-        return replace(self, point=se3.apply(transform, self.point))
-
 
 @dataclass(frozen=True, eq=False)
-class Axis(_Axial):
+class Axis(_Line):
     """A datum line: Sym = C(z), or C(z)⋊⟨Rx(π)⟩ undirected."""
 
     directed: bool = True
@@ -496,19 +488,8 @@ class Axis(_Axial):
     type_name: ClassVar[str] = "axis"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point", self.label))
-        object.__setattr__(self, "axis", _direction(self.axis, "axis", self.label))
-        object.__setattr__(self, "directed", _flag(self.directed, "directed", self.label))
-
-    def group(self) -> SymmetryGroup:
-        base = SymmetryGroup.cylindrical(self.point, self.axis)
-        return base if self.directed else base.with_discrete(reps=(_flip(self.frame()),))
-
-    def invariants(self) -> tuple[Invariant, ...]:
-        return (LineInvariant(self.point, self.axis, directed=self.directed),)
-
-    def transformed(self, transform: Matrix) -> Axis:
-        return replace(self, **self._moved(transform))
+        super().__post_init__()
+        self._validate(_flag, "directed")
 
 
 @dataclass(frozen=True, eq=False)

@@ -172,15 +172,20 @@ class Task:
 
         return solve_task(self, tol=tol, explain=explain)
 
-    def feature(self, ref: FeatureRef, where: str) -> Any:
-        """The feature ``ref`` names; :class:`UnknownNameError` naming ``where`` if none."""
-        body = self.bodies.get(ref.body)
+    def _body(self, name: str, where: str) -> Body:
+        """The body called ``name``; :class:`UnknownNameError` naming ``where`` if none."""
+        body = self.bodies.get(name)
         if body is None:
             raise UnknownNameError(
-                f"unknown body {ref.body!r} (bodies: {', '.join(self.bodies)})",
+                f"unknown body {name!r} (bodies: {', '.join(self.bodies)})",
                 source=self.source,
                 where=where,
             )
+        return body
+
+    def feature(self, ref: FeatureRef, where: str) -> Any:
+        """The feature ``ref`` names; :class:`UnknownNameError` naming ``where`` if none."""
+        body = self._body(ref.body, where)
         found = body.features.get(ref.feature)
         if found is None:
             known = ", ".join(body.features) or "none"
@@ -218,13 +223,7 @@ class Task:
                 source=self.source,
                 where=where,
             )
-        body = self.bodies.get(action.body)
-        if body is None:
-            raise UnknownNameError(
-                f"unknown body {action.body!r} (bodies: {', '.join(self.bodies)})",
-                source=self.source,
-                where=where,
-            )
+        body = self._body(action.body, where)
         if body.fixed:
             raise SchemaError(
                 f"the fixed body {action.body!r} cannot move", source=self.source, where=where

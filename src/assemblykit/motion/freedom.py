@@ -216,8 +216,26 @@ def motion_summary(group: SymmetryGroup | None) -> dict[str, Any]:
     return out
 
 
+class GroupMotion:
+    """The name and dimension of a motion given by its ``group`` (``None``: every rigid
+    motion), as :func:`motion_summary` reports them."""
+
+    group: SymmetryGroup | None
+
+    @property
+    def kind(self) -> str:
+        """The motion's name: ``fixed``, ``revolute``, ``prismatic``, ... or ``free``."""
+        return str(motion_summary(self.group)["motion"])
+
+    @property
+    def dof(self) -> int:
+        """Degrees of freedom of the motion (the group's dimension; for a set of parts,
+        of the bilateral motion)."""
+        return int(motion_summary(self.group)["dof"])
+
+
 @dataclass(frozen=True, eq=False)
-class Motion:
+class Motion(GroupMotion):
     """The motion of a moving set of parts relative to the rest of its assembly.
 
     ``group``: the symmetry group of the compound feature of its contact surfaces (seed
@@ -235,16 +253,6 @@ class Motion:
     def key(self) -> str:
         """The report key: the part name, or ``a+b`` for a subassembly."""
         return subassembly_key(self.parts)
-
-    @property
-    def kind(self) -> str:
-        """The motion's name: ``fixed``, ``revolute``, ``prismatic``, ... or ``free``."""
-        return str(motion_summary(self.group)["motion"])
-
-    @property
-    def dof(self) -> int:
-        """Degrees of freedom of the bilateral motion (the group's dimension)."""
-        return int(motion_summary(self.group)["dof"])
 
     @property
     def separates(self) -> bool:

@@ -39,7 +39,7 @@ from assemblykit.inference import Solution
 from assemblykit.inference.reduction import model_scale
 from assemblykit.model.relations import RELATIONS, Relation, relation_coset
 from assemblykit.model.task import Task
-from assemblykit.motion.freedom import motion_summary
+from assemblykit.motion.freedom import GroupMotion, motion_summary
 from assemblykit.tolerance import Tolerance, current
 
 
@@ -49,7 +49,7 @@ def relation_label(relation: Relation) -> str:
 
 
 @dataclass(frozen=True, eq=False)
-class RelationMotion:
+class RelationMotion(GroupMotion):
     """The motion of one body in one situation relative to the rest of the task.
 
     ``group``: the intersection of the placed groups of its coset relations, ``None``
@@ -68,16 +68,6 @@ class RelationMotion:
     def key(self) -> str:
         """The instance name ``"<body>@<situation>"`` (as in ``solve``)."""
         return f"{self.body}@{self.situation}"
-
-    @property
-    def kind(self) -> str:
-        """The motion's name: ``fixed``, ``revolute``, ``prismatic``, ... or ``free``."""
-        return str(motion_summary(self.group)["motion"])
-
-    @property
-    def dof(self) -> int:
-        """Degrees of freedom of the motion (the group's dimension)."""
-        return int(motion_summary(self.group)["dof"])
 
     def to_dict(self) -> dict[str, Any]:
         """``dof``, ``motion``, ``components``, the invariants (as in
