@@ -160,7 +160,30 @@ def bench_incremental() -> None:
     print(f"  add a part:    {t_add:.4f} vs rebuild {t_add_full:.3f}  (x{t_add_full / t_add:.0f})")
 
 
+def bench_exact_extended() -> None:
+    """Exact Γ_e DBG over all parts along one direction (projection test) on the ASAP
+    beam, per direction: the six axes and two oblique directions."""
+    path = DATA.parent / "asap_beam_assembly"
+    if not path.is_dir():
+        print("ASAP beam: ../shared/data absent, skipped")
+        return
+    from assemblykit import load_assembly
+    from assemblykit.blocking.extended import extended_dbg
+
+    beam = load_assembly(path)
+    tol = beam.tolerance()
+    names = tuple(beam.names)
+    triangles = sum(len(beam.parts[n].mesh.faces) for n in names)
+    directions = [*np.eye(3), *-np.eye(3), np.array([1.0, 1.0, 1.0]), np.array([0.3, -1.0, 0.2])]
+    times = [timed(extended_dbg, beam, d, names, tol, repeats=1)[2] for d in directions]
+    print(
+        f"\nexact extended DBG, ASAP beam ({len(names)} parts, {triangles} triangles): "
+        f"median {np.median(times):.3f} s, max {max(times):.3f} s CPU per direction"
+    )
+
+
 if __name__ == "__main__":
     bench_gamma_t()
     bench_dome()
     bench_incremental()
+    bench_exact_extended()

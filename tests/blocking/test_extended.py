@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
-import numpy as np
-import trimesh
-from blocking_helpers import box, mesh_assembly
+from pathlib import Path
 
-from assemblykit.blocking.extended import extended_dbg
+import numpy as np
+import pytest
+import trimesh
+from blocking_helpers import DATA, box, mesh_assembly
+
+from assemblykit.blocking.extended import extended_dbg, extended_free
 from assemblykit.blocking.ndbg import blocking_graph
+from assemblykit.blocking.queries import can_extract, removable_parts
+from assemblykit.io.assembly import load_assembly
 
 
 def ring(center, plane: str) -> trimesh.Trimesh:
@@ -61,3 +66,40 @@ def test_interlocked_rings_have_no_removable_subassembly():
     # without the interlock (second ring moved away) they separate
     apart = mesh_assembly({"r1": ring([0, 0, 0], "xy"), "r2": ring([5, 0, 0], "xz")})
     assert blocking_graph(apart, "extended").removable() != []
+
+
+ROOT = Path(__file__).resolve().parents[2]
+DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
+
+
+@pytest.mark.slow
+def test_gearbox_pins_and_cover_lift_out_exactly():
+    asm = load_assembly(DEMO)
+    tol = asm.tolerance()
+    up = np.array([0.0, 0.0, 1.0])
+    g = blocking_graph(asm, "extended")
+    # the housing is not convex: Γ_e is exact at each region of Γ_t
+    assert g.exact is not None
+    dbg = g.dbg(up)
+    for pin in ("pin_1", "pin_2", "pin_3", "pin_4"):
+        assert not any(i == pin for i, _ in dbg.arcs), pin
+        # sideways the pin runs into the cover's bore
+        assert not extended_free(asm, [pin], [1.0, 0.0, 0.0], tol)
+        found = can_extract(asm, [pin])
+        assert found is not None and any(np.allclose(d, up) for d in found.directions)
+    assert can_extract(asm, ["gear_a"]) is None  # inside the closed housing
+    for region in g.regions()[:5]:
+        assert region.dbg.arcs == extended_dbg(asm, region.direction, g.parts, tol).arcs
+
+
+def test_asap_beam_parts_are_removable_along_exact_directions():
+    path = DATA / "asap_beam_assembly"
+    if not path.exists():
+        pytest.skip(f"shared data {path} is absent")
+    asm = load_assembly(path)
+    tol = asm.tolerance()
+    removals = removable_parts(asm)
+    assert removals, "some beam part comes out by one translation"
+    for removal in removals:
+        for d in removal.directions[:2]:
+            assert extended_free(asm, removal.parts, d, tol)

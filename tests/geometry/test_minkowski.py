@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 
-from assemblykit.geometry.minkowski import blocking_cone, blocks_along, convex_pieces
+from assemblykit.geometry.minkowski import blocking_cone, blocks_along, convex_bodies
 from assemblykit.tolerance import Tolerance
 
 TOL = Tolerance()
@@ -61,6 +61,15 @@ def test_convex_pieces_split_bodies():
     b = trimesh.creation.box(
         extents=(1, 1, 1), transform=trimesh.transformations.translation_matrix([3, 0, 0])
     )
-    pieces = convex_pieces(trimesh.util.concatenate([a, b]))
-    assert len(pieces) == 2
+    pieces = convex_bodies(trimesh.util.concatenate([a, b]))
+    assert pieces is not None and len(pieces) == 2
     assert sorted(round(float(p[:, 0].mean()), 9) for p in pieces) == [0.0, 3.0]
+
+
+def test_a_non_convex_body_has_no_convex_decomposition():
+    notch = trimesh.creation.box(extents=(2, 2, 2)).difference(
+        trimesh.creation.box(
+            extents=(1, 1, 1), transform=trimesh.transformations.translation_matrix([0.5, 0.5, 0.5])
+        )
+    )
+    assert convex_bodies(notch) is None

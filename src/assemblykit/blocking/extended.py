@@ -1,38 +1,48 @@
 """Blocking for extended translations, Γ_e (seed 004, "Extended translations").
 
 Part ``j`` blocks part ``i`` along ``d`` iff ``i`` swept along ``d`` to infinity meets
-``j``: iff ``d`` lies in the open cone of the grown obstacle ``P_j ⊕ (−P_i)``
-(:mod:`assemblykit.geometry.minkowski`). With convex pieces, each pair of pieces gives
-one cone term, and the pair blocks iff one of its cones contains ``d``; ``P_i`` is
-blocked by ``P_j`` along ``−B`` when ``P_j`` is blocked by ``P_i`` along ``B``.
+the interior of ``j``. Two exact tests decide it, both here and nowhere else:
 
-For the NDBG every pair of parts is needed (any two parts block each other along some
-direction). For one direction, :func:`extended_dbg` only examines the pairs whose
-bounding spheres can meet during the sweep, which makes single-direction queries on
-large assemblies cheap.
+* both parts made of convex bodies: ``d`` lies in the open cone of one grown obstacle
+  ``Q ⊕ (−P)`` of a pair of bodies (:mod:`assemblykit.geometry.minkowski`); the cones
+  are computed once per pair and serve every direction, and their great circles give
+  the exact NDBG (regions over which the DBG is constant);
+* otherwise, one direction at a time, by projecting both meshes on the plane ``⟂ d``
+  and comparing the depths of overlapping triangles
+  (:mod:`assemblykit.geometry.occlusion`).
+
+Before either, the pairs are narrowed to those whose bounding spheres the sweep of the
+moving one can meet. :func:`extended_dbg` is G(d, A) over any parts; the planner and
+the queries ask it (or :func:`extended_free`) for every direction they accept, so each
+reported removal is exact. For assemblies with non-convex parts the NDBG is sampled:
+its regions are those of Γ_t (contacts) and each region's DBG is exact at the region's
+direction (:func:`sampled_ndbg`).
 """
 
 from __future__ import annotations
 
 import itertools
 import weakref
+from collections.abc import Iterable
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph
-from assemblykit.geometry.minkowski import blocking_cone, blocks_along, convex_pieces
+from assemblykit.blocking.ndbg import ConstraintTable, NonDirectionalBlockingGraph
+from assemblykit.geometry.minkowski import blocking_cone, blocks_along, convex_bodies
+from assemblykit.geometry.occlusion import occluded_pairs, shadows
 from assemblykit.tolerance import Tolerance
 
 
 class _Obstacles:
-    """Convex pieces, bounding spheres and pairwise cones of one assembly's parts."""
+    """Convex bodies, bounding spheres and pairwise cones of one assembly's parts."""
 
     def __init__(self, assembly: Any) -> None:
         self.assembly = assembly
-        self.pieces: dict[str, list[NDArray[np.float64]]] = {}
+        self.pieces: dict[str, list[NDArray[np.float64]] | None] = {}
         self.cones: dict[tuple[str, str, Tolerance], list[NDArray[np.float64]]] = {}
         names = list(assembly.names)
         self.names = names
@@ -40,13 +50,18 @@ class _Obstacles:
         self.centers = bounds.mean(axis=1)
         self.radii = np.linalg.norm(bounds[:, 1] - bounds[:, 0], axis=1) / 2
 
-    def of(self, name: str) -> list[NDArray[np.float64]]:
+    def of(self, name: str) -> list[NDArray[np.float64]] | None:
+        """The convex bodies of a part, ``None`` when one of them is not convex."""
         if name not in self.pieces:
-            self.pieces[name] = convex_pieces(self.assembly.parts[name].mesh)
+            self.pieces[name] = convex_bodies(self.assembly.parts[name].mesh)
         return self.pieces[name]
 
+    def convex(self, name: str) -> bool:
+        """Whether the part is a union of convex bodies (cones are exact for it)."""
+        return self.of(name) is not None
+
     def cones_of(self, moving: str, blocker: str, tol: Tolerance) -> list[NDArray[np.float64]]:
-        """The cones along which ``blocker`` blocks ``moving``."""
+        """The cones along which ``blocker`` blocks ``moving`` (both convex)."""
         key = (moving, blocker, tol)
         if key not in self.cones:
             flipped = (blocker, moving, tol)
@@ -55,7 +70,7 @@ class _Obstacles:
             else:
                 self.cones[key] = [
                     blocking_cone(q, p, tol)
-                    for p, q in itertools.product(self.of(moving), self.of(blocker))
+                    for p, q in itertools.product(self.of(moving) or [], self.of(blocker) or [])
                 ]
         return self.cones[key]
 
@@ -70,8 +85,15 @@ def obstacles(assembly: Any) -> _Obstacles:
     return _CACHE[assembly]
 
 
+def all_convex(assembly: Any, parts: Iterable[str]) -> bool:
+    """Whether every part is a union of convex bodies (the cone NDBG is then exact)."""
+    cache = obstacles(assembly)
+    return all(cache.convex(name) for name in parts)
+
+
 def extended_terms(assembly: Any, tol: Tolerance) -> list[BlockingTerm]:
-    """One cone term per pair of convex pieces of every pair of parts, both ways."""
+    """One cone term per pair of convex bodies of every pair of parts, both ways (all
+    parts must be unions of convex bodies, :func:`all_convex`)."""
     cache = obstacles(assembly)
     terms: list[BlockingTerm] = []
     for a, b in itertools.combinations(cache.names, 2):
@@ -94,19 +116,100 @@ def sweep_candidates(assembly: Any, moving: str, direction: NDArray[np.float64])
     return [n for k, n in enumerate(cache.names) if near[k] and k != i]
 
 
-def extended_dbg(
-    assembly: Any, direction: NDArray[np.float64], parts: tuple[str, ...], tol: Tolerance
-) -> DirectionalBlockingGraph:
-    """G(d, A) for extended translations along one direction, over ``parts``."""
-    d = np.asarray(direction, dtype=np.float64)
+def extended_arcs(
+    assembly: Any,
+    direction: ArrayLike,
+    movers: Iterable[str],
+    blockers: Iterable[str],
+    tol: Tolerance,
+) -> set[tuple[str, str]]:
+    """The arcs ``(i, j)``, ``i`` among ``movers`` and ``j ≠ i`` among ``blockers``,
+    such that ``j`` blocks the extended translation of ``i`` along ``direction``: cones
+    for pairs of convex parts, the projection test for the others (module docstring)."""
+    d = np.asarray(direction, dtype=np.float64).ravel()
     d = d / np.linalg.norm(d)
-    inside = set(parts)
     cache = obstacles(assembly)
-    arcs = set()
-    for moving in parts:
+    among = set(blockers)
+    arcs: set[tuple[str, str]] = set()
+    projected: list[tuple[str, str]] = []
+    for moving in movers:
         for blocker in sweep_candidates(assembly, moving, d):
-            if blocker in inside and any(
-                blocks_along(cone, d)[0] for cone in cache.cones_of(moving, blocker, tol)
-            ):
-                arcs.add((moving, blocker))
-    return DirectionalBlockingGraph(parts, d, frozenset(arcs))
+            if blocker not in among:
+                continue
+            if cache.convex(moving) and cache.convex(blocker):
+                if any(blocks_along(c, d)[0] for c in cache.cones_of(moving, blocker, tol)):
+                    arcs.add((moving, blocker))
+            else:
+                projected.append((moving, blocker))
+    if projected:
+        names = sorted({name for pair in projected for name in pair})
+        index = {name: k for k, name in enumerate(names)}
+        allowed = np.zeros((len(names), len(names)), dtype=bool)
+        for moving, blocker in projected:
+            allowed[index[moving], index[blocker]] = True
+        view = shadows([assembly.parts[name].mesh for name in names], d, tol)
+        arcs |= {(names[i], names[j]) for i, j in occluded_pairs(view, allowed, tol)}
+    return arcs
+
+
+def extended_dbg(
+    assembly: Any, direction: ArrayLike, parts: tuple[str, ...], tol: Tolerance
+) -> DirectionalBlockingGraph:
+    """G(d, A) for extended translations along one direction, over ``parts`` (exact)."""
+    d = np.asarray(direction, dtype=np.float64).ravel()
+    d = d / np.linalg.norm(d)
+    return DirectionalBlockingGraph(
+        tuple(parts), d, frozenset(extended_arcs(assembly, d, parts, parts, tol))
+    )
+
+
+def extended_free(
+    assembly: Any,
+    subassembly: Iterable[str],
+    direction: ArrayLike,
+    tol: Tolerance,
+    among: Iterable[str] | None = None,
+) -> bool:
+    """Whether ``subassembly`` leaves the other parts of ``among`` (default: all) by one
+    extended translation along ``direction`` (exact)."""
+    moving = set(subassembly)
+    rest = set(assembly.names if among is None else among) - moving
+    return not extended_arcs(assembly, direction, sorted(moving), sorted(rest), tol)
+
+
+def sampled_ndbg(
+    assembly: Any, parts: tuple[str, ...], local: NonDirectionalBlockingGraph, tol: Tolerance
+) -> NonDirectionalBlockingGraph:
+    """Γ_e over the regions of the Γ_t graph ``local`` of the same parts, each region's
+    DBG computed exactly at its representative direction; ``dbg(d)`` is exact for any
+    ``d``. Used when some part is not convex: the regions are then regular for Γ_t, not
+    necessarily for Γ_e, so free directions strictly between them may be missed."""
+    index = {name: k for k, name in enumerate(parts)}
+    pairs = [(i, j) for i in range(len(parts)) for j in range(len(parts)) if i != j]
+    moving = np.array([p[0] for p in pairs], dtype=np.int64)
+    blocker = np.array([p[1] for p in pairs], dtype=np.int64)
+    circles = local.arrangement.normals
+    table = ConstraintTable(
+        circles,
+        np.zeros((len(circles), len(pairs))),
+        np.zeros((len(circles), len(pairs))),
+        np.full(len(pairs), np.inf),
+        np.arange(len(pairs), dtype=np.int64),
+        moving,
+        blocker,
+    )
+    column = {pair: s for s, pair in enumerate(pairs)}
+    slots = np.zeros((len(local.arrangement), len(pairs)), dtype=bool)
+    for r, d in enumerate(local.arrangement.directions):
+        for i, j in extended_arcs(assembly, d, parts, parts, tol):
+            slots[r, column[(index[i], index[j])]] = True
+    return NonDirectionalBlockingGraph(
+        parts,
+        "extended",
+        local.arrangement,
+        table,
+        np.packbits(slots, axis=1),
+        local.contacts,
+        tol,
+        lambda d, names: extended_dbg(assembly, d, names, tol),
+    )

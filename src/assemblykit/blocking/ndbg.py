@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import weakref
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal, Protocol
 
@@ -200,7 +200,9 @@ def crossing_rule(arrangement: Arrangement, table: ConstraintTable) -> NDArray[n
 @dataclass(frozen=True, eq=False)
 class NonDirectionalBlockingGraph:
     """Γ_t or Γ_e of an assembly (seed 004): the regular regions of the directions and
-    the DBG of each (``packed``: bit-packed blocking slots per region)."""
+    the DBG of each (``packed``: bit-packed blocking slots per region). ``exact``, when
+    given, computes G(d, A) over the given parts for any direction instead of the
+    table (Γ_e of non-convex parts, :func:`assemblykit.blocking.extended.sampled_ndbg`)."""
 
     parts: tuple[str, ...]
     motion: str
@@ -209,6 +211,7 @@ class NonDirectionalBlockingGraph:
     packed: NDArray[np.uint8]
     contacts: int
     tol: Tolerance
+    exact: Callable[[NDArray[np.float64], tuple[str, ...]], DirectionalBlockingGraph] | None = None
 
     def _graph(
         self, direction: NDArray[np.float64], slots: NDArray[np.bool_]
@@ -230,6 +233,8 @@ class NonDirectionalBlockingGraph:
     def dbg(self, direction: ArrayLike) -> DirectionalBlockingGraph:
         """G(d, A) for any direction (2- or 3-vector), computed directly from the terms."""
         d = self._direction(direction)
+        if self.exact is not None:
+            return self.exact(d, self.parts)
         slots = self.table.direct_arcs(d[None, :], self.tol)[0]
         out = d[:2] if self.arrangement.dimension == 2 else d
         return self._graph(out, slots)
@@ -287,6 +292,7 @@ class NonDirectionalBlockingGraph:
             np.packbits(slots, axis=1),
             contacts,
             self.tol,
+            self.exact,
         )
 
     def _slot_matrix(self) -> NDArray[np.bool_]:
@@ -337,6 +343,7 @@ class NonDirectionalBlockingGraph:
             self.packed & np.packbits(keep),
             self.contacts,
             self.tol,
+            self.exact,
         )
 
     def with_terms(
@@ -583,12 +590,18 @@ def blocking_graph(
         from assemblykit.blocking.rigid import RigidBlockingGraph
 
         return RigidBlockingGraph(names, tuple(contacts), tol)
+    from assemblykit.blocking.extended import all_convex, sampled_ndbg
+
     graphs = _GRAPHS.setdefault(assembly, {})
     key = (motion, names, tol)
     whole = graphs.get((motion, tuple(assembly.names), tol))
     if key not in graphs and whole is not None:
         # a sub-assembly of an assembly already analysed: drop the other parts' slots
         graphs[key] = whole.without_parts(set(whole.parts) - inside)
+    if key not in graphs and motion == "extended" and not all_convex(assembly, names):
+        local = blocking_graph(assembly, "infinitesimal", names, tol)
+        assert isinstance(local, NonDirectionalBlockingGraph)
+        graphs[key] = sampled_ndbg(assembly, names, local, tol)
     if key not in graphs:
         terms = [
             t

@@ -6,12 +6,14 @@
 * the fewest parts to remove before extracting a part;
 * whether the assembly comes apart with extended translations only.
 
-For extended translations on large assemblies the directions examined are those where
-the moving parts are locally free (Γ_t, a necessary condition, from the contacts that
-leave them only, a small arrangement), those of the highest dimension (the interior of
-the free cone when it has one); each is then checked exactly against the obstacles
-whose bounding spheres its sweep can meet. A direction reported is thus
-truly free; directions between those examined may be missed.
+For extended translations the directions examined are, in order: those where the moving
+parts are locally free (Γ_t, a necessary condition, from the contacts that leave them
+only, a small arrangement), regions of the highest dimension first (the interior of the
+free cone when it has one), then its lower-dimensional regions (isolated directions such
+as a pin's axis), then the principal axes of the moving parts and the directions away
+from their contacts that pass the same local test. Each is checked exactly
+(:func:`assemblykit.blocking.extended.extended_free`): a direction reported is truly
+free; free directions strictly between those examined may be missed.
 """
 
 from __future__ import annotations
@@ -24,11 +26,16 @@ from numpy.typing import NDArray
 
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import Removal
-from assemblykit.blocking.extended import obstacles, sweep_candidates
-from assemblykit.blocking.ndbg import AssemblyLike, blocking_graph, blocking_terms, build_ndbg
+from assemblykit.blocking.extended import extended_free
+from assemblykit.blocking.ndbg import (
+    AssemblyLike,
+    NonDirectionalBlockingGraph,
+    blocking_graph,
+    blocking_terms,
+    build_ndbg,
+)
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import UnknownNameError
-from assemblykit.geometry.minkowski import blocks_along
 from assemblykit.tolerance import Tolerance
 
 _AXES = np.concatenate([np.eye(3), -np.eye(3)])
@@ -46,24 +53,59 @@ def removable_subassemblies(
     return blocking_graph(assembly, motion, parts, tol).removable(max_size)  # type: ignore[no-any-return]
 
 
-def _local_free_regions(
+def _local_graph(
     assembly: AssemblyLike, subassembly: set[str], tol: Tolerance
-) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
-    """Directions and dimensions of the Γ_t regions where ``subassembly`` is locally
-    free, faces first; the six axis directions (as faces) when it touches nothing."""
+) -> NonDirectionalBlockingGraph | None:
+    """Γ_t of the contacts leaving ``subassembly`` only (``None`` when it touches
+    nothing)."""
     terms: list[BlockingTerm] = [
         t
         for t in blocking_terms(assembly, "infinitesimal", tol)
         if t.moving in subassembly and t.blocker not in subassembly
     ]
     if not terms:
-        return _AXES, np.full(len(_AXES), 2, np.int8)
+        return None
     names = tuple(sorted(subassembly | {t.blocker for t in terms}))
-    graph = build_ndbg(names, "infinitesimal", terms, 0, tol)
+    return build_ndbg(names, "infinitesimal", terms, 0, tol)
+
+
+def _local_free_regions(
+    assembly: AssemblyLike, subassembly: set[str], tol: Tolerance
+) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
+    """Directions and dimensions of the Γ_t regions where ``subassembly`` is locally
+    free, faces first; the six axis directions (as faces) when it touches nothing."""
+    graph = _local_graph(assembly, subassembly, tol)
+    if graph is None:
+        return _AXES, np.full(len(_AXES), 2, np.int8)
     dims = graph.arrangement.dims
     free = np.flatnonzero(~np.any(graph.packed, axis=1))
     order = free[np.lexsort((free, -dims[free]))]
     return graph.arrangement.directions[order], dims[order]
+
+
+def _extra_directions(
+    assembly: AssemblyLike, subassembly: set[str], tol: Tolerance
+) -> NDArray[np.float64]:
+    """The principal axes (both ways) of the moving parts' meshes and the unit normals
+    of their contacts pointing away from the rest, kept where Γ_t leaves them locally
+    free (module docstring)."""
+    candidates = []
+    for name in sorted(subassembly):
+        mesh = assembly.parts[name].mesh  # type: ignore[attr-defined]
+        candidates.extend([*mesh.principal_inertia_vectors, *-mesh.principal_inertia_vectors])
+    for c in assembly.contacts(tol):
+        if (c.a in subassembly) != (c.b in subassembly):
+            away = -1.0 if c.a in subassembly else 1.0
+            candidates.extend(away * np.asarray(p.normal, dtype=np.float64) for p in c.planar)
+    if not candidates:
+        return np.zeros((0, 3))
+    directions = np.array(candidates, dtype=np.float64)
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    graph = _local_graph(assembly, subassembly, tol)
+    if graph is None:
+        return directions
+    free = ~np.any(graph.table.direct_arcs(directions, tol), axis=1)
+    return directions[free]
 
 
 def locally_free_directions(
@@ -74,23 +116,6 @@ def locally_free_directions(
     axis directions when it touches nothing."""
     directions, _ = _local_free_regions(assembly, set(subassembly), assembly.tolerance(tol))
     return list(directions)
-
-
-def _extended_free(
-    assembly: AssemblyLike,
-    subassembly: set[str],
-    direction: NDArray[np.float64],
-    tol: Tolerance,
-    among: set[str],
-) -> bool:
-    cache = obstacles(assembly)
-    for moving in subassembly:
-        for blocker in sweep_candidates(assembly, moving, direction):
-            if blocker in subassembly or blocker not in among:
-                continue
-            if any(blocks_along(c, direction)[0] for c in cache.cones_of(moving, blocker, tol)):
-                return False
-    return True
 
 
 def can_extract(
@@ -114,9 +139,13 @@ def can_extract(
         return None if twist is None else Removal(chosen, (twist,))
     directions, dims = _local_free_regions(assembly, moving, tol)
     if motion == "extended" and len(dims):
-        # the regions of the highest dimension: the open free cone itself when it has one
-        top = directions[dims == dims[0]]
-        directions = np.array([d for d in top if _extended_free(assembly, moving, d, tol, names)])
+        # the highest dimension first (the open free cone when it has one), then the rest
+        top = dims == dims[0]
+        for batch in (directions[top], directions[~top], _extra_directions(assembly, moving, tol)):
+            free = [d for d in batch if extended_free(assembly, moving, d, tol, names)]
+            if free:
+                return Removal(chosen, tuple(free))
+        return None
     return Removal(chosen, tuple(directions)) if len(directions) else None
 
 

@@ -8,11 +8,11 @@ obstacle is the convex hull of the vertex differences (scipy ``ConvexHull``) and
 blocked directions form an open polyhedral cone, bounded by the obstacle's facets
 through the origin once the origin is added to the hull.
 
-Non-convex parts are split into their connected bodies; a body that is not convex is
-decomposed with ``coacd`` when it is installed (extra ``decompose``) and replaced by
-its convex hull otherwise. Both only enlarge the obstacles, so a direction found free
-stays free: the sufficient condition of Γ_e holds. (manifold3d's ``minkowski_sum`` of
-two non-convex meshes took minutes on a 576-triangle torus, too slow to use here.)
+A part made of several convex bodies (one mesh, disjoint shells) has one obstacle per
+pair of bodies; a part with a non-convex body has no such exact decomposition here
+(:func:`convex_bodies` says so) and goes through the projection test of
+:mod:`assemblykit.geometry.occlusion` instead. (manifold3d's ``minkowski_sum`` of two
+non-convex meshes took minutes on a 576-triangle torus, too slow to use here.)
 """
 
 from __future__ import annotations
@@ -25,30 +25,15 @@ from scipy.spatial import ConvexHull, QhullError
 from assemblykit.errors import GeometryError
 from assemblykit.tolerance import Tolerance, current
 
-COACD_THRESHOLD = 0.05
 
-
-def _decompose(body: trimesh.Trimesh) -> list[NDArray[np.float64]]:
-    try:
-        import coacd
-    except ImportError:
-        return [np.asarray(body.convex_hull.vertices, dtype=np.float64)]
-    coacd.set_log_level("error")
-    pieces = coacd.run_coacd(coacd.Mesh(body.vertices, body.faces), threshold=COACD_THRESHOLD)
-    return [np.asarray(v, dtype=np.float64) for v, _ in pieces]
-
-
-def convex_pieces(mesh: trimesh.Trimesh) -> list[NDArray[np.float64]]:
-    """Vertex sets of convex pieces whose union contains the mesh (module docstring)."""
+def convex_bodies(mesh: trimesh.Trimesh) -> list[NDArray[np.float64]] | None:
+    """Vertex sets of the connected bodies of the mesh when each is convex, else ``None``."""
     if mesh.is_convex:
         return [np.asarray(mesh.vertices, dtype=np.float64)]
-    pieces: list[NDArray[np.float64]] = []
-    for body in mesh.split(only_watertight=False) or [mesh]:
-        if body.is_convex:
-            pieces.append(np.asarray(body.vertices, dtype=np.float64))
-        else:
-            pieces.extend(_decompose(body))
-    return pieces
+    bodies = mesh.split(only_watertight=False)
+    if len(bodies) < 2 or not all(body.is_convex for body in bodies):
+        return None
+    return [np.asarray(body.vertices, dtype=np.float64) for body in bodies]
 
 
 def obstacle_hull(obstacle: NDArray[np.float64], moving: NDArray[np.float64]) -> ConvexHull:

@@ -12,8 +12,8 @@ be removed, in what order, and which parts are interlocked. It uses three NDBGs:
 * Γ_e (extended translations) is *sufficient*: a set with no arc leaving it in the DBG
   of Γ_e along ``d`` is taken out by one straight translation ("Extended
   translations"). Only such removals are accepted as steps. Its DBG along a candidate
-  direction is computed from swept volumes (:mod:`assemblykit.planning.sweep`, exact
-  for parts with holes and slots) pair by pair, only when needed, and kept.
+  direction is computed exactly (:func:`assemblykit.blocking.extended.extended_dbg`,
+  also for parts with holes and slots) over all parts, only when needed, and kept.
 * Γ_g (infinitesimal rigid motions), also *necessary*, tells for a set left interlocked
   whether a motion with rotation might still free it.
 
@@ -41,12 +41,10 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import networkx as nx
 import numpy as np
-import trimesh
 from numpy.typing import ArrayLike, NDArray
 from rich.table import Table
 
-from assemblykit.geometry.interference import interferes
-from assemblykit.planning.sweep import swept_volume
+from assemblykit.blocking.extended import extended_dbg
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -129,54 +127,43 @@ class DirectionTable:
 
 
 class ExtendedDirections:
-    """The DBGs of Γ_e along fixed candidate directions, evaluated pair by pair on first
-    use with the swept volumes of :mod:`assemblykit.planning.sweep`."""
+    """The DBGs of Γ_e along fixed candidate directions, each computed exactly over all
+    parts on first use (:func:`assemblykit.blocking.extended.extended_dbg`)."""
 
     def __init__(self, assembly: Assembly, directions: NDArray[np.float64], tol: Tolerance) -> None:
         self.assembly = assembly
         self.names = tuple(assembly.names)
         self.directions = directions
         self.tol = tol
-        self._sweeps: dict[tuple[int, int], trimesh.Trimesh] = {}
-        self._pairs: dict[tuple[int, int, int], bool] = {}
+        self._arcs: dict[int, list[tuple[int, int]]] = {}
 
-    def _sweep(self, i: int, k: int) -> trimesh.Trimesh:
-        key = (i, k)
-        if key not in self._sweeps:
-            mesh = self.assembly.parts[self.names[i]].mesh
-            self._sweeps[key] = swept_volume(
-                mesh, self.directions[k], self.assembly.scale, self.tol
-            )
-        return self._sweeps[key]
-
-    def _blocks(self, i: int, j: int, k: int) -> bool:
-        key = (i, j, k)
-        if key not in self._pairs:
-            blocker = self.assembly.parts[self.names[j]].mesh
-            self._pairs[key] = interferes(self._sweep(i, k), blocker, self.tol)
-        return self._pairs[key]
+    def arcs(self, k: int) -> list[tuple[int, int]]:
+        """The arcs ``(i, j)``, "j blocks i", of the DBG along direction ``k``."""
+        if k not in self._arcs:
+            index = {name: i for i, name in enumerate(self.names)}
+            dbg = extended_dbg(self.assembly, self.directions[k], self.names, self.tol)
+            self._arcs[k] = sorted((index[a], index[b]) for a, b in dbg.arcs)
+        return self._arcs[k]
 
     def graph(self, k: int, members: int) -> nx.DiGraph:
-        """The Γ_e DBG along direction ``k`` induced on ``members`` (pairs are tested
-        once and remembered: blocking is pairwise)."""
-        inside = list(_bits(members))
+        """The Γ_e DBG along direction ``k`` induced on ``members`` (blocking is
+        pairwise, so one DBG over all parts serves every subassembly)."""
         graph = nx.DiGraph()
-        graph.add_nodes_from(inside)
+        graph.add_nodes_from(_bits(members))
         graph.add_edges_from(
-            (i, j) for i in inside for j in inside if i != j and self._blocks(i, j, k)
+            (i, j) for i, j in self.arcs(k) if members >> i & 1 and members >> j & 1
         )
         return graph
 
     @property
     def evaluated(self) -> set[int]:
-        """The directions along which some sweep has been computed."""
-        return {k for _, k in self._sweeps}
+        """The directions whose DBG has been computed."""
+        return set(self._arcs)
 
     def table(self, indices: Iterable[int]) -> DirectionTable:
         """The DBGs over all parts along the directions ``indices``, as a table."""
         chosen = sorted(set(indices))
-        everything = _mask(range(len(self.names)))
-        arcs = [list(self.graph(k, everything).edges) for k in chosen]
+        arcs = [self.arcs(k) for k in chosen]
         return DirectionTable.from_arcs(self.names, self.directions[chosen], arcs)
 
 

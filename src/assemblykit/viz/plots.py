@@ -18,8 +18,18 @@ import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from assemblykit.geometry.contacts import Contact
     from assemblykit.model.assembly import Assembly
+
+
+def _save_png(figure: Figure, path: str | Path, dpi: int) -> Path:
+    """Write ``figure`` as a PNG cropped to its content, close it and return the path."""
+    path = Path(path)
+    figure.savefig(path, dpi=dpi, bbox_inches="tight")
+    plt.close(figure)
+    return path
 
 
 def plot_contacts(
@@ -50,10 +60,7 @@ def plot_contacts(
     axes.set_box_aspect((1, 1, 1))
     axes.set_title(f"{len(assembly)} parts, {len(contacts)} contacts")
     axes.set_axis_off()
-    path = Path(path)
-    figure.savefig(path, dpi=dpi, bbox_inches="tight")
-    plt.close(figure)
-    return path
+    return _save_png(figure, path, dpi)
 
 
 if TYPE_CHECKING:
@@ -197,7 +204,4 @@ def plot_ndbg(
     )
     axes.set_title(f"DBG of region {chosen}: d = {np.array2string(dbg.direction, precision=2)}")
     axes.set_axis_off()
-    path = Path(path)
-    figure.savefig(path, dpi=dpi, bbox_inches="tight")
-    plt.close(figure)
-    return path
+    return _save_png(figure, path, dpi)

@@ -1,0 +1,163 @@
+"""Which meshes a translating mesh runs into: exact extended blocking on triangle meshes
+(seed 004, "Extended translations").
+
+Part ``j`` blocks the extended translation of part ``i`` along ``d`` iff the volume
+``i`` sweeps to infinity meets the interior of ``j``. On a line parallel to ``d`` the
+sweep of ``i`` starts at the lowest depth ``x . d`` of ``i`` on that line, reached on a
+triangle of ``i`` facing backwards (``n . d < 0``), and ``j`` reaches farthest on a
+triangle facing forwards; so ``j`` blocks ``i`` iff, over a set of lines of positive
+area, some forward triangle of ``j`` lies deeper than some backward triangle of ``i``.
+Projected on the plane ``⟂ d`` each triangle's depth is affine, hence so is the
+difference of two depths over the convex overlap of their projections, and its
+maximum is reached at a vertex of that overlap: ``j`` blocks ``i`` iff at a vertex of
+some overlap the depth of ``j`` exceeds that of ``i`` by more than the length tolerance
+(faces in contact give 0). The excess is measured across the faces (times the larger
+``|n . d|`` of the two): coincident faces nearly parallel to ``d`` differ along ``d`` by
+their rounding error divided by that cosine, not by an overlap. The broad phase is
+shapely's STRtree with an affine depth bound, the overlaps one vectorised shapely
+intersection; overlaps thinner than the length tolerance (shared
+edges) have no area and are left out. Triangles within the angle tolerance of parallel
+to ``d`` project to nothing and are skipped. Meshes that do not bound a volume (open or
+inconsistently wound) use all their triangles on both sides, which is still exact, only
+slower.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+import trimesh
+from numpy.typing import ArrayLike, NDArray
+
+from assemblykit.tolerance import Tolerance, current
+
+_FIRST_CHUNK = 1024
+
+
+def view_frame(direction: ArrayLike) -> NDArray[np.float64]:
+    """Rows ``e1, e2, d``: an orthonormal frame whose third axis is the unit ``direction``."""
+    d = np.asarray(direction, dtype=np.float64).ravel()
+    d = d / np.linalg.norm(d)
+    e1 = np.cross(d, np.eye(3)[int(np.argmin(np.abs(d)))])
+    e1 /= np.linalg.norm(e1)
+    return np.array([e1, np.cross(d, e1), d])
+
+
+@dataclass(frozen=True, eq=False)
+class Shadows:
+    """The non-vertical triangles of several meshes seen along a direction.
+
+    ``owner`` is the mesh of each triangle; ``facing`` +1 forwards, -1 backwards, 0 both
+    (a mesh that bounds no volume); ``polygons`` the projected triangles (shapely);
+    ``plane`` rows ``(a, b, c)`` with depth ``a u + b v + c`` at ``(u, v)``; ``low`` and
+    ``high`` each triangle's depth range and ``box`` its ``(umin, vmin, umax, vmax)``."""
+
+    owner: NDArray[np.int64]
+    facing: NDArray[np.int8]
+    polygons: NDArray[np.object_]
+    plane: NDArray[np.float64]
+    low: NDArray[np.float64]
+    high: NDArray[np.float64]
+    box: NDArray[np.float64]
+
+    @property
+    def cos(self) -> NDArray[np.float64]:
+        """``|n . d|`` of each triangle (from its depth gradient)."""
+        return 1.0 / np.sqrt(1.0 + self.plane[:, 0] ** 2 + self.plane[:, 1] ** 2)
+
+    def bound(self, back: NDArray[np.int64], front: NDArray[np.int64]) -> NDArray[np.float64]:
+        """An upper bound of how much deeper triangle ``front`` lies than ``back`` over
+        their overlap: the depth difference at the corners of the overlap of their
+        bounding boxes (an affine function peaks at a corner of a box), capped by
+        their depth ranges."""
+        lo = np.maximum(self.box[back, :2], self.box[front, :2])
+        hi = np.minimum(self.box[back, 2:], self.box[front, 2:])
+        diff = self.plane[front] - self.plane[back]
+        corner = (
+            np.where(diff[:, 0] > 0, hi[:, 0], lo[:, 0]) * diff[:, 0]
+            + np.where(diff[:, 1] > 0, hi[:, 1], lo[:, 1]) * diff[:, 1]
+            + diff[:, 2]
+        )
+        return np.minimum(corner, self.high[front] - self.low[back])
+
+    def depth(self, triangles: NDArray[np.int64], uv: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Depth of each triangle's plane at the points ``uv``, clamped to its range
+        (the points lie on the triangle up to rounding)."""
+        p = self.plane[triangles]
+        z = p[:, 0] * uv[:, 0] + p[:, 1] * uv[:, 1] + p[:, 2]
+        return np.clip(z, self.low[triangles], self.high[triangles])
+
+
+def shadows(
+    meshes: Sequence[trimesh.Trimesh], direction: ArrayLike, tol: Tolerance | None = None
+) -> Shadows:
+    """Project the meshes' triangles on the plane ``⟂ direction`` (module docstring)."""
+    tol = tol or current()
+    frame = view_frame(direction)
+    owner, facing, corners, normals = [], [], [], []
+    for k, mesh in enumerate(meshes):
+        cos = mesh.face_normals @ frame[2]
+        keep = np.abs(cos) > tol.mesh_angle
+        owner.append(np.full(int(keep.sum()), k, dtype=np.int64))
+        # without a consistent outside every triangle may bound the part on either side
+        facing.append(np.sign(cos[keep]).astype(np.int8) * np.int8(mesh.is_volume))
+        corners.append(np.asarray(mesh.triangles[keep], dtype=np.float64) @ frame.T)
+        normals.append(mesh.face_normals[keep] @ frame.T)
+    tri = np.concatenate(corners) if corners else np.zeros((0, 3, 3))
+    n = np.concatenate(normals) if normals else np.zeros((0, 3))
+    # plane n . x = n . p0 solved for the depth coordinate
+    plane = np.column_stack(
+        [-n[:, 0] / n[:, 2], -n[:, 1] / n[:, 2], np.einsum("ij,ij->i", n, tri[:, 0]) / n[:, 2]]
+    )
+    return Shadows(
+        np.concatenate(owner) if owner else np.zeros(0, np.int64),
+        np.concatenate(facing) if facing else np.zeros(0, np.int8),
+        shapely.polygons(tri[:, :, :2]),
+        plane,
+        tri[:, :, 2].min(axis=1),
+        tri[:, :, 2].max(axis=1),
+        np.column_stack([tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)]),
+    )
+
+
+def occluded_pairs(
+    view: Shadows, allowed: NDArray[np.bool_], tol: Tolerance | None = None
+) -> set[tuple[int, int]]:
+    """The pairs ``(i, j)`` of meshes such that ``j`` blocks the extended translation of
+    ``i`` along the view direction, among those with ``allowed[i, j]`` (module
+    docstring). Triangle pairs are examined by decreasing :meth:`Shadows.bound`, and a
+    pair of meshes stops being examined once it blocks."""
+    tol = tol or current()
+    backward = np.flatnonzero((view.facing <= 0) & np.any(allowed, axis=1)[view.owner])
+    forward = np.flatnonzero((view.facing >= 0) & np.any(allowed, axis=0)[view.owner])
+    if not len(backward) or not len(forward):
+        return set()
+    tree = shapely.STRtree(view.polygons[forward])
+    hits = tree.query(view.polygons[backward])
+    back, front = backward[hits[0]], forward[hits[1]]
+    keep = allowed[view.owner[back], view.owner[front]]
+    back, front = back[keep], front[keep]
+    bound = view.bound(back, front) * np.maximum(view.cos[front], view.cos[back])
+    keep = bound > tol.length
+    order = np.argsort(-bound[keep], kind="stable")
+    back, front = back[keep][order], front[keep][order]
+    found: set[tuple[int, int]] = set()
+    size = len(allowed)
+    lo, chunk = 0, _FIRST_CHUNK
+    while lo < len(back):
+        b, f = back[lo : lo + chunk], front[lo : lo + chunk]
+        # growing chunks: blocking pairs are usually found in the first, deepest ones
+        lo, chunk = lo + chunk, 2 * chunk
+        pair = view.owner[b] * size + view.owner[f]
+        fresh = ~np.isin(pair, [i * size + j for i, j in found])
+        b, f, pair = b[fresh], f[fresh], pair[fresh]
+        overlap = shapely.intersection(view.polygons[b], view.polygons[f])
+        thick = shapely.area(overlap) > tol.length * shapely.length(overlap)
+        uv, which = shapely.get_coordinates(overlap[thick], return_index=True)
+        b, f, pair = b[thick][which], f[thick][which], pair[thick][which]
+        excess = (view.depth(f, uv) - view.depth(b, uv)) * np.maximum(view.cos[f], view.cos[b])
+        found |= {(int(p // size), int(p % size)) for p in np.unique(pair[excess > tol.length])}
+    return found

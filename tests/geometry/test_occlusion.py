@@ -1,0 +1,93 @@
+"""Exact extended blocking on triangle meshes by projection (seed 004, "Extended
+translations"), checked by hand and against swept volumes built with manifold3d."""
+
+from __future__ import annotations
+
+import manifold3d
+import numpy as np
+import trimesh
+
+from assemblykit.geometry.interference import interferes, solid
+from assemblykit.geometry.occlusion import occluded_pairs, shadows, view_frame
+from assemblykit.tolerance import Tolerance
+
+TOL = Tolerance(scale=10.0)
+BOTH = ~np.eye(2, dtype=bool)
+UP, DOWN, EAST = [0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0]
+
+
+def mesh_of(shape: manifold3d.Manifold) -> trimesh.Trimesh:
+    out = shape.to_mesh64()
+    return trimesh.Trimesh(np.array(out.vert_properties[:, :3]), np.array(out.tri_verts))
+
+
+def cube(lo, hi) -> manifold3d.Manifold:
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    return manifold3d.Manifold.cube(tuple(hi - lo)).translate(tuple(lo))
+
+
+def blocked(meshes, direction) -> set[tuple[int, int]]:
+    return occluded_pairs(shadows(meshes, direction, TOL), BOTH, TOL)
+
+
+def swept(mesh: trimesh.Trimesh, direction, length: float) -> trimesh.Trimesh:
+    """Oracle: the mesh with the prisms of its forward triangles, one manifold3d union."""
+    step = length * np.asarray(direction, dtype=float) / np.linalg.norm(direction)
+    front = mesh.triangles[mesh.face_normals @ step > 0]
+    prisms = [manifold3d.Manifold.hull_points(np.vstack([t, t + step])) for t in front]
+    return mesh_of(manifold3d.Manifold.batch_boolean([solid(mesh), *prisms], manifold3d.OpType.Add))
+
+
+def pin_in_blind_hole() -> list[trimesh.Trimesh]:
+    bore = manifold3d.Manifold.cylinder(3.0, 0.5, 0.5, 16).translate((0.0, 0.0, -1.0))
+    housing = cube([-2, -2, -2], [2, 2, 2]) - bore  # the hole opens at the top, z = 2
+    pin = manifold3d.Manifold.cylinder(4.0, 0.5, 0.5, 16).translate((0.0, 0.0, -1.0))
+    return [mesh_of(pin), mesh_of(housing)]
+
+
+def test_view_frame_is_orthonormal_with_the_direction_last():
+    frame = view_frame([0.0, 3.0, 4.0])
+    assert np.allclose(frame @ frame.T, np.eye(3))
+    assert np.allclose(frame[2], [0.0, 0.6, 0.8])
+
+
+def test_pin_leaves_a_blind_hole_along_its_axis_only():
+    meshes = pin_in_blind_hole()
+    assert blocked(meshes, UP) == {(1, 0)}  # the pin goes; the housing cannot go up
+    assert blocked(meshes, DOWN) == {(0, 1)}
+    for d in (EAST, [0.0, 1.0, 0.0], [0.0, 0.1, 1.0], [0.1, 0.0, 1.0]):
+        assert blocked(meshes, d) == {(0, 1), (1, 0)}, d
+
+
+def test_hook_under_a_ledge_is_blocked_upwards_and_free_sideways():
+    # an L: a foot under the ledge of a wall, a post rising beside it
+    hook = mesh_of(cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4]))
+    wall = mesh_of(cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1]))
+    meshes = [hook, wall]
+    assert (0, 1) in blocked(meshes, UP)
+    assert (0, 1) not in blocked(meshes, [-1.0, 0.0, 0.0])
+    assert (0, 1) not in blocked(meshes, [0.0, 1.0, 0.0])
+    assert (0, 1) in blocked(meshes, EAST)
+
+
+def test_touching_faces_do_not_block():
+    below, above = mesh_of(cube([0, 0, 0], [1, 1, 1])), mesh_of(cube([0, 0, 1], [1, 1, 2]))
+    assert blocked([below, above], UP) == {(0, 1)}
+    assert blocked([below, above], EAST) == set()
+    # a neighbour sharing only an edge in projection does not block either
+    beside = mesh_of(cube([1, 0, 1], [2, 1, 2]))
+    assert blocked([below, beside], UP) == set()
+
+
+def test_agrees_with_swept_volumes():
+    meshes = pin_in_blind_hole()
+    rng = np.random.default_rng(7)
+    directions = [UP, DOWN, EAST, *rng.normal(size=(5, 3))]
+    for d in directions:
+        expected = {
+            (i, j)
+            for i in range(2)
+            for j in range(2)
+            if i != j and interferes(swept(meshes[i], d, 20.0), meshes[j], TOL.for_mesh())
+        }
+        assert blocked(meshes, d) == expected, d
