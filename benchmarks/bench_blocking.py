@@ -8,7 +8,10 @@ Prints
   regions and scaled), with the growth between sizes;
 * removable-part queries on the COMPAS dome (527 blocks), extended and infinitesimal
   translations (skipped when ../shared/data is absent);
-* incremental removal / addition of a part against rebuilding the NDBG.
+* incremental removal / addition of a part against rebuilding the NDBG;
+* the exact extended-translation DBG per direction on the ASAP beam;
+* Γ_g: the S⁵ arrangement (cells of m generic hyperplanes of twist space, and a block
+  on a table) with its size and build time.
 
 CPU times (``time.process_time``) are reported next to wall times: the machine is shared.
 """
@@ -17,6 +20,7 @@ from __future__ import annotations
 
 import statistics
 import time
+from math import comb
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +28,8 @@ import numpy as np
 from assemblykit.blocking.arrangement import sphere_arrangement
 from assemblykit.blocking.constraints import infinitesimal_terms
 from assemblykit.blocking.ndbg import ConstraintTable, build_ndbg, crossing_rule
+from assemblykit.blocking.rigid import RIGID_MAX_HYPERPLANES, RigidBlockingGraph
+from assemblykit.blocking.twist_arrangement import arrangement_cells
 from assemblykit.geometry.contacts import Contact, PlanarPatch
 from assemblykit.tolerance import Tolerance
 
@@ -78,6 +84,7 @@ def bench_gamma_t() -> None:
         f"{'per c² n² (ns)':>15}"
     )
     previous = None
+    rows = []
     for c in PLANES:
         names, contacts = synthetic(c)
         terms = infinitesimal_terms(contacts)
@@ -105,6 +112,17 @@ def bench_gamma_t() -> None:
         if previous is not None:
             print(f"      growth x{total / previous:.2f} for c x2 (c² predicts x4)")
         previous = total
+        rows.append((c, t_arr, t_cross, t_each))
+    cs = np.log([r[0] for r in rows])
+    print("summary (target: crossing rule >= 10x faster than one region at a time)")
+    for c, t_arr, t_cross, t_each in rows:
+        print(
+            f"  c = {c:>3}: arrangement {t_arr:.3f} s, crossing rule {t_cross:.3f} s, "
+            f"one region at a time {t_each:.2f} s, ratio {t_each / t_cross:.0f}x"
+        )
+    for k, label in ((1, "arrangement"), (2, "crossing rule"), (3, "one region at a time")):
+        slope = np.polyfit(cs, np.log([r[k] for r in rows]), 1)[0]
+        print(f"  growth exponent in c, {label}: {slope:.2f} (regions grow as c²)")
 
 
 def bench_dome() -> None:
@@ -182,8 +200,39 @@ def bench_exact_extended() -> None:
     )
 
 
+def bench_rigid() -> None:
+    """Γ_g: the cells of the S⁵ arrangement, one linear program per candidate cell."""
+    print(f"\nS⁵ arrangement (Γ_g), limit {RIGID_MAX_HYPERPLANES} hyperplanes (CPU seconds)")
+    rng = np.random.default_rng(5)
+    for m in (6, 8, 10, RIGID_MAX_HYPERPLANES):
+        normals = rng.normal(size=(m, 6))
+        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+        (signs, _), _, cpu = timed(arrangement_cells, normals, TOL, repeats=1)
+        expected = 2 * sum(comb(m - 1, k) for k in range(6))
+        print(
+            f"  {m:>2} random hyperplanes: {len(signs):>5} cells in {cpu:.2f} s "
+            f"({expected} in general position; cells thinner than the mesh angle "
+            "tolerance do not count)"
+        )
+    half = 0.5
+    corners = np.array([[x, y, 0.0] for x, y in ((-1, -1), (1, -1), (1, 1), (-1, 1))]) * half
+    table = Contact("block", "table", planar=(PlanarPatch(np.array([0, 0, -1.0]), corners, 1.0),))
+
+    def block_on_table() -> RigidBlockingGraph:
+        graph = RigidBlockingGraph(("block", "table"), (table,), TOL)
+        graph.removable()
+        return graph
+
+    graph, _, cpu = timed(block_on_table)
+    print(
+        f"  block on a table: {graph.arrangement.status}, removable "
+        f"{[sorted(r.parts) for r in graph.removable()]} in {cpu:.3f} s"
+    )
+
+
 if __name__ == "__main__":
     bench_gamma_t()
     bench_dome()
     bench_incremental()
     bench_exact_extended()
+    bench_rigid()

@@ -1,4 +1,5 @@
-"""Γ_g: infinitesimal rigid motions decided by linear programming (seed 004, Fig. 5)."""
+"""Γ_g: infinitesimal rigid motions, from the S⁵ arrangement and by linear programming
+(seed 004, Fig. 5)."""
 
 from __future__ import annotations
 
@@ -6,7 +7,37 @@ import numpy as np
 from blocking_helpers import ContactAssembly, square
 
 from assemblykit.blocking.ndbg import blocking_graph
-from assemblykit.geometry.contacts import Contact
+from assemblykit.blocking.rigid import RIGID_MAX_HYPERPLANES
+from assemblykit.geometry.contacts import Contact, PlanarPatch
+
+
+def point(normal, at) -> PlanarPatch:
+    """A point contact (a patch reduced to one vertex)."""
+    return PlanarPatch(np.asarray(normal, float), np.asarray([at], float), 0.0)
+
+
+def fig5_points() -> ContactAssembly:
+    """Seed 004, Fig. 5 with point contacts: a block wedged in the x-z plane (floor at
+    x = 0.5, ceiling at x = 0.9, left wall at z = 0.9, right wall at z = 0.1) and held in
+    y by a wall on each side at different x. Every translation is blocked; turning about
+    y through (0.7, 0.5) with a little turn about z breaks all six contacts."""
+    return ContactAssembly(
+        ["block", "frame"],
+        [
+            Contact(
+                "block",
+                "frame",
+                planar=(
+                    point([0, 0, -1], [0.5, 0.5, 0.0]),
+                    point([0, 0, 1], [0.9, 0.5, 1.0]),
+                    point([-1, 0, 0], [0.0, 0.5, 0.9]),
+                    point([1, 0, 0], [1.0, 0.5, 0.1]),
+                    point([0, 1, 0], [0.2, 1.0, 0.5]),
+                    point([0, -1, 0], [0.8, 0.0, 0.5]),
+                ),
+            )
+        ],
+    )
 
 
 def wedged_block() -> ContactAssembly:
@@ -59,3 +90,54 @@ def test_rotation_is_blocked_with_a_full_floor_and_ceiling():
     assert rigid.free_twist({"block"}) is None
     assert rigid.removable() == []
     assert rigid.to_dict()["removable"] == []
+
+
+def test_fig5_is_freed_by_a_rotation_in_a_cell_of_the_arrangement():
+    asm = fig5_points()
+    assert blocking_graph(asm, "infinitesimal").removable() == []
+    rigid = blocking_graph(asm, "rigid")
+    result = rigid.to_dict()
+    # the in-plane constraints (omega_y, v_x, v_z) and the y walls (omega_x, omega_z,
+    # v_y) are independent: 4 generic planes of R^3 (14 cells) times 2 of R^3 (4 cells)
+    assert result["regions"] == {"vertices": None, "edges": None, "faces": 56}
+    assert result["arrangement"] == "built: 6 hyperplanes, 56 regions"
+    assert len(rigid.regions()) == 56
+    assert {r.dimension for r in rigid.regions()} == {5}
+    removal = {r.parts: r for r in rigid.removable()}[frozenset({"block"})]
+    (twist,) = removal.directions  # one cell: all six contacts break
+    omega, v = twist[:3], twist[3:]
+    assert abs(np.linalg.norm(twist) - 1) < 1e-12
+    assert abs(omega[1]) > 0.1
+    pts, normals = rigid.constraints({"block"})
+    speeds = np.einsum("ij,ij->i", normals, v + np.cross(omega, pts))
+    assert np.all(speeds < -1e-6)
+    assert rigid.dbg(twist).is_free({"block"})
+
+
+def test_block_on_a_table_lifts_off_in_one_of_14_cells():
+    # the four corners give hyperplanes (p_y, -p_x, 0; 0, 0, 1) spanning a 3-space of
+    # twists, in general position there: 2 (1 + 3 + 3) = 14 cells
+    table = Contact("block", "table", planar=(square([0, 0, -1], (0.0, 0.0, 0.0), 0.5),))
+    rigid = blocking_graph(ContactAssembly(["block", "table"], [table]), "rigid")
+    regions = rigid.regions()
+    assert len(regions) == 14
+    free = {r.parts: r.directions for r in rigid.removable()}
+    assert set(free) == {frozenset({"block"}), frozenset({"table"})}
+    # one cell each: the block lifts straight up, the table drops (no sliding part)
+    assert np.allclose(free[frozenset({"block"})], [[0, 0, 0, 0, 0, 1]], atol=1e-9)
+    assert np.allclose(free[frozenset({"table"})], [[0, 0, 0, 0, 0, -1]], atol=1e-9)
+    # in the other 12 cells some corner sinks in while another lifts: both arcs
+    both = [r for r in regions if r.dbg.arcs == {("block", "table"), ("table", "block")}]
+    assert len(both) == 12
+
+
+def test_beyond_the_limit_the_lp_witness_decides():
+    rigid = blocking_graph(wedged_block(), "rigid")
+    result = rigid.to_dict()
+    assert len(rigid.arrangement.normals) > RIGID_MAX_HYPERPLANES
+    assert result["arrangement"] == (
+        f"not built: {len(rigid.arrangement.normals)} hyperplanes > {RIGID_MAX_HYPERPLANES}"
+    )
+    assert result["regions"]["faces"] is None
+    assert rigid.regions() == []
+    assert [r["parts"] for r in result["removable"]] == [["block"], ["frame"]]

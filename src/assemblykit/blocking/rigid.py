@@ -9,16 +9,25 @@ iff ``n . (v + omega x p) <= 0``, i.e. ``w . (omega; v) <= 0`` with the wrench
 convex hull (seed 004, "for each vertex v of the convex hull of the contacting area");
 for curved patches the sampled boundary points with the surface normals there.
 
-A subassembly is free when some allowed twist breaks at least one contact: the linear
-program "maximise the total separation ``-sum w . xi`` over allowed twists in a box"
-(scipy ``linprog``, HiGHS) decides it and its optimum is the witness twist. The S⁵
-arrangement itself is not enumerated.
+The S⁵ arrangement: every distinct hyperplane ``w . xi = 0`` of the assembly's contact
+points (taken about their centroid with rotations scaled by the model size, so both
+weigh alike) cuts twist space; up to ``RIGID_MAX_HYPERPLANES`` of them, its
+full-dimensional cells are enumerated (:mod:`assemblykit.blocking.twist_arrangement`)
+and each carries its DBG: ``i -> j`` iff some constraint of a contact where ``i``
+touches ``j`` is violated in the cell. A subassembly free in such a DBG leaves by a
+twist that breaks every one of its contacts. Freedom that needs sliding (a twist on
+some hyperplanes, e.g. a block held between two walls turning between them) lies on the
+lower-dimensional cells, which are not enumerated: for it, and beyond the limit, a
+linear program "maximise the total separation ``-sum w . xi`` over allowed twists in a
+box" (scipy ``linprog``, HiGHS) decides each candidate and its optimum is the witness.
 """
 
 from __future__ import annotations
 
+from collections import defaultdict
 from collections.abc import Iterable
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import networkx as nx
@@ -29,10 +38,14 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, QhullError
 
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
+from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
 from assemblykit.geometry.contacts import Contact, CurvedPatch, PlanarPatch
 from assemblykit.tolerance import Tolerance
 
 RIGID_MAX_SIZE = 2
+# about 4 s of linear programs at 12 hyperplanes in general position (2048 cells); the
+# count of cells grows as m^5
+RIGID_MAX_HYPERPLANES = 12
 CURVED_SAMPLES = 8
 
 
@@ -104,9 +117,68 @@ def wrenches(
     return np.column_stack([np.cross(points - origin, normals) / scale, normals])
 
 
+def world_twist(
+    x: NDArray[np.float64], origin: NDArray[np.float64], scale: float
+) -> NDArray[np.float64]:
+    """The unit twist ``(omega; v)`` (``v`` at the world origin) of a twist ``x`` taken
+    about ``origin`` with its rotation multiplied by ``scale`` (as in :func:`wrenches`)."""
+    omega = x[:3] / scale
+    v = x[3:] - np.cross(omega, origin)
+    twist = np.r_[omega, v]
+    return twist / np.linalg.norm(twist)
+
+
+@dataclass(frozen=True, eq=False)
+class TwistArrangement:
+    """The S⁵ arrangement of Γ_g (module docstring), in the coordinates of
+    :func:`wrenches` about ``origin``: the distinct unit hyperplane ``normals``; for
+    every contact point (contacts in order) its hyperplane ``plane_of``, orientation
+    ``orient`` and contact ``contact_of``; the full-dimensional cells' ``signs`` and
+    interior ``points``, ``None`` when there are more than ``RIGID_MAX_HYPERPLANES``
+    hyperplanes (not built)."""
+
+    origin: NDArray[np.float64]
+    normals: NDArray[np.float64]
+    plane_of: NDArray[np.int64]
+    orient: NDArray[np.int8]
+    contact_of: NDArray[np.int64]
+    signs: NDArray[np.int8] | None
+    points: NDArray[np.float64] | None
+
+    @property
+    def status(self) -> str:
+        """``built: ...`` or ``not built: N hyperplanes > limit`` (for the JSON)."""
+        m = len(self.normals)
+        if self.signs is None:
+            return f"not built: {m} hyperplanes > {RIGID_MAX_HYPERPLANES}"
+        return f"built: {m} hyperplanes, {len(self.signs)} regions"
+
+
+def twist_arrangement(contacts: Iterable[Contact], tol: Tolerance) -> TwistArrangement:
+    """The hyperplanes of every contact point of the contacts (normals from ``a`` into
+    ``b``), snapped (:func:`~assemblykit.blocking.twist_arrangement.snap_hyperplanes`),
+    and the cells of their arrangement when there are at most
+    ``RIGID_MAX_HYPERPLANES``."""
+    pts, nrm, owner = [np.zeros((0, 3))], [np.zeros((0, 3))], [np.zeros(0, np.int64)]
+    for k, contact in enumerate(contacts):
+        p, n = contact_points(contact)
+        pts.append(p)
+        nrm.append(n)
+        owner.append(np.full(len(p), k, dtype=np.int64))
+    points, normals = np.concatenate(pts), np.concatenate(nrm)
+    origin = points.mean(axis=0) if len(points) else np.zeros(3)
+    planes, plane_of, orient = snap_hyperplanes(wrenches(points, normals, origin, tol.scale), tol)
+    signs, cells = None, None
+    if len(planes) <= RIGID_MAX_HYPERPLANES:
+        signs, cells = arrangement_cells(planes, tol)
+    return TwistArrangement(origin, planes, plane_of, orient, np.concatenate(owner), signs, cells)
+
+
 @dataclass(frozen=True, eq=False)
 class RigidBlockingGraph:
-    """Γ_g of an assembly: blocking under infinitesimal rigid motions, queried by LP."""
+    """Γ_g of an assembly: blocking under infinitesimal rigid motions, from the cells of
+    the S⁵ arrangement when it is small enough and by linear programs otherwise
+    (module docstring)."""
 
     parts: tuple[str, ...]
     contacts: tuple[Contact, ...]
@@ -146,10 +218,7 @@ class RigidBlockingGraph:
         )
         if result.status != 0 or -result.fun <= self.tol.mesh_angle:
             return None
-        omega = result.x[:3] / self.tol.scale
-        v = result.x[3:] - np.cross(omega, origin)  # velocity of the point at the origin
-        twist = np.r_[omega, v]
-        return twist / np.linalg.norm(twist)
+        return world_twist(result.x, origin, self.tol.scale)
 
     def dbg(self, twist: ArrayLike) -> DirectionalBlockingGraph:
         """G(xi, A): ``j`` blocks ``i`` iff moving ``i`` alone by the twist pushes into
@@ -166,9 +235,39 @@ class RigidBlockingGraph:
                 arcs.add((c.b, c.a))
         return DirectionalBlockingGraph(self.parts, xi, frozenset(arcs))
 
+    @cached_property
+    def arrangement(self) -> TwistArrangement:
+        """The S⁵ arrangement of the contacts (built once, on first use)."""
+        return twist_arrangement(self.contacts, self.tol)
+
+    def _cell_arcs(self) -> list[frozenset[tuple[str, str]]]:
+        """The arcs of every cell's DBG: ``a -> b`` for a contact where some point's
+        constraint is positive in the cell, ``b -> a`` where one is negative."""
+        arr = self.arrangement
+        if arr.signs is None:
+            return []
+        speeds = arr.signs[:, arr.plane_of] * arr.orient  # sign of n . velocity per point
+        out: list[set[tuple[str, str]]] = [set() for _ in range(len(arr.signs))]
+        for k, c in enumerate(self.contacts):
+            rows = speeds[:, arr.contact_of == k]
+            for cell in np.flatnonzero(np.any(rows > 0, axis=1)):
+                out[cell].add((c.a, c.b))
+            for cell in np.flatnonzero(np.any(rows < 0, axis=1)):
+                out[cell].add((c.b, c.a))
+        return [frozenset(arcs) for arcs in out]
+
+    def _cell_twists(self) -> list[NDArray[np.float64]]:
+        arr = self.arrangement
+        cells = np.zeros((0, 6)) if arr.points is None else arr.points
+        return [world_twist(x, arr.origin, self.tol.scale) for x in cells]
+
     def regions(self) -> list[Region]:
-        """The S⁵ arrangement is not enumerated: no regions."""
-        return []
+        """The full-dimensional cells of the S⁵ arrangement (dimension 5) with a unit
+        twist inside each and its DBG; empty when the arrangement is not built."""
+        return [
+            Region(twist, 5, DirectionalBlockingGraph(self.parts, twist, arcs))
+            for twist, arcs in zip(self._cell_twists(), self._cell_arcs(), strict=True)
+        ]
 
     def _candidates(self, max_size: int) -> list[frozenset[str]]:
         graph = nx.Graph()
@@ -185,31 +284,60 @@ class RigidBlockingGraph:
         return sorted((s for s in found if s != everything), key=lambda s: (len(s), sorted(s)))
 
     def removable(self, max_size: int | None = None) -> list[Removal]:
-        """Connected subassemblies (up to ``max_size`` parts, default
-        ``RIGID_MAX_SIZE``) that some rigid twist frees, each with its witness twist:
-        a necessary condition for removal (seed 004)."""
-        out = []
+        """Subassemblies that some rigid twist frees (a necessary condition for
+        removal, seed 004): those free in a cell's DBG (up to ``max_size`` parts), with
+        the cells' twists, which break all their contacts; then the connected ones (up
+        to ``max_size``, default ``RIGID_MAX_SIZE`` parts) not found so, whose freedom
+        needs sliding or lies beyond the arrangement's limit, each with its LP witness."""
+        found: dict[frozenset[str], list[NDArray[np.float64]]] = defaultdict(list)
+        by_arcs: dict[frozenset[tuple[str, str]], list[NDArray[np.float64]]] = defaultdict(list)
+        for twist, arcs in zip(self._cell_twists(), self._cell_arcs(), strict=True):
+            by_arcs[arcs].append(twist)
+        for arcs, twists in by_arcs.items():
+            graph = DirectionalBlockingGraph(self.parts, twists[0], arcs)
+            for subset in graph.free_subassemblies():
+                if max_size is None or len(subset) <= max_size:
+                    found[subset].extend(twists)
         for subset in self._candidates(max_size or RIGID_MAX_SIZE):
-            twist = self.free_twist(subset)
-            if twist is not None:
-                out.append(Removal(subset, (twist,)))
-        return out
+            if subset not in found:
+                twist = self.free_twist(subset)
+                if twist is not None:
+                    found[subset].append(twist)
+        removals = [Removal(s, tuple(t)) for s, t in found.items()]
+        return sorted(removals, key=lambda r: (len(r.parts), sorted(r.parts)))
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON of DESIGN.md §5.3 (no regions: the S⁵ arrangement is not enumerated)."""
+        """JSON of DESIGN.md §5.3: ``regions`` counts only the full-dimensional cells
+        (``faces``; ``null`` when the arrangement is not built); lower-dimensional cells
+        are not enumerated (``vertices`` and ``edges`` are ``null``); ``arrangement``
+        says whether it was built."""
+        arr = self.arrangement
         return {
             "motion": self.motion,
             "parts": list(self.parts),
             "contacts": len(self.contacts),
-            "regions": {"vertices": 0, "edges": 0, "faces": 0},
+            "regions": {
+                "vertices": None,
+                "edges": None,
+                "faces": None if arr.signs is None else len(arr.signs),
+            },
+            "arrangement": arr.status,
             "removable": [r.to_dict() for r in self.removable()],
         }
 
     def render(self) -> Table:
-        """A table of the removable subassemblies with their witness twists."""
-        table = Table(title=f"rigid NDBG: {len(self.parts)} parts, {len(self.contacts)} contacts")
+        """A table of the removable subassemblies with their first twist."""
+        table = Table(
+            title=f"rigid NDBG: {len(self.parts)} parts, {len(self.contacts)} contacts, "
+            f"arrangement {self.arrangement.status}"
+        )
         table.add_column("removable parts")
-        table.add_column("twist (omega; v)")
+        table.add_column("twists")
+        table.add_column("e.g. (omega; v)")
         for r in self.removable():
-            table.add_row(", ".join(sorted(r.parts)), np.array2string(r.directions[0], precision=3))
+            table.add_row(
+                ", ".join(sorted(r.parts)),
+                str(len(r.directions)),
+                np.array2string(r.directions[0], precision=3),
+            )
         return table
