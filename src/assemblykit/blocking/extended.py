@@ -53,15 +53,24 @@ class _Obstacles:
     def of(self, name: str) -> list[NDArray[np.float64]] | None:
         """The convex bodies of a part, ``None`` when one of them is not convex."""
         if name not in self.pieces:
-            self.pieces[name] = convex_bodies(self.assembly.parts[name].mesh)
+            self.pieces[name] = convex_bodies(
+                self.assembly.parts[name].mesh, self.assembly.tolerance()
+            )
         return self.pieces[name]
 
     def convex(self, name: str) -> bool:
         """Whether the part is a union of convex bodies (cones are exact for it)."""
         return self.of(name) is not None
 
+    def hulls(self, name: str) -> list[NDArray[np.float64]]:
+        """The convex bodies of a convex part, else the part's convex hull (its vertices):
+        a hull contains the part, so a direction its cones leave free is free for the part."""
+        pieces = self.of(name)
+        return pieces if pieces is not None else [self.assembly.parts[name].mesh.vertices]
+
     def cones_of(self, moving: str, blocker: str, tol: Tolerance) -> list[NDArray[np.float64]]:
-        """The cones along which ``blocker`` blocks ``moving`` (both convex)."""
+        """The cones along which ``blocker`` blocks ``moving``: exact for convex parts, a
+        superset (the hulls' cones) otherwise."""
         key = (moving, blocker, tol)
         if key not in self.cones:
             flipped = (blocker, moving, tol)
@@ -70,7 +79,7 @@ class _Obstacles:
             else:
                 self.cones[key] = [
                     blocking_cone(q, p, tol)
-                    for p, q in itertools.product(self.of(moving) or [], self.of(blocker) or [])
+                    for p, q in itertools.product(self.hulls(moving), self.hulls(blocker))
                 ]
         return self.cones[key]
 
@@ -125,7 +134,8 @@ def extended_arcs(
 ) -> set[tuple[str, str]]:
     """The arcs ``(i, j)``, ``i`` among ``movers`` and ``j ≠ i`` among ``blockers``,
     such that ``j`` blocks the extended translation of ``i`` along ``direction``: cones
-    for pairs of convex parts, the projection test for the others (module docstring)."""
+    for pairs of convex parts; for the others the hulls' cones first (a free direction for
+    the hulls is free for the parts) and the projection test where they block."""
     d = np.asarray(direction, dtype=np.float64).ravel()
     d = d / np.linalg.norm(d)
     cache = obstacles(assembly)
@@ -134,11 +144,12 @@ def extended_arcs(
     projected: list[tuple[str, str]] = []
     for moving in movers:
         for blocker in sweep_candidates(assembly, moving, d):
-            if blocker not in among:
+            if blocker not in among or not any(
+                blocks_along(c, d)[0] for c in cache.cones_of(moving, blocker, tol)
+            ):
                 continue
             if cache.convex(moving) and cache.convex(blocker):
-                if any(blocks_along(c, d)[0] for c in cache.cones_of(moving, blocker, tol)):
-                    arcs.add((moving, blocker))
+                arcs.add((moving, blocker))
             else:
                 projected.append((moving, blocker))
     if projected:

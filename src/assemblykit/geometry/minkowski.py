@@ -26,14 +26,33 @@ from assemblykit.errors import GeometryError
 from assemblykit.tolerance import Tolerance, current
 
 
-def convex_bodies(mesh: trimesh.Trimesh) -> list[NDArray[np.float64]] | None:
-    """Vertex sets of the connected bodies of the mesh when each is convex, else ``None``."""
-    if mesh.is_convex:
-        return [np.asarray(mesh.vertices, dtype=np.float64)]
-    bodies = mesh.split(only_watertight=False)
-    if len(bodies) < 2 or not all(body.is_convex for body in bodies):
+def convex_bodies(
+    mesh: trimesh.Trimesh, tol: Tolerance | None = None
+) -> list[NDArray[np.float64]] | None:
+    """Vertex sets of the connected bodies of the mesh when each is convex within the
+    length tolerance, else ``None``.
+
+    A body counts as convex when none of its vertices or face centres lies deeper than
+    ``tol.length`` inside its convex hull: blocks whose polygon faces are not quite
+    planar (COMPAS vaults) stay on the exact cone route, and treating them as their hull
+    moves their surface by at most the tolerance."""
+    tol = tol or current()
+    bodies = [mesh] if mesh.body_count < 2 else mesh.split(only_watertight=False)
+    if not all(_convex_within(body, tol) for body in bodies):
         return None
     return [np.asarray(body.vertices, dtype=np.float64) for body in bodies]
+
+
+def _convex_within(body: trimesh.Trimesh, tol: Tolerance) -> bool:
+    """Whether no vertex or face centre of ``body`` is deeper than ``tol.length`` inside
+    its convex hull (hull facets ``a . x + b <= 0`` inside, ``a`` unit)."""
+    points = np.vstack([body.vertices, body.triangles_center])
+    try:
+        facets = ConvexHull(points).equations
+    except QhullError:
+        return False
+    depth = -(points @ facets[:, :3].T + facets[:, 3]).max(axis=1)
+    return bool(depth.max() <= tol.length)
 
 
 def obstacle_hull(obstacle: NDArray[np.float64], moving: NDArray[np.float64]) -> ConvexHull:
