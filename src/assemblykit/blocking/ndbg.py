@@ -34,7 +34,7 @@ from assemblykit.blocking.arrangement import (
     sphere_arrangement,
 )
 from assemblykit.blocking.constraints import BlockingTerm, infinitesimal_terms
-from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
+from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal, removal_table
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import Contact
 from assemblykit.tolerance import Tolerance
@@ -494,20 +494,13 @@ class NonDirectionalBlockingGraph:
     def render(self) -> Table:
         """A table of the removable subassemblies and their first direction."""
         counts = self.arrangement.counts
-        table = Table(
-            title=f"{self.motion} NDBG: {len(self.parts)} parts, {self.contacts} contacts, "
-            f"{counts['vertices']} vertices, {counts['edges']} edges, {counts['faces']} faces"
+        return removal_table(
+            f"{self.motion} NDBG: {len(self.parts)} parts, {self.contacts} contacts, "
+            f"{counts['vertices']} vertices, {counts['edges']} edges, {counts['faces']} faces",
+            "directions",
+            "e.g.",
+            self.removable(),
         )
-        table.add_column("removable parts")
-        table.add_column("directions")
-        table.add_column("e.g.")
-        for r in self.removable():
-            table.add_row(
-                ", ".join(sorted(r.parts)),
-                str(len(r.directions)),
-                np.array2string(r.directions[0], precision=3),
-            )
-        return table
 
 
 def build_ndbg(

@@ -37,7 +37,7 @@ from rich.table import Table
 from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, QhullError
 
-from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
+from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal, removal_table
 from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
 from assemblykit.geometry.contacts import Contact, CurvedPatch, PlanarPatch
 from assemblykit.tolerance import Tolerance
@@ -327,17 +327,10 @@ class RigidBlockingGraph:
 
     def render(self) -> Table:
         """A table of the removable subassemblies with their first twist."""
-        table = Table(
-            title=f"rigid NDBG: {len(self.parts)} parts, {len(self.contacts)} contacts, "
-            f"arrangement {self.arrangement.status}"
+        return removal_table(
+            f"rigid NDBG: {len(self.parts)} parts, {len(self.contacts)} contacts, "
+            f"arrangement {self.arrangement.status}",
+            "twists",
+            "e.g. (omega; v)",
+            self.removable(),
         )
-        table.add_column("removable parts")
-        table.add_column("twists")
-        table.add_column("e.g. (omega; v)")
-        for r in self.removable():
-            table.add_row(
-                ", ".join(sorted(r.parts)),
-                str(len(r.directions)),
-                np.array2string(r.directions[0], precision=3),
-            )
-        return table
