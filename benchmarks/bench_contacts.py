@@ -1,6 +1,7 @@
-"""Contacts benchmark: the 527-block dome of compas_assembly, and grids of unit boxes
+"""Contacts benchmark: the 527-block dome of compas_assembly, grids of unit boxes
 showing how the cost grows with the number of parts (near-linear: the broad phase keeps
-only touching pairs, the narrow phase is vectorised over all of them).
+only touching pairs, the narrow phase is vectorised over all of them), and the ASAP beam
+loaded with and without settling its rounded poses (largest shared volume per pair).
 
 Run: python benchmarks/bench_contacts.py
 """
@@ -17,17 +18,14 @@ import numpy as np
 import trimesh
 
 from assemblykit.geometry.contacts import find_contacts
+from assemblykit.geometry.interference import overlap_volume
+from assemblykit.io.assembly import load_assembly
 from assemblykit.io.compas import load_compas
 from assemblykit.model.assembly import Assembly, Part
 
-DOME = (
-    Path(__file__).resolve().parents[1]
-    / ".."
-    / "shared"
-    / "data"
-    / "compas_assembly"
-    / "dome_assembly.json"
-)
+DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+DOME = DATA / "compas_assembly" / "dome_assembly.json"
+ASAP = DATA / "asap_beam_assembly"
 GRID_SIZES = (1000, 2500, 5000, 10000)
 
 
@@ -47,6 +45,28 @@ def grid(n: int) -> Assembly:
         mesh = trimesh.Trimesh(unit.vertices + np.array(cell), unit.faces, process=False)
         parts.append(Part(f"b{k}", mesh))
     return Assembly(parts)
+
+
+def largest_share(assembly: Assembly) -> float:
+    """The largest volume a touching pair shares, over the smaller part's volume."""
+    return max(
+        overlap_volume(assembly[c.a].mesh, assembly[c.b].mesh)
+        / min(assembly[c.a].volume, assembly[c.b].volume)
+        for c in assembly.contacts()
+    )
+
+
+def asap() -> None:
+    if not ASAP.is_dir():
+        print("asap beam: shared data not present, skipped")
+        return
+    for settle in (False, True):
+        seconds = median_time(lambda settle=settle: load_assembly(ASAP, settle=settle), 3)
+        beam = load_assembly(ASAP, settle=settle)
+        print(
+            f"asap beam {'settled' if settle else 'as written'}: load {seconds:.2f} s, "
+            f"largest shared volume {largest_share(beam):.2g} of the smaller part"
+        )
 
 
 def main() -> None:
@@ -77,6 +97,7 @@ def main() -> None:
         f"CPU time per box, {GRID_SIZES[-1]} vs {GRID_SIZES[0]} boxes: "
         f"ratio {rates[-1] / rates[0]:.2f} (1.0 = linear)"
     )
+    asap()
 
 
 if __name__ == "__main__":

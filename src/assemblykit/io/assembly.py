@@ -34,11 +34,13 @@ def _is_manifest_json(path: Path) -> bool:
     return isinstance(data, dict) and isinstance(data.get("parts"), list)
 
 
-def load_assembly(path: str | Path, tol: Tolerance | None = None) -> Assembly:
-    """The assembly stored at ``path`` (module docstring); ``tol`` becomes its policy."""
+def load_assembly(path: str | Path, tol: Tolerance | None = None, settle: bool = True) -> Assembly:
+    """The assembly stored at ``path`` (module docstring); ``tol`` becomes its policy;
+    ``settle`` closes thin layers left by rounded mesh-folder poses
+    (:func:`assemblykit.io.meshes.load_mesh_folder`)."""
     path = Path(path)
     if path.is_dir():
-        return load_mesh_folder(path, tol)
+        return load_mesh_folder(path, tol, settle)
     if not path.exists():
         raise InputError("no such file or folder", source=str(path))
     suffix = path.suffix.lower()

@@ -33,13 +33,16 @@ if TYPE_CHECKING:
 class Part:
     """One rigid part: ``mesh`` in world (assembled) position, ``pose`` the 4x4 transform
     that was applied to the source mesh to place it, ``surfaces`` the exact surfaces read
-    from CAD (empty for meshes), ``source`` the file it came from."""
+    from CAD (empty for meshes), ``source`` the file it came from, ``settled`` the
+    translation the loader added to a rounded pose to close thin interpenetrations
+    (:mod:`assemblykit.geometry.settling`; ``None`` when the pose is as read)."""
 
     name: str
     mesh: trimesh.Trimesh
     pose: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     surfaces: tuple[Surface, ...] = ()
     source: str | None = None
+    settled: tuple[float, float, float] | None = None
 
     @property
     def volume(self) -> float:
@@ -237,7 +240,8 @@ class Assembly:
         return grown
 
     def to_dict(self) -> dict[str, Any]:
-        """Summary: source, units, scale and per-part triangle count, volume and bounds."""
+        """Summary: source, units, scale and per-part triangle count, volume, bounds,
+        source file and the ``settled`` translation of its pose (``None`` if as read)."""
         return {
             "source": self.source,
             "units": self.units,
@@ -249,6 +253,7 @@ class Assembly:
                     "volume": p.volume,
                     "bounds": p.mesh.bounds.tolist(),
                     "source": p.source,
+                    "settled": None if p.settled is None else list(p.settled),
                 }
                 for name, p in self.parts.items()
             },
