@@ -9,7 +9,7 @@ import pytest
 import trimesh
 from blocking_helpers import DATA, box, mesh_assembly
 
-from assemblykit.blocking.extended import extended_dbg, extended_free
+from assemblykit.blocking.extended import extended_dbg, extended_free, obstacles
 from assemblykit.blocking.ndbg import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
 from assemblykit.io.assembly import load_assembly
@@ -56,6 +56,31 @@ def test_locally_free_but_blocked_farther_along():
     assert sideways.is_free({"block"})
     for region in extended.regions():
         assert region.dbg.arcs == extended.dbg(region.direction).arcs
+
+
+def post_on_plate(layer: float) -> object:
+    """A 1 x 1 x 10 post standing on a 10 x 10 x 1 plate, sunk ``layer`` into it."""
+    return mesh_assembly(
+        {"plate": box([-5, -5, -1], [5, 5, 0]), "post": box([0, 0, -layer], [1, 1, 10 - layer])}
+    )
+
+
+def test_a_layer_thinner_than_the_interference_policy_is_a_contact():
+    probe = post_on_plate(0.0)
+    tol = probe.tolerance()
+    # thicker than the length tolerance (the cones alone would block every direction),
+    # thinner than what the policy calls interference (tolerance x the post's area 42)
+    layer = 5 * tol.length
+    asm = post_on_plate(layer)
+    for direction in ([0, 0, 1], [1, 0, 0], [0, 1, 1]):
+        assert extended_free(asm, ["post"], direction, tol)
+    assert not extended_free(asm, ["post"], [0, 0, -1], tol)
+    assert not extended_free(asm, ["post"], [1, 0, -1], tol)
+    # the post is tested backed out of the plate by the layer, straight up
+    np.testing.assert_allclose(obstacles(asm).backout("post", "plate", tol), [0, 0, layer])
+    # a real interference stays an obstacle in every direction
+    deep = post_on_plate(0.1)
+    assert not any(extended_free(deep, ["post"], d, tol) for d in ([0, 0, 1], [1, 0, 0], [0, 1, 1]))
 
 
 def test_interlocked_rings_have_no_removable_subassembly():

@@ -12,11 +12,18 @@ the interior of ``j``. Two exact tests decide it, both here and nowhere else:
   (:mod:`assemblykit.geometry.occlusion`).
 
 Before either, the pairs are narrowed to those whose bounding spheres the sweep of the
-moving one can meet. :func:`extended_dbg` is G(d, A) over any parts; the planner and
-the queries ask it (or :func:`extended_free`) for every direction they accept, so each
-reported removal is exact. For assemblies with non-convex parts the NDBG is sampled:
-its regions are those of Γ_t (contacts) and each region's DBG is exact at the region's
-direction (:func:`sampled_ndbg`).
+moving one can meet. A pair that shares a volume the interference policy counts as
+touching (:func:`assemblykit.geometry.interference.interference_threshold`; COMPAS
+vault blocks whose generated faces overlap by a few 1e-4) is tested with the moving part
+backed out of the other by their separation
+(:func:`assemblykit.geometry.settling.settle`): a layer the data cannot resolve is a
+contact, not an obstacle in every direction.
+
+:func:`extended_dbg` is G(d, A) over any parts; the planner and the queries ask it (or
+:func:`extended_free`) for every direction they accept, so each reported removal is
+exact. For assemblies with non-convex parts the NDBG is sampled: its regions are those
+of Γ_t (contacts) and each region's DBG is exact at the region's direction
+(:func:`sampled_ndbg`).
 """
 
 from __future__ import annotations
@@ -32,8 +39,10 @@ from numpy.typing import ArrayLike, NDArray
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph
 from assemblykit.blocking.ndbg import ConstraintTable, NonDirectionalBlockingGraph
+from assemblykit.geometry.interference import interference_threshold, overlap_volume
 from assemblykit.geometry.minkowski import blocking_cone, blocks_along, convex_bodies
 from assemblykit.geometry.occlusion import occluded_pairs, shadows
+from assemblykit.geometry.settling import settle
 from assemblykit.tolerance import Tolerance
 
 
@@ -44,6 +53,7 @@ class _Obstacles:
         self.assembly = assembly
         self.pieces: dict[str, list[NDArray[np.float64]] | None] = {}
         self.cones: dict[tuple[str, str, Tolerance], list[NDArray[np.float64]]] = {}
+        self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
         names = list(assembly.names)
         self.names = names
         bounds = np.array([assembly.parts[n].mesh.bounds for n in names]).reshape(-1, 2, 3)
@@ -68,20 +78,48 @@ class _Obstacles:
         pieces = self.of(name)
         return pieces if pieces is not None else [self.assembly.parts[name].mesh.vertices]
 
+    def backout(self, moving: str, blocker: str, tol: Tolerance) -> NDArray[np.float64]:
+        """The translation that backs ``moving`` out of ``blocker`` before blocking is
+        decided: their separation when they share a volume counted as touching (module
+        docstring), else zero."""
+        key = (moving, blocker, tol)
+        if key not in self.backouts:
+            flipped = (blocker, moving, tol)
+            if flipped in self.backouts:
+                self.backouts[key] = -self.backouts[flipped]
+            else:
+                a, b = self.assembly.parts[moving].mesh, self.assembly.parts[blocker].mesh
+                shift = np.zeros(3)
+                if 0 < overlap_volume(a, b) <= interference_threshold(a, b, tol):
+                    shifts = settle([a, b], [(0, 1)]).shifts
+                    shift = shifts[0] - shifts[1]
+                self.backouts[key] = shift
+        return self.backouts[key]
+
     def cones_of(self, moving: str, blocker: str, tol: Tolerance) -> list[NDArray[np.float64]]:
         """The cones along which ``blocker`` blocks ``moving``: exact for convex parts, a
-        superset (the hulls' cones) otherwise."""
+        superset (the hulls' cones) otherwise. An empty cone (the hulls overlap) is
+        recomputed with ``moving`` backed out of ``blocker`` (:meth:`backout`)."""
         key = (moving, blocker, tol)
         if key not in self.cones:
             flipped = (blocker, moving, tol)
             if flipped in self.cones:
                 self.cones[key] = [-c for c in self.cones[flipped]]
             else:
-                self.cones[key] = [
-                    blocking_cone(q, p, tol)
-                    for p, q in itertools.product(self.hulls(moving), self.hulls(blocker))
-                ]
+                self.cones[key] = self._cones(moving, blocker, tol, np.zeros(3))
+                if any(len(c) == 0 for c in self.cones[key]):
+                    shift = self.backout(moving, blocker, tol)
+                    if shift.any():
+                        self.cones[key] = self._cones(moving, blocker, tol, shift)
         return self.cones[key]
+
+    def _cones(
+        self, moving: str, blocker: str, tol: Tolerance, shift: NDArray[np.float64]
+    ) -> list[NDArray[np.float64]]:
+        return [
+            blocking_cone(q, p + shift, tol)
+            for p, q in itertools.product(self.hulls(moving), self.hulls(blocker))
+        ]
 
 
 _CACHE: weakref.WeakKeyDictionary[Any, _Obstacles] = weakref.WeakKeyDictionary()
@@ -152,15 +190,38 @@ def extended_arcs(
                 arcs.add((moving, blocker))
             else:
                 projected.append((moving, blocker))
-    if projected:
-        names = sorted({name for pair in projected for name in pair})
-        index = {name: k for k, name in enumerate(names)}
-        allowed = np.zeros((len(names), len(names)), dtype=bool)
-        for moving, blocker in projected:
-            allowed[index[moving], index[blocker]] = True
-        view = shadows([assembly.parts[name].mesh for name in names], d, tol)
-        arcs |= {(names[i], names[j]) for i, j in occluded_pairs(view, allowed, tol)}
+    plain = [pair for pair in projected if not cache.backout(*pair, tol).any()]
+    arcs |= _occluded(assembly, d, plain, {}, tol)
+    for moving, blocker in projected:
+        shift = cache.backout(moving, blocker, tol)
+        if shift.any():
+            arcs |= _occluded(assembly, d, [(moving, blocker)], {moving: shift}, tol)
     return arcs
+
+
+def _occluded(
+    assembly: Any,
+    direction: NDArray[np.float64],
+    pairs: list[tuple[str, str]],
+    shifts: dict[str, NDArray[np.float64]],
+    tol: Tolerance,
+) -> set[tuple[str, str]]:
+    """Which of ``pairs`` (moving, blocker) block along ``direction`` by the projection
+    test, parts in ``shifts`` translated by them first."""
+    if not pairs:
+        return set()
+    names = sorted({name for pair in pairs for name in pair})
+    index = {name: k for k, name in enumerate(names)}
+    allowed = np.zeros((len(names), len(names)), dtype=bool)
+    for moving, blocker in pairs:
+        allowed[index[moving], index[blocker]] = True
+    meshes = [assembly.parts[name].mesh for name in names]
+    meshes = [
+        mesh.copy().apply_translation(shifts[name]) if name in shifts else mesh
+        for name, mesh in zip(names, meshes, strict=True)
+    ]
+    view = shadows(meshes, direction, tol)
+    return {(names[i], names[j]) for i, j in occluded_pairs(view, allowed, tol)}
 
 
 def extended_dbg(

@@ -12,18 +12,20 @@ be removed, in what order, and which parts are interlocked. It uses three NDBGs:
 * Γ_e (extended translations) is *sufficient*: a set with no arc leaving it in the DBG
   of Γ_e along ``d`` is taken out by one straight translation ("Extended
   translations"). Only such removals are accepted as steps. Its DBG along a candidate
-  direction is computed exactly (:func:`assemblykit.blocking.extended.extended_dbg`,
-  also for parts with holes and slots) over all parts, only when needed, and kept.
+  direction is computed exactly (:func:`assemblykit.blocking.extended.extended_arcs`,
+  also for parts with holes and slots), only for the pairs the search asks about, and
+  kept.
 * Γ_g (infinitesimal rigid motions), also *necessary*, tells for a set left interlocked
   whether a motion with rotation might still free it.
 
 Blocking is pairwise (whether P_j blocks P_i along d does not depend on the other
 parts), so the DBG of a subassembly is the induced subgraph of the assembly's DBG, and
-one DBG per direction serves every node of the search.
+the pairs tested for one node of the search serve every other.
 
-The chosen plan removes, at each step, every minimal free set (sink strong component,
-"Directional Blocking Graph") of one direction at once: parts that can go in parallel
-share a step. The previous step's direction is kept while it frees anything (fewer
+The chosen plan removes, at each step, every part that leaves alone along one
+direction, or when no part leaves alone, every minimal free set (sink strong
+component, "Directional Blocking Graph") of one direction: parts that can go in
+parallel share a step. The previous step's direction is kept while it frees anything (fewer
 direction changes, shallower trees); otherwise the direction freeing the most parts
 wins, then directions along a coordinate axis, then lifting (+z). Removing parts never
 makes the rest harder to take apart (a partition of a set restricts to a partition of
@@ -44,13 +46,15 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from rich.table import Table
 
-from assemblykit.blocking.extended import extended_dbg
+from assemblykit.blocking.extended import extended_arcs
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
 
 Progress = Callable[[str, int, int], None]
+LOOK_AHEAD = 12
+"""Candidate directions still examined after the first removal Γ_e accepts."""
 MotionKind = Literal["translation", "rigid"]
 
 
@@ -118,6 +122,11 @@ class DirectionTable:
         )
         return graph
 
+    def blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
+        """Per part of ``movers``, the mask of its blockers in ``among`` along ``k``."""
+        masks = self.masks(k)
+        return {i: masks[i] & among & ~(1 << i) for i in _bits(movers)}
+
     def masks(self, k: int) -> tuple[int, ...]:
         """Per part, the bit mask of its blockers along direction ``k``."""
         masks = [0] * len(self.names)
@@ -127,38 +136,62 @@ class DirectionTable:
 
 
 class ExtendedDirections:
-    """The DBGs of Γ_e along fixed candidate directions, each computed exactly over all
-    parts on first use (:func:`assemblykit.blocking.extended.extended_dbg`)."""
+    """The DBGs of Γ_e along fixed candidate directions, computed exactly
+    (:func:`assemblykit.blocking.extended.extended_arcs`) pair by pair as the search
+    asks for them, and kept: per direction and moving part, the parts already tested
+    as blockers and those found blocking."""
 
     def __init__(self, assembly: Assembly, directions: NDArray[np.float64], tol: Tolerance) -> None:
         self.assembly = assembly
         self.names = tuple(assembly.names)
+        self.index = {name: i for i, name in enumerate(self.names)}
         self.directions = directions
         self.tol = tol
-        self._arcs: dict[int, list[tuple[int, int]]] = {}
+        self._tested: dict[tuple[int, int], int] = {}
+        self._blocking: dict[tuple[int, int], int] = {}
+
+    def blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
+        """Per part of ``movers``, the mask of its blockers in ``among`` along ``k``;
+        only the pairs not tested before are computed, in one call."""
+        untested = [i for i in _bits(movers) if among & ~self._tested.get((k, i), 1 << i)]
+        if untested:
+            arcs = extended_arcs(
+                self.assembly,
+                self.directions[k],
+                [self.names[i] for i in untested],
+                [self.names[j] for j in _bits(among)],
+                self.tol,
+            )
+            for i in untested:
+                self._tested[(k, i)] = self._tested.get((k, i), 1 << i) | among
+            for a, b in arcs:
+                key = (k, self.index[a])
+                self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
+        return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in _bits(movers)}
 
     def arcs(self, k: int) -> list[tuple[int, int]]:
         """The arcs ``(i, j)``, "j blocks i", of the DBG along direction ``k``."""
-        if k not in self._arcs:
-            index = {name: i for i, name in enumerate(self.names)}
-            dbg = extended_dbg(self.assembly, self.directions[k], self.names, self.tol)
-            self._arcs[k] = sorted((index[a], index[b]) for a, b in dbg.arcs)
-        return self._arcs[k]
+        everything = _mask(range(len(self.names)))
+        return [
+            (i, j)
+            for i, mask in self.blockers(k, everything, everything).items()
+            for j in _bits(mask)
+        ]
 
     def graph(self, k: int, members: int) -> nx.DiGraph:
         """The Γ_e DBG along direction ``k`` induced on ``members`` (blocking is
-        pairwise, so one DBG over all parts serves every subassembly)."""
+        pairwise, so the arcs found for one subassembly serve every other)."""
         graph = nx.DiGraph()
         graph.add_nodes_from(_bits(members))
         graph.add_edges_from(
-            (i, j) for i, j in self.arcs(k) if members >> i & 1 and members >> j & 1
+            (i, j) for i, mask in self.blockers(k, members, members).items() for j in _bits(mask)
         )
         return graph
 
     @property
     def evaluated(self) -> set[int]:
-        """The directions whose DBG has been computed."""
-        return set(self._arcs)
+        """The directions along which some pair has been tested."""
+        return {k for k, _ in self._tested}
 
     def table(self, indices: Iterable[int]) -> DirectionTable:
         """The DBGs over all parts along the directions ``indices``, as a table."""
@@ -171,7 +204,9 @@ class ExtendedDirections:
 class Step:
     """One disassembly step: ``parts`` translate along unit ``direction`` away from
     ``rest`` (the other parts of the subassembly they leave). ``blocking`` lists the
-    arcs (i, j), "j blocks i", of the DBG along ``direction`` within that subassembly."""
+    arcs (i, j), "j blocks i", of the DBG along ``direction`` that end in a moved part:
+    the parts of ``rest`` they held in place, and the moved parts that leave together
+    because they hold one another."""
 
     parts: tuple[str, ...]
     direction: NDArray[np.float64]
@@ -340,7 +375,7 @@ def _bits(mask: int) -> Iterable[int]:
 def _mask(indices: Iterable[int]) -> int:
     total = 0
     for i in indices:
-        total |= 1 << i
+        total |= 1 << int(i)  # numpy integers would overflow past 63 parts
     return total
 
 
@@ -424,16 +459,11 @@ def _removal(sinks: list[int], members: int, volumes: Sequence[float]) -> list[i
     return [s for s in sinks if not s & base]
 
 
-def _bounds(translations: DirectionTable, members: int, volumes: Sequence[float]) -> dict[int, int]:
-    """Per candidate direction, how many parts Γ_t lets leave ``members`` on their own
-    (a bound for Γ_e on single parts). They are counted for all directions at once;
-    only when no direction frees a single part are the DBGs condensed, so that groups
-    that must leave together count too."""
-    free = translations.free_parts(members)
-    free[:, _base(members, volumes)] = False
-    counts = free.sum(axis=1)
-    if counts.max(initial=0) > 0:
-        return {int(k): int(counts[k]) for k in np.flatnonzero(counts)}
+def _group_bounds(
+    translations: DirectionTable, members: int, volumes: Sequence[float]
+) -> dict[int, int]:
+    """Per candidate direction, how many parts the free sets of Γ_t (sink components,
+    the base's excluded) take out of ``members``: a bound for those of Γ_e."""
     bounds = {
         k: _count(_union(_removal(_sinks(translations, k, members), members, volumes)))
         for k in range(len(translations.directions))
@@ -450,13 +480,46 @@ def _choose_removal(
 ) -> tuple[int, list[int]] | None:
     """The direction index and the free sets of Γ_e it removes from ``members``.
 
-    The previous step's direction is tried first and kept if it frees anything. Other
-    candidates are visited best Γ_t bound first (most parts, closest to a coordinate
-    axis, then +z); the search stops as soon as a bound cannot beat the best removal
-    that Γ_e accepted.
+    Single parts first: where Γ_t lets single parts leave (counted for all directions at
+    once), only those parts are tested against Γ_e. When none leaves alone, the sink
+    components of Γ_e, so that groups that must leave together can.
     """
-    if previous is not None:
-        sinks = _removal(_sinks(extended, previous, members), members, volumes)
+    free = translations.free_parts(members)
+    free[:, _base(members, volumes)] = False
+    counts = free.sum(axis=1)
+
+    def singles(k: int) -> list[int]:
+        held = extended.blockers(k, _mask(np.flatnonzero(free[k])), members)
+        return [1 << i for i, mask in held.items() if not mask]
+
+    def groups(k: int) -> list[int]:
+        return _removal(_sinks(extended, k, members), members, volumes)
+
+    choice = None
+    if counts.any():
+        bounds = {int(k): int(counts[k]) for k in np.flatnonzero(counts)}
+        choice = _best_direction(translations, bounds, singles, previous)
+    if choice is None:
+        bounds = _group_bounds(translations, members, volumes)
+        choice = _best_direction(translations, bounds, groups, previous)
+    return choice
+
+
+def _best_direction(
+    translations: DirectionTable,
+    bounds: dict[int, int],
+    removal: Callable[[int], list[int]],
+    previous: int | None,
+) -> tuple[int, list[int]] | None:
+    """The candidate whose ``removal`` moves most, with its free sets.
+
+    The previous step's direction is tried first and kept if it frees anything. Other
+    candidates are visited best bound first (most parts, closest to a coordinate axis,
+    then +z); the search stops when a bound cannot beat the best removal accepted, or
+    ``LOOK_AHEAD`` candidates after the first one accepted.
+    """
+    if previous in bounds:
+        sinks = removal(previous)
         if sinks:
             return previous, sinks
 
@@ -464,12 +527,14 @@ def _choose_removal(
         direction = translations.directions[k]
         return (moved, float(np.abs(direction).max()), float(direction[2]), -k)
 
-    bounds = _bounds(translations, members, volumes)
     best: tuple[tuple[float, ...], int, list[int]] | None = None
+    patience = LOOK_AHEAD
     for k in sorted(bounds, key=lambda k: rank(k, bounds[k]), reverse=True):
-        if best is not None and rank(k, bounds[k]) <= best[0]:
-            break
-        sinks = _removal(_sinks(extended, k, members), members, volumes)
+        if best is not None:
+            if rank(k, bounds[k]) <= best[0] or patience == 0:
+                break
+            patience -= 1
+        sinks = removal(k)
         if sinks and (best is None or rank(k, _count(_union(sinks))) > best[0]):
             best = (rank(k, _count(_union(sinks))), k, sinks)
     return None if best is None else (best[1], best[2])
@@ -506,13 +571,15 @@ class _Search:
 
     def _record(self, k: int, moved: int, members: int) -> None:
         names = self.translations.names
-        graph = self.extended.graph(k, members)
+        rest = members & ~moved
+        held = self.extended.blockers(k, rest, moved) | self.extended.blockers(k, moved, moved)
+        arcs = sorted((i, j) for i, mask in held.items() for j in _bits(mask))
         self.steps.append(
             Step(
                 parts=tuple(names[i] for i in _bits(moved)),
                 direction=self.translations.directions[k],
-                rest=tuple(names[i] for i in _bits(members & ~moved)),
-                blocking=tuple((names[i], names[j]) for i, j in sorted(graph.edges)),
+                rest=tuple(names[i] for i in _bits(rest)),
+                blocking=tuple((names[i], names[j]) for i, j in arcs),
             )
         )
         self.progress("planning", len(self.steps), len(names))
