@@ -76,12 +76,15 @@ class _Obstacles:
         """The convex bodies of a convex part, else the part's convex hull (its vertices):
         a hull contains the part, so a direction its cones leave free is free for the part."""
         pieces = self.of(name)
-        return pieces if pieces is not None else [self.assembly.parts[name].mesh.vertices]
+        if pieces is not None:
+            return pieces
+        return [np.asarray(self.assembly.parts[name].mesh.convex_hull.vertices, dtype=np.float64)]
 
     def backout(self, moving: str, blocker: str, tol: Tolerance) -> NDArray[np.float64]:
         """The translation that backs ``moving`` out of ``blocker`` before blocking is
         decided: their separation when they share a volume counted as touching (module
-        docstring), else zero."""
+        docstring) and it is longer than the length tolerance the tests allow anyway,
+        else zero."""
         key = (moving, blocker, tol)
         if key not in self.backouts:
             flipped = (blocker, moving, tol)
@@ -92,14 +95,16 @@ class _Obstacles:
                 shift = np.zeros(3)
                 if 0 < overlap_volume(a, b) <= interference_threshold(a, b, tol):
                     shifts = settle([a, b], [(0, 1)]).shifts
-                    shift = shifts[0] - shifts[1]
+                    if np.linalg.norm(shifts[0] - shifts[1]) > tol.length:
+                        shift = shifts[0] - shifts[1]
                 self.backouts[key] = shift
         return self.backouts[key]
 
     def cones_of(self, moving: str, blocker: str, tol: Tolerance) -> list[NDArray[np.float64]]:
         """The cones along which ``blocker`` blocks ``moving``: exact for convex parts, a
-        superset (the hulls' cones) otherwise. An empty cone (the hulls overlap) is
-        recomputed with ``moving`` backed out of ``blocker`` (:meth:`backout`)."""
+        superset (the hulls' cones) otherwise. For convex parts, an empty cone (they
+        overlap) is recomputed with ``moving`` backed out of ``blocker``
+        (:meth:`backout`); other parts go to the projection test, which backs them out."""
         key = (moving, blocker, tol)
         if key not in self.cones:
             flipped = (blocker, moving, tol)
@@ -107,7 +112,8 @@ class _Obstacles:
                 self.cones[key] = [-c for c in self.cones[flipped]]
             else:
                 self.cones[key] = self._cones(moving, blocker, tol, np.zeros(3))
-                if any(len(c) == 0 for c in self.cones[key]):
+                convex = self.convex(moving) and self.convex(blocker)
+                if convex and any(len(c) == 0 for c in self.cones[key]):
                     shift = self.backout(moving, blocker, tol)
                     if shift.any():
                         self.cones[key] = self._cones(moving, blocker, tol, shift)

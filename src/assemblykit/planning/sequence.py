@@ -122,6 +122,15 @@ class DirectionTable:
         )
         return graph
 
+    def incomplete(self, members: int) -> list[int]:
+        """The directions along which some part of ``members`` does not block another:
+        the only ones that may separate any subset of ``members`` (Γ_e blocks at least
+        where Γ_t does)."""
+        columns = self._active(members)
+        size = _count(members)
+        arcs = self.slots[:, columns].sum(axis=1)
+        return [int(k) for k in np.flatnonzero(arcs < size * (size - 1))]
+
     def blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
         """Per part of ``movers``, the mask of its blockers in ``among`` along ``k``."""
         masks = self.masks(k)
@@ -169,13 +178,12 @@ class ExtendedDirections:
                 self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in _bits(movers)}
 
-    def arcs(self, k: int) -> list[tuple[int, int]]:
-        """The arcs ``(i, j)``, "j blocks i", of the DBG along direction ``k``."""
-        everything = _mask(range(len(self.names)))
+    def arcs(self, k: int, members: int | None = None) -> list[tuple[int, int]]:
+        """The arcs ``(i, j)``, "j blocks i", of the DBG along direction ``k`` among
+        ``members`` (default: all parts)."""
+        among = _mask(range(len(self.names))) if members is None else members
         return [
-            (i, j)
-            for i, mask in self.blockers(k, everything, everything).items()
-            for j in _bits(mask)
+            (i, j) for i, mask in self.blockers(k, among, among).items() for j in _bits(mask)
         ]
 
     def graph(self, k: int, members: int) -> nx.DiGraph:
@@ -193,10 +201,11 @@ class ExtendedDirections:
         """The directions along which some pair has been tested."""
         return {k for k, _ in self._tested}
 
-    def table(self, indices: Iterable[int]) -> DirectionTable:
-        """The DBGs over all parts along the directions ``indices``, as a table."""
+    def table(self, indices: Iterable[int], members: int | None = None) -> DirectionTable:
+        """The DBGs among ``members`` (default: all parts) along the directions
+        ``indices``, as a table."""
         chosen = sorted(set(indices))
-        arcs = [self.arcs(k) for k in chosen]
+        arcs = [self.arcs(k, members) for k in chosen]
         return DirectionTable.from_arcs(self.names, self.directions[chosen], arcs)
 
 
@@ -679,9 +688,16 @@ def plan(
     search.disassemble(_mask(range(len(names))))
     interlocks: tuple[Interlock, ...] = ()
     if search.locked:
-        complete = extended.table(range(len(translations.directions)))
         interlocks = tuple(
-            _interlock(assembly, names, minimal_interlocked(complete, members), translations, tol)
+            _interlock(
+                assembly,
+                names,
+                minimal_interlocked(
+                    extended.table(translations.incomplete(members), members), members
+                ),
+                translations,
+                tol,
+            )
             for members in search.locked
         )
     and_or = None
