@@ -182,9 +182,7 @@ class ExtendedDirections:
         """The arcs ``(i, j)``, "j blocks i", of the DBG along direction ``k`` among
         ``members`` (default: all parts)."""
         among = _mask(range(len(self.names))) if members is None else members
-        return [
-            (i, j) for i, mask in self.blockers(k, among, among).items() for j in _bits(mask)
-        ]
+        return [(i, j) for i, mask in self.blockers(k, among, among).items() for j in _bits(mask)]
 
     def graph(self, k: int, members: int) -> nx.DiGraph:
         """The Γ_e DBG along direction ``k`` induced on ``members`` (blocking is
