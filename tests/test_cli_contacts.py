@@ -83,3 +83,27 @@ def test_bad_input_exits_2_with_one_line_naming_the_file(kind, tmp_path, capsys)
     assert code == 2
     assert out == ""
     assert len(err.strip().splitlines()) == 1 and str(named) in err.replace("\n", "")
+
+
+def test_rounded_poses_are_settled_unless_kept_as_written(tmp_path, capsys):
+    # block b was meant to sit on a at z = 1; its pose, written to 4 decimals, sinks it
+    # 1e-4 into a: deeper than the tolerance (the 8.7e-5 the rounding allows)
+    trimesh.creation.box(extents=[1, 1, 1]).export(tmp_path / "a.stl")
+    trimesh.creation.box(extents=[1, 1, 1]).export(tmp_path / "b.stl")
+    states = {"a": [0, 0, 0, 0, 0, 0], "b": [0, 0, 0.9999, 0, 0, 0]}
+    (tmp_path / "config.json").write_text(
+        json.dumps({k: {"final_state": v} for k, v in states.items()})
+    )
+    main(["contacts", str(tmp_path), "--json"])
+    out = capsys.readouterr().out
+    parts = json.loads(out)["parts"]
+    # each moves half the layer, a down and b up, and they touch
+    assert parts["a"]["settled"] == pytest.approx([0, 0, -5e-5], abs=1e-9)
+    assert parts["b"]["settled"] == pytest.approx([0, 0, 5e-5], abs=1e-9)
+    assert [(c["a"], c["b"]) for c in json.loads(out)["contacts"]] == [("a", "b")]
+    main(["contacts", str(tmp_path), "--json", "--as-written"])
+    data = json.loads(capsys.readouterr().out)
+    assert [p["settled"] for p in data["parts"].values()] == [None, None]
+    # as written they neither touch within the tolerance nor interfere
+    assert data["contacts"] == []
+    assert data["interferences"] == []

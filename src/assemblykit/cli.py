@@ -1,7 +1,8 @@
 """The ``assemblykit`` command (DESIGN.md §5.3).
 
 Every command takes ``INPUT``, ``--json`` (the documented JSON on stdout), ``--tolerance``
-(relative length tolerance) and ``--debug`` (tracebacks). Exit codes: 0 for every answer
+(relative length tolerance) and ``--debug`` (tracebacks); the commands that load an
+assembly take ``--as-written`` (keep rounded mesh-folder poses unsettled). Exit codes: 0 for every answer
 (including *inconsistent* or *infeasible*), 2 for bad input (one line on stderr naming the
 file and the fault), 1 for an internal error.
 """
@@ -40,6 +41,13 @@ ToleranceOption = Annotated[
     ),
 ]
 DebugOption = Annotated[bool, typer.Option("--debug", help="Show tracebacks on errors.")]
+AsWrittenOption = Annotated[
+    bool,
+    typer.Option(
+        "--as-written",
+        help="Keep rounded mesh-folder poses as written (do not settle thin overlaps).",
+    ),
+]
 
 
 class Result(Protocol):
@@ -163,6 +171,7 @@ def plan_cmd(
     ] = None,
     as_json: JsonOption = False,
     tolerance: ToleranceOption = None,
+    as_written: AsWrittenOption = False,
     debug: DebugOption = False,
 ) -> None:
     """Disassembly (and assembly) sequence by extended translations (seed 004)."""
@@ -172,7 +181,7 @@ def plan_cmd(
     tol = tolerance_from(tolerance)
     with _progress_bar() as bar:
         update = _updater(bar)
-        loaded = load_assembly(assembly, tol)
+        loaded = load_assembly(assembly, tol, settle=not as_written)
         result = plan(loaded, tol=tol, progress=update)
         if html is not None:
             from assemblykit.viz.viewer import write_report
@@ -308,6 +317,7 @@ def motion_cmd(
     html: HtmlOption = None,
     as_json: JsonOption = False,
     tolerance: ToleranceOption = None,
+    as_written: AsWrittenOption = False,
     debug: DebugOption = False,
 ) -> None:
     """Motion of each part and subassembly relative to the rest, gear trains (seed 003);
@@ -321,7 +331,7 @@ def motion_cmd(
             raise InputError("--subassembly and --html apply to assemblies, not tasks")
         _task_motion(assembly, tol, as_json)
         return
-    loaded = load_assembly(assembly, tol)
+    loaded = load_assembly(assembly, tol, settle=not as_written)
     sets = [[n.strip() for n in spec.split(",") if n.strip()] for spec in subassembly or ()]
     if any(not names for names in sets):
         raise InputError("--subassembly needs comma-separated part names", source=assembly)
@@ -362,13 +372,14 @@ def contacts_cmd(
     png: PngOption = None,
     as_json: JsonOption = False,
     tolerance: ToleranceOption = None,
+    as_written: AsWrittenOption = False,
     debug: DebugOption = False,
 ) -> None:
     """Parts, contact patches (areas, normals), surface features and interferences."""
     from assemblykit.io.assembly import contact_report, load_assembly
 
     tol = tolerance_from(tolerance)
-    result = contact_report(load_assembly(assembly, tol), tol)
+    result = contact_report(load_assembly(assembly, tol, settle=not as_written), tol)
     if png is not None:
         from assemblykit.viz.plots import plot_contacts
 
@@ -397,6 +408,7 @@ def blocking_cmd(
     ] = None,
     as_json: JsonOption = False,
     tolerance: ToleranceOption = None,
+    as_written: AsWrittenOption = False,
     debug: DebugOption = False,
 ) -> None:
     """Non-directional blocking graph: regions of directions, removable subassemblies."""
@@ -413,7 +425,7 @@ def blocking_cmd(
     else:
         from assemblykit.io.assembly import load_assembly
 
-        model = load_assembly(assembly, tol)
+        model = load_assembly(assembly, tol, settle=not as_written)
     result = blocking_graph(model, motion, tol=tol)  # type: ignore[arg-type]
     if png is not None:
         if motion == "rigid":
