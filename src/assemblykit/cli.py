@@ -2,9 +2,9 @@
 
 Every command takes ``INPUT``, ``--json`` (the documented JSON on stdout), ``--tolerance``
 (relative length tolerance) and ``--debug`` (tracebacks); the commands that load an
-assembly take ``--as-written`` (keep rounded mesh-folder poses unsettled). Exit codes: 0 for every answer
-(including *inconsistent* or *infeasible*), 2 for bad input (one line on stderr naming the
-file and the fault), 1 for an internal error.
+assembly take ``--as-written`` (keep rounded mesh-folder poses unsettled). Exit codes: 0
+for every answer (including *inconsistent* or *infeasible*), 2 for bad input (one line on
+stderr naming the file and the fault), 1 for an internal error.
 """
 
 from __future__ import annotations
