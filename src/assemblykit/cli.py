@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Callable
-from typing import Annotated, Any, Protocol
+from typing import TYPE_CHECKING, Annotated, Any, Protocol
 
 import click
 import typer
@@ -20,6 +20,9 @@ from rich.console import Console
 
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
 from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
 
 app = typer.Typer(
     name="assemblykit",
@@ -61,6 +64,14 @@ class Result(Protocol):
 def tolerance_from(option: float | None) -> Tolerance:
     """The tolerance policy with the command line's ``--tolerance`` applied."""
     return Tolerance() if option is None else Tolerance(rel_length=option)
+
+
+def loaded_assembly(path: str, tol: Tolerance, as_written: bool) -> Assembly:
+    """The assembly at ``path`` with the command line's tolerance, settled unless
+    ``--as-written``."""
+    from assemblykit.io.assembly import load_assembly
+
+    return load_assembly(path, tol, settle=not as_written)
 
 
 def emit(result: Result, as_json: bool) -> None:
@@ -175,13 +186,12 @@ def plan_cmd(
     debug: DebugOption = False,
 ) -> None:
     """Disassembly (and assembly) sequence by extended translations (seed 004)."""
-    from assemblykit.io.assembly import load_assembly
     from assemblykit.planning.sequence import plan
 
     tol = tolerance_from(tolerance)
     with _progress_bar() as bar:
         update = _updater(bar)
-        loaded = load_assembly(assembly, tol, settle=not as_written)
+        loaded = loaded_assembly(assembly, tol, as_written)
         result = plan(loaded, tol=tol, progress=update)
         if html is not None:
             from assemblykit.viz.viewer import write_report
@@ -322,7 +332,6 @@ def motion_cmd(
 ) -> None:
     """Motion of each part and subassembly relative to the rest, gear trains (seed 003);
     on a task, of each body in each situation from the relations it takes part in."""
-    from assemblykit.io.assembly import load_assembly
     from assemblykit.motion.articulation import articulation
 
     tol = tolerance_from(tolerance)
@@ -331,7 +340,7 @@ def motion_cmd(
             raise InputError("--subassembly and --html apply to assemblies, not tasks")
         _task_motion(assembly, tol, as_json)
         return
-    loaded = load_assembly(assembly, tol, settle=not as_written)
+    loaded = loaded_assembly(assembly, tol, as_written)
     sets = [[n.strip() for n in spec.split(",") if n.strip()] for spec in subassembly or ()]
     if any(not names for names in sets):
         raise InputError("--subassembly needs comma-separated part names", source=assembly)
@@ -376,10 +385,10 @@ def contacts_cmd(
     debug: DebugOption = False,
 ) -> None:
     """Parts, contact patches (areas, normals), surface features and interferences."""
-    from assemblykit.io.assembly import contact_report, load_assembly
+    from assemblykit.io.assembly import contact_report
 
     tol = tolerance_from(tolerance)
-    result = contact_report(load_assembly(assembly, tol, settle=not as_written), tol)
+    result = contact_report(loaded_assembly(assembly, tol, as_written), tol)
     if png is not None:
         from assemblykit.viz.plots import plot_contacts
 
@@ -423,9 +432,7 @@ def blocking_cmd(
     if is_polygon_file(assembly):
         model: Any = load_polygons(assembly)
     else:
-        from assemblykit.io.assembly import load_assembly
-
-        model = load_assembly(assembly, tol, settle=not as_written)
+        model = loaded_assembly(assembly, tol, as_written)
     result = blocking_graph(model, motion, tol=tol)  # type: ignore[arg-type]
     if png is not None:
         if motion == "rigid":
