@@ -14,6 +14,7 @@ from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.sequence import (
     DirectionTable,
+    ExtendedDirections,
     Plan,
     _Search,
     and_or_graph,
@@ -182,6 +183,31 @@ def assert_free_by_cones(assembly: Assembly, result: Plan) -> None:
         members = (*step.parts, *step.rest)
         dbg = extended_dbg(assembly, step.direction, members, tol)
         assert dbg.is_free(frozenset(step.parts)), step
+
+
+def test_pairs_tested_for_one_subassembly_serve_the_others():
+    # blocking is pairwise: the DBG asked of a set, after its supersets or subsets were
+    # asked, is the one computed from scratch
+    assembly = load_assembly(DEMO)
+    names = tuple(assembly.names)
+    tol = assembly.tolerance()
+    directions = np.array([UP, DOWN, [1.0, 0.0, 0.0], [0.0, 0.6, 0.8]])
+    extended = ExtendedDirections(assembly, directions, tol)
+    rng = np.random.default_rng(3)
+    everything = (1 << len(names)) - 1
+    for _ in range(12):
+        k = int(rng.integers(len(directions)))
+        members = int(rng.integers(1, everything + 1)) | 1
+        chosen = tuple(names[i] for i in range(len(names)) if members >> i & 1)
+        expected = extended_dbg(assembly, directions[k], chosen, tol).arcs
+        got = {(names[i], names[j]) for i, j in extended.graph(k, members).edges}
+        assert got == expected
+    # a single part asked alone is tested against the members given, no more
+    fresh = ExtendedDirections(assembly, directions, tol)
+    cover = names.index("cover")
+    held = fresh.blockers(0, 1 << cover, everything)
+    assert held == {cover: 0}  # the cover lifts off
+    assert fresh.evaluated == {0}
 
 
 def test_gearbox_plan_lifts_pins_and_cover_first():
