@@ -1,9 +1,10 @@
-"""Planning times: the bundled gearbox, the shared ASAP beam, arch and crossvault, and
-synthetic stacks of growing size.
+"""Planning times: the bundled gearbox, the shared ASAP beam, arch, crossvault and dome,
+and synthetic stacks of growing size.
 
 Run ``python benchmarks/bench_planning.py``. Each figure is the median wall time of
 ``REPEATS`` runs on a freshly loaded assembly (contacts and blocking graphs included);
-the beam and the crossvault (184 blocks) run once. Shared assemblies are skipped when
+the beam, the crossvault (184 blocks) and the dome (527 blocks, candidate directions from
+each block's own arrangement) run once. Shared assemblies are skipped when
 ``../shared/data`` is absent.
 """
 
@@ -65,6 +66,7 @@ def main() -> None:
         ("compas stack", DATA / "compas_assembly" / "stack_assembly.json", REPEATS),
         ("compas arch", DATA / "compas_assembly" / "arch_assembly.json", REPEATS),
         ("compas crossvault", DATA / "compas_assembly" / "crossvault_assembly.json", 1),
+        ("compas dome", DATA / "compas_assembly" / "dome_assembly.json", 1),
     ]
     for name, path, repeats in cases:
         if not path.exists():

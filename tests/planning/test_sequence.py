@@ -10,17 +10,21 @@ import pytest
 import trimesh
 
 from assemblykit.blocking.extended import extended_dbg, extended_free
+from assemblykit.blocking.ndbg import blocking_graph, blocking_terms
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning import sequence
 from assemblykit.planning.sequence import (
     DirectionTable,
     ExtendedDirections,
     Plan,
     _Search,
     and_or_graph,
+    local_table,
     minimal_interlocked,
     plan,
     separable,
+    translation_table,
 )
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -280,3 +284,45 @@ def test_crossvault_plan_takes_all_184_blocks_apart():
     assert np.allclose(result.steps[0].direction, UP)
     assert len(result.steps[0].parts) == 10
     assert len(result.steps) <= 40
+
+
+def test_free_parts_of_shrinking_sets_match_a_fresh_count():
+    rng = np.random.default_rng(7)
+    names = tuple("abcdefgh")
+    arcs = [
+        [(i, j) for i in range(8) for j in range(8) if i != j and rng.random() < 0.3]
+        for _ in range(20)
+    ]
+    tab = table_from(names, rng.normal(size=(20, 3)), arcs)
+    members = (1 << 8) - 1
+    while members:
+        fresh = table_from(names, tab.directions, arcs)
+        np.testing.assert_array_equal(tab.free_parts(members), fresh.free_parts(members))
+        members &= ~(1 << int(rng.choice([i for i in range(8) if members >> i & 1])))
+
+
+def table_from(names, directions, arcs) -> DirectionTable:
+    return DirectionTable.from_arcs(names, directions, arcs)
+
+
+def test_large_assemblies_take_candidates_from_each_parts_own_arrangement(monkeypatch):
+    assembly = load_assembly(shared("compas_assembly/arch_assembly.json"))
+    tol = assembly.tolerance()
+    whole = translation_table(assembly, tol)
+    terms = blocking_terms(assembly, "infinitesimal", tol)
+    local = local_table(tuple(assembly.names), terms, tol)
+    # along every local direction, Γ_t is the NDBG's DBG there
+    ndbg = blocking_graph(assembly, "infinitesimal", tol=tol)
+    for k in range(0, len(local.directions), 7):
+        arcs = {(local.names[i], local.names[j]) for i, j in local.graph(k, (1 << 30) - 1).edges}
+        assert arcs == set(ndbg.dbg(local.directions[k]).arcs)
+    # every part that Γ_t lets leave the whole arch along some region leaves along some
+    # local direction
+    everything = (1 << len(assembly.names)) - 1
+    assert set(np.flatnonzero(whole.free_parts(everything).any(axis=0))) == set(
+        np.flatnonzero(local.free_parts(everything).any(axis=0))
+    )
+    monkeypatch.setattr(sequence, "FULL_ARRANGEMENT_REGIONS", 0)
+    result = plan(assembly)
+    assert result.directions == len(local.directions)
+    assert_every_step_free(assembly, result)
