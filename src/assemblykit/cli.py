@@ -44,6 +44,9 @@ ToleranceOption = Annotated[
     ),
 ]
 DebugOption = Annotated[bool, typer.Option("--debug", help="Show tracebacks on errors.")]
+AssemblyArgument = Annotated[
+    str, typer.Argument(help="Assembly: mesh folder, .yaml manifest, .step or COMPAS .json.")
+]
 AsWrittenOption = Annotated[
     bool,
     typer.Option(
@@ -171,9 +174,7 @@ def _updater(bar: Any) -> Callable[[str, int, int], None]:
 
 @command
 def plan_cmd(
-    assembly: Annotated[
-        str, typer.Argument(help="Assembly: mesh folder, .yaml manifest, .step or COMPAS .json.")
-    ],
+    assembly: AssemblyArgument,
     html: Annotated[
         str | None, typer.Option("--html", help="Write a self-contained HTML report here.")
     ] = None,
@@ -375,9 +376,7 @@ PngOption = Annotated[
 
 @command
 def contacts_cmd(
-    assembly: Annotated[
-        str, typer.Argument(help="Assembly: mesh folder, .yaml manifest, .step or COMPAS .json.")
-    ],
+    assembly: AssemblyArgument,
     png: PngOption = None,
     as_json: JsonOption = False,
     tolerance: ToleranceOption = None,
