@@ -3,9 +3,15 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import trimesh
 
-from assemblykit.geometry.minkowski import blocking_cone, blocks_along, convex_bodies
+from assemblykit.geometry.minkowski import (
+    blocking_cone,
+    blocks_along,
+    convex_bodies,
+    overlap_depth,
+)
 from assemblykit.tolerance import Tolerance
 
 TOL = Tolerance()
@@ -73,3 +79,25 @@ def test_a_non_convex_body_has_no_convex_decomposition():
         )
     )
     assert convex_bodies(notch) is None
+
+
+def test_overlap_depth_is_the_largest_ball_inside_both_hulls():
+    # unit cubes sharing a 0.2-thick slab: a ball of radius 0.1 fits in both
+    assert overlap_depth(corners([0, 0, 0], [1, 1, 1]), corners([0.8, 0, 0], [1.8, 1, 1])) == (
+        pytest.approx(0.1)
+    )
+    # 0.5 apart: negative, half the gap
+    assert overlap_depth(corners([0, 0, 0], [1, 1, 1]), corners([1.5, 0, 0], [2.5, 1, 1])) == (
+        pytest.approx(-0.25)
+    )
+
+
+def test_pieces_with_many_vertices_that_overlap_block_every_direction():
+    # two spheres of 642 vertices each, interpenetrating: the linear program answers
+    # before the hull of 412,164 differences is built
+    a = np.asarray(trimesh.creation.icosphere(subdivisions=3).vertices)
+    b = a + np.array([1.5, 0.0, 0.0])
+    assert len(a) * len(b) > 20_000
+    cone = blocking_cone(b, a, TOL)
+    assert cone.shape == (0, 3)
+    assert blocks_along(cone, np.array([[-1.0, 0.0, 0.0]]))[0]

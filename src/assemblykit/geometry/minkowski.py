@@ -20,10 +20,15 @@ from __future__ import annotations
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
+from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, QhullError
 
 from assemblykit.errors import GeometryError
 from assemblykit.tolerance import Tolerance, current
+
+LP_FIRST = 20_000
+"""Vertex pairs beyond which :func:`blocking_cone` first asks :func:`overlap_depth`
+whether the pieces overlap (then the hull of their differences is not needed)."""
 
 
 def convex_bodies(
@@ -79,15 +84,38 @@ def blocking_cone(
     to infinity enters the interior of the convex piece ``obstacle`` iff ``n . d > 0`` for
     all of them. An empty array means every direction (the pieces overlap)."""
     tol = tol or current()
-    hull = obstacle_hull(
-        np.asarray(obstacle, dtype=np.float64), np.asarray(moving, dtype=np.float64)
-    )
+    obstacle = np.asarray(obstacle, dtype=np.float64)
+    moving = np.asarray(moving, dtype=np.float64)
+    if len(obstacle) * len(moving) > LP_FIRST and overlap_depth(obstacle, moving) > tol.length:
+        return np.zeros((0, 3))
+    hull = obstacle_hull(obstacle, moving)
     through = np.abs(hull.equations[:, 3]) <= tol.length
     normals = -hull.equations[through, :3]
     # qhull triangulates facets: keep one normal per plane (first of each repeat)
     same = normals @ normals.T >= np.cos(tol.angle)
     first = ~np.any(np.triu(same, 1), axis=0)
     return np.ascontiguousarray(normals[first], dtype=np.float64).reshape(-1, 3)
+
+
+def overlap_depth(first: NDArray[np.float64], second: NDArray[np.float64]) -> float:
+    """How deep a ball fits inside both convex hulls of the point sets (a linear
+    program, scipy ``linprog``): positive when their interiors overlap, so that the
+    grown obstacle holds the origin and every direction is blocked. Much cheaper than
+    the hull of all vertex differences for pieces with many vertices."""
+    try:
+        facets = np.vstack([ConvexHull(first).equations, ConvexHull(second).equations])
+    except QhullError:
+        return 0.0
+    # maximise r with a . x + b + r <= 0 for every facet (a unit): x is r inside both
+    bounds = [(None, None)] * 3 + [(None, None)]
+    found = linprog(
+        c=[0.0, 0.0, 0.0, -1.0],
+        A_ub=np.column_stack([facets[:, :3], np.ones(len(facets))]),
+        b_ub=-facets[:, 3],
+        bounds=bounds,
+        method="highs",
+    )
+    return float(found.x[3]) if found.status == 0 else 0.0
 
 
 def blocks_along(cone: NDArray[np.float64], directions: NDArray[np.float64]) -> NDArray[np.bool_]:
