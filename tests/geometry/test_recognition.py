@@ -74,3 +74,56 @@ def test_cone_apex_axis_and_half_angle():
     np.testing.assert_allclose(cone.point, [0, 0, 2], atol=1e-9)
     np.testing.assert_allclose(cone.axis, [0, 0, -1], atol=1e-9)
     assert isinstance(cone.feature(), Cone)
+
+
+def rounded_box(radius: float) -> trimesh.Trimesh:
+    """The hull of eight spheres: a 1 x 2 x 0.5 box core with every edge rounded to
+    ``radius`` (cylinders) and every corner a sphere octant."""
+    import manifold3d
+
+    spheres = [
+        manifold3d.Manifold.sphere(radius, 32).translate((x, y, z))
+        for x in (0.0, 1.0)
+        for y in (0.0, 2.0)
+        for z in (0.0, 0.5)
+    ]
+    mesh = manifold3d.Manifold.batch_hull(spheres).to_mesh64()
+    return trimesh.Trimesh(np.asarray(mesh.vert_properties)[:, :3], np.asarray(mesh.tri_verts))
+
+
+def test_rounded_edges_and_corners_are_split_into_cylinders_spheres_and_planes():
+    # every face joins its neighbours smoothly, so the whole box is one smooth region
+    surfaces = recognise(rounded_box(0.1), Tolerance(scale=2.6).for_mesh())
+    cylinders = [s for s in surfaces if s.kind == "cylinder"]
+    spheres = [s for s in surfaces if s.kind == "sphere"]
+    planes = [s for s in surfaces if s.kind == "plane"]
+    assert len(cylinders) == 12 and len(spheres) == 8 and len(planes) == 6
+    for s in cylinders + spheres:
+        assert s.radius == pytest.approx(0.1, abs=1e-6)
+        assert s.convex
+    # four rounded edges along each axis; corners centred on the spheres' centres
+    axes = sorted(int(np.argmax(np.abs(s.axis))) for s in cylinders)
+    assert axes == [0] * 4 + [1] * 4 + [2] * 4
+    centres = {tuple(np.round(s.point, 6) + 0.0) for s in spheres}
+    assert centres == {(x, y, z) for x in (0.0, 1.0) for y in (0.0, 2.0) for z in (0.0, 0.5)}
+    assert sorted(round(s.area, 6) for s in planes) == [0.5, 0.5, 1.0, 1.0, 2.0, 2.0]
+    assert isinstance(cylinders[0].feature(), Shaft) and isinstance(spheres[0].feature(), Ball)
+
+
+def test_asap_beam_fillets_are_found():
+    from pathlib import Path
+
+    from assemblykit.io.assembly import load_assembly
+
+    folder = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "asap_beam_assembly"
+    if not folder.is_dir():
+        pytest.skip("shared data not present")
+    beam = load_assembly(folder)
+    surfaces = beam.surfaces("0")
+    cylinders = [s for s in surfaces if s.kind == "cylinder"]
+    spheres = [s for s in surfaces if s.kind == "sphere"]
+    # the edges are rounded to 0.0762 (0.03 inch, in centimetres), outward
+    assert len(cylinders) >= 40 and len(spheres) >= 8
+    for s in cylinders + spheres:
+        assert s.radius == pytest.approx(0.0762, abs=2e-3)
+        assert s.convex

@@ -28,6 +28,15 @@ Method on meshes (all thresholds from the tolerance policy):
 
    A surface is convex (shaft, ball, male cone) when the outward normals point away
    from the axis or centre, concave (hole, socket, female cone) otherwise.
+4. **Split** smooth regions that fit no surface as a whole (rounded edges join every
+   face of a part, as on the ASAP beam): their smooth edges that are not coplanar turn
+   the normal about an axis ``n₀ × n₁``; edges with one axis (within ``AXIS_ANGLE``)
+   that share coplanar groups form one candidate cylinder, through the edges' vertices (the
+   tessellation's rulings lie on it). Each candidate claims the adjacent triangles whose
+   vertices all lie on it and is fitted again by step 3; larger ones first, a triangle
+   goes to one surface at most. The rest, joined by the remaining smooth edges, is
+   fitted with a sphere (the rounded corners). Pieces of one sphere or one cylinder are
+   fitted again as one surface.
 """
 
 from __future__ import annotations
@@ -47,6 +56,13 @@ from assemblykit.tolerance import Tolerance, current
 SurfaceKind = Literal["plane", "cylinder", "cone", "sphere", "torus"]
 SMOOTH_ANGLE = np.radians(30.0)
 MIN_CURVED_FACES = 3
+STRIP_WIDTHS = 2.0
+"""A group joined to a rounded edge counts as one of its strips when it is at most this
+many times as wide across the axis as the median group of its set (step 4)."""
+AXIS_ANGLE = np.radians(1.0)
+"""Edge axes within this angle count as one axis when a smooth region is split (step 4):
+the edges of one tessellated cylinder turn about parallel axes, up to the noise of the
+normals of small triangles."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -293,14 +309,16 @@ def fit_surface(
     areas: NDArray[np.float64],
     tol: Tolerance,
     ids: NDArray[np.int64],
+    kinds: tuple[SurfaceKind, ...] = ("cylinder", "cone", "sphere"),
 ) -> Surface | None:
-    """The cylinder, cone or sphere through the triangles ``faces`` (numbered ``ids`` in
-    their mesh) by method step 3, or ``None`` when none fits within the tolerance."""
+    """The first of ``kinds`` (cylinder, cone, sphere) through the triangles ``faces``
+    (numbered ``ids`` in their mesh) by method step 3, or ``None`` when none fits within
+    the tolerance."""
     used = np.unique(faces)
     points = vertices[used]
     if len(points) < 4:
         return None
-    for fit in (_fit_cylinder, _fit_cone, _fit_sphere):
+    for fit in (FITS[kind] for kind in kinds):
         found = fit(points, normals, areas, tol)
         if found is not None:
             break
@@ -308,6 +326,9 @@ def fit_surface(
         return None
     convex = is_convex(vertices, faces, found["point"], found["axis"])
     return Surface(faces=ids, area=float(areas.sum()), convex=convex, **found)
+
+
+FITS = {"cylinder": _fit_cylinder, "cone": _fit_cone, "sphere": _fit_sphere}
 
 
 def is_convex(
@@ -334,7 +355,12 @@ def recognise(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surf
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     seg = segment(vertices, faces, tol)
-    curved = curved_surfaces(vertices, faces, seg, tol, np.flatnonzero(seg.curved))
+    candidates = np.flatnonzero(seg.curved)
+    curved = curved_surfaces(vertices, faces, seg, tol, candidates)
+    fitted = np.isin(candidates, seg.region[[int(c.faces[0]) for c in curved]])
+    unfit = np.isin(seg.region, candidates[~fitted])
+    if unfit.any():
+        curved += split_surfaces(vertices, faces, seg, tol, unfit)
     return curved + planes(seg, faces_on(curved, len(faces)))
 
 
@@ -355,6 +381,171 @@ def curved_surfaces(
         if surface is not None:
             found.append(surface)
     return tuple(found)
+
+
+def split_surfaces(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    seg: Segmentation,
+    tol: Tolerance,
+    inside: NDArray[np.bool_],
+) -> tuple[Surface, ...]:
+    """The surfaces of the triangles ``inside`` (smooth regions that fit no surface as
+    a whole) found by splitting them (method step 4)."""
+    adjacency, edges = trimesh.graph.face_adjacency(faces=faces, return_edges=True)
+    adjacency = np.asarray(adjacency, dtype=np.int64).reshape(-1, 2)
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    n0, n1 = seg.normals[adjacency[:, 0]], seg.normals[adjacency[:, 1]]
+    bent = (
+        inside[adjacency[:, 0]]
+        & inside[adjacency[:, 1]]
+        & (seg.group[adjacency[:, 0]] != seg.group[adjacency[:, 1]])
+        & (np.einsum("ij,ij->i", n0, n1) >= np.cos(SMOOTH_ANGLE))
+    )
+    axes = np.cross(n0, n1)
+    sines = np.linalg.norm(axes, axis=1)
+    bent &= sines > tol.angle
+    adjacency, edges = adjacency[bent], edges[bent]
+    axes = axes[bent] / sines[bent, None]
+    cluster = _axis_clusters(axes)
+    # coplanar groups (a cylinder's strips) joined by edges of one axis: one node per
+    # (group, axis)
+    ends = seg.group[np.concatenate([adjacency[:, 0], adjacency[:, 1]])]
+    nodes, node = np.unique(
+        np.column_stack([ends, np.tile(cluster, 2)]), axis=0, return_inverse=True
+    )
+    node = node.ravel()
+    pairs = np.column_stack([node[: len(adjacency)], node[len(adjacency) :]])
+    # a face between two parallel rounded edges would join them: within each set of
+    # joined groups, drop the groups much wider across the axis than the typical strip
+    label = _components(len(nodes), pairs)
+    width = np.array([_width(vertices, faces, seg, g, axes[cluster == c][0]) for g, c in nodes])
+    typical = np.zeros(len(nodes))
+    for members in _classes(label):
+        typical[members] = np.median(width[members])
+    narrow = width <= STRIP_WIDTHS * typical
+    kept = narrow[pairs[:, 0]] & narrow[pairs[:, 1]]
+    adjacency, edges, axes, pairs = adjacency[kept], edges[kept], axes[kept], pairs[kept]
+    label = _components(len(nodes), pairs)[pairs[:, 0]]
+    claimed = np.zeros(len(faces), dtype=bool)
+    found: list[Surface] = []
+    candidates: list[NDArray[np.int64]] = []
+    for members in _classes(label):
+        if len(members) < MIN_CURVED_FACES - 1:
+            continue
+        turns = axes[members]
+        axis = (turns * np.sign(turns @ turns[0])[:, None]).mean(axis=0)
+        axis /= np.linalg.norm(axis)
+        points = vertices[np.unique(edges[members])]
+        plane = _basis(axis)
+        centre, radius = _circle_fit(points @ plane.T)
+        if np.abs(np.linalg.norm(points @ plane.T - centre, axis=1) - radius).max() > tol.length:
+            continue
+        near = np.flatnonzero(np.isin(seg.group, seg.group[adjacency[members]]))
+        corners = vertices[faces[near]] @ plane.T - centre
+        on = np.abs(np.linalg.norm(corners, axis=2) - radius).max(axis=1) <= tol.length
+        candidates.append(near[on])
+    for ids in sorted(candidates, key=lambda ids: -float(seg.areas[ids].sum())):
+        if len(ids) < MIN_CURVED_FACES or claimed[ids].any():
+            continue
+        surface = fit_surface(
+            vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, ids, ("cylinder",)
+        )
+        if surface is not None:
+            found.append(surface)
+            claimed[ids] = True
+    rest = ~claimed[adjacency[:, 0]] & ~claimed[adjacency[:, 1]]
+    label = _components(len(faces), adjacency[rest])
+    for patch in np.unique(label[adjacency[rest, 0]]):
+        ids = np.flatnonzero((label == patch) & inside & ~claimed)
+        if len(ids) < MIN_CURVED_FACES:
+            continue
+        sphere = fit_surface(
+            vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, ids, ("sphere",)
+        )
+        if sphere is not None:
+            found.append(sphere)
+    return _merged(vertices, faces, seg, tol, found)
+
+
+def _merged(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    seg: Segmentation,
+    tol: Tolerance,
+    surfaces: list[Surface],
+) -> tuple[Surface, ...]:
+    """``surfaces`` with the pieces of one sphere (same centre and radius) or one
+    cylinder (same axis line and radius) fitted again as one surface."""
+    merged: list[Surface] = []
+    for surface in surfaces:
+        for k, other in enumerate(merged):
+            if _same_surface(surface, other, tol):
+                ids = np.concatenate([other.faces, surface.faces])
+                union = fit_surface(
+                    vertices,
+                    faces[ids],
+                    seg.normals[ids],
+                    seg.areas[ids],
+                    tol,
+                    ids,
+                    (surface.kind,),
+                )
+                if union is not None:
+                    merged[k] = union
+                    break
+        else:
+            merged.append(surface)
+    return tuple(merged)
+
+
+def _same_surface(a: Surface, b: Surface, tol: Tolerance) -> bool:
+    """Whether two spheres, or two cylinders, lie on one surface within the tolerance."""
+    if a.kind != b.kind or a.kind not in ("sphere", "cylinder"):
+        return False
+    if abs(a.radius - b.radius) > tol.length:
+        return False
+    offset = b.point - a.point
+    if a.kind == "sphere":
+        return bool(np.linalg.norm(offset) <= tol.length)
+    assert a.axis is not None and b.axis is not None
+    parallel = np.linalg.norm(np.cross(a.axis, b.axis)) <= tol.angle
+    return bool(parallel and np.linalg.norm(np.cross(offset, a.axis)) <= tol.length)
+
+
+def _classes(label: NDArray[np.int64]) -> list[NDArray[np.int64]]:
+    """The indices of each label, one array per distinct label."""
+    order = np.argsort(label, kind="stable")
+    return np.split(order, np.flatnonzero(np.diff(label[order])) + 1)
+
+
+def _width(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    seg: Segmentation,
+    group: int,
+    axis: NDArray[np.float64],
+) -> float:
+    """How wide coplanar group ``group`` is across ``axis``, within its plane."""
+    across = np.cross(seg.normal[group], axis)
+    return float(np.ptp(vertices[faces[seg.faces_of(group)]].reshape(-1, 3) @ across))
+
+
+def _axis_clusters(axes: NDArray[np.float64]) -> NDArray[np.int64]:
+    """One label per unit axis (sign ignored): each joins the first earlier leader
+    within ``AXIS_ANGLE``, else leads a new cluster."""
+    leaders: list[NDArray[np.float64]] = []
+    labels = np.empty(len(axes), dtype=np.int64)
+    for i, axis in enumerate(axes):
+        if leaders:
+            sines = np.linalg.norm(np.cross(np.asarray(leaders), axis), axis=1)
+            k = int(np.argmin(sines))
+            if sines[k] <= np.sin(AXIS_ANGLE):
+                labels[i] = k
+                continue
+        leaders.append(axis)
+        labels[i] = len(leaders) - 1
+    return labels
 
 
 def faces_on(surfaces: tuple[Surface, ...], n_faces: int) -> NDArray[np.bool_]:
