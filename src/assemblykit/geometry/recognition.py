@@ -331,6 +331,18 @@ def fit_surface(
 FITS = {"cylinder": _fit_cylinder, "cone": _fit_cone, "sphere": _fit_sphere}
 
 
+def _fit_faces(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    seg: Segmentation,
+    tol: Tolerance,
+    ids: NDArray[np.int64],
+    kinds: tuple[SurfaceKind, ...] = ("cylinder", "cone", "sphere"),
+) -> Surface | None:
+    """:func:`fit_surface` on the triangles ``ids`` of a segmented mesh."""
+    return fit_surface(vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, ids, kinds)
+
+
 def is_convex(
     vertices: NDArray[np.float64],
     faces: NDArray[np.int64],
@@ -377,7 +389,7 @@ def curved_surfaces(
         ids = np.flatnonzero(seg.region == r)
         if len(ids) < MIN_CURVED_FACES:
             continue
-        surface = fit_surface(vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, ids)
+        surface = _fit_faces(vertices, faces, seg, tol, ids)
         if surface is not None:
             found.append(surface)
     return tuple(found)
@@ -448,9 +460,7 @@ def split_surfaces(
     for ids in sorted(candidates, key=lambda ids: -float(seg.areas[ids].sum())):
         if len(ids) < MIN_CURVED_FACES or claimed[ids].any():
             continue
-        surface = fit_surface(
-            vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, ids, ("cylinder",)
-        )
+        surface = _fit_faces(vertices, faces, seg, tol, ids, ("cylinder",))
         if surface is not None:
             found.append(surface)
             claimed[ids] = True
@@ -460,9 +470,7 @@ def split_surfaces(
         ids = np.flatnonzero((label == patch) & inside & ~claimed)
         if len(ids) < MIN_CURVED_FACES:
             continue
-        sphere = fit_surface(
-            vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, ids, ("sphere",)
-        )
+        sphere = _fit_faces(vertices, faces, seg, tol, ids, ("sphere",))
         if sphere is not None:
             found.append(sphere)
     return _merged(vertices, faces, seg, tol, found)
@@ -482,15 +490,7 @@ def _merged(
         for k, other in enumerate(merged):
             if _same_surface(surface, other, tol):
                 ids = np.concatenate([other.faces, surface.faces])
-                union = fit_surface(
-                    vertices,
-                    faces[ids],
-                    seg.normals[ids],
-                    seg.areas[ids],
-                    tol,
-                    ids,
-                    (surface.kind,),
-                )
+                union = _fit_faces(vertices, faces, seg, tol, ids, (surface.kind,))
                 if union is not None:
                     merged[k] = union
                     break
