@@ -120,3 +120,11 @@ def test_inverse_is_exact_on_rigid_transforms(seed):
     np.testing.assert_allclose(se3.inverse(t) @ t, np.eye(4), atol=1e-13)
     np.testing.assert_allclose(se3.inverse(t), np.linalg.inv(t), atol=1e-12)
     assert se3.inverse(t)[3].tolist() == [0.0, 0.0, 0.0, 1.0]
+
+
+def test_line_classes_group_parallel_and_antiparallel_vectors():
+    vectors = np.array([[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, 1e-7, 1.0], [1, 1e-6, 0]])
+    leaders, index, orient = se3.line_classes(vectors, 1e-5)
+    np.testing.assert_array_equal(leaders, [[1, 0, 0], [0, 1, 0], [0, 1e-7, 1.0]])
+    assert index.tolist() == [0, 1, 0, 2, 0]
+    assert orient.tolist() == [1, 1, -1, 1, 1]

@@ -71,6 +71,27 @@ def unit(v: np.ndarray | tuple[float, ...] | list[float]) -> np.ndarray:
     return a / n if n > 0.0 else a.copy()
 
 
+def line_classes(vectors: np.ndarray, max_sine: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Group unit vectors that are parallel or antiparallel: each joins the first earlier
+    leader whose sine with it is at most ``max_sine``, else leads a new class. Returns
+    the leaders, the class of each vector and its orientation (+1 same, -1 opposite)."""
+    units = np.asarray(vectors, dtype=np.float64).reshape(-1, 3)
+    leaders: list[np.ndarray] = []
+    index = np.empty(len(units), dtype=np.int64)
+    orient = np.empty(len(units), dtype=np.int8)
+    for i, n in enumerate(units):
+        if leaders:
+            stack = np.asarray(leaders)
+            sines = np.linalg.norm(np.cross(stack, n), axis=1)
+            k = int(np.argmin(sines))
+            if sines[k] <= max_sine:
+                index[i], orient[i] = k, 1 if stack[k] @ n > 0 else -1
+                continue
+        leaders.append(n)
+        index[i], orient[i] = len(leaders) - 1, 1
+    return np.asarray(leaders, dtype=np.float64).reshape(-1, 3), index, orient
+
+
 def skew(w: np.ndarray) -> np.ndarray:
     """The 3x3 matrix ``[w]x`` with ``[w]x @ x == cross(w, x)``."""
     x, y, z = (float(c) for c in w)

@@ -34,6 +34,7 @@ from numpy.typing import NDArray
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from assemblykit.algebra.se3 import line_classes
 from assemblykit.tolerance import Tolerance, current
 
 # Rounding error of a 3-term dot product of unit vectors, in units of its magnitude.
@@ -111,22 +112,7 @@ def snap_normals(
     circle of each input normal and its orientation (+1 same, -1 opposite)."""
     tol = tol or current()
     units = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
-    units = units / np.linalg.norm(units, axis=1, keepdims=True)
-    circles: list[NDArray[np.float64]] = []
-    index = np.empty(len(units), dtype=np.int64)
-    orient = np.empty(len(units), dtype=np.int8)
-    for i, n in enumerate(units):
-        if circles:
-            stack = np.asarray(circles)
-            dots = stack @ n
-            sines = np.linalg.norm(np.cross(stack, n), axis=1)
-            k = int(np.argmin(sines))
-            if sines[k] <= tol.angle:
-                index[i], orient[i] = k, 1 if dots[k] > 0 else -1
-                continue
-        circles.append(n)
-        index[i], orient[i] = len(circles) - 1, 1
-    return np.asarray(circles, dtype=np.float64).reshape(-1, 3), index, orient
+    return line_classes(units / np.linalg.norm(units, axis=1, keepdims=True), tol.angle)
 
 
 def _links(rows: list[tuple[int, int, int, int]]) -> tuple[NDArray[np.int64], ...]:

@@ -51,6 +51,7 @@ from scipy.optimize import least_squares
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from assemblykit.algebra.se3 import line_classes
 from assemblykit.tolerance import Tolerance, current
 
 SurfaceKind = Literal["plane", "cylinder", "cone", "sphere", "torus"]
@@ -419,7 +420,7 @@ def split_surfaces(
     bent &= sines > tol.angle
     adjacency, edges = adjacency[bent], edges[bent]
     axes = axes[bent] / sines[bent, None]
-    cluster = _axis_clusters(axes)
+    cluster = line_classes(axes, np.sin(AXIS_ANGLE))[1]
     # coplanar groups (a cylinder's strips) joined by edges of one axis: one node per
     # (group, axis)
     ends = seg.group[np.concatenate([adjacency[:, 0], adjacency[:, 1]])]
@@ -529,23 +530,6 @@ def _width(
     """How wide coplanar group ``group`` is across ``axis``, within its plane."""
     across = np.cross(seg.normal[group], axis)
     return float(np.ptp(vertices[faces[seg.faces_of(group)]].reshape(-1, 3) @ across))
-
-
-def _axis_clusters(axes: NDArray[np.float64]) -> NDArray[np.int64]:
-    """One label per unit axis (sign ignored): each joins the first earlier leader
-    within ``AXIS_ANGLE``, else leads a new cluster."""
-    leaders: list[NDArray[np.float64]] = []
-    labels = np.empty(len(axes), dtype=np.int64)
-    for i, axis in enumerate(axes):
-        if leaders:
-            sines = np.linalg.norm(np.cross(np.asarray(leaders), axis), axis=1)
-            k = int(np.argmin(sines))
-            if sines[k] <= np.sin(AXIS_ANGLE):
-                labels[i] = k
-                continue
-        leaders.append(axis)
-        labels[i] = len(leaders) - 1
-    return labels
 
 
 def faces_on(surfaces: tuple[Surface, ...], n_faces: int) -> NDArray[np.bool_]:
