@@ -1,10 +1,14 @@
-"""Shared fixtures."""
+"""Shared fixtures; puts this folder on ``sys.path`` so that test modules import
+``datasets`` (importlib import mode adds no test directory itself)."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 @pytest.fixture(scope="session")

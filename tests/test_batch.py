@@ -10,9 +10,9 @@ import pytest
 
 from assemblykit.batch import finished_inputs, run_batch
 from assemblykit.errors import InputError
+from datasets import dataset
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT.parent / "shared" / "data"
 DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
 
 
@@ -21,13 +21,8 @@ def lines(path: Path) -> dict[str, dict]:
 
 
 def shared_inputs() -> list[str]:
-    paths = [
-        DATA / "compas_assembly" / "two-blocks_assembly.json",
-        DATA / "compas_assembly" / "stack_assembly.json",
-    ]
-    if not all(p.exists() for p in paths):
-        pytest.skip("shared data is absent")
-    return [str(p) for p in paths]
+    names = ("two-blocks_assembly.json", "stack_assembly.json")
+    return [str(dataset(f"compas_assembly/{name}")) for name in names]
 
 
 @pytest.mark.slow

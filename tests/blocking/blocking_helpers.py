@@ -6,14 +6,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pytest
 import trimesh
 
 from assemblykit.geometry.contacts import Contact, CurvedPatch, PlanarPatch
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance, current
-
-DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data"
+from datasets import dataset
 
 
 @dataclass(eq=False)
@@ -86,8 +84,5 @@ def random_box_contacts(rng: np.random.Generator, n: int, c: int) -> ContactAsse
 
 
 def compas_folder() -> Path:
-    """The COMPAS assemblies of the shared data; skips the test when absent."""
-    folder = DATA / "compas_assembly"
-    if not folder.is_dir():
-        pytest.skip("shared data (../shared/data) not available")
-    return folder
+    """The folder of the bundled COMPAS assemblies."""
+    return dataset("compas_assembly")

@@ -7,12 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from blocking_helpers import DATA, box, mesh_assembly
+from blocking_helpers import box, mesh_assembly
 
 from assemblykit.blocking.extended import extended_dbg, extended_free, obstacles
 from assemblykit.blocking.ndbg import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
 from assemblykit.io.assembly import load_assembly
+from datasets import dataset
 
 
 def ring(center, plane: str) -> trimesh.Trimesh:
@@ -118,10 +119,7 @@ def test_gearbox_pins_and_cover_lift_out_exactly():
 
 
 def test_asap_beam_parts_are_removable_along_exact_directions():
-    path = DATA / "asap_beam_assembly"
-    if not path.exists():
-        pytest.skip(f"shared data {path} is absent")
-    asm = load_assembly(path)
+    asm = load_assembly(dataset("asap_beam_assembly"))
     tol = asm.tolerance()
     removals = removable_parts(asm)
     assert removals, "some beam part comes out by one translation"

@@ -14,8 +14,7 @@ import trimesh
 from assemblykit.geometry.contacts import candidate_pairs, find_contacts
 from assemblykit.io.compas import load_compas
 from assemblykit.model.assembly import Assembly, Part
-
-DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "compas_assembly"
+from datasets import dataset
 
 
 def box(lo, hi) -> trimesh.Trimesh:
@@ -141,9 +140,7 @@ def _reference(path: Path) -> dict[frozenset[str], float]:
     ],
 )
 def test_touching_pairs_and_areas_agree_with_compas_assembly(name, measured, jaccard):
-    path = DATA / name
-    if not path.is_file():
-        pytest.skip("shared data not present")
+    path = dataset(f"compas_assembly/{name}")
     asm = load_compas(path)
     assert asm.precision.length == pytest.approx(measured, rel=1e-9)
     found = {frozenset(c.pair): c.area for c in asm.contacts()}

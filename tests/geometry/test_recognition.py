@@ -9,6 +9,7 @@ import trimesh
 from assemblykit.features.primitives import Ball, Cone, Hole, Plane, Shaft, Socket
 from assemblykit.geometry.recognition import recognise, segment
 from assemblykit.tolerance import Tolerance
+from datasets import dataset
 
 TOL = Tolerance(scale=10.0).for_mesh()
 
@@ -111,14 +112,9 @@ def test_rounded_edges_and_corners_are_split_into_cylinders_spheres_and_planes()
 
 
 def test_asap_beam_fillets_are_found():
-    from pathlib import Path
-
     from assemblykit.io.assembly import load_assembly
 
-    folder = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "asap_beam_assembly"
-    if not folder.is_dir():
-        pytest.skip("shared data not present")
-    beam = load_assembly(folder)
+    beam = load_assembly(dataset("asap_beam_assembly"))
     surfaces = beam.surfaces("0")
     cylinders = [s for s in surfaces if s.kind == "cylinder"]
     spheres = [s for s in surfaces if s.kind == "sphere"]

@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import pytest
 
 from assemblykit.errors import SchemaError
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.compas import load_compas
-
-DATA = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "compas_assembly"
+from datasets import dataset
 
 CUBE = {
     "vertex": {
@@ -96,9 +94,6 @@ def test_malformed_block_names_the_field(tmp_path):
     ],
 )
 def test_published_files_load(name, count):
-    path = DATA / name
-    if not path.is_file():
-        pytest.skip("shared data not present")
-    asm = load_compas(path)
+    asm = load_compas(dataset(f"compas_assembly/{name}"))
     assert len(asm) == count
     assert all(p.mesh.is_watertight for p in asm)

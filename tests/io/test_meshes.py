@@ -14,13 +14,10 @@ from assemblykit.errors import GeometryError, SchemaError
 from assemblykit.geometry.interference import interferences, overlap_volume
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.meshes import load_manifest, pose_from_spec, pose_from_state, read_mesh
+from datasets import BUNDLED, dataset
 
-ASAP = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "asap_beam_assembly"
-STATES = (
-    {k: v["final_state"] for k, v in json.loads((ASAP / "config.json").read_text()).items()}
-    if ASAP.is_dir()
-    else {}
-)
+ASAP = BUNDLED / "asap_beam_assembly"
+STATES = {k: v["final_state"] for k, v in json.loads((ASAP / "config.json").read_text()).items()}
 
 
 def unit_box(folder: Path, name: str) -> Path:
@@ -112,9 +109,7 @@ def test_open_mesh_that_cannot_be_closed_is_rejected(tmp_path):
 
 
 def test_asap_beam_touches_without_interfering_with_final_state_poses():
-    if not ASAP.is_dir():
-        pytest.skip("shared data not present")
-    asm = load_assembly(ASAP)
+    asm = load_assembly(dataset("asap_beam_assembly"))
     assert asm.names == ["0", "1", "2", "3", "6"]
     # translation after Rotation.from_euler('xyz') of the mesh as read: beams on posts
     assert {c.pair for c in asm.contacts()} == {("0", "2"), ("1", "3"), ("2", "6"), ("3", "6")}
@@ -138,9 +133,7 @@ def test_asap_beam_touches_without_interfering_with_final_state_poses():
 
 
 def test_asap_beam_as_written_shares_thin_layers():
-    if not ASAP.is_dir():
-        pytest.skip("shared data not present")
-    asm = load_assembly(ASAP, settle=False)
+    asm = load_assembly(dataset("asap_beam_assembly"), settle=False)
     assert all(part.settled is None for part in asm)
     assert interferences(asm) == []
     # The poses as written leave layers thinner than their rounding (docs/geometry.md):
