@@ -78,4 +78,4 @@ def test_batch_command(capsys, tmp_path):
     record = json.loads(out_file.read_text())
     assert record["input"] == str(DEMO) and record["status"] == "ok"
     code, _, err = run(capsys, "batch", str(DEMO), "--command", "solve")
-    assert code == 2 and "unknown command 'solve'" in err
+    assert code == 2 and "'solve' is not one of 'plan', 'motion'" in err

@@ -256,11 +256,13 @@ def test_box_on_table_with_a_corner_on_the_wall_keeps_two_dof(suffix: str, capsy
 
 
 @needs_engine
-def test_explain_text_names_rule_link_places_and_dof(capsys, monkeypatch):
+@pytest.mark.parametrize("columns", ["40", "140", "400"])
+def test_explain_text_names_rule_link_places_and_dof(capsys, monkeypatch, columns):
     """The four-bar's trace: each joint's two relations (with their lines) intersect to a
     revolute, and the loop goes to the residue solver: 4 dof along the chains from the
-    world (crank 1, rocker 1, coupler 2 through the crank), 1 after closing it."""
-    monkeypatch.setenv("COLUMNS", "400")
+    world (crank 1, rocker 1, coupler 2 through the crank), 1 after closing it. One line
+    per step whatever the terminal's width."""
+    monkeypatch.setenv("COLUMNS", columns)
     assert run(["solve", str(EXAMPLES / "four_bar.rapt"), "--explain"]) == 0
     lines = [line for line in capsys.readouterr().out.splitlines() if ": " in line]
     assert (
@@ -278,8 +280,7 @@ def test_explain_text_names_rule_link_places_and_dof(capsys, monkeypatch):
 
 
 @needs_engine
-def test_explain_text_says_where_a_merged_body_ended(capsys, monkeypatch):
-    monkeypatch.setenv("COLUMNS", "400")
+def test_explain_text_says_where_a_merged_body_ended(capsys):
     assert run(["solve", str(EXAMPLES / "stack_and_move.rapt"), "--explain"]) == 0
     text = capsys.readouterr().out
     assert "plate@lifted fixed relative to" in text or "fixed relative to plate@lifted" in text

@@ -9,51 +9,66 @@ stderr naming the file and the fault), 1 for an internal error.
 
 from __future__ import annotations
 
+import functools
 import json
 import sys
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Annotated, Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import click
-import typer
-from rich.console import Console
 
+from assemblykit import __version__
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
+    from rich.console import Console
+
     from assemblykit.model.assembly import Assembly
 
-app = typer.Typer(
+# Output captured by a program (a pipe, a file, a test) is laid out at this width whatever
+# the terminal says, so that what machines read never depends on COLUMNS.
+PLAIN_WIDTH = 120
+
+
+@click.group(
     name="assemblykit",
-    help="Geometric reasoning about mechanical assemblies.",
+    context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100},
     no_args_is_help=True,
-    add_completion=False,
-    pretty_exceptions_enable=False,
 )
+@click.version_option(__version__, "--version", "-V", prog_name="assemblykit")
+def app() -> None:
+    """Geometric reasoning about mechanical assemblies."""
 
-console = Console()
-err_console = Console(stderr=True)
 
-JsonOption = Annotated[bool, typer.Option("--json", help="Print the result as JSON on stdout.")]
-ToleranceOption = Annotated[
-    float | None,
-    typer.Option(
-        "--tolerance",
-        help="Relative length tolerance (fraction of the model's bounding-box diagonal).",
-    ),
-]
-DebugOption = Annotated[bool, typer.Option("--debug", help="Show tracebacks on errors.")]
-AssemblyArgument = Annotated[
-    str, typer.Argument(help="Assembly: mesh folder, .yaml manifest, .step or COMPAS .json.")
-]
-AsWrittenOption = Annotated[
-    bool,
-    typer.Option(
-        "--as-written",
-        help="Keep rounded mesh-folder poses as written (do not settle thin overlaps).",
-    ),
-]
+@functools.cache
+def console(stderr: bool = False) -> Console:
+    """The rich console of stdout (or stderr): the terminal's width when it is one,
+    ``PLAIN_WIDTH`` otherwise."""
+    from rich.console import Console
+
+    stream = sys.stderr if stderr else sys.stdout
+    width = None if stream.isatty() else PLAIN_WIDTH
+    return Console(stderr=stderr, width=width)
+
+
+json_option = click.option(
+    "--json", "as_json", is_flag=True, help="Print the result as JSON on stdout."
+)
+tolerance_option = click.option(
+    "--tolerance",
+    type=float,
+    default=None,
+    help="Relative length tolerance (fraction of the model's bounding-box diagonal).",
+)
+debug_option = click.option("--debug", is_flag=True, help="Show tracebacks on errors.")
+as_written_option = click.option(
+    "--as-written",
+    is_flag=True,
+    help="Keep rounded mesh-folder poses as written (do not settle thin overlaps).",
+)
+assembly_argument = click.argument("assembly", metavar="ASSEMBLY")
+ASSEMBLY_HELP = "ASSEMBLY: mesh folder, .yaml manifest, .step or COMPAS .json."
 
 
 class Result(Protocol):
@@ -82,26 +97,36 @@ def emit(result: Result, as_json: bool) -> None:
     if as_json:
         sys.stdout.write(json.dumps(result.to_dict(), indent=2) + "\n")
     else:
-        console.print(result.render())
+        # lines longer than the width (a trace, a path) are wrapped or kept, never cut
+        console().print(result.render(), crop=False)
+
+
+def note(message: str) -> None:
+    """One line on stderr, printed as written (no markup, no wrapping)."""
+    console(stderr=True).print(message, markup=False, highlight=False, soft_wrap=True)
 
 
 def _fail(message: str, code: int) -> None:
-    err_console.print(f"assemblykit: {message}", markup=False, highlight=False, soft_wrap=True)
+    note(f"assemblykit: {message}")
     raise SystemExit(code)
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Entry point of the console script: maps errors to one line and an exit code."""
+    """Entry point of the console script: maps errors to one line and an exit code
+    (usage errors print the usage and exit 2, like bad input)."""
     args = sys.argv[1:] if argv is None else argv
     debug = "--debug" in args
     try:
-        app(args=args, prog_name="assemblykit", standalone_mode=False)
+        app.main(args=args, prog_name="assemblykit", standalone_mode=False)
     except click.exceptions.Exit as done:
         raise SystemExit(done.exit_code) from None
-    except click.ClickException as usage:
+    except click.UsageError as usage:
+        usage.show()
+        raise SystemExit(2) from None
+    except click.ClickException as bad:
         if debug:
             raise
-        _fail(usage.format_message(), 2)
+        _fail(bad.format_message(), 2)
     except (click.exceptions.Abort, KeyboardInterrupt):
         _fail("interrupted", 1)
     except (InputError, MissingExtraError) as bad:
@@ -118,7 +143,7 @@ def main(argv: list[str] | None = None) -> None:
         _fail(f"internal error: {type(bug).__name__}: {bug} (rerun with --debug)", 1)
 
 
-def command(fn: Callable[..., None]) -> Callable[..., None]:
+def command(fn: Callable[..., None]) -> click.Command:
     """Register ``fn`` as a sub-command named after it (underscores become dashes)."""
     return app.command(name=fn.__name__.removesuffix("_cmd").replace("_", "-"))(fn)
 
@@ -126,20 +151,19 @@ def command(fn: Callable[..., None]) -> Callable[..., None]:
 # Commands follow; each one is a thin layer over the library's public API.
 
 
-ExplainOption = Annotated[
-    bool, typer.Option("--explain", help="Also print the reduction steps (the trace).")
-]
-
-
 @command
+@click.argument("task")
+@json_option
+@tolerance_option
+@click.option("--explain", is_flag=True, help="Also print the reduction steps (the trace).")
+@debug_option
 def solve_cmd(
-    task: Annotated[str, typer.Argument(help="Task file: .yaml, .yml, .json or .rapt.")],
-    as_json: JsonOption = False,
-    tolerance: ToleranceOption = None,
-    explain: ExplainOption = False,
-    debug: DebugOption = False,
+    task: str, as_json: bool, tolerance: float | None, explain: bool, debug: bool
 ) -> None:
-    """Pose of every body in every situation of a task (RAPT network reduction, seed 000)."""
+    """Pose of every body in every situation of a task (RAPT network reduction, seed 000).
+
+    TASK: task file, .yaml, .yml, .json or .rapt.
+    """
     from assemblykit.io.spec import load_task
     from assemblykit.tolerance import using
 
@@ -152,14 +176,15 @@ def _progress_bar() -> Any:
     """A rich progress bar on stderr (shown when stderr is a terminal)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    err = console(stderr=True)
     return Progress(
         TextColumn("{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
         TimeElapsedColumn(),
-        console=err_console,
+        console=err,
         transient=True,
-        disable=not err_console.is_terminal,
+        disable=not err.is_terminal,
     )
 
 
@@ -173,20 +198,26 @@ def _updater(bar: Any) -> Callable[[str, int, int], None]:
 
 
 @command
+@assembly_argument
+@click.option("--html", default=None, help="Write a self-contained HTML report here.")
+@click.option("--png", default=None, help="Write a static exploded view (PNG) here.")
+@json_option
+@tolerance_option
+@as_written_option
+@debug_option
 def plan_cmd(
-    assembly: AssemblyArgument,
-    html: Annotated[
-        str | None, typer.Option("--html", help="Write a self-contained HTML report here.")
-    ] = None,
-    png: Annotated[
-        str | None, typer.Option("--png", help="Write a static exploded view (PNG) here.")
-    ] = None,
-    as_json: JsonOption = False,
-    tolerance: ToleranceOption = None,
-    as_written: AsWrittenOption = False,
-    debug: DebugOption = False,
+    assembly: str,
+    html: str | None,
+    png: str | None,
+    as_json: bool,
+    tolerance: float | None,
+    as_written: bool,
+    debug: bool,
 ) -> None:
-    """Disassembly (and assembly) sequence by extended translations (seed 004)."""
+    """Disassembly (and assembly) sequence by extended translations (seed 004).
+
+    ASSEMBLY: mesh folder, .yaml manifest, .step or COMPAS .json.
+    """
     from assemblykit.planning.sequence import plan
 
     tol = tolerance_from(tolerance)
@@ -206,19 +237,16 @@ def plan_cmd(
             exploded_view_png(loaded, result, png)
     for written in (html, png):
         if written is not None:
-            err_console.print(f"wrote {written}", markup=False, highlight=False)
+            note(f"wrote {written}")
     emit(result, as_json)
 
 
 @command
-def demo_cmd(
-    out: Annotated[
-        str, typer.Option("--out", help="Folder for the report (created if missing).")
-    ] = ".",
-    as_json: JsonOption = False,
-    tolerance: ToleranceOption = None,
-    debug: DebugOption = False,
-) -> None:
+@click.option("--out", default=".", help="Folder for the report (created if missing).")
+@json_option
+@tolerance_option
+@debug_option
+def demo_cmd(out: str, as_json: bool, tolerance: float | None, debug: bool) -> None:
     """Plan the bundled 14-part gearbox and write its HTML report (start here)."""
     from assemblykit.demo import run_demo
 
@@ -228,39 +256,53 @@ def demo_cmd(
         emit(result, as_json)
     else:
         # soft wrap: the report's path must stay whole to be copied
-        console.print(result.render(), soft_wrap=True)
+        console().print(result.render(), soft_wrap=True)
 
 
 @command
+@click.argument("inputs", nargs=-1, required=True)
+@click.option("--out", default="results.jsonl", help="JSON Lines file (appended to).")
+@click.option(
+    "--engine",
+    type=click.Choice(["local", "dask"]),
+    default="local",
+    help="local (processes here) or dask.",
+)
+@click.option("--scheduler", default=None, help="Dask scheduler address (else a local one).")
+@click.option(
+    "--command",
+    "run",
+    type=click.Choice(["plan", "motion"]),
+    default="plan",
+    help="plan or motion.",
+)
+@click.option("--timeout", type=float, default=None, help="Seconds allowed per assembly.")
+@click.option("--workers", type=click.IntRange(min=1), default=2, help="Assemblies run at once.")
+@json_option
+@tolerance_option
+@debug_option
 def batch_cmd(
-    inputs: Annotated[list[str], typer.Argument(help="Assemblies (files or mesh folders).")],
-    out: Annotated[str, typer.Option("--out", help="JSON Lines file (appended to).")] = (
-        "results.jsonl"
-    ),
-    engine: Annotated[
-        str, typer.Option("--engine", help="local (processes here) or dask.")
-    ] = "local",
-    scheduler: Annotated[
-        str | None, typer.Option("--scheduler", help="Dask scheduler address (else a local one).")
-    ] = None,
-    run: Annotated[str, typer.Option("--command", help="plan or motion.")] = "plan",
-    timeout: Annotated[
-        float | None, typer.Option("--timeout", help="Seconds allowed per assembly.")
-    ] = None,
-    workers: Annotated[int, typer.Option("--workers", help="Assemblies run at once.")] = 2,
-    as_json: JsonOption = False,
-    tolerance: ToleranceOption = None,
-    debug: DebugOption = False,
+    inputs: tuple[str, ...],
+    out: str,
+    engine: str,
+    scheduler: str | None,
+    run: str,
+    timeout: float | None,
+    workers: int,
+    as_json: bool,
+    tolerance: float | None,
+    debug: bool,
 ) -> None:
-    """Run plan or motion over many assemblies: one JSON line each; reruns skip done ones."""
+    """Run plan or motion over many assemblies: one JSON line each; reruns skip done ones.
+
+    INPUTS: assemblies (files or mesh folders).
+    """
     from assemblykit.batch import run_batch
 
-    if run not in ("plan", "motion"):
-        raise InputError(f"unknown command {run!r} (use plan or motion)", where="--command")
     with _progress_bar() as bar:
         task = bar.add_task("assemblies", total=len(inputs))
         summary = run_batch(
-            inputs,
+            list(inputs),
             out,
             engine=engine,  # type: ignore[arg-type]
             command=run,  # type: ignore[arg-type]
@@ -273,24 +315,13 @@ def batch_cmd(
     emit(summary, as_json)
 
 
-SubassemblyOption = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--subassembly",
-        help="Comma-separated parts that move together (e.g. a,b); repeat for several.",
-    ),
-]
-HtmlOption = Annotated[
-    str | None, typer.Option("--html", help="Also write a self-contained HTML view to FILE.")
-]
-
-
 def _is_task_file(path: str) -> bool:
     """Whether ``path`` is a task: ``.rapt``, or YAML/JSON whose top level has
     ``situations`` (DESIGN.md §5.1); anything else is read as an assembly."""
     from pathlib import Path
 
-    import yaml
+    from assemblykit.errors import SchemaError
+    from assemblykit.io.documents import read_yaml
 
     file = Path(path)
     suffix = file.suffix.lower()
@@ -299,8 +330,8 @@ def _is_task_file(path: str) -> bool:
     if suffix not in (".yaml", ".yml", ".json") or not file.is_file():
         return False
     try:
-        data = yaml.safe_load(file.read_text())
-    except (yaml.YAMLError, UnicodeDecodeError):
+        data = read_yaml(file.read_text())
+    except (SchemaError, UnicodeDecodeError):
         return False
     return isinstance(data, dict) and "situations" in data
 
@@ -316,23 +347,32 @@ def _task_motion(path: str, tol: Tolerance, as_json: bool) -> None:
 
 
 @command
+@click.argument("assembly")
+@click.option(
+    "--subassembly",
+    multiple=True,
+    help="Comma-separated parts that move together (e.g. a,b); repeat for several.",
+)
+@click.option("--html", default=None, help="Also write a self-contained HTML view to FILE.")
+@json_option
+@tolerance_option
+@as_written_option
+@debug_option
 def motion_cmd(
-    assembly: Annotated[
-        str,
-        typer.Argument(
-            help="Assembly (mesh folder, .yaml manifest, .step or COMPAS .json) "
-            "or task (.yaml/.json with situations, or .rapt)."
-        ),
-    ],
-    subassembly: SubassemblyOption = None,
-    html: HtmlOption = None,
-    as_json: JsonOption = False,
-    tolerance: ToleranceOption = None,
-    as_written: AsWrittenOption = False,
-    debug: DebugOption = False,
+    assembly: str,
+    subassembly: tuple[str, ...],
+    html: str | None,
+    as_json: bool,
+    tolerance: float | None,
+    as_written: bool,
+    debug: bool,
 ) -> None:
     """Motion of each part and subassembly relative to the rest, gear trains (seed 003);
-    on a task, of each body in each situation from the relations it takes part in."""
+    on a task, of each body in each situation from the relations it takes part in.
+
+    ASSEMBLY: mesh folder, .yaml manifest, .step or COMPAS .json, or a task (.yaml/.json
+    with situations, or .rapt).
+    """
     from assemblykit.motion.articulation import articulation
 
     tol = tolerance_from(tolerance)
@@ -342,7 +382,7 @@ def motion_cmd(
         _task_motion(assembly, tol, as_json)
         return
     loaded = loaded_assembly(assembly, tol, as_written)
-    sets = [[n.strip() for n in spec.split(",") if n.strip()] for spec in subassembly or ()]
+    sets = [[n.strip() for n in spec.split(",") if n.strip()] for spec in subassembly]
     if any(not names for names in sets):
         raise InputError("--subassembly needs comma-separated part names", source=assembly)
     result = articulation(loaded, sets, tol)
@@ -369,21 +409,25 @@ class _RoundedResult:
         return self.result.render()
 
 
-PngOption = Annotated[
-    str | None, typer.Option("--png", help="Also write a PNG of the parts and contacts to FILE.")
-]
-
-
 @command
+@assembly_argument
+@click.option("--png", default=None, help="Also write a PNG of the parts and contacts to FILE.")
+@json_option
+@tolerance_option
+@as_written_option
+@debug_option
 def contacts_cmd(
-    assembly: AssemblyArgument,
-    png: PngOption = None,
-    as_json: JsonOption = False,
-    tolerance: ToleranceOption = None,
-    as_written: AsWrittenOption = False,
-    debug: DebugOption = False,
+    assembly: str,
+    png: str | None,
+    as_json: bool,
+    tolerance: float | None,
+    as_written: bool,
+    debug: bool,
 ) -> None:
-    """Parts, contact patches (areas, normals), surface features and interferences."""
+    """Parts, contact patches (areas, normals), surface features and interferences.
+
+    ASSEMBLY: mesh folder, .yaml manifest, .step or COMPAS .json.
+    """
     from assemblykit.io.assembly import contact_report
 
     tol = tolerance_from(tolerance)
@@ -399,34 +443,35 @@ BLOCKING_MOTIONS = ("infinitesimal", "extended", "rigid")
 
 
 @command
+@assembly_argument
+@click.option(
+    "--motion",
+    type=click.Choice(BLOCKING_MOTIONS),
+    default="infinitesimal",
+    help="infinitesimal, extended or rigid.",
+)
+@click.option("--png", default=None, help="Also write a PNG of the arrangement and a DBG to FILE.")
+@json_option
+@tolerance_option
+@as_written_option
+@debug_option
 def blocking_cmd(
-    assembly: Annotated[
-        str,
-        typer.Argument(
-            help="Assembly (mesh folder, .yaml manifest, .step, COMPAS .json) or a YAML "
-            "file of 2D polygons 'parts: {name: [[x, y], ...]}'."
-        ),
-    ],
-    motion: Annotated[
-        str, typer.Option("--motion", help="infinitesimal, extended or rigid.")
-    ] = "infinitesimal",
-    png: Annotated[
-        str | None,
-        typer.Option("--png", help="Also write a PNG of the arrangement and a DBG to FILE."),
-    ] = None,
-    as_json: JsonOption = False,
-    tolerance: ToleranceOption = None,
-    as_written: AsWrittenOption = False,
-    debug: DebugOption = False,
+    assembly: str,
+    motion: str,
+    png: str | None,
+    as_json: bool,
+    tolerance: float | None,
+    as_written: bool,
+    debug: bool,
 ) -> None:
-    """Non-directional blocking graph: regions of directions, removable subassemblies."""
+    """Non-directional blocking graph: regions of directions, removable subassemblies.
+
+    ASSEMBLY: mesh folder, .yaml manifest, .step, COMPAS .json, or a YAML file of 2D
+    polygons 'parts: {name: [[x, y], ...]}'.
+    """
     from assemblykit.blocking.ndbg import blocking_graph
     from assemblykit.blocking.polygons import is_polygon_file, load_polygons
 
-    if motion not in BLOCKING_MOTIONS:
-        raise InputError(
-            f"unknown motion {motion!r} (choose {', '.join(BLOCKING_MOTIONS)})", where="--motion"
-        )
     tol = tolerance_from(tolerance)
     if is_polygon_file(assembly):
         model: Any = load_polygons(assembly)
@@ -443,13 +488,15 @@ def blocking_cmd(
 
 
 @command
-def mate_cmd(
-    problem: Annotated[str, typer.Argument(help="Mating problem: .yaml, .yml or .json.")],
-    as_json: JsonOption = False,
-    tolerance: ToleranceOption = None,
-    debug: DebugOption = False,
-) -> None:
-    """Mating inference (seed 002): which compound features mate to satisfy the goals."""
+@click.argument("problem")
+@json_option
+@tolerance_option
+@debug_option
+def mate_cmd(problem: str, as_json: bool, tolerance: float | None, debug: bool) -> None:
+    """Mating inference (seed 002): which compound features mate to satisfy the goals.
+
+    PROBLEM: mating problem, .yaml, .yml or .json.
+    """
     from assemblykit.io.problem import load_problem
     from assemblykit.mating.search import mate
 

@@ -191,11 +191,14 @@ class Solution:
             parts.append(Text(f"conflict ({c.kind} {c.value:.6g}): {', '.join(c.relations)}"))
             parts.append(Text(f"  {c.message}"))
         if self.explain:
+            # one line per step whatever the width: the trace is read by people and programs
             for step in self.trace:
                 parts.append(
                     Text(
                         f"{step.rule}: {step.link} dof {step.dof_before} -> {step.dof_after}"
-                        + (f" ({step.detail})" if step.detail else "")
+                        + (f" ({step.detail})" if step.detail else ""),
+                        no_wrap=True,
+                        overflow="ignore",
                     )
                 )
         return Group(*parts)

@@ -36,7 +36,6 @@ from typing import Any
 
 import numpy as np
 import trimesh
-import yaml
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
@@ -50,6 +49,7 @@ from assemblykit.geometry.precision import (
 )
 from assemblykit.geometry.settling import settle as settle_parts
 from assemblykit.geometry.solids import placed
+from assemblykit.io.documents import read_yaml
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance, current
 
@@ -258,9 +258,10 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     path = Path(path)
     source = str(path)
     try:
-        data = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as bad:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as bad:
         raise SchemaError(f"cannot read manifest: {bad}", source=source) from None
+    data = read_yaml(text, source)
     if not isinstance(data, dict) or not isinstance(data.get("parts"), list) or not data["parts"]:
         raise SchemaError("expected a non-empty list", source=source, where="parts")
     units = data.get("units")

@@ -36,8 +36,9 @@ from assemblykit.algebra import se3
 from assemblykit.errors import GeometryError, InputError, SchemaError, UnknownNameError
 from assemblykit.features import Feature, feature_from_dict, parse_angle
 from assemblykit.geometry.solids import Box, Cylinder, Primitive, generated_mesh
+from assemblykit.io.documents import read_json, read_yaml
 from assemblykit.io.meshes import read_mesh
-from assemblykit.io.spec import UNITS, Name, read_json, read_yaml, schema_error, with_source
+from assemblykit.io.spec import UNITS, Name, schema_error, with_source
 from assemblykit.mating.problem import (
     Goal,
     MatingBody,

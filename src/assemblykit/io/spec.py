@@ -10,18 +10,17 @@ same mapping and passes the line of every entry as its place.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import MISSING, fields
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StringConstraints, ValidationError
 
 from assemblykit.errors import InputError, SchemaError
 from assemblykit.features.primitives import FEATURE_TYPES, Feature, feature_from_dict, parse_angle
+from assemblykit.io.documents import read_json, read_yaml
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Action, Situation, Task
@@ -84,57 +83,6 @@ def load_task(path: str | Path) -> Task:
         f"unknown task file type {path.suffix!r} (expected .yaml, .yml, .json or .rapt)",
         source=source,
     )
-
-
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """A YAML loader that rejects a key given twice in one mapping (PyYAML keeps the last)."""
-
-    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
-        seen: set[Any] = set()
-        for key_node, _ in node.value:
-            key = self.construct_object(key_node, deep=deep)
-            if key in seen:
-                raise SchemaError(
-                    f"duplicate key {key!r}", where=f"line {key_node.start_mark.line + 1}"
-                )
-            seen.add(key)
-        return super().construct_mapping(node, deep=deep)
-
-
-def read_yaml(text: str, source: str | None = None) -> Any:
-    """Parse YAML text; :class:`SchemaError` with the line for malformed text or a
-    duplicate key."""
-    try:
-        return yaml.load(text, Loader=_UniqueKeyLoader)
-    except SchemaError as error:
-        raise SchemaError(error.detail, source=source, where=error.where) from None
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = None if mark is None else f"line {mark.line + 1}, column {mark.column + 1}"
-        problem = getattr(error, "problem", None) or str(error)
-        raise SchemaError(f"malformed YAML: {problem}", source=source, where=where) from None
-
-
-def read_json(text: str, source: str | None = None) -> Any:
-    """Parse JSON text; :class:`SchemaError` with the line for malformed text or a
-    duplicate key."""
-
-    def unique(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-        out: dict[str, Any] = {}
-        for key, value in pairs:
-            if key in out:
-                raise SchemaError(f"duplicate key {key!r}", source=source)
-            out[key] = value
-        return out
-
-    try:
-        return json.loads(text, object_pairs_hook=unique)
-    except json.JSONDecodeError as error:
-        raise SchemaError(
-            f"malformed JSON: {error.msg}",
-            source=source,
-            where=f"line {error.lineno}, column {error.colno}",
-        ) from None
 
 
 def parse_task(
