@@ -29,28 +29,40 @@ def shared_inputs() -> list[str]:
 def test_results_errors_and_rerun_skipping(tmp_path):
     out = tmp_path / "runs" / "results.jsonl"
     missing = str(tmp_path / "missing.yaml")
-    summary = run_batch([str(DEMO), missing], out, workers=2)
-    assert summary.to_dict() == {
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("parts: 3\n")
+    inputs = [str(DEMO), missing, str(broken)]
+    summary = run_batch(inputs, out, workers=2)
+    data = summary.to_dict()
+    assert {k: v for k, v in data.items() if k != "failed"} == {
         "out": str(out),
-        "total": 2,
+        "total": 3,
         "skipped": 0,
         "ran": 2,
         "ok": 1,
         "error": 1,
         "timeout": 0,
+        "missing": 1,
     }
+    # every input without an answer is listed, in the order given, with its message
+    assert [(f["input"], f["status"]) for f in data["failed"]] == [
+        (missing, "missing"),
+        (str(broken), "error"),
+    ]
+    assert data["failed"][0]["error"] == "no such file or folder"
+    assert "broken.yaml" in data["failed"][1]["error"]
+    # the missing input is not recorded: only the two that ran are
     records = lines(out)
-    assert set(records) == {str(DEMO), missing}
+    assert set(records) == {str(DEMO), str(broken)}
     good = records[str(DEMO)]
     assert good["status"] == "ok"
     assert good["result"]["feasible"] is True
     assert good["seconds"] > 0
-    bad = records[missing]
-    assert bad["status"] == "error"
-    assert "no such file or folder" in bad["error"]
-    # a rerun finds both finished and appends nothing
-    again = run_batch([str(DEMO), missing], out)
+    assert records[str(broken)]["status"] == "error"
+    # a rerun skips the two finished inputs and tries the missing one again
+    again = run_batch(inputs, out)
     assert again.skipped == 2 and again.to_dict()["ran"] == 0
+    assert again.missing == (missing,)
     assert len(out.read_text().splitlines()) == 2
 
 

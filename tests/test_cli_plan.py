@@ -79,3 +79,13 @@ def test_batch_command(capsys, tmp_path):
     assert record["input"] == str(DEMO) and record["status"] == "ok"
     code, _, err = run(capsys, "batch", str(DEMO), "--command", "solve")
     assert code == 2 and "'solve' is not one of 'plan', 'motion'" in err
+
+
+def test_batch_lists_a_missing_input_and_exits_2(capsys, tmp_path):
+    out_file = tmp_path / "r.jsonl"
+    missing = str(tmp_path / "nowhere.yaml")
+    code, out, err = run(capsys, "batch", missing, "--out", str(out_file))
+    assert code == 2
+    assert "missing: " in out and "nowhere.yaml: no such file or folder" in out
+    assert err.count("\n") == 1 and "not found" in err and "nowhere.yaml" in err
+    assert not out_file.exists() or out_file.read_text() == ""

@@ -10,7 +10,9 @@ give the same answers.
 The output is JSON Lines, one line per assembly, appended as soon as it is known:
 ``input``, ``status`` (``ok``, ``error`` or ``timeout``), ``result`` (the command's JSON)
 or ``error`` (one line), and ``seconds``. A rerun reads the file first and skips the
-inputs already finished (``ok`` or ``error``); timed-out inputs are tried again.
+inputs already finished (``ok`` or ``error``); timed-out inputs are tried again. An input
+that does not exist is not run and not written: the summary lists it with the other
+failures, and the next run tries it again.
 """
 
 from __future__ import annotations
@@ -26,7 +28,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal, cast
 
+from rich.console import Group
 from rich.table import Table
+from rich.text import Text
 
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
 
@@ -47,33 +51,59 @@ class Job:
 
 
 @dataclass(frozen=True)
+class Failure:
+    """An input that gave no answer: ``error``, ``timeout`` or ``missing`` (not found)."""
+
+    input: str
+    status: str
+    error: str
+
+    def to_dict(self) -> dict[str, str]:
+        return {"input": self.input, "status": self.status, "error": self.error}
+
+
+@dataclass(frozen=True)
 class BatchSummary:
-    """What a batch run did: the output file, how many inputs it skipped and the count
-    of each status among the inputs it ran."""
+    """What a batch run did: the output file, how many inputs it skipped, the count of
+    each status among the inputs it ran, and every input that gave no answer."""
 
     out: str
     total: int
     skipped: int
     statuses: dict[str, int]
+    failed: tuple[Failure, ...] = ()
+
+    @property
+    def missing(self) -> tuple[str, ...]:
+        """Inputs that do not exist (not run, not written, tried again next time)."""
+        return tuple(f.input for f in self.failed if f.status == "missing")
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``out``, ``total``, ``skipped``, ``ran`` and the status counts."""
+        """JSON form: ``out``, ``total``, ``skipped``, ``ran``, the status counts,
+        ``missing`` and ``failed`` (each failed input with its status and message)."""
         return {
             "out": self.out,
             "total": self.total,
             "skipped": self.skipped,
             "ran": sum(self.statuses.values()),
             **{status: self.statuses.get(status, 0) for status in ("ok", "error", "timeout")},
+            "missing": len(self.missing),
+            "failed": [failure.to_dict() for failure in self.failed],
         }
 
-    def render(self) -> Table:
-        """A one-row rich table of the counts."""
+    def render(self) -> Group:
+        """A one-row rich table of the counts, then one line per failed input."""
         data = self.to_dict()
+        keys = ("total", "skipped", "ok", "error", "timeout", "missing")
         table = Table(title=f"batch -> {self.out}")
-        for key in ("total", "skipped", "ok", "error", "timeout"):
+        for key in keys:
             table.add_column(key)
-        table.add_row(*(str(data[key]) for key in ("total", "skipped", "ok", "error", "timeout")))
-        return table
+        table.add_row(*(str(data[key]) for key in keys))
+        lines = [
+            Text(f"{f.status}: {f.input}: {f.error}", no_wrap=True, overflow="ignore")
+            for f in self.failed
+        ]
+        return Group(table, *lines)
 
 
 def compute(command: Command, path: str, rel_tolerance: float | None = None) -> dict[str, Any]:
@@ -202,7 +232,13 @@ def run_batch(
     target = Path(out)
     names = [str(path) for path in inputs]
     done = finished_inputs(target)
-    todo = [Job(name, command, timeout, rel_tolerance) for name in names if _key(name) not in done]
+    pending = [name for name in names if _key(name) not in done]
+    failed = [
+        Failure(name, "missing", "no such file or folder")
+        for name in pending
+        if not Path(name).exists()
+    ]
+    todo = [Job(name, command, timeout, rel_tolerance) for name in pending if Path(name).exists()]
     target.parent.mkdir(parents=True, exist_ok=True)
     lines = _local(todo, workers) if engine == "local" else _dask(todo, workers, scheduler)
     statuses: Counter[str] = Counter()
@@ -211,9 +247,15 @@ def run_batch(
             sink.write(json.dumps(record) + "\n")
             sink.flush()
             statuses[record["status"]] += 1
+            if record["status"] != "ok":
+                failed.append(Failure(record["input"], record["status"], record["error"]))
             if progress is not None:
                 progress(sum(statuses.values()), len(todo))
-    return BatchSummary(str(target), len(names), len(names) - len(todo), dict(statuses))
+    order = {name: i for i, name in enumerate(names)}
+    failed.sort(key=lambda f: order[f.input])
+    return BatchSummary(
+        str(target), len(names), len(names) - len(pending), dict(statuses), tuple(failed)
+    )
 
 
 def _child(argv: Sequence[str]) -> int:

@@ -313,6 +313,8 @@ def batch_cmd(
             progress=lambda done, total: bar.update(task, completed=done, total=total),
         )
     emit(summary, as_json)
+    if summary.missing:
+        raise InputError(f"not found: {', '.join(summary.missing)} (tried again on the next run)")
 
 
 def _is_task_file(path: str) -> bool:
