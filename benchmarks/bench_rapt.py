@@ -7,6 +7,10 @@ residue solver, the "equation solving" system of seed 000 §III G) to reduction.
 Shapes: ``stack`` (equal cubes, so reduction reuses the intersections of repeated
 geometry), ``stack~`` (every cube a different size: no reuse), ``tree`` and ``grid``.
 
+Then a task file of 1,000 stacked bodies (YAML, DESIGN.md §5.1) read and solved in one
+process: load time (YAML parsing through libyaml when PyYAML has it, and validation),
+solve time and their sum.
+
 Run: python benchmarks/bench_rapt.py [--quick] [--one-start]
 
 ``--quick`` stops at N = 1,000. The numeric-only path runs with the residue solver's
@@ -19,12 +23,17 @@ from __future__ import annotations
 
 import statistics
 import sys
+import tempfile
 import time
 import timeit
 from collections.abc import Callable
+from pathlib import Path
+
+import yaml
 
 from assemblykit.features.primitives import Plane
 from assemblykit.inference.reduction import solve_numeric_only, solve_task
+from assemblykit.io.spec import load_task
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Situation, Task
@@ -126,6 +135,53 @@ def grid(n: int) -> Task:
     return Task("mm", bodies, (Situation("s1", tuple(relations)),))
 
 
+def stack_file(n: int) -> dict[str, object]:
+    """The task file of N unit cubes stacked on a fixed base, as written by a user."""
+
+    def cube(fixed: bool) -> dict[str, object]:
+        planes = {
+            "bottom": ([0, 0, 0], [0, 0, -1]),
+            "top": ([0, 0, 1], [0, 0, 1]),
+            "left": ([0, 0, 0], [-1, 0, 0]),
+            "front": ([0, 0, 0], [0, -1, 0]),
+        }
+        features = {k: {"type": "plane", "point": p, "normal": v} for k, (p, v) in planes.items()}
+        return {"fixed": fixed, "features": features}
+
+    relations = []
+    for i in range(1, n + 1):
+        relations += [
+            ["against", f"b{i}.bottom", f"b{i - 1}.top"],
+            ["coplanar", f"b{i}.left", f"b{i - 1}.left"],
+            ["coplanar", f"b{i}.front", f"b{i - 1}.front"],
+        ]
+    bodies = {f"b{i}": cube(i == 0) for i in range(n + 1)}
+    return {"units": "mm", "bodies": bodies, "situations": [{"name": "s1", "relations": relations}]}
+
+
+def load_and_solve(n: int, repeats: int = 5) -> None:
+    """Median load, solve and total time of a task file of N stacked bodies."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / f"stack{n}.yaml"
+        path.write_text(yaml.safe_dump(stack_file(n), sort_keys=False))
+        size = path.stat().st_size
+        loads, solves = [], []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            task = load_task(path)
+            middle = time.perf_counter()
+            solution = task.solve()
+            loads.append(middle - start)
+            solves.append(time.perf_counter() - middle)
+            assert solution.status == "solved", solution.status
+    load, solve = statistics.median(loads), statistics.median(solves)
+    parser = "libyaml" if yaml.__with_libyaml__ else "pure-Python"
+    print(
+        f"task file of {n} bodies ({size / 1e6:.2f} MB, {parser} parser): "
+        f"load {load:.3f} s, solve {solve:.3f} s, load + solve {load + solve:.3f} s (median)"
+    )
+
+
 def timed(fn: Callable[[], object], repeats: int) -> float:
     """Median wall time of ``repeats`` calls (garbage collection left on, as in use)."""
     return statistics.median(timeit.repeat(fn, "gc.enable()", number=1, repeat=repeats))
@@ -133,6 +189,7 @@ def timed(fn: Callable[[], object], repeats: int) -> float:
 
 def main() -> None:
     quick = "--quick" in sys.argv
+    load_and_solve(1000)
     sizes = (10, 100, 1000) if quick else (10, 100, 1000, 10000)
     print(f"{'shape':8} {'N':>7} {'median s':>10} {'bodies/s':>10}")
     shapes = (("stack", stack), ("stack~", distinct_stack), ("tree", tree), ("grid", grid))

@@ -128,3 +128,38 @@ def test_line_classes_group_parallel_and_antiparallel_vectors():
     np.testing.assert_array_equal(leaders, [[1, 0, 0], [0, 1, 0], [0, 1e-7, 1.0]])
     assert index.tolist() == [0, 1, 0, 2, 0]
     assert orient.tolist() == [1, 1, -1, 1, 1]
+
+
+rotation_vectors = st.builds(
+    lambda axis, angle: angle * np.asarray(axis) / np.linalg.norm(axis),
+    st.tuples(*[st.floats(-1, 1) for _ in range(3)]).filter(lambda a: np.linalg.norm(a) > 1e-3),
+    st.one_of(
+        st.floats(0.0, math.pi),
+        st.floats(0.0, 1e-7),
+        st.floats(math.pi - 1e-7, math.pi),
+    ),
+)
+
+
+@given(rotation_vectors)
+@settings(max_examples=300, deadline=None)
+def test_rotation_matrix_and_vector_agree_with_scipy(w):
+    """Rodrigues' formula and the quaternion logarithm against scipy's Rotation, also
+    within 1e-7 of angle 0 and of angle pi (where the axis sign is ambiguous)."""
+    from scipy.spatial.transform import Rotation
+
+    r = se3.rotation_matrix(w)
+    np.testing.assert_allclose(r, Rotation.from_rotvec(w).as_matrix(), atol=1e-12)
+    back = se3.rotation_vector(r)
+    np.testing.assert_allclose(se3.rotation_matrix(back), r, atol=1e-12)
+    assert np.linalg.norm(back) == pytest.approx(np.linalg.norm(w), abs=1e-9)
+    if np.linalg.norm(w) < math.pi - 1e-6:
+        np.testing.assert_allclose(back, w, atol=1e-9)
+
+
+def test_rotation_vector_of_half_turns_and_identity():
+    assert se3.rotation_vector(np.eye(3)).tolist() == [0.0, 0.0, 0.0]
+    half_x = np.diag([1.0, -1.0, -1.0])
+    assert np.abs(se3.rotation_vector(half_x)).tolist() == pytest.approx([math.pi, 0.0, 0.0])
+    quarter_z = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    assert se3.rotation_vector(quarter_z) == pytest.approx([0.0, 0.0, math.pi / 2])

@@ -16,7 +16,6 @@ from fractions import Fraction
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from assemblykit.algebra import se3
 from assemblykit.algebra.caching import cached
@@ -440,6 +439,8 @@ def _starts(rng: np.random.Generator, angles: np.ndarray, length: float) -> np.n
 def _numeric_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
     """A common point from least squares over both parameterisations, from a deterministic
     multi-start (§2.5 "Numeric fallback"); never claims emptiness."""
+    from scipy.optimize import least_squares  # imported here: only numeric cases need it
+
     a, b = p.group, q.group
     group = a.intersect(b, tol)
     na = a.dof
@@ -563,6 +564,8 @@ class Chain:
     def contains(self, x: np.ndarray, tol: Tolerance | None = None) -> bool:
         """Whether ``x`` is in the product set, by least squares over the factors'
         parameters from a deterministic multi-start."""
+        from scipy.optimize import least_squares
+
         tol = tol or current()
         x = np.asarray(x, dtype=np.float64)
         if any(f.group.lattice for f in self.factors):

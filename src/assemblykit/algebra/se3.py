@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from assemblykit.tolerance import Tolerance, current
 
@@ -39,6 +38,8 @@ __all__ = [
     "rot_z",
     "rotation",
     "rotation_angle",
+    "rotation_matrix",
+    "rotation_vector",
     "screw",
     "skew",
     "translation",
@@ -272,13 +273,52 @@ def _left_jacobian(w: np.ndarray, theta: float) -> np.ndarray:
     return np.eye(3) + a * k + b * (k @ k)
 
 
+def rotation_matrix(w: np.ndarray) -> np.ndarray:
+    """The rotation ``exp(skew(w))`` of the rotation vector ``w`` (Rodrigues' formula)."""
+    w = np.asarray(w, dtype=np.float64)
+    theta = math.sqrt(float(w @ w))
+    k = skew(w)
+    if theta < _SERIES_SWITCH:
+        return np.eye(3) + k + 0.5 * (k @ k)
+    return (
+        np.eye(3) + (math.sin(theta) / theta) * k + ((1.0 - math.cos(theta)) / theta**2) * (k @ k)
+    )
+
+
+def rotation_vector(r: np.ndarray) -> np.ndarray:
+    """The rotation vector (axis times angle in [0, pi]) of the rotation matrix ``r``.
+
+    Through the unit quaternion, taken from the largest of its four squared components
+    (Shepperd's method), so that it is accurate near 0 and near pi alike.
+    """
+    r = np.asarray(r, dtype=np.float64)
+    trace = r[0, 0] + r[1, 1] + r[2, 2]
+    squares = (trace, r[0, 0], r[1, 1], r[2, 2])
+    k = int(np.argmax(squares))
+    if k == 0:
+        w = math.sqrt(max(1.0 + trace, 0.0)) / 2.0
+        q = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]]) / (4.0 * w)
+    else:
+        i, j, m = k - 1, k % 3, (k + 1) % 3
+        q = np.empty(3)
+        q[i] = math.sqrt(max(1.0 + 2.0 * r[i, i] - trace, 0.0)) / 2.0
+        q[j] = (r[j, i] + r[i, j]) / (4.0 * q[i])
+        q[m] = (r[m, i] + r[i, m]) / (4.0 * q[i])
+        w = (r[m, j] - r[j, m]) / (4.0 * q[i])
+    if w < 0.0:  # the same rotation; this sign gives the angle in [0, pi]
+        w, q = -w, -q
+    sine = math.sqrt(float(q @ q))
+    if sine == 0.0:
+        return np.zeros(3)
+    return q * (2.0 * math.atan2(sine, w) / sine)
+
+
 def exp(xi: np.ndarray) -> np.ndarray:
     """The exponential of the twist ``xi = (omega; v)`` in closed form."""
     xi = np.asarray(xi, dtype=np.float64)
     w, v = xi[:3], xi[3:]
     theta = math.sqrt(float(w @ w))
-    r = Rotation.from_rotvec(w).as_matrix()
-    return _compose(r, _left_jacobian(w, theta) @ v)
+    return _compose(rotation_matrix(w), _left_jacobian(w, theta) @ v)
 
 
 def log(t: np.ndarray) -> np.ndarray:
@@ -287,7 +327,7 @@ def log(t: np.ndarray) -> np.ndarray:
     The logarithm is multivalued (at angle pi and by 2 pi periodicity); it is used for
     parameterisation and residuals, never to decide membership (ALGEBRA.md §2.3).
     """
-    w = Rotation.from_matrix(t[:3, :3]).as_rotvec()
+    w = rotation_vector(t[:3, :3])
     theta = math.sqrt(float(w @ w))
     v = np.linalg.solve(_left_jacobian(w, theta), t[:3, 3])
     return np.concatenate((w, v))
@@ -305,7 +345,7 @@ def adjoint(t: np.ndarray) -> np.ndarray:
 
 def rotation_angle(t: np.ndarray) -> float:
     """The rotation angle of ``t`` in [0, pi] (robust near 0 and pi)."""
-    return float(np.linalg.norm(Rotation.from_matrix(t[:3, :3]).as_rotvec()))
+    return float(np.linalg.norm(rotation_vector(t[:3, :3])))
 
 
 def is_rigid(t: np.ndarray, tol: Tolerance | None = None) -> bool:
@@ -322,5 +362,7 @@ def is_rigid(t: np.ndarray, tol: Tolerance | None = None) -> bool:
 
 def random_transform(rng: np.random.Generator, scale: float = 10.0) -> np.ndarray:
     """A random rigid transform: uniform rotation and translation in ``[-scale, scale]^3``."""
+    from scipy.spatial.transform import Rotation
+
     r = Rotation.random(random_state=rng).as_matrix()
     return _compose(r, rng.uniform(-scale, scale, 3))

@@ -14,7 +14,6 @@ from enum import StrEnum
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from assemblykit.algebra import se3
 from assemblykit.algebra.caching import cached
@@ -313,7 +312,7 @@ def _canonical_element(kind: Kind, pitch: float, params: np.ndarray) -> np.ndarr
         return se3.translation(p)
     if kind is Kind.SPHERICAL:
         out = np.eye(4)
-        out[:3, :3] = Rotation.from_rotvec(p).as_matrix()
+        out[:3, :3] = se3.rotation_matrix(p)
         return out
     if kind is Kind.PLANAR:
         return se3.translation((p[0], p[1], 0.0)) @ se3.rot_z(p[2])
@@ -322,7 +321,7 @@ def _canonical_element(kind: Kind, pitch: float, params: np.ndarray) -> np.ndarr
     if kind is Kind.SCHOENFLIES:
         return se3.translation(p[:3]) @ se3.rot_z(p[3])
     out = se3.translation(p[:3])
-    out[:3, :3] = Rotation.from_rotvec(p[3:]).as_matrix()
+    out[:3, :3] = se3.rotation_matrix(p[3:])
     return out
 
 
@@ -727,7 +726,7 @@ class SymmetryGroup:
         tol = current()
         for gen in self.lattice:
             if se3.rotation_angle(gen) > tol.angle:
-                axis = se3.unit(Rotation.from_matrix(gen[:3, :3]).as_rotvec())
+                axis = se3.unit(se3.rotation_vector(gen[:3, :3]))
                 space = _sub_meet(space, _Sub(1, axis), tol)
         basis = {0: np.zeros((3, 0)), 3: np.eye(3)}.get(space.dim)
         if basis is None:

@@ -24,9 +24,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
-from scipy.spatial.transform import Rotation
 
+from assemblykit.algebra import se3
 from assemblykit.tolerance import Tolerance, current
 
 Residual = Callable[[Sequence[np.ndarray]], np.ndarray]
@@ -83,7 +82,7 @@ class ResidueResult:
 def pose_from_twist(start: np.ndarray, twist: np.ndarray) -> np.ndarray:
     """The pose ``[exp(ω) R0 | t0 + v]`` for the local coordinates ``twist = (ω; v)``."""
     pose = np.eye(4)
-    pose[:3, :3] = Rotation.from_rotvec(twist[:3]).as_matrix() @ start[:3, :3]
+    pose[:3, :3] = se3.rotation_matrix(twist[:3]) @ start[:3, :3]
     pose[:3, 3] = start[:3, 3] + twist[3:]
     return pose
 
@@ -140,7 +139,7 @@ def _distance(
 
 def _midpoint(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The pose halfway from ``a`` to ``b`` in the local coordinates of :func:`pose_from_twist`."""
-    rotvec = Rotation.from_matrix(b[:3, :3] @ a[:3, :3].T).as_rotvec()
+    rotvec = se3.rotation_vector(b[:3, :3] @ a[:3, :3].T)
     return pose_from_twist(a, 0.5 * np.concatenate([rotvec, b[:3, 3] - a[:3, 3]]))
 
 
@@ -180,6 +179,8 @@ def _sparsity(problem: ResidueProblem, start: Mapping[Hashable, np.ndarray]) -> 
 
 def _start_points(problem: ResidueProblem, count: int, seed: int, scale: float) -> list[np.ndarray]:
     """The deterministic multi-start: the given start, then seeded random twists."""
+    from scipy.spatial.transform import Rotation  # imported here: only residues need it
+
     n = 6 * len(problem.unknowns)
     rng = np.random.default_rng(seed)
     points = [np.zeros(n)]
@@ -214,6 +215,10 @@ def solve_residue(
         worst = float(np.abs(r).max()) if r.size else 0.0
         sols = (NumericSolution(dict(poses), {}, 0, worst),) if worst <= tol.mesh_length else ()
         return ResidueResult(sols, worst, 1)
+    # imported here: a residue with nothing unknown (a check) and every other command
+    # start faster without scipy.optimize
+    from scipy.optimize import least_squares
+
     origin = {node: np.asarray(problem.start[node], dtype=np.float64) for node in problem.unknowns}
     found: list[NumericSolution] = []
     best = np.inf
