@@ -12,7 +12,6 @@ import statistics
 import time
 import timeit
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 import trimesh
@@ -22,10 +21,10 @@ from assemblykit.geometry.interference import overlap_volume
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.compas import load_compas
 from assemblykit.model.assembly import Assembly, Part
+from datasets import dataset
 
-DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
-DOME = DATA / "compas_assembly" / "dome_assembly.json"
-ASAP = DATA / "asap_beam_assembly"
+DOME = dataset("compas_assembly/dome_assembly.json")
+ASAP = dataset("asap_beam_assembly")
 GRID_SIZES = (1000, 2500, 5000, 10000)
 
 
@@ -57,8 +56,8 @@ def largest_share(assembly: Assembly) -> float:
 
 
 def asap() -> None:
-    if not ASAP.is_dir():
-        print("asap beam: shared data not present, skipped")
+    if ASAP is None:
+        print("asap beam: data not present, skipped")
         return
     for settle in (False, True):
         seconds = median_time(lambda settle=settle: load_assembly(ASAP, settle=settle), 3)
@@ -70,7 +69,7 @@ def asap() -> None:
 
 
 def main() -> None:
-    if DOME.is_file():
+    if DOME is not None:
         load = median_time(lambda: load_compas(DOME), 3)
         dome = load_compas(DOME)
         found = find_contacts(dome)
@@ -80,7 +79,9 @@ def main() -> None:
             f"(load, measuring the joints' precision {dome.precision.length:.2g}: {load:.2f} s)"
         )
     else:
-        print("dome: shared data not present, skipped")
+        print(
+            "dome: not bundled, skipped (set ASSEMBLYKIT_DATA to a folder holding compas_assembly/)"
+        )
     rates = []
     for n in GRID_SIZES:
         boxes = grid(n)

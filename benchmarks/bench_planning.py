@@ -1,11 +1,11 @@
-"""Planning times: the bundled gearbox, the shared ASAP beam, arch, crossvault and dome,
-and synthetic stacks of growing size.
+"""Planning times: the bundled gearbox, the ASAP beam, arch and crossvault (shipped with
+the tests), the dome, and synthetic stacks of growing size.
 
 Run ``python benchmarks/bench_planning.py``. Each figure is the median wall time of
 ``REPEATS`` runs on a freshly loaded assembly (contacts and blocking graphs included);
 the beam, the crossvault (184 blocks) and the dome (527 blocks, candidate directions from
-each block's own arrangement) run once. Shared assemblies are skipped when
-``../shared/data`` is absent.
+each block's own arrangement) run once. The dome is skipped unless ``$ASSEMBLYKIT_DATA``
+holds ``compas_assembly/dome_assembly.json``.
 """
 
 from __future__ import annotations
@@ -20,9 +20,9 @@ import trimesh
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.sequence import Plan, plan
+from datasets import dataset
 
 ROOT = Path(__file__).resolve().parents[1]
-DATA = ROOT.parent / "shared" / "data"
 REPEATS = 3
 STACK_SIZES = (5, 10, 20, 40, 80)
 
@@ -62,15 +62,15 @@ def main() -> None:
     demo = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
     cases = [("gearbox demo", demo, REPEATS)]
     cases += [
-        ("asap beam", DATA / "asap_beam_assembly", 1),
-        ("compas stack", DATA / "compas_assembly" / "stack_assembly.json", REPEATS),
-        ("compas arch", DATA / "compas_assembly" / "arch_assembly.json", REPEATS),
-        ("compas crossvault", DATA / "compas_assembly" / "crossvault_assembly.json", 1),
-        ("compas dome", DATA / "compas_assembly" / "dome_assembly.json", 1),
+        ("asap beam", dataset("asap_beam_assembly"), 1),
+        ("compas stack", dataset("compas_assembly/stack_assembly.json"), REPEATS),
+        ("compas arch", dataset("compas_assembly/arch_assembly.json"), REPEATS),
+        ("compas crossvault", dataset("compas_assembly/crossvault_assembly.json"), 1),
+        ("compas dome", dataset("compas_assembly/dome_assembly.json"), 1),
     ]
     for name, path, repeats in cases:
-        if not path.exists():
-            print(f"{name:<28} skipped ({path} is absent)")
+        if path is None:
+            print(f"{name:<28} skipped (not bundled; set ASSEMBLYKIT_DATA)")
             continue
         seconds, result = timed(lambda p=path: load_assembly(p), repeats)
         row(name, len(result.parts), seconds, result)
