@@ -8,11 +8,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import trimesh
 import yaml
 
-from assemblykit.algebra import Locus, se3
+from assemblykit.algebra import Coset, Locus, SymmetryGroup, se3
+from assemblykit.geometry.interference import interference_threshold, overlap_volume
+from assemblykit.geometry.solids import placed
 from assemblykit.io.problem import load_problem, parse_problem
-from assemblykit.mating import search
+from assemblykit.mating import clearance, search
 from assemblykit.mating.graph import build_graph
 from assemblykit.mating.laws import equivalent_features
 from assemblykit.mating.loci import locus_meet
@@ -218,3 +221,126 @@ def test_cp_sat_finds_the_same_assignments(
     key = [{g: (c.first, c.second) for g, c in a.items()} for a in small]
     assert key == [{g: (c.first, c.second) for g, c in a.items()} for a in large]
     assert len(key) == 2
+
+
+# ----------------------------------------------------------------------------- clearance
+
+
+def _lens_area(radius: float, distance: float) -> float:
+    """Area shared by two discs of equal radius whose centres are ``distance`` apart."""
+    half = distance / 2
+    return 2 * radius**2 * math.acos(half / radius) - half * math.sqrt(4 * radius**2 - distance**2)
+
+
+def test_two_arms_overlapping_at_every_angle_have_no_configuration(mating_examples: Path) -> None:
+    problem = load_problem(mating_examples / "two_arms.yaml")
+    # By hand: the hubs (radius 3, height 1, centres 4 apart) share a lens at any angles.
+    lens = _lens_area(3.0, 4.0)
+    assert lens == pytest.approx(18 * math.acos(2 / 3) - 2 * math.sqrt(20))
+    arm = problem.bodies["arm1"].mesh
+    for first, second in ((0.0, 0.0), (1.0, -2.0), (math.pi, 0.5), (-2.5, 2.5)):
+        a = placed(arm, se3.rot_z(first))
+        b = placed(arm, se3.translation((4, 0, 0)) @ se3.rot_z(second))
+        # The 48-gon hubs lose under 1 % of the lens.
+        assert overlap_volume(a, b) > 0.98 * lens
+    result = mate(problem)
+    assert result.count == 0 and result.configurations == ()
+    assert (result.emptied.goal, result.emptied.law) == (1, "arc consistency")
+    assert result.emptied.reason == "arm1 and arm2 interfere in every position of goals 1 and 2"
+    assert result.statistics[1] == (2, 2, 2, 2, 0, 0)
+    assert result.to_dict()["status"] == "no solution"
+
+
+def test_step_three_rejects_two_arms_that_interfere_everywhere(mating_examples: Path) -> None:
+    problem = load_problem(mating_examples / "two_arms.yaml")
+    domains = build_graph(problem).domains
+    # Without the arc consistency pruning: arm1 on the left bore, arm2 on the right.
+    pairs = (
+        next(c for c in domains[1] if c.second == "seat_left"),
+        next(c for c in domains[2] if c.second == "seat_right"),
+    )
+    placement = search.place(problem, pairs)
+    assert placement.configurations == ()
+    (rejection,) = placement.rejections
+    assert rejection.bodies == ("arm1", "arm2") and rejection.proven
+    assert rejection.reason == "arm1 and arm2 interfere in every position"
+
+
+def test_two_arms_far_apart_turn_clear_of_each_other(mating_examples: Path) -> None:
+    data = yaml.safe_load((mating_examples / "two_arms.yaml").read_text())
+    # Bores 12 apart: the hubs are clear, the bars (length 10) cross only at some angles.
+    data["bodies"]["base"]["features"]["right"]["point"] = [12, 0, 0]
+    data["bodies"]["base"]["mesh"]["add"][0]["box"]["max"] = [18, 6, 0]
+    data["bodies"]["base"]["mesh"]["cut"][1]["cylinder"]["point"] = [12, 0, -4]
+    problem = parse_problem(data)
+    result = mate(problem)
+    assert result.count == 2 and result.rejections == ()
+    arm = problem.bodies["arm1"].mesh
+    threshold = interference_threshold(arm, arm, problem.tolerance.for_mesh())
+    for config in result.configurations:
+        a = placed(arm, config.poses["arm1"])
+        b = placed(arm, config.poses["arm2"])
+        assert overlap_volume(a, b) <= threshold
+        for name in ("arm1", "arm2"):
+            assert config.motions[name].kind == "revolute"
+            assert overlap_volume(placed(arm, config.poses[name]), problem.bodies["base"].mesh) <= (
+                threshold
+            )
+
+
+def test_shaft_only_fit_slides_its_head_out_of_the_base(mating_examples: Path) -> None:
+    problem = load_problem(mating_examples / "shaft_fit.yaml")
+    result = mate(problem)
+    (config,) = result.configurations
+    peg, base = problem.bodies["peg"].mesh, problem.bodies["base"].mesh
+    # The representative pose (shaft frame on the bore frame) buries the head 2 deep:
+    # 6 x 6 x 2 less the bore (a 48-gon of radius 1), computed here by manifold3d.
+    bore = 24 * math.sin(2 * math.pi / 48)
+    assert overlap_volume(peg, base) == pytest.approx(2 * (36 - bore), rel=1e-6)
+    pose = config.poses["peg"]
+    # The pose reported is within the cylindrical freedom (same axis, no tilt) ...
+    np.testing.assert_allclose(pose[:3, 2], [0, 0, 1], atol=1e-9)
+    np.testing.assert_allclose(pose[:2, 3], [0, 0], atol=1e-9)
+    # ... lifted by the hand answer, 2, until the head rests on the top, and clear.
+    assert pose[2, 3] == pytest.approx(2.0, abs=1e-3)
+    threshold = interference_threshold(peg, base, problem.tolerance.for_mesh())
+    assert overlap_volume(placed(peg, pose), base) <= threshold
+    assert config.motions["peg"].kind == "cylindrical"
+
+
+def test_cylindrical_bodies_are_judged_over_both_parameters() -> None:
+    tol = Tolerance(scale=20.0)
+    box = trimesh.creation.box(bounds=[[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]])
+    axis_z = SymmetryGroup.cylindrical((0, 0, 0), (0, 0, 1))
+    # A cube turning and sliding on the z axis against a plate with a hole of radius 1:
+    # the cube's corner (radius sqrt 2) hits the plate at every turn, but a slide of
+    # more than 1 above or below clears it (the witness).
+    plate = trimesh.creation.box(bounds=[[-5.0, -5.0, -0.5], [5.0, 5.0, 0.5]])
+    hole = trimesh.creation.cylinder(radius=1.0, height=2.0, sections=48)
+    plate = trimesh.boolean.difference([plate, hole], engine="manifold")
+    cube = clearance.mover("cube", box, Coset(axis_z, np.eye(4)), tol)
+    fixed = clearance.mover("plate", plate, Coset(SymmetryGroup.identity(), np.eye(4)), tol)
+    found = clearance.judge_pair(cube, fixed, tol)
+    assert found.verdict is clearance.Verdict.FREE
+    assert abs(found.witness[1]) >= 1.5 - 1e-9
+    # Two cylindrical cubes on axes 1 apart: their cores (the largest discs about each
+    # axis, radius 1) overlap whatever the turns, but the slides part them: free.
+    other = Coset(SymmetryGroup.cylindrical((1, 0, 0), (0, 0, 1)), se3.translation((1, 0, 0)))
+    second = clearance.mover("second", box, other, tol)
+    assert clearance.judge_pair(cube, second, tol).verdict is clearance.Verdict.FREE
+    # Turning only (revolute), the same two cubes share the cores' lens at every angle.
+    turning = [
+        clearance.mover(
+            n, box, Coset(SymmetryGroup.revolute(p, (0, 0, 1)), se3.translation(p)), tol
+        )
+        for n, p in (("a", (0, 0, 0)), ("b", (1, 0, 0)))
+    ]
+    assert clearance.judge_pair(*turning, tol).verdict is clearance.Verdict.BLOCKED
+    # Far apart (axes 4 apart, radius sqrt 2 each), the sweeps prove them clear.
+    apart = clearance.mover(
+        "c",
+        box,
+        Coset(SymmetryGroup.revolute((4, 0, 0), (0, 0, 1)), se3.translation((4, 0, 0))),
+        tol,
+    )
+    assert clearance.judge_pair(turning[0], apart, tol).verdict is clearance.Verdict.CLEAR

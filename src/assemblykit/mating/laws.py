@@ -8,7 +8,10 @@ shrink the goals' domains.
   counted as copies. It is applied only to bodies in a single goal: for a body in
   several goals, dismissing orbit members would end the process (seed 002 Example 2).
 * **Arc consistency** (Mackworth 1985; Mohr & Henderson 1986, AC-3): two candidates of
-  different goals are compatible unless they use a common non-sharable feature; a
+  different goals are compatible unless they use a common non-sharable feature or, for
+  goals sharing a body, the two other bodies interfere in every position the candidates
+  allow (seed 002 Example one: "intersection is found by arc consistency checking",
+  Figure 2; judged over both freedoms by :mod:`assemblykit.mating.clearance`); a
   candidate without a compatible one in some other goal is deleted.
 * **Path consistency** (Mohr & Henderson 1986; seed 002 step two, "arc/path
   consistency"): the allowed pairs of candidates of two goals start as the compatible
@@ -21,11 +24,12 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from itertools import combinations
 
 from assemblykit.features import Relationship, relationship
 from assemblykit.features.compound import feature_transporter
+from assemblykit.mating.clearance import Verdict, judge_pair, mover, sweepable
 from assemblykit.mating.graph import Candidate, Domains
 from assemblykit.mating.problem import Goal, MatingBody, MatingProblem
 from assemblykit.tolerance import Tolerance
@@ -134,18 +138,88 @@ def _representatives(
     return tuple(sorted(kept, key=lambda c: order.get(id(c), len(order))))
 
 
-def arc_consistency(domains: Domains) -> Domains:
-    """AC-3 over the pairwise compatibility of candidates of different goals."""
+@dataclass(eq=False)
+class Clashes:
+    """Interference between candidates of two goals sharing a body (seed 002 Example
+    one, Figure 2): with the shared body as the frame, each candidate places the goal's
+    other body on its relative coset; the candidates clash when those two bodies
+    interfere in every pair of positions (a certified verdict, never a sample). Verdicts
+    are cached; ``reasons`` keeps, per goal, why arc consistency deleted its candidates.
+    """
+
+    problem: MatingProblem
+    reasons: dict[int, str] = field(default_factory=dict)
+    _cache: dict[tuple[int, int], bool] = field(default_factory=dict)
+
+    def others(self, a: Candidate, b: Candidate) -> tuple[str, str] | None:
+        """The two bodies placed relative to the common body, if the goals share one."""
+        ga, gb = a.goal, b.goal
+        common = {ga.first, ga.second} & {gb.first, gb.second}
+        if len(common) != 1:
+            return None
+        (shared,) = common
+        p = ga.second if ga.first == shared else ga.first
+        q = gb.second if gb.first == shared else gb.first
+        bodies = self.problem.bodies
+        if p == q or bodies[p].mesh is None or bodies[q].mesh is None:
+            return None
+        return p, q
+
+    def __call__(self, a: Candidate, b: Candidate) -> bool:
+        key = (id(a), id(b)) if id(a) < id(b) else (id(b), id(a))
+        if key not in self._cache:
+            self._cache[key] = self._judge(a, b)
+        return self._cache[key]
+
+    def _judge(self, a: Candidate, b: Candidate) -> bool:
+        names = self.others(a, b)
+        if names is None:
+            return False
+        tol = self.problem.tolerance
+        movers = []
+        for candidate, name in zip((a, b), names, strict=True):
+            # X = L_second⁻¹·L_first: the first body sits on the coset in the second's
+            # frame, the second on its inverse in the first's.
+            coset = candidate.coset if candidate.goal.first == name else candidate.coset.inverse()
+            if not sweepable(coset):
+                return False
+            movers.append(mover(name, self.problem.bodies[name].mesh, coset, tol))
+        return judge_pair(movers[0], movers[1], tol).verdict is Verdict.BLOCKED
+
+
+def arc_consistency(domains: Domains, clashes: Clashes | None = None) -> Domains:
+    """AC-3 over the pairwise compatibility of candidates of different goals: no common
+    non-sharable feature and, with ``clashes``, no interference in every position."""
     current = {g: tuple(d) for g, d in domains.items()}
     goals = list(current)
-    neighbours = {
-        g: [h for h in goals if h != g and _constrained(current[g], current[h])] for g in goals
-    }
+
+    def linked(g: int, h: int) -> bool:
+        if _constrained(current[g], current[h]):
+            return True
+        if clashes is None or not current[g] or not current[h]:
+            return False
+        return clashes.others(current[g][0], current[h][0]) is not None
+
+    def allowed(c: Candidate, d: Candidate) -> bool:
+        return compatible(c, d) and not (clashes is not None and clashes(c, d))
+
+    neighbours = {g: [h for h in goals if h != g and linked(g, h)] for g in goals}
     queue = deque((g, h) for g in goals for h in neighbours[g])
     while queue:
         g, h = queue.popleft()
-        kept = tuple(c for c in current[g] if any(compatible(c, d) for d in current[h]))
+        kept = tuple(c for c in current[g] if any(allowed(c, d) for d in current[h]))
         if len(kept) != len(current[g]):
+            if clashes is not None:
+                dropped = [c for c in current[g] if c not in kept]
+                for c in dropped:
+                    names = next(
+                        (clashes.others(c, d) for d in current[h] if compatible(c, d)), None
+                    )
+                    if names is not None:
+                        clashes.reasons[g] = (
+                            f"{names[0]} and {names[1]} interfere in every position of "
+                            f"goals {g} and {h}"
+                        )
             current[g] = kept
             queue.extend((k, g) for k in neighbours[g] if k != h)
     return current

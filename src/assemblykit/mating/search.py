@@ -12,14 +12,19 @@ the bodies globally and checks the spatial constraint:
   chaining leaves open is closed by the representative-point loci of seed 002 Figs 4-5
   or, without a closed form, numerically (:mod:`assemblykit.mating.loci`), each
   solution a configuration;
-* **interference** between every two placed bodies (manifold3d volumes);
-* **sweeping** (beyond the seed; its Discussion): a body left with a one-parameter group
-  is swept over it, sampled finely, the collision-free intervals refined by bisection and
-  reported as its range of motion; a configuration with no free position is rejected.
+* **interference** between every two placed bodies over their joint parameter ranges
+  (:mod:`assemblykit.mating.clearance`): a pair proved to interfere in every position
+  rejects the configuration with the reason; otherwise a joint free pose is found by
+  exact checks (the representative when it is free, else the nearest free pose along
+  the freedom) and reported;
+* **sweeping** (seed 002 Discussion): a body left with a one-parameter group is swept
+  with the others at their chosen poses, sampled finely, the collision-free intervals
+  refined by bisection and reported as its range of motion.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -30,10 +35,21 @@ import numpy as np
 from rich.console import Group
 from rich.text import Text
 
-from assemblykit.algebra import Coset, EmptySet, Kind, SymmetryGroup, se3
+from assemblykit.algebra import Coset, EmptySet, Kind, SymmetryGroup
 from assemblykit.errors import MissingExtraError
-from assemblykit.mating.graph import Candidate, Domains, build_graph, interfering
+from assemblykit.geometry.interference import interferes as interfering_solids
+from assemblykit.geometry.solids import placed
+from assemblykit.mating.clearance import (
+    Mover,
+    Verdict,
+    judge_pair,
+    mover,
+    overlaps,
+    sweepable,
+)
+from assemblykit.mating.graph import Candidate, Domains, build_graph
 from assemblykit.mating.laws import (
+    Clashes,
     arc_consistency,
     compatible,
     equivalent_features,
@@ -60,8 +76,12 @@ SMALL_SEARCH = 10**6
 SWEEP_SAMPLES = 72
 #: Bisection steps refining each end of a collision-free interval.
 BISECTION_STEPS = 12
-
-_ONE_PARAMETER = frozenset({Kind.REVOLUTE, Kind.PRISMATIC, Kind.HELICAL})
+#: Steps per parameter of the grid searched for a joint free pose.
+WITNESS_STEPS = 64
+#: Most exact checks spent searching for a joint free pose of one configuration.
+WITNESS_CHECKS = 4000
+#: Bisection steps pulling a free pose back towards the representative.
+REFINE_STEPS = 24
 
 
 @dataclass(frozen=True)
@@ -119,6 +139,15 @@ class Emptied:
 
     goal: int
     law: str
+    reason: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """``goal`` and ``law``, and the ``reason`` when arc consistency found bodies
+        interfering in every position."""
+        found: dict[str, Any] = {"goal": self.goal, "law": self.law}
+        if self.reason is not None:
+            found["reason"] = self.reason
+        return found
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,6 +163,7 @@ class MatingResult:
     assignments: int
     rejected: int
     pairs_removed: int = 0
+    rejections: tuple[Rejection, ...] = ()
 
     @property
     def count(self) -> int:
@@ -153,9 +183,8 @@ class MatingResult:
                 "rejected": self.rejected,
                 "path_pairs_removed": self.pairs_removed,
             },
-            "emptied": None
-            if self.emptied is None
-            else {"goal": self.emptied.goal, "law": self.emptied.law},
+            "emptied": None if self.emptied is None else self.emptied.to_dict(),
+            "rejections": [r.to_dict() for r in self.rejections],
         }
 
     def render(self) -> Group:
@@ -165,6 +194,10 @@ class MatingResult:
             lines.append(
                 Text(f"goal {self.emptied.goal}: domain emptied by the {self.emptied.law} law")
             )
+            if self.emptied.reason:
+                lines.append(Text(f"  {self.emptied.reason}"))
+        for rejection in self.rejections:
+            lines.append(Text(f"rejected: {rejection.reason}"))
         lines.append(Text(f"{self.count} configurations ({len(self.configurations)} found)"))
         for config in self.configurations:
             for name, motion in config.motions.items():
@@ -195,31 +228,39 @@ def mate(problem: MatingProblem) -> MatingResult:
     stages: list[Domains] = [graph.initial, graph.domains]
     stages.append(mandatory_request(stages[-1]))
     stages.append(equivalent_features(problem, stages[-1]))
-    stages.append(arc_consistency(stages[-1]))
+    clashes = Clashes(problem)
+    stages.append(arc_consistency(stages[-1], clashes))
     path = path_consistency(stages[-1], problem.goals)
     stages.append(path.domains)
     statistics = {g.number: tuple(len(s[g.number]) for s in stages) for g in problem.goals}
-    emptied = _emptied(stages, problem)
+    emptied = _emptied(stages, problem, clashes)
     domains = stages[-1]
     if emptied is not None:
         return MatingResult((), statistics, emptied, 0, 0, path.pairs_removed)
     assignments = solve_csp(domains)
-    configurations = [
-        config
+    placements = [
+        place(problem, tuple(assignment[g.number] for g in problem.goals))
         for assignment in assignments
-        for config in place(problem, tuple(assignment[g.number] for g in problem.goals))
     ]
-    rejected = len(assignments) - len({tuple(map(id, c.pairs)) for c in configurations})
+    configurations = [c for p in placements for c in p.configurations]
+    rejected = sum(1 for p in placements if not p.configurations)
     return MatingResult(
-        tuple(configurations), statistics, None, len(assignments), rejected, path.pairs_removed
+        tuple(configurations),
+        statistics,
+        None,
+        len(assignments),
+        rejected,
+        path.pairs_removed,
+        tuple(r for p in placements for r in p.rejections),
     )
 
 
-def _emptied(stages: Sequence[Domains], problem: MatingProblem) -> Emptied | None:
+def _emptied(stages: Sequence[Domains], problem: MatingProblem, clashes: Clashes) -> Emptied | None:
     for stage, law in zip(stages, LAWS, strict=True):
         for goal in problem.goals:
             if not stage[goal.number]:
-                return Emptied(goal.number, law)
+                reason = clashes.reasons.get(goal.number) if law == "arc consistency" else None
+                return Emptied(goal.number, law, reason)
     return None
 
 
@@ -297,27 +338,75 @@ def _solve_cp_sat(domains: Domains) -> list[dict[int, Candidate]]:
 # ----------------------------------------------------------------------------- placement
 
 
-def place(problem: MatingProblem, pairs: tuple[Candidate, ...]) -> list[Configuration]:
+@dataclass(frozen=True)
+class Rejection:
+    """Why step three rejected a configuration of an assignment: the ``bodies`` that
+    interfere (or have no free position), the ``reason``, and whether it is ``proven``
+    (every pose shown to interfere) or only no free pose was found."""
+
+    pairs: tuple[Candidate, ...]
+    bodies: tuple[str, ...]
+    reason: str
+    proven: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "pairs": [c.describe() for c in self.pairs],
+            "bodies": list(self.bodies),
+            "reason": self.reason,
+            "proven": self.proven,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class Placement:
+    """The configurations of one assignment and the rejections of its other branches."""
+
+    configurations: tuple[Configuration, ...]
+    rejections: tuple[Rejection, ...]
+
+
+def place(problem: MatingProblem, pairs: tuple[Candidate, ...]) -> Placement:
     """The configurations of one assignment (seed 002 step three): global positions by
-    coset chaining and representative-point loci, then interference and sweeping."""
+    coset chaining and representative-point loci, then the no-pairwise-interference
+    constraint over the bodies' remaining freedoms (:mod:`assemblykit.mating.clearance`)."""
     tol = problem.tolerance
     root = _root(pairs, list(problem.bodies))
-    configurations = []
+    configurations: list[Configuration] = []
+    rejections: list[Rejection] = []
     for world in _positions({root: Coset(SymmetryGroup.identity(), np.eye(4))}, pairs, tol):
-        fixed = {b: w.rep for b, w in world.items() if w.is_point}
-        moving = {b: w for b, w in world.items() if not w.is_point}
-        if not _clear(problem, fixed, tol):
-            continue
-        motions: dict[str, Motion] = {}
-        poses = dict(fixed)
-        for name, coset in moving.items():
-            swept = _sweep(problem, name, coset, fixed, tol)
-            if swept is None:
-                break
-            poses[name], motions[name] = swept
+        outcome = _spatial(problem, pairs, world)
+        if isinstance(outcome, Rejection):
+            rejections.append(outcome)
         else:
-            configurations.append(Configuration(pairs, poses, motions))
-    return configurations
+            configurations.append(outcome)
+    return Placement(tuple(configurations), tuple(rejections))
+
+
+def _units(pairs: Sequence[Candidate], world: World, tol: Tolerance) -> list[list[str]]:
+    """Bodies that move together: a goal with a determined relative position between two
+    bodies with the same world group attaches them rigidly (one set of parameters)."""
+    unit = {name: name for name in world}
+
+    def top(name: str) -> str:
+        while unit[name] != name:
+            name = unit[name]
+        return name
+
+    for c in pairs:
+        a, b = c.goal.first, c.goal.second
+        if (
+            c.coset.is_point
+            and a in world
+            and b in world
+            and not world[a].is_point
+            and world[a].group.equals(world[b].group, tol)
+        ):
+            unit[top(a)] = top(b)
+    groups: dict[str, list[str]] = {}
+    for name in world:
+        groups.setdefault(top(name), []).append(name)
+    return list(groups.values())
 
 
 def _root(pairs: Sequence[Candidate], names: Sequence[str]) -> str:
@@ -407,41 +496,188 @@ def _propagate(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> Worl
 # ----------------------------------------------------------------------------- space
 
 
-def _clear(problem: MatingProblem, poses: Mapping[str, np.ndarray], tol: Tolerance) -> bool:
-    """No two placed bodies interfere (seed 002 step three, spatial constraint)."""
-    names = sorted(poses)
-    return not any(
-        interfering(
-            problem.bodies[a],
-            problem.bodies[b],
-            se3.inverse(poses[b]) @ poses[a],
-            tol,
+def _spatial(
+    problem: MatingProblem, pairs: tuple[Candidate, ...], world: World
+) -> Configuration | Rejection:
+    """The no-pairwise-interference constraint (seed 002 step three) on one set of world
+    cosets: every two bodies are judged over their joint parameter ranges (fixed ones at
+    their pose, moving ones over their whole freedom, :func:`judge_pair`); a pair proved
+    to interfere everywhere rejects the configuration; otherwise a joint free pose is
+    searched for the pairs not proved clear, and each moving body's range of motion is
+    swept with the others at their chosen poses (seed 002 Discussion)."""
+    tol = problem.tolerance
+    units = _units(pairs, world, tol)
+    movers: dict[str, Mover] = {}
+    for name, coset in world.items():
+        mesh = problem.bodies[name].mesh
+        if mesh is not None:
+            # A freedom the cylindrical bounds do not cover stays at its representative.
+            placed_at = coset if sweepable(coset) else Coset(SymmetryGroup.identity(), coset.rep)
+            movers[name] = mover(name, mesh, placed_at, tol)
+    owner = {name: i for i, members in enumerate(units) for name in members}
+    names = sorted(movers)
+    open_pairs: list[tuple[str, str]] = []
+    for i, a in enumerate(names):
+        for b in names[i + 1 :]:
+            first, second = movers[a], movers[b]
+            if owner[a] == owner[b] and first.span:
+                # Rigidly attached: one relative pose, checked once.
+                if overlaps(first, [0.0] * first.dof, second, [0.0] * second.dof, tol):
+                    return Rejection(pairs, (a, b), f"{a} and {b} interfere", True)
+                continue
+            verdict = judge_pair(first, second, tol).verdict
+            if verdict is Verdict.BLOCKED:
+                where = " in every position" if first.span or second.span else ""
+                return Rejection(pairs, (a, b), f"{a} and {b} interfere{where}", True)
+            if verdict is not Verdict.CLEAR:
+                open_pairs.append((a, b))
+    moving = [u for u in units if any(movers.get(n) and movers[n].span for n in u)]
+    chosen = _joint_witness(movers, moving, open_pairs, tol)
+    if chosen is None:
+        bodies = tuple(sorted({n for pair in open_pairs for n in pair}))
+        return Rejection(
+            pairs, bodies, "no collision-free position found for " + ", ".join(bodies), False
         )
-        for i, a in enumerate(names)
-        for b in names[i + 1 :]
-    )
+    poses = {name: coset.rep for name, coset in world.items()}
+    motions: dict[str, Motion] = {}
+    for index, unit in enumerate(moving):
+        params = chosen[index]
+        lead = next(movers[n] for n in unit if n in movers and movers[n].span)
+        for name in unit:
+            poses[name] = world[name].group.element(list(params)) @ world[name].rep
+        motions.update(_ranges(movers, unit, lead, params, poses, open_pairs, tol))
+    for name, coset in world.items():
+        if not coset.is_point and name not in motions:
+            motions[name] = Motion(coset.kind.value, "none", ())
+    return Configuration(pairs, poses, motions)
 
 
-def _sweep(
-    problem: MatingProblem,
-    name: str,
-    coset: Coset,
-    fixed: Mapping[str, np.ndarray],
+def _candidates(body: Mover) -> list[tuple[float, ...]]:
+    """Parameter values tried for a free pose, nearest the representative first."""
+    axes = []
+    for (lo, hi), weight in zip(body.span, body.weights(), strict=True):
+        steps = np.linspace(lo, hi, WITNESS_STEPS + 1)
+        axes.append(sorted({0.0, *map(float, steps)}, key=lambda t, w=weight: abs(t) * w))
+    grid = [tuple(p) for p in itertools.product(*axes)]
+    weights = body.weights()
+    grid.sort(key=lambda p: math.hypot(*(t * w for t, w in zip(p, weights, strict=True))))
+    return grid
+
+
+def _joint_witness(
+    movers: Mapping[str, Mover],
+    units: Sequence[list[str]],
+    open_pairs: Sequence[tuple[str, str]],
     tol: Tolerance,
-) -> tuple[np.ndarray, Motion] | None:
-    """Sweep body ``name`` over its one-parameter world coset against the placed bodies
-    (seed 002 Discussion): sample, keep the collision-free intervals, refine their ends by
-    bisection. Returns a free pose and the range of motion, or ``None`` if none is free.
-    Bodies with more freedom are reported without a sweep (their representative pose)."""
-    if coset.kind not in _ONE_PARAMETER:
-        return coset.rep, Motion(coset.kind.value, "none", ())
-    angle = coset.kind is not Kind.PRISMATIC
-    span = (-math.pi, math.pi) if angle else (-tol.scale, tol.scale)
+) -> list[tuple[float, ...]] | None:
+    """Parameters of every moving unit such that no open pair interferes (exact checks),
+    by backtracking over candidate values; each unit's value is then pulled back towards
+    its representative by bisection along the segment, staying free."""
+    owner = {name: i for i, unit in enumerate(units) for name in unit}
+    leads = [next(movers[n] for n in unit if n in movers and movers[n].span) for unit in units]
+    budget = [WITNESS_CHECKS]
+
+    def params_of(name: str, chosen: Mapping[int, tuple[float, ...]]) -> tuple[float, ...]:
+        unit = owner.get(name)
+        if unit is None:
+            return ()
+        return chosen[unit]
+
+    def free(index: int, value: tuple[float, ...], chosen: Mapping[int, tuple[float, ...]]) -> bool:
+        trial = {**chosen, index: value}
+        for a, b in open_pairs:
+            involved = {owner.get(a), owner.get(b)}
+            if index not in involved or any(u is not None and u not in trial for u in involved):
+                continue
+            budget[0] -= 1
+            first, second = movers[a], movers[b]
+            pa = params_of(a, trial) if first.span else ()
+            pb = params_of(b, trial) if second.span else ()
+            if overlaps(first, pa, second, pb, tol):
+                return False
+        return True
+
+    Chosen = dict[int, tuple[float, ...]]
+
+    def search(index: int, chosen: Chosen) -> Chosen | None:
+        if index == len(units):
+            return chosen
+        for value in _candidates(leads[index]):
+            if budget[0] <= 0:
+                return None
+            if free(index, value, chosen):
+                found = search(index + 1, {**chosen, index: value})
+                if found is not None:
+                    return found
+        return None
+
+    found = search(0, {})
+    if found is None:
+        return None
+    for index in range(len(units)):
+        value = np.asarray(found[index])
+        others = {k: v for k, v in found.items() if k != index}
+        if not value.any() or free(index, tuple(0.0 * value), others):
+            found[index] = tuple(0.0 * value) if value.any() else found[index]
+            continue
+        near, far = 0.0, 1.0
+        for _ in range(REFINE_STEPS):
+            middle = 0.5 * (near + far)
+            if free(index, tuple(middle * value), others):
+                far = middle
+            else:
+                near = middle
+        found[index] = tuple(float(x) for x in far * value)
+    return [found[i] for i in range(len(units))]
+
+
+def _ranges(
+    movers: Mapping[str, Mover],
+    unit: Sequence[str],
+    lead: Mover,
+    params: tuple[float, ...],
+    poses: Mapping[str, np.ndarray],
+    open_pairs: Sequence[tuple[str, str]],
+    tol: Tolerance,
+) -> dict[str, Motion]:
+    """The range of motion of a one-parameter unit with every other body at its chosen
+    pose: the whole turn or travel when no pair of it is open (its sweeps clear them,
+    certified); else sampled and refined by bisection (seed 002 Discussion). Units with
+    more freedom report their kind only; their pose was checked."""
+    kind = lead.coset.kind
+    if lead.dof != 1:
+        return {name: Motion(kind.value, "none", ()) for name in unit}
+    angle = kind is not Kind.PRISMATIC
+    parameter = "angle" if angle else "travel"
+    span = lead.span[0]
+    inside = set(unit)
+    watched = [(a, b) for a, b in open_pairs if (a in inside) != (b in inside)]
+    if not watched:
+        return {name: Motion(kind.value, parameter, (span,)) for name in unit}
 
     def free(t: float) -> bool:
-        pose = coset.group.element([t]) @ coset.rep
-        return _clear(problem, {**fixed, name: pose}, tol)
+        for a, b in watched:
+            mine, other = (a, b) if a in inside else (b, a)
+            pose = movers[mine].coset.group.element([t]) @ movers[mine].coset.rep
+            if interfering_meshes(movers[mine].mesh, pose, movers[other].mesh, poses[other], tol):
+                return False
+        return True
 
+    intervals = _free_intervals(free, span, angle)
+    return {name: Motion(kind.value, parameter, intervals) for name in unit}
+
+
+def interfering_meshes(
+    mesh_a: Any, pose_a: np.ndarray, mesh_b: Any, pose_b: np.ndarray, tol: Tolerance
+) -> bool:
+    """Whether two meshes at world poses share more than a touching volume."""
+    return interfering_solids(placed(mesh_a, pose_a), placed(mesh_b, pose_b), tol.for_mesh())
+
+
+def _free_intervals(
+    free: Any, span: tuple[float, float], angle: bool
+) -> tuple[tuple[float, float], ...]:
+    """The free intervals of a sampled parameter, ends refined by bisection."""
     samples = np.linspace(span[0], span[1], SWEEP_SAMPLES + 1)
     flags = [free(float(t)) for t in samples]
     intervals = []
@@ -454,19 +690,10 @@ def _sweep(
             start = None
     if start is not None:
         intervals.append((start, span[1]))
-    if not intervals:
-        return None
     if angle and len(intervals) > 1 and intervals[0][0] == span[0] and intervals[-1][1] == span[1]:
         # A full turn is periodic: the pieces at -pi and +pi are one interval.
         intervals = [*intervals[1:-1], (intervals[-1][0], intervals[0][1] + 2 * math.pi)]
-    kept = _inside(0.0, intervals)
-    parameter = 0.0 if kept else 0.5 * sum(max(intervals, key=lambda i: i[1] - i[0]))
-    pose = coset.group.element([parameter]) @ coset.rep
-    return pose, Motion(coset.kind.value, "angle" if angle else "travel", tuple(intervals))
-
-
-def _inside(value: float, intervals: Sequence[tuple[float, float]]) -> bool:
-    return any(lo <= value <= hi for lo, hi in intervals)
+    return tuple(intervals)
 
 
 def _edge(free: Any, blocked: float, clear: float) -> float:
