@@ -8,7 +8,7 @@ Shapes: ``stack`` (equal cubes, so reduction reuses the intersections of repeate
 geometry), ``stack~`` (every cube a different size: no reuse), ``tree`` and ``grid``.
 
 Then a task file of 1,000 stacked bodies (YAML, DESIGN.md §5.1) read and solved in one
-process: load time (YAML parsing through libyaml when PyYAML has it, and validation),
+process: load time (YAML parsing, by yaml-rs, and validation),
 solve time and their sum.
 
 Run: python benchmarks/bench_rapt.py [--quick] [--one-start]
@@ -175,9 +175,8 @@ def load_and_solve(n: int, repeats: int = 5) -> None:
             solves.append(time.perf_counter() - middle)
             assert solution.status == "solved", solution.status
     load, solve = statistics.median(loads), statistics.median(solves)
-    parser = "libyaml" if yaml.__with_libyaml__ else "pure-Python"
     print(
-        f"task file of {n} bodies ({size / 1e6:.2f} MB, {parser} parser): "
+        f"task file of {n} bodies ({size / 1e6:.2f} MB): "
         f"load {load:.3f} s, solve {solve:.3f} s, load + solve {load + solve:.3f} s (median)"
     )
 
