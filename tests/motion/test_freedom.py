@@ -228,3 +228,29 @@ def test_a_cube_boxed_in_on_six_sides_has_the_24_rotations_of_the_cube() -> None
     quarter_turn_z = se3.rot_z(np.pi / 2)
     assert group.contains(half_turn_x) and group.contains(quarter_turn_z @ half_turn_x)
     assert not group.contains(se3.translation((0.5, 0.0, 0.0)))
+
+
+def test_a_rod_in_a_half_round_groove_slides_along_it_and_lifts_off_upwards() -> None:
+    from curved_parts import rod_in_groove
+
+    rod = part_motion(rod_in_groove(through=True), "rod")
+    # the fit of seed 003 keeps the shaft: turning about and sliding along y
+    assert rod.kind == "cylindrical"
+    reading = rod.unilateral
+    # the groove pushes only along its half circle of normals -x, -z, +x: the free
+    # translations are d_x = 0, d_z >= 0, i.e. sliding along y and lifting off along +z
+    (sliding,) = reading.sliding
+    np.testing.assert_allclose(np.abs(sliding), [0.0, 1.0, 0.0], atol=1e-6)
+    (lift,) = reading.lift_off
+    np.testing.assert_allclose(lift, [0.0, 0.0, 1.0], atol=1e-6)
+
+
+def test_a_rod_in_a_closed_groove_turns_in_it_and_lifts_off_only_upwards() -> None:
+    from curved_parts import rod_in_groove
+
+    rod = part_motion(rod_in_groove(through=False), "rod")
+    assert rod.kind == "revolute"
+    assert rod.unilateral.sliding == ()
+    (lift,) = rod.unilateral.lift_off
+    np.testing.assert_allclose(lift, [0.0, 0.0, 1.0], atol=1e-6)
+    np.testing.assert_allclose(rod.unilateral.witness, [0, 0, 0, 0, 0, 1], atol=1e-6)

@@ -1,4 +1,4 @@
-"""The ball-in-socket contact region (motion/spherical.py) and its unilateral reading."""
+"""The ball-in-socket contact region (geometry/curved.py) and its unilateral reading."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import assemblykit
+from assemblykit.geometry.curved import in_region
 from assemblykit.io.assembly import load_assembly
 from assemblykit.motion.freedom import MotionSolver
-from assemblykit.motion.spherical import in_region, sphere_contact_points
 from assemblykit.tolerance import Tolerance
 
 BALL_JOINT = Path(assemblykit.__file__).parent / "examples" / "motion" / "ball_joint"
@@ -44,10 +44,9 @@ def test_orientation_of_the_triangle_does_not_matter_and_flat_ones_cover_nothing
 
 def _region_and_ball(path: Path) -> tuple[np.ndarray, np.ndarray]:
     assembly = load_assembly(path)
-    tol = assembly.tolerance()
     contact = next(c for c in assembly.contacts() if c.curved)
     patch = contact.curved[0]
-    region = sphere_contact_points(assembly, contact, patch, tol)
+    region = patch.points
     assert region is not None
     ball = MotionSolver(assembly).motion_of(patch.inner)
     return region - patch.center, np.array(ball.unilateral.to_dict()["lift_off"])

@@ -11,12 +11,18 @@ holds at d. Every kind of motion of seed 004 reduces to such terms:
 * extended translations (Γ_e): one term per pair, the open cone of the Minkowski
   difference (:mod:`assemblykit.blocking.extended`).
 
-Curved contacts (this module): a cylinder's normals fill a great circle, so it blocks
-every direction except ±axis, exactly the union of the four half-spaces ``±e1 . d > 0``,
-``±e2 . d > 0`` (e1, e2 ⟂ axis); a sphere blocks every direction (six half-spaces
-``±x, ±y, ±z``). A cone (inner part leaving along +axis, towards the opening) blocks the
-directions entering any of its normals' half-spaces; it is sampled at a few azimuths,
-which can only leave out blocked directions, so freedom stays a necessary condition.
+Curved contacts (this module): the moving part is blocked along d iff ``n . d > 0`` for
+some normal ``n`` of the contact patch, out of the moving part. The patch carries unit
+normals generating the cone of its normals (:meth:`CurvedPatch.normal_cone`, from the
+part of the surface both parts really cover), so the union of their half-spaces is
+exactly the blocked set: a shaft in a hole (the whole circle, ``±e1, ±e2``) is blocked
+along every direction but ±axis, a rod in a half-round groove everywhere but the closed
+half-circle of directions out of the groove, a whole sphere everywhere, a ball in a
+shallow cup everywhere but the cone above the rim. A cone's normals are sampled at a
+few azimuths, and so are a spherical cap's extreme rays (the rim of a meshed cup has as
+many as the mesh has sides, each a great circle of the arrangement): this can only leave
+out blocked directions, so freedom stays a necessary condition, and the extended and
+push-only readings use all of them.
 """
 
 from __future__ import annotations
@@ -29,9 +35,7 @@ from numpy.typing import NDArray
 
 from assemblykit.errors import FeatureError
 from assemblykit.geometry.contacts import Contact, CurvedPatch
-
-CONE_AZIMUTHS = 8
-_AXES = np.eye(3)
+from assemblykit.geometry.curved import CONE_AZIMUTHS, spread
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,29 +52,16 @@ class BlockingTerm:
         return len(self.normals) == 1
 
 
-def _perpendicular(axis: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    a = axis / np.linalg.norm(axis)
-    helper = _AXES[int(np.argmin(np.abs(a)))]
-    e1 = np.cross(a, helper)
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(a, e1)
-
-
 def curved_normals(patch: CurvedPatch, moving_is_inner: bool) -> NDArray[np.float64]:
     """Normals of half-spaces whose union is the set of directions along which the
-    moving part of a curved contact is blocked (module docstring)."""
-    if patch.kind == "spherical":
-        return np.concatenate([_AXES, -_AXES])
-    if patch.axis is None or not np.linalg.norm(patch.axis) > 0:
+    moving part of a curved contact is blocked (module docstring): the patch's normal
+    cone, out of the moving part (a spherical cap's at ``CONE_AZIMUTHS`` of its rays)."""
+    if patch.kind != "spherical" and (patch.axis is None or not np.linalg.norm(patch.axis) > 0):
         raise FeatureError(f"{patch.kind} contact without an axis", where=patch.inner)
-    e1, e2 = _perpendicular(np.asarray(patch.axis, dtype=np.float64))
-    if patch.kind == "cylindrical":
-        return np.array([e1, -e1, e2, -e2])
-    axis = np.asarray(patch.axis, dtype=np.float64) / np.linalg.norm(patch.axis)
-    phi = np.linspace(0.0, 2 * np.pi, CONE_AZIMUTHS, endpoint=False)
-    radial = np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2
-    inner_out = np.cos(patch.half_angle) * radial - np.sin(patch.half_angle) * axis
-    return inner_out if moving_is_inner else -inner_out
+    normals = patch.normal_cone()
+    if patch.kind == "spherical":
+        normals = spread(normals, CONE_AZIMUTHS)
+    return normals if moving_is_inner else -normals
 
 
 def infinitesimal_terms(contacts: Iterable[Contact]) -> list[BlockingTerm]:

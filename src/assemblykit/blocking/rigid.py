@@ -7,7 +7,9 @@ with normal ``n`` pointing from the moving part into the other, the twist is all
 iff ``n . (v + omega x p) <= 0``, i.e. ``w . (omega; v) <= 0`` with the wrench
 ``w = (p x n; n)``. For planar patches the points are the vertices of the patch's
 convex hull (seed 004, "for each vertex v of the convex hull of the contacting area");
-for curved patches the sampled boundary points with the surface normals there.
+for curved patches the normals generating the patch's normal cone at both ends of its
+axial extent (:meth:`~assemblykit.geometry.contacts.CurvedPatch.samples`; exact for
+cylinders and spheres, whose constraints are linear in the normal).
 
 The S⁵ arrangement: every distinct hyperplane ``w . xi = 0`` of the assembly's contact
 points (taken about their centroid with rotations scaled by the model size, so both
@@ -39,14 +41,13 @@ from scipy.spatial import ConvexHull, QhullError
 
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal, removal_table
 from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
-from assemblykit.geometry.contacts import Contact, CurvedPatch, PlanarPatch
+from assemblykit.geometry.contacts import Contact, PlanarPatch
 from assemblykit.tolerance import Tolerance
 
 RIGID_MAX_SIZE = 2
 # about 4 s of linear programs at 12 hyperplanes in general position (2048 cells); the
 # count of cells grows as m^5
 RIGID_MAX_HYPERPLANES = 12
-CURVED_SAMPLES = 8
 
 
 def _patch_hull_points(patch: PlanarPatch) -> NDArray[np.float64]:
@@ -62,32 +63,6 @@ def _patch_hull_points(patch: PlanarPatch) -> NDArray[np.float64]:
     return poly[hull.vertices]
 
 
-def _curved_points(patch: CurvedPatch) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Points of a curved patch and the outward normals of its inner part there."""
-    center = np.asarray(patch.center, dtype=np.float64)
-    if patch.points is not None:
-        pts = np.asarray(patch.points, dtype=np.float64).reshape(-1, 3)
-    else:
-        axis = np.asarray(patch.axis if patch.axis is not None else [0.0, 0.0, 1.0])
-        axis = axis / np.linalg.norm(axis)
-        e1 = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(axis, e1)
-        phi = np.linspace(0, 2 * np.pi, CURVED_SAMPLES, endpoint=False)
-        ring = np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2
-        ends = patch.extent or (0.0, 0.0)
-        pts = np.concatenate([center + s * axis + patch.radius * ring for s in ends])
-    if patch.kind == "spherical" or patch.axis is None:
-        normals = pts - center
-    else:
-        axis = np.asarray(patch.axis, dtype=np.float64) / np.linalg.norm(patch.axis)
-        rel = pts - center
-        radial = rel - np.outer(rel @ axis, axis)
-        radial /= np.linalg.norm(radial, axis=1, keepdims=True)
-        normals = np.cos(patch.half_angle) * radial - np.sin(patch.half_angle) * axis
-    return pts, normals / np.linalg.norm(normals, axis=1, keepdims=True)
-
-
 def contact_points(contact: Contact) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Contact points and unit normals from ``contact.a`` into ``contact.b``."""
     pts: list[NDArray[np.float64]] = []
@@ -98,7 +73,8 @@ def contact_points(contact: Contact) -> tuple[NDArray[np.float64], NDArray[np.fl
         pts.append(hull)
         nrm.append(np.tile(n / np.linalg.norm(n), (len(hull), 1)))
     for curved in contact.curved:
-        p, n = _curved_points(curved)
+        # the inner part's outward normals on the part of the surface really touched
+        p, n = curved.samples()
         pts.append(p)
         nrm.append(n if curved.inner == contact.a else -n)
     if not pts:

@@ -13,7 +13,8 @@ over all candidate pairs at once, the coplanar groups of facets
 groups of the other that lie in the same plane with the opposite normal, and their
 overlap is measured by shapely in that plane. Curved contacts are coaxial cylinders
 and cones and concentric spheres of equal size, one convex and one concave, read from
-the parts' exact or recognised surfaces.
+the parts' exact or recognised surfaces; each keeps only the part of the surface of
+revolution both parts cover, as the normals there (:mod:`assemblykit.geometry.curved`).
 
 Convention: every normal stored here is the outward normal of part ``a``'s surface, so
 it points from ``a`` into ``b``. Translating ``a`` infinitesimally along ``d`` pushes
@@ -22,6 +23,7 @@ into ``b`` across a planar patch iff ``d . normal > 0`` (seed 004, DBG arcs).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -30,6 +32,17 @@ import shapely
 from numpy.typing import NDArray
 from rtree import index
 
+from assemblykit.geometry.curved import (
+    ARC_STEP,
+    CONE_AZIMUTHS,
+    TURN,
+    arc_angles,
+    cone_generators,
+    covered_arcs,
+    intersect_arcs,
+    revolution_normals,
+    sphere_region,
+)
 from assemblykit.geometry.recognition import Segmentation, Surface, faces_on, segment
 from assemblykit.tolerance import Tolerance
 
@@ -63,7 +76,11 @@ class CurvedPatch:
     radius (cylinders, spheres) and ``half_angle`` the cone's half-angle.
     ``inner`` names the part that is inside (the shaft or ball). ``extent`` is the axial
     interval ``(s0, s1)`` of the contact, measured from ``center`` along ``axis``.
-    ``points`` samples the patch's boundary in world coordinates (for rigid-motion LPs).
+    ``normals`` (k x 3) are unit outward normals of the inner part on the part of the
+    surface where the two really touch, whose non-negative combinations are every normal
+    there (:mod:`assemblykit.geometry.curved`: a half-round groove gives a half circle of
+    normals, a shallow cup a cap); ``None`` is the whole surface of revolution.
+    ``points`` holds the contact region's vertices in world coordinates (for drawing).
     """
 
     kind: CurvedKind
@@ -74,6 +91,45 @@ class CurvedPatch:
     extent: tuple[float, float] | None = None
     half_angle: float = 0.0
     points: NDArray[np.float64] | None = None
+    normals: NDArray[np.float64] | None = None
+
+    def normal_cone(self) -> NDArray[np.float64]:
+        """Unit outward normals of the inner part generating the cone of the patch's
+        normals (seed 004, "Infinitesimal translations": the inner part is blocked along
+        ``d`` iff ``n . d > 0`` for one of them): ``normals``, or for the whole surface
+        the four directions ``±e1, ±e2`` across a cylinder's axis, the six signed axes
+        for a sphere, ``CONE_AZIMUTHS`` normals around a cone."""
+        if self.normals is not None:
+            return np.asarray(self.normals, dtype=np.float64).reshape(-1, 3)
+        if self.kind == "spherical" or self.axis is None:
+            return np.vstack([np.eye(3), -np.eye(3)])
+        axis = np.asarray(self.axis, dtype=np.float64)
+        if self.kind == "cylindrical":
+            return revolution_normals(axis, arc_angles(np.array([[0.0, TURN]]), ARC_STEP))
+        angles = arc_angles(np.array([[0.0, TURN]]), TURN / CONE_AZIMUTHS)
+        return revolution_normals(axis, angles, self.half_angle)
+
+    def samples(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Points of the patch with the inner part's outward unit normals there: each
+        normal of :meth:`normal_cone` at both ends of the axial extent (cylinders,
+        cones), or at ``center + radius n`` (spheres). The constraints of the unilateral
+        and rigid readings at these points are those of the whole patch (module
+        docstring of :mod:`assemblykit.geometry.curved`)."""
+        normals = self.normal_cone()
+        center = np.asarray(self.center, dtype=np.float64)
+        if self.kind == "spherical" or self.axis is None:
+            return center + self.radius * normals, normals
+        axis = np.asarray(self.axis, dtype=np.float64)
+        axis = axis / np.linalg.norm(axis)
+        # the direction away from the axis where each normal holds
+        radial = normals + math.sin(self.half_angle) * axis
+        radial /= np.linalg.norm(radial, axis=1, keepdims=True)
+        ends = self.extent if self.extent is not None else (0.0, 0.0)
+        rings = []
+        for s in ends:
+            r = self.radius if self.kind == "cylindrical" else abs(s) * math.tan(self.half_angle)
+            rings.append(center + s * axis + r * radial)
+        return np.vstack(rings), np.vstack([normals, normals])
 
 
 @dataclass(frozen=True, eq=False)
@@ -365,23 +421,30 @@ def curved_contact(
     first: Surface,
     second: Surface,
     names: tuple[str, str],
-    points: tuple[NDArray[np.float64], NDArray[np.float64]],
+    triangles: tuple[NDArray[np.float64], NDArray[np.float64]],
     tol: Tolerance,
 ) -> CurvedPatch | None:
     """The curved contact of two surfaces of parts ``names``, or ``None``: equal coaxial
     cylinders or cones, or equal concentric spheres, one convex and one concave, whose
     axial extents overlap by more than the length tolerance (seed 003 §2: a shaft fits
-    a hole, a ball a socket). ``points``: each surface's vertices, to sample the
-    boundary."""
+    a hole, a ball a socket) and that share more than a line. ``triangles``: each
+    surface's triangles (t x 3 x 3, world), which tell the part of the surface of
+    revolution both cover (:mod:`assemblykit.geometry.curved`; seed 004 builds the
+    blocking constraints from the normals of that part only)."""
     if first.kind != second.kind or first.convex == second.convex:
         return None
     inner = names[0] if first.convex else names[1]
-    every = np.vstack(points)
     if first.kind == "sphere":
         same_centre = np.linalg.norm(first.point - second.point) <= tol.length
         if not (same_centre and abs(first.radius - second.radius) <= tol.length):
             return None
-        return CurvedPatch("spherical", first.point, None, first.radius, inner, points=every)
+        region = sphere_region(triangles, first.point, tol)
+        if len(region) == 0:
+            return None
+        normals = cone_generators(region - first.point, tol)
+        return CurvedPatch(
+            "spherical", first.point, None, first.radius, inner, points=region, normals=normals
+        )
     if first.kind not in ("cylinder", "cone"):
         return None
     axis = first.axis
@@ -403,7 +466,24 @@ def curved_contact(
     lo, hi = _axial_overlap(first, second, axis, first.point)
     if hi - lo <= tol.length:
         return None
+    every = np.vstack([t.reshape(-1, 3) for t in triangles])
+    rel = every - first.point
+    widest = float(np.max(np.linalg.norm(rel - np.outer(rel @ axis, axis), axis=1)))
+    # the azimuth a length tolerance subtends on the widest circle of the surfaces
+    gap = tol.length / widest
+    arcs = intersect_arcs(
+        covered_arcs(triangles[0], first.point, axis, gap),
+        covered_arcs(triangles[1], first.point, axis, gap),
+        gap,
+    )
+    if len(arcs) == 0:
+        return None
     kind: CurvedKind = "cylindrical" if first.kind == "cylinder" else "conical"
+    if kind == "cylindrical":
+        normals = revolution_normals(axis, arc_angles(arcs, ARC_STEP))
+    else:
+        angles = arc_angles(arcs, TURN / CONE_AZIMUTHS)
+        normals = revolution_normals(axis, angles, first.half_angle)
     centre = first.point + lo * axis if kind == "cylindrical" else first.point
     extent = (0.0, hi - lo) if kind == "cylindrical" else (lo, hi)
     return CurvedPatch(
@@ -415,12 +495,14 @@ def curved_contact(
         extent=extent,
         half_angle=first.half_angle,
         points=_boundary(every, axis, first.point, lo, hi, tol),
+        normals=normals,
     )
 
 
-def _surface_points(assembly: Assembly, name: str, surface: Surface) -> NDArray[np.float64]:
+def _surface_triangles(assembly: Assembly, name: str, surface: Surface) -> NDArray[np.float64]:
     mesh = assembly.parts[name].mesh
-    return np.asarray(mesh.vertices[np.unique(mesh.faces[surface.faces])], dtype=np.float64)
+    faces = np.asarray(mesh.faces, dtype=np.int64)[surface.faces]
+    return np.asarray(mesh.vertices, dtype=np.float64)[faces]
 
 
 def find_contacts(
@@ -467,11 +549,11 @@ def find_contacts(
     for a, b in pairs:
         for sa in surfaces.get(int(a), ()):
             for sb in surfaces.get(int(b), ()):
-                pts = (
-                    _surface_points(assembly, names[a], sa),
-                    _surface_points(assembly, names[b], sb),
+                triangles = (
+                    _surface_triangles(assembly, names[a], sa),
+                    _surface_triangles(assembly, names[b], sb),
                 )
-                patch = curved_contact(sa, sb, (names[a], names[b]), pts, tol)
+                patch = curved_contact(sa, sb, (names[a], names[b]), triangles, tol)
                 if patch is not None:
                     curved.setdefault((int(a), int(b)), []).append(patch)
 

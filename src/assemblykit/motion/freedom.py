@@ -37,15 +37,10 @@ from assemblykit.features import compound_group
 from assemblykit.features.primitives import Ball, Cone, Feature, Hole, Plane, Shaft, Socket
 from assemblykit.geometry.contacts import Contact, CurvedPatch
 from assemblykit.model.assembly import Assembly
-from assemblykit.motion.spherical import with_sphere_regions
 from assemblykit.motion.unilateral import UnilateralReading, unilateral_readings
 from assemblykit.tolerance import Tolerance
 
 Vector = NDArray[np.float64]
-
-# samples per circle of a curved patch for the unilateral reading; 8 directions
-# positively span the circle's plane, which is all the linear program needs
-CIRCLE_SAMPLES = 8
 
 
 def subassembly_key(names: Iterable[str]) -> str:
@@ -62,48 +57,12 @@ class ContactSamples:
     normals: NDArray[np.float64]
 
 
-def _radial(points: NDArray[np.float64], center: Vector, axis: Vector) -> NDArray:
-    """Unit directions from the axis line (``center``, ``axis``) to each point."""
-    offset = points - center
-    radial = offset - np.outer(offset @ axis, axis)
-    return radial / np.linalg.norm(radial, axis=1, keepdims=True)
-
-
-def _circle(center: Vector, axis: Vector, radius: float, s: float) -> NDArray:
-    """``CIRCLE_SAMPLES`` points of the circle of ``radius`` about the axis at height ``s``."""
-    e1, e2 = se3.frame(center, axis)[:3, :2].T
-    angles = np.linspace(0.0, 2.0 * np.pi, CIRCLE_SAMPLES, endpoint=False)
-    ring = np.outer(np.cos(angles), e1) + np.outer(np.sin(angles), e2)
-    return center + s * axis + radius * ring
-
-
-def _sphere_samples(patch: CurvedPatch) -> NDArray:
-    """Unit directions from the centre to the points of a spherical patch: the contact
-    region once :func:`assemblykit.motion.spherical.with_sphere_regions` has narrowed
-    them. Without points the whole sphere is sampled: the fit is then kept in every
-    direction."""
-    if patch.points is None or len(patch.points) == 0:
-        return np.vstack([np.eye(3), -np.eye(3)])
-    directions = np.asarray(patch.points, dtype=np.float64) - patch.center
-    return directions / np.linalg.norm(directions, axis=1, keepdims=True)
-
-
 def _curved_samples(patch: CurvedPatch, inside: bool) -> tuple[NDArray, NDArray]:
-    """Points and normals out of the moving side sampling a curved patch."""
-    sign = 1.0 if inside else -1.0
-    if patch.kind == "spherical":
-        directions = _sphere_samples(patch)
-        return patch.center + patch.radius * directions, sign * directions
-    axis = se3.unit(np.asarray(patch.axis, dtype=np.float64))
-    s0, s1 = patch.extent if patch.extent is not None else (0.0, 0.0)
-    if patch.kind == "cylindrical":
-        points = np.vstack([_circle(patch.center, axis, patch.radius, s) for s in (s0, s1)])
-        return points, sign * _radial(points, patch.center, axis)
-    slope = np.tan(patch.half_angle)
-    points = np.vstack([_circle(patch.center, axis, abs(s) * slope, s) for s in (s0, s1)])
-    radial = _radial(points, patch.center, axis)
-    outward = np.cos(patch.half_angle) * radial - np.sin(patch.half_angle) * axis
-    return points, sign * outward
+    """Points and normals out of the moving side sampling a curved patch where the two
+    parts really touch (:meth:`CurvedPatch.samples`): a ball is pushed only where its
+    socket is, a rod only where its groove is."""
+    points, normals = patch.samples()
+    return points, normals if inside else -normals
 
 
 def _patch_feature(patch: CurvedPatch, inside: bool) -> Feature:
@@ -311,8 +270,7 @@ class MotionSolver:
     def __init__(self, assembly: Assembly, tol: Tolerance | None = None) -> None:
         self.assembly = assembly
         self.tol = assembly.tolerance(tol)
-        # a ball is pushed only where its socket is: narrow spherical patches to that
-        self.contacts = with_sphere_regions(assembly, assembly.contacts(tol), self.tol)
+        self.contacts = assembly.contacts(tol)
         self._groups: dict[tuple[Any, ...], tuple[SymmetryGroup, Vector]] = {}
         self._by_part: dict[str, list[Contact]] = {}
         for contact in self.contacts:
