@@ -10,8 +10,10 @@ import trimesh
 from blocking_helpers import box, mesh_assembly
 
 from assemblykit.blocking.extended import extended_dbg, extended_free, obstacles
+from assemblykit.blocking.free_cones import exact_free_directions
 from assemblykit.blocking.ndbg import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
+from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.io.assembly import load_assembly
 from datasets import dataset
 
@@ -126,3 +128,70 @@ def test_asap_beam_parts_are_removable_along_exact_directions():
     for removal in removals:
         for d in removal.directions[:2]:
             assert extended_free(asm, removal.parts, d, tol)
+
+
+# a cube cage (outer half-size 2, cavity half-size 1) with one straight square tunnel of
+# side 0.6 from the centre along the body diagonal, through the corner (2, 2, 2)
+DIAGONAL = np.ones(3) / np.sqrt(3.0)
+
+
+def tunnel_cage() -> trimesh.Trimesh:
+    """One non-convex body: the shell minus the tunnel (manifold3d booleans)."""
+    import manifold3d
+
+    tunnel = manifold3d.Manifold.cube([0.6, 0.6, 5.0]).translate([-0.3, -0.3, 0.0])
+    z = np.array([0.0, 0.0, 1.0])
+    turn = trimesh.transformations.rotation_matrix(np.arccos(z @ DIAGONAL), np.cross(z, DIAGONAL))
+    shell = manifold3d.Manifold.cube([4.0, 4.0, 4.0], True) - manifold3d.Manifold.cube(
+        [2.0, 2.0, 2.0], True
+    )
+    mesh = (shell - tunnel.transform(turn[:3, :4])).to_mesh()
+    return trimesh.Trimesh(mesh.vert_properties[:, :3], mesh.tri_verts)
+
+
+def caged_cube() -> object:
+    """The cage and a cube of side 0.3 floating at its centre: seen along the diagonal
+    the cube is a regular hexagon of circumradius 0.3 √(2/3) = 0.245 (inradius 0.212),
+    inside the tunnel's square of half-width 0.3; sideways it is 0.7 from every wall."""
+    return mesh_assembly({"cage": tunnel_cage(), "cube": box([-0.15] * 3, [0.15] * 3)})
+
+
+# Within the wall the tunnel is at least 1.2 long (from the cavity's corner, √3 from the
+# centre, to the outer corner, 2√3, less the corners cut by the square's half-width): the
+# hexagon drifts sideways by at most 2 (0.3 - 0.212) = 0.176 over it, tan θ < 0.147.
+APERTURE = 0.15
+
+
+def test_a_cube_leaves_a_one_piece_cage_only_through_its_diagonal_tunnel():
+    asm = caged_cube()
+    tol = asm.tolerance()
+    assert asm.contacts() == []
+    # hand-derived: free along the tunnel's axis, blocked 0.2 rad off it and along the axes
+    assert extended_free(asm, ["cube"], DIAGONAL, tol)
+    off = DIAGONAL + 0.2 * np.array([1.0, -1.0, 0.0]) / np.sqrt(2.0)
+    assert not extended_free(asm, ["cube"], off, tol)
+    for axis in np.vstack([np.eye(3), -np.eye(3)]):
+        assert not extended_free(asm, ["cube"], axis, tol)
+    free = exact_free_directions(asm, ["cube"], tol)
+    assert free.complete and not free.tolerance_dependent and free.directions
+    for d in free.directions:
+        assert np.arccos(np.clip(d @ DIAGONAL, -1, 1)) < APERTURE
+        assert extended_free(asm, ["cube"], d, tol)
+    found = can_extract(asm, ["cube"])
+    assert found is not None and not found.tolerance_dependent
+    assert all(np.arccos(np.clip(d @ DIAGONAL, -1, 1)) < APERTURE for d in found.directions)
+
+
+def test_triangle_cones_of_a_face_above_a_face():
+    # the unit triangle at z = 0 swept upwards meets the same triangle at z = 1 (shifted
+    # by 0.1 in x): the cone is spanned by the nine differences, all with z = 1
+    tri = np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]])
+    normals, valid = triangle_cones(tri, tri + np.array([0.1, 0.0, 1.0]), None, None)
+    assert valid.all()
+    inside = np.all(normals[0] @ np.array([0.1, 0.0, 1.0]) >= 0)
+    assert inside and np.any(normals[0] @ np.array([0.0, 0.0, -1.0]) < 0)
+    # (2, 0, 1) is a difference only at a vertex: on the boundary, not inside (open cone)
+    assert not np.all(normals[0][np.linalg.norm(normals[0], axis=1) > 0] @ [2.0, 0, 1] > 0)
+    # coplanar faces (in contact) have no cone with an interior
+    _, flat = triangle_cones(tri, tri + np.array([0.5, 0.5, 0.0]), None, None)
+    assert not flat.any()

@@ -8,16 +8,18 @@ import trimesh
 from blocking_helpers import ContactAssembly, box, cylinder, mesh_assembly, square
 from test_extended import ring
 
+from assemblykit.blocking.extended import extended_dbg, extended_free
 from assemblykit.blocking.queries import (
     can_extract,
     locally_free_directions,
     parts_to_remove_before,
     removable_parts,
     removable_subassemblies,
-    separable_by_translations,
+    removal_before,
 )
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import Contact
+from assemblykit.planning.sequence import plan, separable_by_translations
 
 GAP = 0.01
 
@@ -94,3 +96,112 @@ def test_peg_extraction_directions_for_each_motion():
     # the only freeing twists are along +z, possibly with a spin about the axis
     assert twist.directions[0][5] > 0
     assert np.allclose(twist.directions[0][[3, 4]], 0, atol=1e-9)
+
+
+def cup(half: float, wall: float, bottom: float, top: float) -> trimesh.Trimesh:
+    """An open square cup (one non-convex body): outer half-size ``half``, walls and floor
+    ``wall`` thick, from ``bottom`` to ``top``."""
+    import manifold3d
+
+    outer = manifold3d.Manifold.cube([2 * half, 2 * half, top - bottom]).translate(
+        [-half, -half, bottom]
+    )
+    inner = half - wall
+    hollow = manifold3d.Manifold.cube([2 * inner, 2 * inner, top - bottom]).translate(
+        [-inner, -inner, bottom + wall]
+    )
+    mesh = (outer - hollow).to_mesh()
+    return trimesh.Trimesh(mesh.vert_properties[:, :3], mesh.tri_verts)
+
+
+def nested_cups() -> object:
+    """A table, an outer cup on it (inside half-size 1.8, rim at z = 2), an inner cup on
+    its floor (half-size 1.7, rim at 1.7) and a lid on the outer rim."""
+    return mesh_assembly(
+        {
+            "table": box([-5, -5, -1], [5, 5, 0]),
+            "outer": cup(2.0, 0.2, 0.0, 2.0),
+            "inner": cup(1.7, 0.2, 0.2, 1.7),
+            "lid": box([-2, -2, 2], [2, 2, 2.3]),
+        }
+    )
+
+
+def test_nested_cups_need_only_the_lid_removed_over_all_directions():
+    asm = nested_cups()
+    # by hand: the inner cup is blocked upwards by the lid only, sideways by the outer
+    # cup only (its walls 0.1 away), downwards by the outer cup and the table. The outer
+    # cup cannot leave first: the inner cup is inside it, the table under it. So {lid}
+    # (up) is the only removable set of one part; {outer} is as small but not removable.
+    found = removal_before(asm, "inner")
+    assert found.parts == frozenset({"lid"}) and found.minimal
+    assert found.direction is not None and found.direction[2] > 0
+    assert parts_to_remove_before(asm, "inner") == frozenset({"lid"})
+    assert parts_to_remove_before(asm, "lid") == frozenset()
+    assert can_extract(asm, ["inner"]) is None
+    assert separable_by_translations(asm)
+
+
+def box_packing(n: int, seed: int) -> object:
+    """``n`` touching boxes: a 10-cube cut at random (guillotine cuts, largest first)."""
+    rng = np.random.default_rng(seed)
+    cells = [(np.zeros(3), np.full(3, 10.0))]
+    while len(cells) < n:
+        lo, hi = cells.pop(int(np.argmax([np.prod(h - lo) for lo, h in cells])))
+        axis = int(np.argmax((hi - lo) * rng.uniform(0.5, 1.0, 3)))
+        cut = lo[axis] + (hi[axis] - lo[axis]) * rng.uniform(0.3, 0.7)
+        upper, lower = hi.copy(), lo.copy()
+        upper[axis], lower[axis] = cut, cut
+        cells += [(lo, upper), (lower, hi)]
+    return mesh_assembly({f"b{k}": box(lo, hi) for k, (lo, hi) in enumerate(cells)})
+
+
+def swept_free(asm, moving, rest, direction, threshold: float) -> bool:
+    """Independent sweep (manifold3d): the moving parts translated in steps of a quarter
+    of their smallest extent along ``direction`` until past the bounding box never share
+    more than ``threshold`` of volume with the rest."""
+    import manifold3d
+
+    def solid(names):
+        total = manifold3d.Manifold()
+        for name in names:
+            mesh = asm.parts[name].mesh
+            total += manifold3d.Manifold(
+                manifold3d.Mesh(
+                    np.asarray(mesh.vertices, dtype=np.float32),
+                    np.asarray(mesh.faces, dtype=np.uint32),
+                )
+            )
+        return total
+
+    mover, others = solid(moving), solid(rest)
+    extent = min(np.ptp(asm.parts[n].mesh.bounds, axis=0).min() for n in moving)
+    step = extent / 4
+    reach = np.linalg.norm(np.ptp(asm.bounds, axis=0)) * 2
+    for k in range(1, int(reach / step) + 2):
+        moved = mover.translate(list(k * step * np.asarray(direction)))
+        if (moved ^ others).volume() > threshold:
+            return False
+    return True
+
+
+@pytest.mark.parametrize(("n", "seed"), [(20, 1), (35, 2), (50, 3)])
+def test_box_packings_plans_and_queries_agree(n, seed):
+    asm = box_packing(n, seed)
+    tol = asm.tolerance()
+    result = plan(asm, max_and_or_parts=0)
+    assert result.feasible == separable_by_translations(asm)
+    assert result.feasible  # guillotine cuts come apart
+    members = set(asm.names)
+    for number, step in enumerate(result.steps):
+        rest = [p for p in members if p not in step.parts]
+        dbg = extended_dbg(asm, step.direction, tuple(sorted(members)), tol)
+        assert not any(i in step.parts and j in rest for i, j in dbg.arcs)
+        if number == 0:
+            for name in step.parts:
+                found = can_extract(asm, [name])
+                assert found is not None
+                assert all(extended_free(asm, [name], d, tol) for d in found.directions)
+        area = min(asm.parts[p].mesh.area for p in step.parts)
+        assert swept_free(asm, step.parts, rest, step.direction, 1e-6 * area), step
+        members -= set(step.parts)

@@ -97,13 +97,20 @@ class Removal:
 
     parts: frozenset[str]
     directions: tuple[NDArray[np.float64], ...]
+    # the directions lie in faces of the free set thinner than the mesh angle
+    # tolerance: the parts leave only if the tolerance lets them touch
+    tolerance_dependent: bool = False
 
     def to_dict(self) -> dict[str, object]:
-        """JSON form (DESIGN.md §5.3): sorted part names and direction lists."""
-        return {
+        """JSON form (DESIGN.md §5.3): sorted part names and direction lists (and
+        ``tolerance_dependent`` when set)."""
+        out: dict[str, object] = {
             "parts": sorted(self.parts),
             "directions": [[float(x) for x in d] for d in self.directions],
         }
+        if self.tolerance_dependent:
+            out["tolerance_dependent"] = True
+        return out
 
 
 def removal_table(title: str, kind: str, example: str, removals: list[Removal]) -> Table:

@@ -19,6 +19,7 @@ free; free directions strictly between those examined may be missed.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass
 
 import networkx as nx
 import numpy as np
@@ -26,7 +27,8 @@ from numpy.typing import NDArray
 
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import Removal
-from assemblykit.blocking.extended import extended_free
+from assemblykit.blocking.extended import extended_arcs, extended_free
+from assemblykit.blocking.free_cones import blocked_sets, exact_free_directions, overlay_faces
 from assemblykit.blocking.ndbg import (
     AssemblyLike,
     NonDirectionalBlockingGraph,
@@ -145,6 +147,10 @@ def can_extract(
             free = [d for d in batch if extended_free(assembly, moving, d, tol, names)]
             if free:
                 return Removal(chosen, tuple(free))
+        # none of the sampled directions: a face of the exact free set (a tunnel)
+        exact = exact_free_directions(assembly, moving, tol)
+        if exact.directions:
+            return Removal(chosen, exact.directions, exact.tolerance_dependent)
         return None
     return Removal(chosen, tuple(directions)) if len(directions) else None
 
@@ -166,6 +172,84 @@ def removable_parts(
     return out
 
 
+@dataclass(frozen=True, eq=False)
+class Prerequisite:
+    """The parts to take out before ``part`` (seed 004, introduction): ``parts`` leave
+    first (in some order, one at a time, each by an extended translation), then
+    ``part`` leaves along ``direction``. ``minimal`` is true when no smaller set
+    works along any direction; false when a smaller set of direct blockers exists that
+    could not be shown removable one part at a time (the answer is then a heuristic)."""
+
+    part: str
+    parts: frozenset[str]
+    direction: NDArray[np.float64] | None
+    minimal: bool
+
+
+def removal_before(assembly: AssemblyLike, part: str, tol: Tolerance | None = None) -> Prerequisite:
+    """The fewest parts to remove before ``part`` can leave by an extended translation,
+    over all directions (seed 004 §5): the directions are one per face of the overlay of
+    the sets each other part blocks (over a face, the parts blocking ``part`` are
+    constant), so every set of direct blockers is seen; the sets are tried smallest
+    first, and the first whose parts can be taken out one at a time (each along a face
+    of its exact free set) is the answer."""
+    if part not in assembly.names:
+        raise UnknownNameError(f"no part named {part!r}")
+    tol = assembly.tolerance(tol)
+    names = list(assembly.names)
+    others = [n for n in names if n != part]
+    sets = blocked_sets(assembly, [part], names, tol)
+    if sets is None:
+        directions = np.vstack([_AXES, *locally_free_directions(assembly, [part], tol)])
+    else:
+        faces = overlay_faces(list(sets.values()), tol)
+        directions = np.vstack([faces.directions, faces.thin]).reshape(-1, 3)
+    options: dict[frozenset[str], NDArray[np.float64]] = {}
+    for d in directions:
+        # inside a face the blocked sets say who blocks; the direction kept for each
+        # set is checked exactly below
+        if sets is None:
+            blockers = frozenset(j for _, j in extended_arcs(assembly, d, [part], others, tol))
+        else:
+            blockers = frozenset(j for j, blocked in sets.items() if blocked.contains(d))
+        options.setdefault(blockers, d)
+    for blockers, d in list(options.items()):
+        exact = frozenset(j for _, j in extended_arcs(assembly, d, [part], others, tol))
+        if exact != blockers:
+            del options[blockers]
+            options.setdefault(exact, d)
+    smallest = min((len(r) for r in options), default=0)
+    for blockers in sorted(options, key=lambda r: (len(r), sorted(r))):
+        if _removable_first(assembly, blockers, names, tol):
+            return Prerequisite(
+                part, blockers, options[blockers], len(blockers) == smallest and sets is not None
+            )
+    return Prerequisite(part, frozenset(others), None, False)
+
+
+def _removable_first(
+    assembly: AssemblyLike, chosen: frozenset[str], names: list[str], tol: Tolerance
+) -> bool:
+    """Whether the parts of ``chosen`` can be taken out of ``names`` one at a time, each
+    along a face of its exact free set among the parts still there (removing parts only
+    removes obstacles, so any part that can leave may leave first)."""
+    remaining, pending = set(names), set(chosen)
+    while pending:
+        leaving = next(
+            (
+                r
+                for r in sorted(pending)
+                if exact_free_directions(assembly, [r], tol, remaining, limit=1).directions
+            ),
+            None,
+        )
+        if leaving is None:
+            return False
+        pending.discard(leaving)
+        remaining.discard(leaving)
+    return True
+
+
 def parts_to_remove_before(
     assembly: AssemblyLike,
     part: str,
@@ -173,10 +257,13 @@ def parts_to_remove_before(
     tol: Tolerance | None = None,
 ) -> frozenset[str]:
     """The smallest set of other parts that must leave before ``part`` can be taken
-    out: over every region's DBG, the parts ``part`` would push along (everything
-    reachable from it); the least such set."""
+    out. Extended translations: :func:`removal_before` (over all directions, the set
+    removable itself). Other motions: over every region's DBG, the parts ``part`` would
+    push along (everything reachable from it); the least such set."""
     if part not in assembly.names:
         raise UnknownNameError(f"no part named {part!r}")
+    if motion == "extended":
+        return removal_before(assembly, part, tol).parts
     if motion == "rigid":
         graph = blocking_graph(assembly, "rigid", tol=tol)
         best = min(
@@ -194,22 +281,3 @@ def parts_to_remove_before(
         if len(pushed) < len(best_set):
             best_set = pushed
     return best_set
-
-
-def separable_by_translations(
-    assembly: AssemblyLike, parts: Iterable[str] | None = None, tol: Tolerance | None = None
-) -> bool:
-    """Whether the assembly comes completely apart with extended translations, one
-    subassembly moving at a time (seed 004, conclusion). Any removable subassembly can
-    be taken first: removing parts only removes obstacles."""
-    names = list(assembly.names) if parts is None else list(parts)
-    if len(names) <= 1:
-        return True
-    removals = blocking_graph(assembly, "extended", names, tol).removable()
-    if not removals:
-        return False
-    first = removals[0].parts
-    rest = [n for n in names if n not in first]
-    return separable_by_translations(assembly, first, tol) and separable_by_translations(
-        assembly, rest, tol
-    )
