@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import time
 from pathlib import Path
 
@@ -89,3 +90,34 @@ def test_batch_lists_a_missing_input_and_exits_2(capsys, tmp_path):
     assert "missing: " in out and "nowhere.yaml: no such file or folder" in out
     assert err.count("\n") == 1 and "not found" in err and "nowhere.yaml" in err
     assert not out_file.exists() or out_file.read_text() == ""
+
+
+PLANAR = ROOT / "src" / "assemblykit" / "examples" / "planar"
+
+
+def test_plan_of_a_polygon_file_is_planar(capsys):
+    """The hook: the peg leaves along one direction of its free arc [atan(1/3), 45°]."""
+    code, out, err = run(capsys, "plan", str(PLANAR / "hook.yaml"), "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["feasible"] is True
+    (step,) = data["steps"]
+    assert step["parts"] == ["peg"]
+    x, y, z = step["direction"]
+    assert z == 0.0 and math.atan(1 / 3) - 1e-9 <= math.atan2(y, x) <= math.pi / 4 + 1e-9
+    code, _, err = run(capsys, "plan", str(PLANAR / "hook.yaml"), "--png", "x.png")
+    assert code == 2 and "2D polygon" in err
+
+
+def test_plan_reports_the_hands_a_planar_interlock_needs(capsys):
+    code, out, err = run(capsys, "plan", str(PLANAR / "three_hands.yaml"), "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["feasible"] is False
+    assert data["hands"]["needed"] == 3
+    code, out, _ = run(
+        capsys, "plan", str(PLANAR / "three_hands.yaml"), "--json", "--max-hands", "2"
+    )
+    assert json.loads(out)["hands"]["needed"] is None
+    code, _, err = run(capsys, "plan", str(PLANAR / "three_hands.yaml"), "--max-hands", "1")
+    assert code == 2 and "--max-hands" in err

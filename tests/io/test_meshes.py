@@ -108,6 +108,55 @@ def test_open_mesh_that_cannot_be_closed_is_rejected(tmp_path):
         read_mesh(path)
 
 
+def edge_piece(path: Path) -> Path:
+    """Two unit cubes sharing only the edge x = y = 1, written as one mesh (its vertices
+    on that edge shared: four faces meet there)."""
+    first = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    second = trimesh.creation.box(bounds=[[1, 1, 0], [2, 2, 1]])
+    trimesh.util.concatenate([first, second]).export(path)
+    merged = trimesh.load(path, force="mesh")
+    assert not merged.is_watertight  # as trimesh reads it: a non-manifold edge
+    return path
+
+
+def test_solids_meeting_along_an_edge_load_as_one_piece(tmp_path):
+    piece = read_mesh(edge_piece(tmp_path / "piece.obj"))
+    assert piece.is_watertight
+    assert piece.volume == pytest.approx(2.0, abs=1e-12)
+    assert piece.body_count == 2
+
+
+def test_contacts_and_blocking_of_a_piece_with_cubes_meeting_along_an_edge(tmp_path):
+    from assemblykit.blocking.ndbg import blocking_graph
+
+    edge_piece(tmp_path / "piece.obj")
+    trimesh.creation.box(bounds=[[0, 0, 1], [1, 1, 2]]).export(tmp_path / "lid.stl")
+    asm = load_assembly(tmp_path)
+    assert asm.parts["piece"].volume == pytest.approx(2.0, abs=1e-12)
+    # the lid lies on the first cube: one unit square of contact, normal +z
+    (contact,) = asm.contacts()
+    assert contact.pair == ("lid", "piece")
+    assert sum(p.area for p in contact.planar) == pytest.approx(1.0)
+    ndbg = blocking_graph(asm, "extended")
+    assert ndbg.dbg([0, 0, 1]).arcs == {("piece", "lid")}
+    assert ndbg.dbg([0, 0, -1]).arcs == {("lid", "piece")}
+    # sliding along +x the lid passes over the second cube (touching, not blocked)
+    assert ndbg.dbg([1, 0, 0]).arcs == set()
+
+
+def test_open_sheets_meeting_along_an_edge_are_still_rejected(tmp_path):
+    # the two cubes of the edge piece, each cut in half: open, and the file is named
+    first = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    second = trimesh.creation.box(bounds=[[1, 1, 0], [2, 2, 1]])
+    both = trimesh.util.concatenate([first, second])
+    path = tmp_path / "holed.stl"
+    # half of each box, as in the half box above: holes too big to fill
+    keep = [*range(6), *range(12, 18)]
+    trimesh.Trimesh(both.vertices, both.faces[keep], process=False).export(path)
+    with pytest.raises(GeometryError, match=r"holed\.stl"):
+        read_mesh(path)
+
+
 def test_asap_beam_touches_without_interfering_with_final_state_poses():
     asm = load_assembly(dataset("asap_beam_assembly"))
     assert asm.names == ["0", "1", "2", "3", "6"]

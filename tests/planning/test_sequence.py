@@ -322,3 +322,101 @@ def test_large_assemblies_take_candidates_from_each_parts_own_arrangement(monkey
     result = plan(assembly)
     assert result.directions == len(local.directions)
     assert_every_step_free(assembly, result)
+
+
+PLANAR = ROOT / "src" / "assemblykit" / "examples" / "planar"
+
+
+def test_planar_peg_leaves_the_hook_at_the_low_end_of_its_free_arc():
+    from assemblykit.blocking.polygons import load_polygons
+
+    # the peg is free on [atan(1/3), 45 deg] (tests/blocking/test_polygons.py); of the
+    # regions there, the end point (3, 1)/sqrt(10) is the closest to a coordinate axis
+    result = plan(load_polygons(PLANAR / "hook.yaml"))
+    assert result.feasible
+    (step,) = result.steps
+    assert step.parts == ("peg",) and step.rest == ("hook",)
+    assert np.allclose(step.direction, np.array([3.0, 1.0, 0.0]) / np.sqrt(10))
+    assert result.to_dict()["order"] == [["peg"]]
+    assert result.and_or is not None and result.and_or.plans == 1
+
+
+def test_stuck_lists_the_part_trapped_behind_an_interlock():
+    from assemblykit.blocking.polygons import load_polygons
+
+    # bottle and plug interlock (the foot is wider than the neck, the stem fills it);
+    # the block leaves the bottle alone (up the neck) and the plug alone (down), but
+    # not the two: all three are stuck, the block held by the minimal interlock
+    model = load_polygons(PLANAR / "bottle.yaml")
+    result = plan(model)
+    assert not result.feasible
+    assert result.stuck == ("block", "bottle", "plug")
+    (lock,) = result.interlocked
+    assert lock.parts == ("bottle", "plug")
+    assert lock.held == ("block",)
+    # the foot hangs: an infinitesimal translation down may start, none with rotation
+    assert lock.translation_locked is False
+    assert lock.rigid_may_free is False
+    data = result.to_dict()
+    assert data["stuck"] == ["block", "bottle", "plug"]
+    assert data["interlocked"][0]["held"] == ["block"]
+    # consistent with blocking: no proper part of the stuck set is removable (Γ_e is
+    # exact for polygons), while each pair with the block is separable
+    assert blocking_graph(model, "extended", parts=result.stuck).removable() == []
+    for other in ("bottle", "plug"):
+        assert blocking_graph(model, "extended", parts=["block", other]).removable()
+
+
+def test_a_cube_in_a_one_piece_cage_leaves_through_the_diagonal_tunnel():
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tests" / "blocking"))
+    from test_extended import APERTURE, DIAGONAL, caged_cube
+
+    from assemblykit.blocking.queries import can_extract
+
+    asm = caged_cube()
+    result = plan(asm)
+    assert result.feasible
+    (step,) = result.steps
+    assert step.parts == ("cube",) and step.rest == ("cage",)
+    # within the tunnel's aperture around its axis (derived in test_extended)
+    assert np.arccos(np.clip(step.direction @ DIAGONAL, -1, 1)) < APERTURE
+    assert extended_free(asm, ["cube"], step.direction, asm.tolerance())
+    assert can_extract(asm, ["cube"]) is not None
+
+
+@pytest.mark.parametrize("through", [False, True])
+def test_a_rod_in_a_half_round_groove_is_planned_out_of_it(through: bool):
+    from curved_parts import DISTANCES, rod_in_groove, swept_overlaps
+
+    asm = rod_in_groove(through)
+    result = plan(asm)
+    assert result.feasible
+    (step,) = result.steps
+    assert step.parts == ("rod",)
+    # the groove frees d_x = 0, d_z >= 0; its closed ends leave only +z
+    assert abs(step.direction[0]) < 1e-6 and step.direction[2] >= -1e-6
+    if not through:
+        np.testing.assert_allclose(step.direction, [0.0, 0.0, 1.0], atol=1e-6)
+    volumes, touching = swept_overlaps(asm, "rod", step.direction, DISTANCES)
+    assert np.all(volumes <= touching)
+
+
+def test_plan_blocking_and_motion_agree_that_the_ball_joint_ball_lifts_out():
+    from assemblykit.motion.freedom import part_motion
+    from curved_parts import BALL_JOINT, DISTANCES, swept_overlaps
+
+    asm = load_assembly(BALL_JOINT / "ball_joint.yaml")
+    result = plan(asm)
+    assert result.feasible and result.stuck == ()
+    first = result.steps[0]
+    assert first.parts == ("ball",)
+    # up, inside the cone above the cup's rim (0.2 of the radius below the centre)
+    assert first.direction[2] >= np.sqrt(1.0 - 0.2**2) - 1e-3
+    assert any(r.parts == {"ball"} for r in blocking_graph(asm, "extended").removable())
+    assert any(r.parts == {"ball"} for r in blocking_graph(asm, "infinitesimal").removable())
+    reading = part_motion(asm, "ball").unilateral
+    assert reading.can_lift_off and min(r[2] for r in reading.lift_off) > 0.97
+    volumes, touching = swept_overlaps(asm, "ball", first.direction, DISTANCES)
+    assert np.all(volumes <= touching)

@@ -540,7 +540,11 @@ def blocking_terms(assembly: AssemblyLike, motion: str, tol: Tolerance) -> list[
     cache = _TERMS.setdefault(assembly, {})
     key = (motion, tol)
     if key not in cache:
-        if motion == "extended":
+        if motion == "extended" and getattr(assembly, "dimension", 3) == 2:
+            from assemblykit.blocking.planar import planar_extended_terms
+
+            cache[key] = planar_extended_terms(assembly, tol)
+        elif motion == "extended":
             from assemblykit.blocking.extended import extended_terms
 
             cache[key] = extended_terms(assembly, tol)
@@ -591,7 +595,13 @@ def blocking_graph(
     if key not in graphs and whole is not None:
         # a sub-assembly of an assembly already analysed: drop the other parts' slots
         graphs[key] = whole.without_parts(set(whole.parts) - inside)
-    if key not in graphs and motion == "extended" and not all_convex(assembly, names):
+    planar = getattr(assembly, "dimension", 3) == 2  # polygons: exact terms, any shape
+    if (
+        key not in graphs
+        and motion == "extended"
+        and not planar
+        and not all_convex(assembly, names)
+    ):
         local = blocking_graph(assembly, "infinitesimal", names, tol)
         assert isinstance(local, NonDirectionalBlockingGraph)
         graphs[key] = sampled_ndbg(assembly, names, local, tol)

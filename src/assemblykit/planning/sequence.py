@@ -52,6 +52,7 @@ from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
+    from assemblykit.planning.hands import Hands
 
 Progress = Callable[[str, int, int], None]
 LOOK_AHEAD = 12
@@ -160,6 +161,16 @@ class DirectionTable:
         masks = self.masks(k)
         return {i: masks[i] & among & ~(1 << i) for i in _bits(movers)}
 
+    def appended(self, directions: NDArray[np.float64], slots: NDArray[np.bool_]) -> DirectionTable:
+        """The table with more directions (rows of ``slots`` over the same slots)."""
+        return DirectionTable(
+            self.names,
+            np.vstack([self.directions, directions]),
+            np.vstack([self.slots, slots]),
+            self.moving,
+            self.blocker,
+        )
+
     def masks(self, k: int) -> tuple[int, ...]:
         """Per part, the bit mask of its blockers along direction ``k``."""
         masks = [0] * len(self.names)
@@ -218,6 +229,10 @@ class ExtendedDirections:
         )
         return graph
 
+    def add(self, directions: NDArray[np.float64]) -> None:
+        """Append candidate directions (indices follow the existing ones)."""
+        self.directions = np.vstack([self.directions, directions])
+
     @property
     def evaluated(self) -> set[int]:
         """The directions along which some pair has been tested."""
@@ -268,11 +283,16 @@ class Interlock:
     parts: tuple[str, ...]
     translation_locked: bool
     rigid_may_free: bool
+    held: tuple[str, ...] = ()
+    """The other parts of the set where the search stopped: free from the minimal set
+    or from the rest alone, but no candidate direction separates any of them from the
+    others (a part trapped behind the interlock, or a second interlock linked to it)."""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON form."""
         return {
             "parts": list(self.parts),
+            "held": list(self.held),
             "translation_locked": self.translation_locked,
             "rigid_may_free": self.rigid_may_free,
         }
@@ -319,6 +339,7 @@ class Plan:
     interlocked: tuple[Interlock, ...]
     and_or: AndOrGraph | None
     directions: int
+    hands: Hands | None = None
 
     @property
     def feasible(self) -> bool:
@@ -327,8 +348,13 @@ class Plan:
 
     @property
     def stuck(self) -> tuple[str, ...]:
-        """All interlocked parts (empty when feasible)."""
-        return tuple(sorted({name for lock in self.interlocked for name in lock.parts}))
+        """Every part that no translation plan separates from all the others: the sets
+        where the search stopped, minimal interlocks and the parts they hold (empty
+        when feasible). Blocking is pairwise, so a split of the whole restricts to a
+        split of such a set: none of its parts can leave, in any order."""
+        return tuple(
+            sorted({name for lock in self.interlocked for name in (*lock.parts, *lock.held)})
+        )
 
     @property
     def order(self) -> tuple[tuple[str, ...], ...]:
@@ -360,6 +386,7 @@ class Plan:
             "parts": list(self.parts),
             "directions": self.directions,
             "and_or": None if self.and_or is None else self.and_or.to_dict(),
+            "hands": None if self.hands is None else self.hands.to_dict(),
         }
 
     def render(self) -> Table:
@@ -381,6 +408,22 @@ class Plan:
         for lock in self.interlocked:
             freed = "rigid motion may free" if lock.rigid_may_free else "locked"
             table.add_row("-", ", ".join(lock.parts), "-", f"interlocked ({freed})", "-")
+            if lock.held:
+                table.add_row("-", ", ".join(lock.held), "-", "held by the interlock", "-")
+        if self.hands is not None and self.hands.moves:
+            # the groups of the operations two hands cannot do, one row per group
+            for move in self.hands.moves:
+                for group, direction in zip(move.groups[1:], move.directions[1:], strict=True):
+                    table.add_row(
+                        f"{move.hands} hands",
+                        ", ".join(group),
+                        format_direction(direction),
+                        "translation, together",
+                        _abbreviate(move.groups[0]),
+                    )
+            table.caption = f"needs {self.hands.summary()}"
+        elif self.hands is not None and self.hands.needed is None:
+            table.caption = f"needs {self.hands.summary()}"
         return table
 
 
@@ -579,6 +622,20 @@ class _Search:
     progress: Progress
     steps: list[Step]
     locked: list[int]
+    exact: Callable[[int], NDArray[np.float64]] | None = None
+    add_translations: Callable[[NDArray[np.float64]], NDArray[np.bool_]] | None = None
+
+    def _refined(self, members: int) -> bool:
+        """Add the directions of the exact free sets of ``members`` (:func:`exact_candidates`)
+        as candidates; whether there were any."""
+        if self.exact is None or self.add_translations is None:
+            return False
+        found = self.exact(members)
+        if not len(found) or not isinstance(self.extended, ExtendedDirections):
+            return False
+        self.translations = self.translations.appended(found, self.add_translations(found))
+        self.extended.add(found)
+        return True
 
     def disassemble(self, members: int) -> None:
         """Append the steps that take ``members`` apart, or record it as interlocked."""
@@ -590,6 +647,11 @@ class _Search:
                 choice = _choose_removal(
                     self.translations, self.extended, current, self.volumes, previous
                 )
+                if choice is None and self._refined(current):
+                    # the sampled candidates free nothing: those of the exact free sets
+                    choice = _choose_removal(
+                        self.translations, self.extended, current, self.volumes, previous
+                    )
                 if choice is None:
                     self.locked.append(current)
                     break
@@ -722,12 +784,78 @@ def local_table(
     return DirectionTable(names, directions, slots, *ends.T)
 
 
+EXACT_GROUP_PARTS = 12
+"""The largest set left by the candidates of Γ_t whose groups get the directions of the
+overlay of every pair's blocked set (single parts always get their free set's)."""
+
+
+def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDArray[np.float64]]:
+    """For a set of parts the sampled candidates do not separate: a direction in every
+    face of each part's exact free set among the set (seed 004 §5, checked free), and,
+    when none leaves alone and the set has at most ``EXACT_GROUP_PARTS`` parts, one in
+    every face of the overlay of the pairs' blocked sets (over which every DBG is
+    constant, so groups leaving together are found as well)."""
+    from assemblykit.blocking.free_cones import blocked_by, exact_free_directions, overlay_faces
+
+    names = tuple(assembly.names)
+
+    def directions(members: int) -> NDArray[np.float64]:
+        among = [names[i] for i in _bits(members)]
+        found: list[NDArray[np.float64]] = []
+        for name in among:
+            found.extend(exact_free_directions(assembly, [name], tol, among, limit=2).directions)
+        if found or len(among) > EXACT_GROUP_PARTS:
+            return np.array(found).reshape(-1, 3)
+        sets = []
+        for a in among:
+            for b in among:
+                if a != b:
+                    blocked = blocked_by(assembly, [a], b, tol)
+                    if blocked is None:
+                        return np.zeros((0, 3))
+                    sets.append(blocked)
+        return overlay_faces(sets, tol).directions
+
+    return directions
+
+
+def translation_slots(
+    assembly: Assembly, table: DirectionTable, tol: Tolerance
+) -> Callable[[NDArray[np.float64]], NDArray[np.bool_]]:
+    """Γ_t along new directions over the slots of ``table``: a slot blocks when one of its
+    infinitesimal terms holds strictly (beyond the angle tolerance, as the arrangement's
+    snapping has it)."""
+    from assemblykit.blocking.ndbg import blocking_terms
+
+    index = {name: i for i, name in enumerate(table.names)}
+    column = {
+        (int(i), int(j)): s
+        for s, (i, j) in enumerate(zip(table.moving, table.blocker, strict=True))
+    }
+    terms = blocking_terms(assembly, "infinitesimal", tol)
+
+    def slots(directions: NDArray[np.float64]) -> NDArray[np.bool_]:
+        out = np.zeros((len(directions), len(table.moving)), dtype=bool)
+        for term in terms:
+            s = column.get((index[term.moving], index[term.blocker]))
+            if s is not None:
+                out[:, s] |= np.all(directions @ np.atleast_2d(term.normals).T > tol.angle, axis=1)
+        return out
+
+    return slots
+
+
 def rigid_may_free(assembly: Assembly, parts: Iterable[str], tol: Tolerance | None = None) -> bool:
     """Whether some DBG of Γ_g (infinitesimal rigid motions) of the sub-assembly
     ``parts`` frees a proper part of it: the necessary condition of seed 004 ("a
     necessary condition for a subassembly S to be directly removable")."""
     from assemblykit.blocking.ndbg import blocking_graph
 
+    if getattr(assembly, "dimension", 3) == 2:
+        # polygons move in their plane: lifting off it would free every part
+        from assemblykit.planning.planar import planar_rigid_may_free
+
+        return planar_rigid_may_free(assembly, parts, assembly.tolerance(tol))
     return bool(blocking_graph(assembly, motion="rigid", parts=parts, tol=tol).removable())
 
 
@@ -736,50 +864,101 @@ def plan(
     tol: Tolerance | None = None,
     max_and_or_parts: int = 8,
     progress: Progress | None = None,
+    max_hands: int = 4,
 ) -> Plan:
     """Plan the disassembly of ``assembly`` by extended translations (seed 004).
 
     ``progress(stage, done, total)`` is called as the work advances. The result is
     feasible when every part is separated; otherwise ``interlocked`` holds the minimal
     sets that no candidate direction separates, each classified with Γ_t and Γ_g
-    (module doc).
+    (module doc), and ``hands`` whether up to ``max_hands`` hands take them apart
+    (:mod:`assemblykit.planning.hands`). A polygon assembly is planned in the plane
+    (:mod:`assemblykit.planning.planar`).
     """
     tol = assembly.tolerance(tol)
     names = tuple(assembly.names)
     report: Progress = progress or (lambda stage, done, total: None)
     report("blocking graph (infinitesimal translations)", 0, len(names))
+    if getattr(assembly, "dimension", 3) == 2:
+        from assemblykit.planning.planar import planar_search
+
+        planar = planar_search(assembly, tol, report)
+        return finish_plan(assembly, planar, tol, max_and_or_parts, max_hands, report)
     translations = translation_table(assembly, tol)
     extended = ExtendedDirections(assembly, translations.directions, tol)
     volumes = tuple(assembly.parts[name].volume for name in names)
-    search = _Search(translations, extended, volumes, report, [], [])
+    search = _Search(
+        translations,
+        extended,
+        volumes,
+        report,
+        [],
+        [],
+        exact_candidates(assembly, tol),
+        translation_slots(assembly, translations, tol),
+    )
     search.disassemble(_mask(range(len(names))))
-    interlocks: tuple[Interlock, ...] = ()
-    if search.locked:
-        interlocks = tuple(
-            _interlock(
-                assembly,
-                names,
-                minimal_interlocked(
-                    extended.table(translations.incomplete(members), members), members
-                ),
-                translations,
-                tol,
-            )
-            for members in search.locked
+    return finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
+
+
+def finish_plan(
+    assembly: Any,
+    search: _Search,
+    tol: Tolerance,
+    max_and_or_parts: int,
+    max_hands: int,
+    report: Progress,
+) -> Plan:
+    """The plan of a finished search: each set where it stopped, reported whole (its
+    minimal interlocked subset and the parts that subset holds), the AND/OR graph of a
+    small assembly, and the hands that take the stopped sets apart."""
+    from assemblykit.planning.hands import Hands, hands_needed
+
+    names = search.translations.names
+    translations = search.translations
+    # ExtendedDirections, or PlanarExtended for polygons: both give table and evaluated
+    extended: Any = search.extended
+    interlocks = tuple(
+        _interlock(
+            assembly,
+            names,
+            minimal_interlocked(extended.table(translations.incomplete(members), members), members),
+            members,
+            translations,
+            tol,
         )
+        for members in search.locked
+    )
     and_or = None
     if 1 < len(names) <= max_and_or_parts:
         # one direction per distinct DBG of Γ_t, and those the search already swept
         directions = set(distinct_directions(translations)) | extended.evaluated
         and_or = and_or_graph(extended.table(directions))
+    hands = Hands(min(2, len(names)), max_hands)
+    if search.locked and max_hands > 2:
+        report("hands", 0, len(search.locked))
+        # each stopped set on its own: its groups never need the parts already removed
+        found = [
+            hands_needed(assembly, [names[i] for i in _bits(members)], max_hands, tol)
+            for members in search.locked
+        ]
+        needed = [h.needed for h in found]
+        hands = Hands(
+            None if None in needed else max(n for n in needed if n is not None),
+            max_hands,
+            tuple(move for h in found for move in h.moves),
+        )
+    elif search.locked:
+        hands = Hands(None, max_hands)
     report("done", len(names), len(names))
-    return Plan(names, tuple(search.steps), interlocks, and_or, len(translations.directions))
+    return Plan(names, tuple(search.steps), interlocks, and_or, len(translations.directions), hands)
 
 
 def _interlock(
     assembly: Assembly,
     names: Sequence[str],
     members: int,
+    locked: int,
     translations: DirectionTable,
     tol: Tolerance,
 ) -> Interlock:
@@ -788,4 +967,21 @@ def _interlock(
         parts=parts,
         translation_locked=not separable(translations, members),
         rigid_may_free=rigid_may_free(assembly, parts, tol),
+        held=tuple(names[i] for i in _bits(locked & ~members)),
     )
+
+
+def separable_by_translations(
+    assembly: Any, parts: Iterable[str] | None = None, tol: Tolerance | None = None
+) -> bool:
+    """Whether the assembly comes completely apart with extended translations, one
+    subassembly moving at a time (seed 004, conclusion). Removing parts only removes
+    obstacles, so any removable subassembly can be taken first and a greedy
+    disassembly decides it: this is the planner's search
+    (:func:`plan`), with its candidate directions (Γ_t
+    regions, then the faces of the exact free sets), so the two always agree."""
+    names = list(assembly.names) if parts is None else list(parts)
+    if len(names) <= 1:
+        return True
+    whole = assembly if len(names) == len(assembly.names) else assembly.subset(names)  # type: ignore[attr-defined]
+    return plan(whole, tol, max_and_or_parts=0).feasible

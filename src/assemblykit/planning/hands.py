@@ -1,0 +1,319 @@
+"""How many hands an assembly needs (seed 004, "Conclusion": every operation of an NDBG
+plan moves one subassembly relative to the rest, i.e. two hands; an arbitrary device
+may need more [Natarajan, 1988]).
+
+A *k-handed* operation splits a set of parts into ``k`` groups: group 0 stays, and each
+other group ``g`` translates with its own constant velocity ``v_g`` to infinity, all at
+once. Groups ``g`` and ``h`` then move relative to each other along ``v_g − v_h``, a
+straight line, so the operation is collision-free iff for every two groups (the fixed
+one has ``v = 0``) the parts of ``h`` do not block those of ``g`` for the extended
+translation along ``v_g − v_h`` (Γ_e, pairwise as everywhere in seed 004). Two hands
+are the case ``k = 2``.
+
+The search runs where the two-handed planner stops (a set no translation separates):
+
+* the partitions of the set into ``k`` groups (``k = 3`` first, then up to
+  ``max_hands``), the group with the largest part fixed;
+* for each moving group, the directions that free it from the fixed group: the regions
+  of the set's Γ_e arrangement (exact for polygons and convex parts, sampled at the
+  regions of Γ_t otherwise, as in the planner);
+* speeds: with ``v_g = r d_g`` and ``v_h = d_h``, the relative direction ``r d_g − d_h``
+  sweeps the arc from ``−d_h`` to ``d_g`` as ``r`` runs over ``(0, ∞)``; it crosses the
+  circle of normal ``n`` at ``r = (n . d_h) / (n . d_g)``. Those crossings and one ratio
+  inside each interval between them visit every region of the arrangement the arc
+  meets, and each relative direction is checked exactly (``dbg(d)`` of the NDBG).
+
+Every operation reported is therefore collision-free; the search may miss one whose
+directions lie strictly inside regions other than at their representatives. Each group
+is then taken apart the same way (two hands first), so ``needed`` is the largest ``k``
+used, ``None`` when ``max_hands`` do not suffice.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from rich.table import Table
+
+from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph, blocking_graph
+from assemblykit.planning.sequence import (
+    DirectionTable,
+    _bits,
+    _mask,
+    _Search,
+    _several,
+    direction_table,
+    format_direction,
+)
+from assemblykit.tolerance import Tolerance
+
+MAX_HANDS = 4
+"""The most hands the planner tries by default."""
+
+HANDS_MAX_PARTS = 8
+"""The largest set split into groups (the partitions grow as k^n / k!)."""
+
+
+@dataclass(frozen=True, eq=False)
+class HandsMove:
+    """One k-handed operation: ``groups[0]`` stays and every other group translates with
+    velocity ``velocities[g]`` (``velocities[0]`` is zero) at the same time."""
+
+    groups: tuple[tuple[str, ...], ...]
+    velocities: NDArray[np.float64]
+
+    @property
+    def hands(self) -> int:
+        """The number of groups moved relative to one another."""
+        return len(self.groups)
+
+    @property
+    def speeds(self) -> tuple[float, ...]:
+        """The speed of each group (0 for the fixed one)."""
+        return tuple(float(np.linalg.norm(v)) for v in self.velocities)
+
+    @property
+    def directions(self) -> tuple[NDArray[np.float64], ...]:
+        """The unit direction of each group (the zero vector for the fixed one)."""
+        return tuple(
+            v / s if s > 0 else np.zeros_like(v)
+            for v, s in zip(self.velocities, self.speeds, strict=True)
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``groups`` (the fixed one first), unit ``directions``, ``speeds``."""
+        return {
+            "groups": [list(g) for g in self.groups],
+            "directions": [[float(x) + 0.0 for x in d] for d in self.directions],
+            "speeds": [round(s, 12) + 0.0 for s in self.speeds],
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class Hands:
+    """How many hands take the assembly apart: ``needed`` (``None`` when more than
+    ``max_hands``), and the operations with more than two hands, in order."""
+
+    needed: int | None
+    max_hands: int
+    moves: tuple[HandsMove, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``needed``, ``max_hands``, the ``groups``, ``directions`` and
+        ``speeds`` of the first operation with more than two hands, and all ``moves``."""
+        first = self.moves[0].to_dict() if self.moves else {}
+        return {
+            "needed": self.needed,
+            "max_hands": self.max_hands,
+            "groups": first.get("groups", []),
+            "directions": first.get("directions", []),
+            "speeds": first.get("speeds", []),
+            "moves": [move.to_dict() for move in self.moves],
+        }
+
+    def summary(self) -> str:
+        """One line: how many hands, e.g. ``3 hands`` or ``more than 4 hands``."""
+        if self.needed is None:
+            return f"more than {self.max_hands} hands"
+        return f"{self.needed} hand" + ("s" if self.needed > 1 else "")
+
+    def render(self) -> Table:
+        """A rich table of the operations with more than two hands."""
+        table = Table(title=f"Hands: {self.summary()}")
+        for column in ("operation", "group", "parts", "direction", "speed"):
+            table.add_column(column)
+        for number, move in enumerate(self.moves, start=1):
+            for g, (group, direction, speed) in enumerate(
+                zip(move.groups, move.directions, move.speeds, strict=True)
+            ):
+                table.add_row(
+                    str(number) if g == 0 else "",
+                    "fixed" if g == 0 else str(g),
+                    ", ".join(group),
+                    "-" if g == 0 else format_direction(direction),
+                    "-" if g == 0 else f"{speed:.3g}",
+                )
+        return table
+
+
+def _sizes(assembly: Any) -> dict[str, float]:
+    """Volumes of the parts (areas for polygons): the largest stays fixed."""
+    if getattr(assembly, "dimension", 3) == 2:
+        from assemblykit.blocking.planar import areas
+
+        return areas(assembly)
+    return {name: float(assembly.parts[name].volume) for name in assembly.names}
+
+
+def partitions(items: Sequence[int], k: int) -> Iterator[tuple[tuple[int, ...], ...]]:
+    """Every partition of ``items`` into exactly ``k`` non-empty groups, the group of
+    ``items[0]`` first (restricted growth strings)."""
+    n = len(items)
+    if not 1 <= k <= n:
+        return
+    labels = [0] * n
+
+    def grow(i: int, used: int) -> Iterator[tuple[tuple[int, ...], ...]]:
+        if n - i < k - used:
+            return
+        if i == n:
+            yield tuple(tuple(items[j] for j in range(n) if labels[j] == g) for g in range(k))
+            return
+        for g in range(min(used + 1, k)):
+            labels[i] = g
+            yield from grow(i + 1, max(used, g + 1))
+
+    yield from grow(1, 1)
+
+
+@dataclass
+class _HandsSearch:
+    ndbg: NonDirectionalBlockingGraph
+    table: DirectionTable
+    sizes: tuple[float, ...]
+    max_hands: int
+    tol: Tolerance
+
+    def __post_init__(self) -> None:
+        self.masks = [self.table.masks(k) for k in range(len(self.table.directions))]
+        self.circles = np.asarray(self.ndbg.arrangement.normals, dtype=np.float64)
+
+    def free(self, group: int, others: int, k: int) -> bool:
+        """Whether ``group`` leaves ``others`` along candidate direction ``k``."""
+        return all(self.masks[k][i] & others == 0 for i in _bits(group))
+
+    def free_along(self, group: int, others: int, direction: NDArray[np.float64]) -> bool:
+        """Whether ``group`` leaves ``others`` along any ``direction`` (exact)."""
+        names = self.table.names
+        dbg = self.ndbg.dbg(direction)
+        inside = {names[i] for i in _bits(group)}
+        outside = {names[j] for j in _bits(others)}
+        return not any(i in inside and j in outside for i, j in dbg.arcs)
+
+    def ratios(self, d_g: NDArray[np.float64], d_h: NDArray[np.float64]) -> list[float]:
+        """Speed ratios ``r`` at which ``r d_g − d_h`` meets each region of the
+        arrangement along its arc (module docstring), equal speeds first."""
+        along = self.circles @ d_g
+        ok = np.abs(along) > self.tol.angle
+        cuts = (self.circles[ok] @ d_h) / along[ok]
+        cuts = np.unique(cuts[cuts > 0])
+        inner = np.sqrt(cuts[1:] * cuts[:-1]) if len(cuts) > 1 else np.zeros(0)
+        ends = [cuts[0] / 2, cuts[-1] * 2] if len(cuts) else [1.0]
+        return sorted({1.0, *cuts.tolist(), *inner.tolist(), *ends}, key=lambda r: abs(np.log(r)))
+
+    def relative_ok(
+        self, g: int, h: int, v_g: NDArray[np.float64], v_h: NDArray[np.float64]
+    ) -> bool:
+        """Whether groups ``g`` and ``h`` (masks) miss each other with these velocities."""
+        e = v_g - v_h
+        length = float(np.linalg.norm(e))
+        if length <= self.tol.angle * max(np.linalg.norm(v_g), np.linalg.norm(v_h)):
+            return False  # they would move as one: the set was not separated
+        return self.free_along(g, h, e / length)
+
+    def velocities(self, groups: tuple[int, ...]) -> NDArray[np.float64] | None:
+        """Velocities that take ``groups`` apart, group 0 fixed, or ``None``: the last
+        group at unit speed along one of its free directions, each other moving group
+        along one of its own with a speed ratio against the last (module docstring),
+        every two moving groups checked."""
+        directions = self.table.directions
+        options = []
+        for g in groups[1:]:
+            ks = [k for k in range(len(directions)) if self.free(g, groups[0], k)]
+            if not ks:
+                return None
+            options.append(ks)
+        for k_last in options[-1]:
+            chosen = self._extend(groups, options, [], directions[k_last])
+            if chosen is not None:
+                return np.vstack([np.zeros(3), *chosen, directions[k_last]])
+        return None
+
+    def _extend(
+        self,
+        groups: tuple[int, ...],
+        options: list[list[int]],
+        chosen: list[NDArray[np.float64]],
+        d_last: NDArray[np.float64],
+    ) -> list[NDArray[np.float64]] | None:
+        g, last = len(chosen) + 1, len(groups) - 1
+        if g == last:
+            return chosen
+        for k in options[g - 1]:
+            d = self.table.directions[k]
+            for r in self.ratios(d, d_last):
+                v = r * d
+                if not self.relative_ok(groups[g], groups[last], v, d_last):
+                    continue
+                if not all(
+                    self.relative_ok(groups[g], groups[h], v, chosen[h - 1]) for h in range(1, g)
+                ):
+                    continue
+                result = self._extend(groups, options, [*chosen, v], d_last)
+                if result is not None:
+                    return result
+        return None
+
+    def split(self, members: int) -> HandsMove | None:
+        """The first operation with the fewest hands (3 to ``max_hands``) that splits
+        ``members``, the group of its largest part fixed."""
+        parts = sorted(_bits(members), key=lambda i: (-self.sizes[i], i))
+        if len(parts) > HANDS_MAX_PARTS:
+            return None
+        names = self.table.names
+        for k in range(3, self.max_hands + 1):
+            for split in partitions(parts, k):
+                groups = tuple(_mask(g) for g in split)
+                velocities = self.velocities(groups)
+                if velocities is not None:
+                    labels = tuple(tuple(names[i] for i in sorted(g)) for g in split)
+                    return HandsMove(labels, velocities)
+        return None
+
+    def take_apart(self, members: int) -> tuple[int | None, list[HandsMove]]:
+        """Hands needed for ``members`` and the operations with more than two, taking
+        it apart with two hands wherever the planner's search can."""
+        if not _several(members):
+            return 1, []
+        search = _Search(self.table, self.table, self.sizes, lambda *_: None, [], [])
+        search.disassemble(members)
+        needed: int | None = 2
+        moves: list[HandsMove] = []
+        index = {name: i for i, name in enumerate(self.table.names)}
+        for locked in search.locked:
+            move = self.split(locked)
+            if move is None:
+                return None, moves
+            moves.append(move)
+            needed = max(needed, move.hands)
+            for group in move.groups:
+                inner, more = self.take_apart(_mask(index[n] for n in group))
+                moves.extend(more)
+                if inner is None:
+                    return None, moves
+                needed = max(needed, inner)
+        return needed, moves
+
+
+def hands_needed(
+    assembly: Any,
+    parts: Sequence[str] | None = None,
+    max_hands: int = MAX_HANDS,
+    tol: Tolerance | None = None,
+) -> Hands:
+    """How many hands (up to ``max_hands``) take ``parts`` (default: all) of
+    ``assembly`` apart by translations, and the operations with more than two hands
+    (module docstring). Works for 3D assemblies and polygon assemblies alike."""
+    tol = assembly.tolerance(tol)
+    names = tuple(assembly.names if parts is None else parts)
+    ndbg = blocking_graph(assembly, "extended", parts=names, tol=tol)
+    assert isinstance(ndbg, NonDirectionalBlockingGraph)
+    table = direction_table(ndbg)
+    sizes = _sizes(assembly)
+    search = _HandsSearch(ndbg, table, tuple(sizes[n] for n in table.names), max_hands, tol)
+    needed, moves = search.take_apart(_mask(range(len(table.names))))
+    return Hands(needed, max_hands, tuple(moves))

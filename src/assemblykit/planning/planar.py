@@ -1,0 +1,126 @@
+"""Planning for polygon assemblies (seed 004, 2D case): the tables the planner of
+:mod:`assemblykit.planning.sequence` searches, and Γ_g restricted to the plane.
+
+In the plane Γ_e is exact for every polygon (:mod:`assemblykit.blocking.planar`), so
+the candidate directions are the regions of one arrangement of S¹: the points and open
+arcs cut by the diameters of both Γ_t (contacts) and Γ_e (grown obstacles). It refines
+both NDBGs, so each DBG is constant over each of its regions: a part that leaves along
+some direction leaves along one of them. Γ_t over these directions bounds and explains
+(``translation_locked``), Γ_e accepts the steps, as in 3D.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linprog
+
+from assemblykit.blocking.arrangement import circle_partition, snap_normals
+from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph, blocking_graph
+from assemblykit.blocking.rigid import RIGID_MAX_SIZE, RigidBlockingGraph, wrenches
+from assemblykit.planning.sequence import DirectionTable, Progress, _mask, _Search
+from assemblykit.tolerance import Tolerance
+
+# twists (omega; v) of the plane z = 0: a turn about z and a translation in the plane
+_PLANAR_TWIST_BOUNDS = [(0.0, 0.0), (0.0, 0.0), (-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0), (0.0, 0.0)]
+
+
+@dataclass(frozen=True, eq=False)
+class PlanarExtended(DirectionTable):
+    """Γ_e of polygons along every candidate direction, exact and complete (module
+    docstring): what :class:`assemblykit.planning.sequence.ExtendedDirections` computes
+    pair by pair in 3D is known here for every direction at once."""
+
+    def table(self, indices: Iterable[int], members: int | None = None) -> DirectionTable:
+        """The DBGs among ``members`` (default: all parts) along the directions
+        ``indices``, as a table."""
+        chosen = sorted(set(indices))
+        among = _mask(range(len(self.names))) if members is None else members
+        arcs = [list(self.graph(k, among).edges) for k in chosen]
+        return DirectionTable.from_arcs(self.names, self.directions[chosen], arcs)
+
+    @property
+    def evaluated(self) -> set[int]:
+        """Every direction: the whole table is exact."""
+        return set(range(len(self.directions)))
+
+
+def _slots_table(
+    cls: type[DirectionTable],
+    ndbg: NonDirectionalBlockingGraph,
+    directions: NDArray[np.float64],
+    tol: Tolerance,
+) -> DirectionTable:
+    """``ndbg``'s DBGs at ``directions``, computed directly from its terms."""
+    return cls(
+        tuple(ndbg.parts),
+        directions,
+        ndbg.table.direct_arcs(directions, tol),
+        np.asarray(ndbg.table.slot_moving, dtype=np.int64),
+        np.asarray(ndbg.table.slot_blocker, dtype=np.int64),
+    )
+
+
+def planar_tables(
+    model: Any, tol: Tolerance
+) -> tuple[DirectionTable, PlanarExtended, tuple[float, ...]]:
+    """Γ_t and Γ_e of a polygon assembly along the regions of their common arrangement
+    of S¹ (module docstring), and the parts' areas (the largest stays as the base)."""
+    from assemblykit.blocking.planar import areas
+
+    local = blocking_graph(model, "infinitesimal", tol=tol)
+    grown = blocking_graph(model, "extended", tol=tol)
+    assert isinstance(local, NonDirectionalBlockingGraph)
+    assert isinstance(grown, NonDirectionalBlockingGraph)
+    normals = np.vstack([local.table.normals, grown.table.normals])
+    circles = snap_normals(normals, tol)[0] if len(normals) else normals.reshape(0, 3)
+    directions = circle_partition(circles, tol).directions
+    area = areas(model)
+    return (
+        _slots_table(DirectionTable, local, directions, tol),
+        _slots_table(PlanarExtended, grown, directions, tol),  # type: ignore[arg-type]
+        tuple(area[name] for name in model.names),
+    )
+
+
+def planar_search(model: Any, tol: Tolerance, report: Progress) -> _Search:
+    """The planner's search over a polygon assembly, run: Γ_t bounds and Γ_e accepts
+    along every region of the common arrangement (:func:`planar_tables`)."""
+    translations, extended, volumes = planar_tables(model, tol)
+    search = _Search(translations, extended, volumes, report, [], [])
+    search.disassemble(_mask(range(len(translations.names))))
+    return search
+
+
+def planar_rigid_may_free(model: Any, parts: Iterable[str], tol: Tolerance) -> bool:
+    """Whether some infinitesimal rigid motion of the plane (a turn about z and a
+    translation in z = 0) moves a proper part of ``parts`` away from the others without
+    penetration, breaking some contact (Γ_g in 2D, seed 004: "the 2D case is just
+    simpler"). Each candidate set of at most ``RIGID_MAX_SIZE`` parts is decided by
+    the linear program of :meth:`assemblykit.blocking.rigid.RigidBlockingGraph.free_twist`
+    with the out-of-plane twist components held at zero."""
+    names = tuple(parts)
+    inside = set(names)
+    contacts = tuple(c for c in model.contacts(tol) if c.a in inside and c.b in inside)
+    graph = RigidBlockingGraph(names, contacts, tol)
+    for size in range(1, min(RIGID_MAX_SIZE, len(names) - 1) + 1):
+        for chosen in itertools.combinations(names, size):
+            pts, nrm = graph.constraints(chosen)
+            if len(pts) == 0:
+                return True
+            rows = wrenches(pts, nrm, pts.mean(axis=0), tol.scale)
+            result = linprog(
+                c=rows.sum(axis=0),
+                A_ub=rows,
+                b_ub=np.zeros(len(rows)),
+                bounds=_PLANAR_TWIST_BOUNDS,
+                method="highs",
+            )
+            if result.status == 0 and -result.fun > tol.mesh_angle:
+                return True
+    return False
