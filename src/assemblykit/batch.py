@@ -33,6 +33,7 @@ from rich.table import Table
 from rich.text import Text
 
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
+from assemblykit.io.documents import read_text
 
 Engine = Literal["local", "dask"]
 Command = Literal["plan", "motion"]
@@ -157,7 +158,7 @@ def finished_inputs(out: Path) -> set[str]:
     if not out.exists():
         return set()
     done = set()
-    lines = out.read_text(encoding="utf-8").splitlines()
+    lines = read_text(out, "results file").splitlines()
     for number, text in enumerate(lines, start=1):
         if not text.strip():
             continue
@@ -167,6 +168,12 @@ def finished_inputs(out: Path) -> set[str]:
             if number == len(lines):
                 continue
             raise InputError("not a JSON line", source=str(out), where=f"line {number}") from None
+        if not (isinstance(record, dict) and isinstance(record.get("input"), str)):
+            raise InputError(
+                "not a result line (an object with 'input')",
+                source=str(out),
+                where=f"line {number}",
+            )
         if record.get("status") in FINISHED:
             done.add(_key(record["input"]))
     return done

@@ -13,13 +13,14 @@ import functools
 import json
 import sys
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, NoReturn, Protocol
 
 import click
 
 from assemblykit import __version__
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
-from assemblykit.tolerance import Tolerance
+from assemblykit.io.outputs import HTML_SUFFIXES, PNG_SUFFIXES, checked_output
+from assemblykit.tolerance import MAX_REL_LENGTH, MIN_REL_LENGTH, Tolerance
 
 if TYPE_CHECKING:
     from rich.console import Console
@@ -52,12 +53,23 @@ def console(stderr: bool = False) -> Console:
     return Console(stderr=stderr, width=width)
 
 
+class _OptionRange(click.FloatRange):
+    """A number in a range whose faults are bad input: one line naming the option and
+    exit 2, like a bad file (click's own faults print the whole usage)."""
+
+    def fail(
+        self, message: str, param: click.Parameter | None = None, ctx: click.Context | None = None
+    ) -> NoReturn:
+        option = param.opts[0] if param is not None and param.opts else None
+        raise InputError(message, where=option)
+
+
 json_option = click.option(
     "--json", "as_json", is_flag=True, help="Print the result as JSON on stdout."
 )
 tolerance_option = click.option(
     "--tolerance",
-    type=float,
+    type=_OptionRange(MIN_REL_LENGTH, MAX_REL_LENGTH),
     default=None,
     help="Relative length tolerance (fraction of the model's bounding-box diagonal).",
 )
@@ -92,6 +104,16 @@ def loaded_assembly(path: str, tol: Tolerance, as_written: bool) -> Assembly:
     return load_assembly(path, tol, settle=not as_written)
 
 
+def assembly_or_polygons(path: str, tol: Tolerance, as_written: bool) -> Any:
+    """A YAML file of 2D polygons (``parts: {name: [[x, y], ...]}``) as a polygon
+    assembly, anything else as :func:`loaded_assembly`."""
+    from assemblykit.blocking.polygons import is_polygon_file, load_polygons
+
+    if is_polygon_file(path):
+        return load_polygons(path)
+    return loaded_assembly(path, tol, as_written)
+
+
 def emit(result: Result, as_json: bool) -> None:
     """Print a result: JSON on stdout, or its rich rendering."""
     if as_json:
@@ -107,7 +129,8 @@ def note(message: str) -> None:
 
 
 def _fail(message: str, code: int) -> None:
-    note(f"assemblykit: {message}")
+    # one line whatever the message holds (parsers' messages may span lines)
+    note(f"assemblykit: {' '.join(message.split())}")
     raise SystemExit(code)
 
 
@@ -201,6 +224,13 @@ def _updater(bar: Any) -> Callable[[str, int, int], None]:
 @assembly_argument
 @click.option("--html", default=None, help="Write a self-contained HTML report here.")
 @click.option("--png", default=None, help="Write a static exploded view (PNG) here.")
+@click.option(
+    "--max-hands",
+    type=click.IntRange(min=2),
+    default=4,
+    show_default=True,
+    help="For parts no two-handed move separates: try up to this many hands.",
+)
 @json_option
 @tolerance_option
 @as_written_option
@@ -209,6 +239,7 @@ def plan_cmd(
     assembly: str,
     html: str | None,
     png: str | None,
+    max_hands: int,
     as_json: bool,
     tolerance: float | None,
     as_written: bool,
@@ -216,15 +247,22 @@ def plan_cmd(
 ) -> None:
     """Disassembly (and assembly) sequence by extended translations (seed 004).
 
-    ASSEMBLY: mesh folder, .yaml manifest, .step or COMPAS .json.
+    ASSEMBLY: mesh folder, .yaml manifest, .step, COMPAS .json, or a YAML file of 2D
+    polygons 'parts: {name: [[x, y], ...]}' (planned in the plane).
     """
     from assemblykit.planning.sequence import plan
 
+    if html is not None:
+        checked_output(html, "--html", HTML_SUFFIXES)
+    if png is not None:
+        checked_output(png, "--png", PNG_SUFFIXES)
     tol = tolerance_from(tolerance)
     with _progress_bar() as bar:
         update = _updater(bar)
-        loaded = loaded_assembly(assembly, tol, as_written)
-        result = plan(loaded, tol=tol, progress=update)
+        loaded = assembly_or_polygons(assembly, tol, as_written)
+        if getattr(loaded, "dimension", 3) == 2 and (html is not None or png is not None):
+            raise InputError("--html and --png draw meshes: not for a 2D polygon assembly")
+        result = plan(loaded, tol=tol, progress=update, max_hands=max_hands)
         if html is not None:
             from assemblykit.viz.viewer import write_report
 
@@ -248,8 +286,17 @@ def plan_cmd(
 @debug_option
 def demo_cmd(out: str, as_json: bool, tolerance: float | None, debug: bool) -> None:
     """Plan the bundled 14-part gearbox and write its HTML report (start here)."""
-    from assemblykit.demo import run_demo
+    from pathlib import Path
 
+    from assemblykit.demo import REPORT_NAME, run_demo
+
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(
+            "is a file; --out names the folder of the report", source=out, where="--out"
+        )
+    if folder.is_dir():
+        checked_output(folder / REPORT_NAME, "--out")
     with _progress_bar() as bar:
         result = run_demo(out, tol=tolerance_from(tolerance), progress=_updater(bar))
     if as_json:
@@ -299,6 +346,7 @@ def batch_cmd(
     """
     from assemblykit.batch import run_batch
 
+    checked_output(out, "--out")
     with _progress_bar() as bar:
         task = bar.add_task("assemblies", total=len(inputs))
         summary = run_batch(
@@ -322,8 +370,7 @@ def _is_task_file(path: str) -> bool:
     ``situations`` (DESIGN.md §5.1); anything else is read as an assembly."""
     from pathlib import Path
 
-    from assemblykit.errors import SchemaError
-    from assemblykit.io.documents import read_yaml
+    from assemblykit.io.documents import read_text, read_yaml
 
     file = Path(path)
     suffix = file.suffix.lower()
@@ -332,9 +379,9 @@ def _is_task_file(path: str) -> bool:
     if suffix not in (".yaml", ".yml", ".json") or not file.is_file():
         return False
     try:
-        data = read_yaml(file.read_text())
-    except (SchemaError, UnicodeDecodeError):
-        return False
+        data = read_yaml(read_text(file))
+    except InputError:
+        return False  # the assembly loaders name the fault
     return isinstance(data, dict) and "situations" in data
 
 
@@ -377,6 +424,8 @@ def motion_cmd(
     """
     from assemblykit.motion.articulation import articulation
 
+    if html is not None:
+        checked_output(html, "--html", HTML_SUFFIXES)
     tol = tolerance_from(tolerance)
     if _is_task_file(assembly):
         if subassembly or html is not None:
@@ -432,6 +481,8 @@ def contacts_cmd(
     """
     from assemblykit.io.assembly import contact_report
 
+    if png is not None:
+        checked_output(png, "--png", PNG_SUFFIXES)
     tol = tolerance_from(tolerance)
     result = contact_report(loaded_assembly(assembly, tol, as_written), tol)
     if png is not None:
@@ -472,17 +523,15 @@ def blocking_cmd(
     polygons 'parts: {name: [[x, y], ...]}'.
     """
     from assemblykit.blocking.ndbg import blocking_graph
-    from assemblykit.blocking.polygons import is_polygon_file, load_polygons
 
-    tol = tolerance_from(tolerance)
-    if is_polygon_file(assembly):
-        model: Any = load_polygons(assembly)
-    else:
-        model = loaded_assembly(assembly, tol, as_written)
-    result = blocking_graph(model, motion, tol=tol)  # type: ignore[arg-type]
     if png is not None:
         if motion == "rigid":
             raise InputError("--png draws the direction sphere: not for --motion rigid")
+        checked_output(png, "--png", PNG_SUFFIXES)
+    tol = tolerance_from(tolerance)
+    model = assembly_or_polygons(assembly, tol, as_written)
+    result = blocking_graph(model, motion, tol=tol)  # type: ignore[arg-type]
+    if png is not None:
         from assemblykit.viz.plots import plot_ndbg
 
         plot_ndbg(result, png)

@@ -26,6 +26,18 @@ DEFAULT_ANGLE = 1e-9
 DEFAULT_MESH_REL_LENGTH = 1e-6
 DEFAULT_MESH_ANGLE = 1e-5
 
+MAX_MAGNITUDE = 1e100
+"""Largest coordinate, length or radius accepted from a file: sums of squares (norms) and
+products of three (volumes) of such numbers stay finite in float64 (at most 1.8e308)."""
+
+MIN_REL_LENGTH = 1e-15
+"""Smallest relative length tolerance a user may ask for: below float64's resolution
+(2.2e-16 relative) no two computed lengths could ever be told equal."""
+
+MAX_REL_LENGTH = 0.1
+"""Largest relative length tolerance a user may ask for: a tenth of the model's size.
+Beyond it whole parts coincide and every answer (contact, blocking, fit) is meaningless."""
+
 
 @dataclass(frozen=True)
 class Tolerance:

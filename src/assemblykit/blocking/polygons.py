@@ -17,13 +17,13 @@ from pathlib import Path
 
 import numpy as np
 import trimesh
-import yaml
 from numpy.typing import NDArray
 from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
-from assemblykit.errors import GeometryError, SchemaError, UnknownNameError
+from assemblykit.errors import GeometryError, InputError, SchemaError, UnknownNameError
 from assemblykit.geometry.contacts import Contact, PlanarPatch
+from assemblykit.io.documents import read_text, read_yaml
 from assemblykit.tolerance import Tolerance, current
 
 
@@ -80,23 +80,35 @@ def _ccw(points: NDArray[np.float64], name: str, source: str | None) -> NDArray[
     return np.asarray(orient(poly, 1.0).exterior.coords, dtype=np.float64)[:-1]
 
 
+def _points(value: object) -> NDArray[np.float64]:
+    """``value`` as an array of numbers, or an empty one when it is not a list of lists
+    of numbers (booleans and strings are not coordinates)."""
+    if not isinstance(value, list) or not all(
+        isinstance(p, list)
+        and all(isinstance(c, int | float) and not isinstance(c, bool) for c in p)
+        for p in value
+    ):
+        return np.zeros(0)
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except ValueError:  # ragged rows
+        return np.zeros(0)
+
+
 def load_polygons(path: str | Path) -> PolygonAssembly:
     """Read ``parts: {name: [[x, y], ...]}`` from a YAML file."""
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as bad:
-        raise GeometryError(f"cannot read polygons: {bad}", source=str(path)) from None
+    data = read_yaml(read_text(path, "polygon file"), str(path))
     if not isinstance(data, dict) or not isinstance(data.get("parts"), dict):
         raise SchemaError(
             "expected a mapping 'parts: {name: [[x, y], ...]}'", source=str(path), where="parts"
         )
     polygons = {}
     for name, pts in data["parts"].items():
-        arr = np.asarray(pts, dtype=np.float64) if isinstance(pts, list) else np.zeros(0)
-        if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3:
+        arr = _points(pts)
+        if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3 or not np.isfinite(arr).all():
             raise SchemaError(
-                "a polygon is a list of at least three [x, y] points",
+                "a polygon is a list of at least three [x, y] points of finite numbers",
                 source=str(path),
                 where=f"parts.{name}",
             )
@@ -173,7 +185,7 @@ def is_polygon_file(path: str | Path) -> bool:
     if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
         return False
     try:
-        data = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError):
-        return False
+        data = read_yaml(read_text(path), str(path))
+    except InputError:
+        return False  # not readable as polygons: the assembly loaders name the fault
     return isinstance(data, dict) and isinstance(data.get("parts"), dict)

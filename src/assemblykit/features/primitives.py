@@ -37,6 +37,7 @@ from assemblykit.algebra import (
     se3,
 )
 from assemblykit.errors import FeatureError, SchemaError
+from assemblykit.tolerance import MAX_MAGNITUDE
 
 Vector = NDArray[np.float64]
 Matrix = NDArray[np.float64]
@@ -67,15 +68,31 @@ def _frozen(array: NDArray[np.float64]) -> NDArray[np.float64]:
     return array
 
 
+def _is_number(value: Any) -> bool:
+    """Whether ``value`` is a real number (``true`` in a file is not the number 1)."""
+    return isinstance(value, int | float | np.floating | np.integer) and not isinstance(
+        value, bool | np.bool_
+    )
+
+
 def _vector(value: Any, field: str, owner: str) -> Vector:
-    try:
-        vec = np.array(value, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        raise FeatureError(f"{field} must be 3 numbers, got {value!r}", where=owner) from None
-    if vec.shape != (3,):
+    """Three finite numbers of magnitude at most ``MAX_MAGNITUDE``: a flat list from a
+    file, or any array of three numbers from code."""
+    if isinstance(value, np.ndarray):
+        numeric = value.size == 3 and value.dtype.kind in "iuf"
+        items = value.reshape(-1).tolist() if numeric else []
+    else:
+        items = list(value) if isinstance(value, list | tuple) else []
+        numeric = len(items) == 3 and all(_is_number(v) for v in items)
+    if not numeric:
         raise FeatureError(f"{field} must be 3 numbers, got {value!r}", where=owner)
+    vec = np.array(items, dtype=np.float64)
     if not np.all(np.isfinite(vec)):
         raise FeatureError(f"{field} must be finite, got {vec.tolist()}", where=owner)
+    if np.any(np.abs(vec) > MAX_MAGNITUDE):
+        raise FeatureError(
+            f"{field} must be at most {MAX_MAGNITUDE:g} in size, got {vec.tolist()}", where=owner
+        )
     return _frozen(vec)
 
 
@@ -88,11 +105,13 @@ def _direction(value: Any, field: str, owner: str) -> Vector:
 
 
 def _positive(value: Any, field: str, owner: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float | np.floating | np.integer):
+    if not _is_number(value):
         raise FeatureError(f"{field} must be a number, got {value!r}", where=owner)
     number = float(value)
     if not (math.isfinite(number) and number > 0):
         raise FeatureError(f"{field} must be a positive number, got {value!r}", where=owner)
+    if number > MAX_MAGNITUDE:
+        raise FeatureError(f"{field} must be at most {MAX_MAGNITUDE:g}, got {value!r}", where=owner)
     return number
 
 
@@ -549,7 +568,7 @@ def feature_from_dict(name: str, data: Mapping[str, Any], where: str | None = No
     if not isinstance(data, Mapping):
         raise SchemaError(f"a feature must be a mapping, got {data!r}", where=where)
     kind = data.get("type")
-    if kind not in FEATURE_TYPES:
+    if not isinstance(kind, str) or kind not in FEATURE_TYPES:
         known = ", ".join(FEATURE_TYPES)
         raise SchemaError(f"unknown feature type {kind!r} (expected one of {known})", where=where)
     cls = FEATURE_TYPES[kind]

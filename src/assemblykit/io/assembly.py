@@ -11,7 +11,6 @@
 
 from __future__ import annotations
 
-import json
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +20,7 @@ from assemblykit.errors import GeometryError, InputError
 from assemblykit.geometry.contacts import Contact
 from assemblykit.geometry.precision import coordinate_precision
 from assemblykit.geometry.recognition import Surface
+from assemblykit.io.documents import read_json, read_text
 from assemblykit.io.meshes import MESH_SUFFIXES, load_manifest, load_mesh_folder, read_mesh
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance
@@ -28,9 +28,9 @@ from assemblykit.tolerance import Tolerance
 
 def _is_manifest_json(path: Path) -> bool:
     try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return False
+        data = read_json(read_text(path), str(path))
+    except InputError:
+        return False  # the COMPAS reader names the fault
     return isinstance(data, dict) and isinstance(data.get("parts"), list)
 
 

@@ -17,7 +17,6 @@ as its measured precision (:func:`assemblykit.geometry.precision.joint_mismatch`
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -27,24 +26,53 @@ import trimesh
 
 from assemblykit.errors import GeometryError, SchemaError
 from assemblykit.geometry.precision import joint_mismatch
+from assemblykit.io.documents import read_json, read_text
 from assemblykit.io.meshes import DEFAULT_UNITS, repaired
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance
 
+DTYPES = frozenset(
+    {
+        "compas_assembly.datastructures/Assembly",
+        "compas.datastructures/Graph",
+        "compas_assembly.datastructures/Block",
+        "compas.datastructures/Mesh",
+    }
+)
+"""The COMPAS types whose payload holds blocks; any other ``dtype`` on the way to a mesh is
+a misspelling or another kind of document, refused rather than read as geometry."""
 
-def _payload(obj: Any) -> Any:
-    """Unwrap COMPAS' ``{dtype, data}`` (COMPAS 2) or ``{dtype, value}`` (COMPAS 1)."""
+
+def _payload(obj: Any, source: str | None = None, where: str | None = None) -> Any:
+    """Unwrap COMPAS' ``{dtype, data}`` (COMPAS 2) or ``{dtype, value}`` (COMPAS 1);
+    :class:`SchemaError` for a ``dtype`` not in :data:`DTYPES`."""
     while isinstance(obj, Mapping) and "dtype" in obj and ("data" in obj or "value" in obj):
+        if not isinstance(obj["dtype"], str) or obj["dtype"] not in DTYPES:
+            raise SchemaError(
+                f"unknown COMPAS type {obj['dtype']!r} "
+                f"(expected one of {', '.join(sorted(DTYPES))})",
+                source=source,
+                where=where,
+            )
         obj = obj["data"] if "data" in obj else obj["value"]
     if isinstance(obj, Mapping) and "vertex" not in obj and "node" not in obj and "data" in obj:
-        return _payload(obj["data"])
+        return _payload(obj["data"], source, where)
     return obj
 
 
-def mesh_from_compas(data: Mapping[str, Any], source: str, where: str) -> trimesh.Trimesh:
+def _coordinate(vertex: Any, axis: str) -> float:
+    """The ``axis`` coordinate of a COMPAS vertex; a ``TypeError`` when it is not a number
+    (``true`` or ``"1"`` are not coordinates; ``float`` would accept both)."""
+    value = vertex[axis]
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise TypeError(f"coordinate {axis} is {value!r}, not a number")
+    return float(value)
+
+
+def mesh_from_compas(data: Any, source: str, where: str) -> trimesh.Trimesh:
     """The triangle mesh of a COMPAS mesh payload (``vertex`` and ``face`` dicts)."""
-    vertices = data.get("vertex")
-    faces = data.get("face")
+    vertices = data.get("vertex") if isinstance(data, Mapping) else None
+    faces = data.get("face") if isinstance(data, Mapping) else None
     if not isinstance(vertices, Mapping) or not isinstance(faces, Mapping) or not faces:
         raise SchemaError(
             "a block mesh needs 'vertex' and 'face' dicts", source=source, where=where
@@ -52,7 +80,7 @@ def mesh_from_compas(data: Mapping[str, Any], source: str, where: str) -> trimes
     keys = {str(k): i for i, k in enumerate(vertices)}
     try:
         xyz = np.array(
-            [[float(v["x"]), float(v["y"]), float(v["z"])] for v in vertices.values()],
+            [[_coordinate(v, axis) for axis in "xyz"] for v in vertices.values()],
             dtype=np.float64,
         )
         triangles = [
@@ -62,6 +90,8 @@ def mesh_from_compas(data: Mapping[str, Any], source: str, where: str) -> trimes
         ]
     except (KeyError, TypeError, ValueError) as bad:
         raise SchemaError(f"malformed vertex or face: {bad}", source=source, where=where) from None
+    if not triangles:
+        raise SchemaError("no face has three vertices", source=source, where=where)
     mesh = trimesh.Trimesh(vertices=xyz, faces=np.array(triangles, dtype=np.int64), process=False)
     return repaired(mesh, f"{source}: {where}")
 
@@ -69,9 +99,13 @@ def mesh_from_compas(data: Mapping[str, Any], source: str, where: str) -> trimes
 def _blocks(data: Any, source: str) -> list[tuple[str, Any, str]]:
     """``(name, mesh payload, field path)`` for every block in a COMPAS document."""
     if isinstance(data, list):
-        return [(str(i), _payload(item), f"[{i}]") for i, item in enumerate(data)]
-    body = _payload(data)
-    graph = _payload(body.get("graph")) if isinstance(body, Mapping) and "graph" in body else body
+        return [(str(i), _payload(item, source, f"[{i}]"), f"[{i}]") for i, item in enumerate(data)]
+    body = _payload(data, source)
+    graph = (
+        _payload(body.get("graph"), source, "graph")
+        if isinstance(body, Mapping) and "graph" in body
+        else body
+    )
     nodes = graph.get("node") if isinstance(graph, Mapping) else None
     if not isinstance(nodes, Mapping):
         raise SchemaError("neither a COMPAS assembly nor a list of meshes", source=source)
@@ -80,7 +114,8 @@ def _blocks(data: Any, source: str) -> list[tuple[str, Any, str]]:
         block = node.get("block") if isinstance(node, Mapping) else None
         if block is None:
             raise SchemaError("node has no block", source=source, where=f"node.{key}")
-        blocks.append((str(key), _payload(block), f"node.{key}.block"))
+        where = f"node.{key}.block"
+        blocks.append((str(key), _payload(block, source, where), where))
     return blocks
 
 
@@ -88,10 +123,7 @@ def load_compas(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     """An assembly of the blocks of a COMPAS JSON file (module docstring)."""
     path = Path(path)
     source = str(path)
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError) as bad:
-        raise SchemaError(f"cannot read JSON: {bad}", source=source) from None
+    data = read_json(read_text(path, "COMPAS file"), source)
     parts = [
         Part(name, mesh_from_compas(mesh, source, where), source=source)
         for name, mesh, where in _blocks(data, source)

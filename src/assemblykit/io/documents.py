@@ -5,17 +5,36 @@ file in 0.04 s, against 0.6 s for PyYAML even on libyaml's C parser). Text it re
 is read again by PyYAML (through libyaml when PyYAML was built with it), whose errors
 give the line and column of the fault and which, with the loader below, rejects a key
 given twice in one mapping (PyYAML alone keeps the last one silently).
+
+Documents are refused, with :class:`SchemaError`, before anything walks them when they
+nest deeper than :data:`MAX_DEPTH` or, through YAML aliases, expand to more than
+:data:`MAX_NODES` values (a "billion laughs" file is a few hundred bytes that expands to
+10^9 strings). Files that are not UTF-8 text are refused by :func:`read_text`.
 """
 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 from typing import Any
 
 import yaml
 import yaml_rs
 
-from assemblykit.errors import SchemaError
+from assemblykit.errors import InputError, SchemaError
+
+MAX_DEPTH = 64
+"""Deepest nesting of lists and mappings accepted in a document. The deepest file format
+here (a 4x4 pose in a part of a manifest) nests 5 levels; recursive code downstream
+(pydantic, the report writer) would exhaust Python's stack near 1,000."""
+
+MAX_NODES = 1_000_000
+"""Most values a document may hold once its YAML aliases are expanded: ten times the
+largest bundled example, and small enough to count in well under a second."""
+
+_ALIAS_LIMITS = yaml_rs.AliasLimits(
+    max_total_replayed_events=MAX_NODES, max_replay_stack_depth=MAX_DEPTH
+)
 
 _BaseLoader: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
@@ -49,21 +68,81 @@ class _UniqueKeyLoader(_BaseLoader):  # type: ignore[misc, valid-type]
         return super().construct_mapping(node, deep=deep)
 
 
+def read_text(path: str | Path, what: str = "file") -> str:
+    """The text of ``path`` read as UTF-8; :class:`InputError` naming the file when it
+    cannot be read or is not UTF-8 text (binary, Latin-1, UTF-16). ``what`` names the
+    file's role in the message (``task file``, ``manifest``)."""
+    source = str(path)
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except UnicodeDecodeError as bad:
+        raise InputError(
+            f"the {what} is not UTF-8 text (byte {bad.start}); save it as UTF-8",
+            source=source,
+        ) from None
+    except OSError as error:
+        reason = error.strerror or type(error).__name__
+        raise InputError(f"cannot read the {what}: {reason}", source=source) from None
+
+
+def checked_shape(data: Any, source: str | None = None) -> Any:
+    """``data`` when it nests at most :data:`MAX_DEPTH` levels and holds at most
+    :data:`MAX_NODES` values counting every alias again; else :class:`SchemaError`.
+
+    The walk uses its own stack (no recursion) and stops at the first limit exceeded, so
+    an alias bomb costs at most :data:`MAX_NODES` steps."""
+    stack: list[tuple[Any, int]] = [(data, 0)]
+    count = 0
+    while stack:
+        value, depth = stack.pop()
+        count += 1
+        if count > MAX_NODES:
+            raise SchemaError(
+                f"document expands to more than {MAX_NODES} values (YAML aliases?)",
+                source=source,
+            )
+        if isinstance(value, dict | list):
+            if depth >= MAX_DEPTH:
+                raise SchemaError(f"nested deeper than {MAX_DEPTH} levels", source=source)
+            children = value.values() if isinstance(value, dict) else value
+            stack.extend((child, depth + 1) for child in children)
+    return data
+
+
 def read_yaml(text: str, source: str | None = None) -> Any:
-    """Parse YAML text; :class:`SchemaError` with the line for malformed text or a
-    duplicate key."""
+    """Parse YAML text; :class:`SchemaError` with the line for malformed text, a
+    duplicate key, or a document too deep or too large (module docstring)."""
     try:
-        return yaml_rs.loads(text, parse_datetime=False)
-    except yaml_rs.YAMLDecodeError:
-        pass  # PyYAML below names the line and column of the fault
+        return checked_shape(
+            yaml_rs.loads(text, parse_datetime=False, alias_limits=_ALIAS_LIMITS), source
+        )
+    except yaml_rs.YAMLDecodeError as error:
+        message = str(error)
+        if "recursion limit exceeded" in message:
+            raise SchemaError(f"nested deeper than {MAX_DEPTH} levels", source=source) from None
+        if "alias replay limit exceeded" in message:
+            # PyYAML would build the same bomb: refuse it here
+            raise SchemaError(
+                f"YAML aliases expand to more than {MAX_NODES} values", source=source
+            ) from None
+    except RecursionError:
+        raise SchemaError(f"nested deeper than {MAX_DEPTH} levels", source=source) from None
+    # PyYAML below names the line and column of the fault
     try:
-        return yaml.load(text, Loader=_UniqueKeyLoader)
+        return checked_shape(yaml.load(text, Loader=_UniqueKeyLoader), source)
+    except RecursionError:
+        raise SchemaError(f"nested deeper than {MAX_DEPTH} levels", source=source) from None
     except SchemaError as error:
         raise SchemaError(error.detail, source=source, where=error.where) from None
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         where = None if mark is None else f"line {mark.line + 1}, column {mark.column + 1}"
-        problem = getattr(error, "problem", None) or str(error)
+        if isinstance(error, yaml.reader.ReaderError):  # a character YAML does not allow
+            where = f"line {text.count(chr(10), 0, error.position) + 1}"
+            problem = f"character {error.character!r} is not allowed"
+        else:
+            # PyYAML's text spans lines; the place is already in ``where``
+            problem = getattr(error, "problem", None) or str(error).splitlines()[0]
         raise SchemaError(f"malformed YAML: {problem}", source=source, where=where) from None
 
 
@@ -80,7 +159,9 @@ def read_json(text: str, source: str | None = None) -> Any:
         return out
 
     try:
-        return json.loads(text, object_pairs_hook=unique)
+        return checked_shape(json.loads(text, object_pairs_hook=unique), source)
+    except RecursionError:
+        raise SchemaError(f"nested deeper than {MAX_DEPTH} levels", source=source) from None
     except json.JSONDecodeError as error:
         raise SchemaError(
             f"malformed JSON: {error.msg}",

@@ -22,14 +22,15 @@ rounding allows: the settled poses are then as true to the file as the written o
 Otherwise the poses stay as written. Each part records its ``settled`` translation.
 
 Every mesh is checked and repaired with trimesh (merged vertices, degenerate and
-duplicate faces dropped, normals made consistent and outward, holes filled); a mesh
-that is empty, has non-finite vertices or stays open is rejected with a
-:class:`GeometryError` naming the file.
+duplicate faces dropped, normals made consistent and outward, holes filled); solids that
+meet along an edge or at a vertex only (voxel pieces) get their own vertices there, so
+each is closed; a mesh that is empty, has non-finite vertices or stays open is rejected
+with a :class:`GeometryError` naming the file.
 """
 
 from __future__ import annotations
 
-import json
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -49,12 +50,16 @@ from assemblykit.geometry.precision import (
 )
 from assemblykit.geometry.settling import settle as settle_parts
 from assemblykit.geometry.solids import placed
-from assemblykit.io.documents import read_yaml
+from assemblykit.io.documents import read_json, read_text, read_yaml
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance, current
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".glb")
 DEFAULT_UNITS = "mm"
+
+MAX_MESH_COORDINATE = 1e10
+"""Largest mesh coordinate accepted: trimesh merges vertices by hashing coordinates scaled
+by 1e8 as 64-bit integers (at most 9.2e18), which overflows beyond about 9e10."""
 
 
 def read_mesh(path: str | Path) -> trimesh.Trimesh:
@@ -81,6 +86,13 @@ def repaired(mesh: trimesh.Trimesh, source: str | None = None) -> trimesh.Trimes
     if not np.all(np.isfinite(vertices)):
         bad = int(np.count_nonzero(~np.all(np.isfinite(vertices), axis=1)))
         raise GeometryError(f"{bad} vertices are NaN or infinite", source=source)
+    if np.any(np.abs(vertices) > MAX_MESH_COORDINATE):
+        raise GeometryError(f"coordinates beyond {MAX_MESH_COORDINATE:g}", source=source)
+    faces = np.asarray(mesh.faces)
+    if vertices.ndim != 2 or vertices.shape[1] != 3 or faces.ndim != 2 or faces.shape[1] != 3:
+        raise GeometryError("faces must be triangles of 3D vertices", source=source)
+    if faces.size and (faces.min() < 0 or faces.max() >= len(vertices)):
+        raise GeometryError("a face refers to a vertex that does not exist", source=source)
     fixed = trimesh.Trimesh(vertices=vertices, faces=mesh.faces, process=True)
     fixed.update_faces(fixed.nondegenerate_faces())
     fixed.update_faces(fixed.unique_faces())
@@ -88,11 +100,60 @@ def repaired(mesh: trimesh.Trimesh, source: str | None = None) -> trimesh.Trimes
     if len(fixed.faces) == 0:
         raise GeometryError("all triangles are degenerate", source=source)
     if not fixed.is_watertight:
+        fixed = _split_at_shared_edges(fixed)
+    if not fixed.is_watertight:
         trimesh.repair.fill_holes(fixed)
     if not fixed.is_watertight:
         raise GeometryError("mesh is not closed (watertight) and cannot be repaired", source=source)
-    trimesh.repair.fix_normals(fixed)
+    with np.errstate(invalid="ignore", divide="ignore"):  # trimesh divides by the volume
+        trimesh.repair.fix_normals(fixed)
+        volume = float(fixed.volume)
+    # a closed but flat surface (coplanar vertices) encloses nothing: contacts, blocking
+    # and interference all divide by or compare volumes (measured once the normals
+    # agree, so that no two pieces cancel)
+    scale = float(np.linalg.norm(fixed.extents))
+    if abs(volume) <= current().mesh_rel_length * scale**3:
+        raise GeometryError("mesh encloses no volume (flat)", source=source)
     return fixed
+
+
+def _split_at_shared_edges(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh`` with its vertices duplicated where closed solids meet along an edge or at
+    a vertex only (voxel pieces whose cubes touch along an edge: four faces on one edge),
+    when that makes every solid watertight; else ``mesh`` unchanged.
+
+    Faces are grouped across the edges that exactly two faces share; each group becomes
+    a body with vertices of its own, so an edge where two solids meet counts once per
+    solid. The union of solids touching along a line is still one solid (its volume is
+    the sum), so the part keeps its mesh as one."""
+    edges = mesh.edges_sorted
+    _, inverse, counts = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    if not np.any(counts > 2):
+        return mesh  # an open mesh, not solids meeting along an edge: nothing to split
+    manifold = counts[inverse] == 2
+    # faces sharing a manifold edge are neighbours (edges_face gives each edge's face)
+    order = np.argsort(inverse, kind="stable")
+    faces_of = mesh.edges_face[order]
+    groups = inverse[order]
+    keep = manifold[order]
+    pairs = [
+        (int(faces_of[k]), int(faces_of[k + 1]))
+        for k in range(len(order) - 1)
+        if keep[k] and groups[k] == groups[k + 1]
+    ]
+    labels = trimesh.graph.connected_component_labels(pairs, node_count=len(mesh.faces))
+    bodies = [
+        mesh.submesh([np.flatnonzero(labels == label)], append=True, only_watertight=False)
+        for label in np.unique(labels)
+    ]
+    if not all(body.is_watertight for body in bodies):
+        return mesh
+    vertices = np.vstack([body.vertices for body in bodies])
+    offsets = np.cumsum([0] + [len(body.vertices) for body in bodies[:-1]])
+    faces = np.vstack([body.faces + offset for body, offset in zip(bodies, offsets, strict=True)])
+    # no processing: merging the duplicated vertices would join the solids again
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
 
 
 def pose_from_state(state: Sequence[float]) -> NDArray[np.float64]:
@@ -139,7 +200,11 @@ def load_mesh_folder(
     ``final_state`` poses of ``config.json`` when present, settled if ``settle``
     (module docstring)."""
     folder = Path(folder)
-    files = sorted(f for f in folder.iterdir() if f.suffix.lower() in MESH_SUFFIXES)
+    try:
+        files = sorted(f for f in folder.iterdir() if f.suffix.lower() in MESH_SUFFIXES)
+    except OSError as error:
+        reason = error.strerror or type(error).__name__
+        raise GeometryError(f"cannot list the folder: {reason}", source=str(folder)) from None
     if not files:
         raise GeometryError(
             f"no mesh files ({', '.join(MESH_SUFFIXES)}) in folder", source=str(folder)
@@ -192,10 +257,7 @@ def _final_states(config: Path) -> dict[str, list[float]]:
     if not config.is_file():
         return {}
     source = str(config)
-    try:
-        data = json.loads(config.read_text())
-    except (OSError, ValueError) as bad:
-        raise SchemaError(f"cannot read JSON: {bad}", source=source) from None
+    data = read_json(read_text(config, "config.json"), source)
     if not isinstance(data, dict):
         raise SchemaError("expected an object keyed by part name", source=source)
     states = {}
@@ -205,7 +267,7 @@ def _final_states(config: Path) -> dict[str, list[float]]:
         state = entry["final_state"]
         if not (isinstance(state, list) and len(state) == 6 and _numbers(state)):
             raise SchemaError(
-                "final_state must be 6 numbers [x, y, z, rx, ry, rz]",
+                "final_state must be 6 finite numbers [x, y, z, rx, ry, rz]",
                 source=source,
                 where=f"{name}.final_state",
             )
@@ -214,7 +276,10 @@ def _final_states(config: Path) -> dict[str, list[float]]:
 
 
 def _numbers(values: Sequence[Any]) -> bool:
-    return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
+    """Whether every value is a finite number (NaN or infinity would place a part nowhere)."""
+    return all(
+        isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in values
+    )
 
 
 def pose_from_spec(
@@ -233,7 +298,9 @@ def pose_from_spec(
         for key in ("translation", "rotation_xyz_deg"):
             value = spec.get(key, [0.0, 0.0, 0.0])
             if not (isinstance(value, list) and len(value) == 3 and _numbers(value)):
-                raise SchemaError("expected 3 numbers", source=source, where=f"{where}.{key}")
+                raise SchemaError(
+                    "expected 3 finite numbers", source=source, where=f"{where}.{key}"
+                )
         rotation = Rotation.from_euler("xyz", spec.get("rotation_xyz_deg", [0, 0, 0]), degrees=True)
         pose[:3, :3] = rotation.as_matrix()
         pose[:3, 3] = spec.get("translation", [0.0, 0.0, 0.0])
@@ -244,7 +311,7 @@ def pose_from_spec(
             "expected a 4x4 matrix or {translation, rotation_xyz_deg}", source=source, where=where
         )
     if not all(_numbers(r) for r in rows):
-        raise SchemaError("matrix entries must be numbers", source=source, where=where)
+        raise SchemaError("matrix entries must be finite numbers", source=source, where=where)
     pose = np.array(rows, dtype=np.float64)
     rotation = pose[:3, :3]
     rigid = np.allclose(rotation.T @ rotation, np.eye(3), atol=tol.mesh_angle, rtol=0)
@@ -257,11 +324,7 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     """An assembly from a YAML/JSON manifest ``{units?, parts: [{name, mesh, pose?}]}``."""
     path = Path(path)
     source = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as bad:
-        raise SchemaError(f"cannot read manifest: {bad}", source=source) from None
-    data = read_yaml(text, source)
+    data = read_yaml(read_text(path, "manifest"), source)
     if not isinstance(data, dict) or not isinstance(data.get("parts"), list) or not data["parts"]:
         raise SchemaError("expected a non-empty list", source=source, where="parts")
     units = data.get("units")

@@ -30,13 +30,20 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 import trimesh
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    model_validator,
+)
 
 from assemblykit.algebra import se3
 from assemblykit.errors import GeometryError, InputError, SchemaError, UnknownNameError
 from assemblykit.features import Feature, feature_from_dict, parse_angle
 from assemblykit.geometry.solids import Box, Cylinder, Primitive, generated_mesh
-from assemblykit.io.documents import read_json, read_yaml
+from assemblykit.io.documents import read_json, read_text, read_yaml
 from assemblykit.io.meshes import read_mesh
 from assemblykit.io.spec import UNITS, Name, schema_error, with_source
 from assemblykit.mating.problem import (
@@ -47,9 +54,25 @@ from assemblykit.mating.problem import (
     mating_body,
     problem_diagonal,
 )
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import MAX_MAGNITUDE, Tolerance, current
 
-Vector3 = tuple[float, float, float]
+
+def _not_bool(value: Any) -> Any:
+    """Refuse ``true``/``false`` where a number is expected (pydantic reads them as 1/0)."""
+    if isinstance(value, bool):
+        raise ValueError("expected a number, got a boolean")
+    return value
+
+
+Number = Annotated[
+    float,
+    BeforeValidator(_not_bool),
+    Field(allow_inf_nan=False, ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE),
+]
+"""A finite coordinate or length of magnitude at most ``MAX_MAGNITUDE``."""
+
+Length = Annotated[Number, Field(gt=0)]
+Vector3 = tuple[Number, Number, Number]
 
 
 class _Model(BaseModel):
@@ -68,8 +91,8 @@ class CylinderModel(_Model):
 
     point: Vector3
     axis: Vector3
-    radius: Annotated[float, Field(gt=0)]
-    height: Annotated[float, Field(gt=0)]
+    radius: Length
+    height: Length
 
 
 class PrimitiveModel(_Model):
@@ -105,7 +128,7 @@ class RotationModel(_Model):
 
     point: Vector3 = (0.0, 0.0, 0.0)
     axis: Vector3
-    angle: float | str
+    angle: Number | str
 
 
 class BodyModel(_Model):
@@ -129,10 +152,7 @@ class ProblemModel(_Model):
 def load_problem(path: str | Path, tol: Tolerance | None = None) -> MatingProblem:
     """Read and validate a mating problem (``.yaml``, ``.yml`` or ``.json``)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise InputError(f"cannot read the problem: {error.strerror}", source=str(path)) from None
+    text = read_text(path, "problem")
     suffix = path.suffix.lower()
     if suffix in (".yaml", ".yml"):
         data = read_yaml(text, path.name)

@@ -20,7 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, StrictBool, StringConstraints
 
 from assemblykit.errors import InputError, SchemaError
 from assemblykit.features.primitives import FEATURE_TYPES, Feature, feature_from_dict, parse_angle
-from assemblykit.io.documents import read_json, read_yaml
+from assemblykit.io.documents import read_json, read_text, read_yaml
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Action, Situation, Task
@@ -66,10 +66,7 @@ def load_task(path: str | Path) -> Task:
     """Read and validate a task file: ``.yaml``/``.yml``, ``.json`` or ``.rapt``."""
     path = Path(path)
     source = path.name
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise InputError(f"cannot read the task file: {error.strerror}", source=str(path)) from None
+    text = read_text(path, "task file")
     suffix = path.suffix.lower()
     if suffix == ".rapt":
         from assemblykit.io.rapt import parse_rapt

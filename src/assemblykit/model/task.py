@@ -211,6 +211,15 @@ class Task:
                 source=self.source,
                 where=where,
             )
+        bodies = [ref.body for ref in relation.refs]
+        if len(set(bodies)) < len(bodies):
+            # a relation constrains the relative pose of two bodies; a body's pose
+            # relative to itself is the identity, so such a relation is a slip
+            raise SchemaError(
+                f"{relation.kind} relates body {bodies[0]!r} to itself (name two bodies)",
+                source=self.source,
+                where=where,
+            )
         try:
             check_relation(relation, *features)
         except (FeatureError, SchemaError) as error:

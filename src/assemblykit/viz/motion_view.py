@@ -18,6 +18,7 @@ import plotly.graph_objects as go
 from numpy.typing import NDArray
 
 from assemblykit.algebra import se3
+from assemblykit.io.outputs import atomic_output
 from assemblykit.model.assembly import Assembly
 from assemblykit.motion.freedom import Motion, MotionReport
 from assemblykit.viz.viewer import part_colors
@@ -149,7 +150,9 @@ def motion_figure(assembly: Assembly, report: MotionReport) -> go.Figure:
 def write_motion_html(assembly: Assembly, report: MotionReport, path: str | Path) -> Path:
     """Write the self-contained HTML view to ``path`` and return it."""
     path = Path(path)
-    motion_figure(assembly, report).write_html(path, include_plotlyjs=True, full_html=True)
+    figure = motion_figure(assembly, report)
+    with atomic_output(path) as temporary:
+        figure.write_html(temporary, include_plotlyjs=True, full_html=True)
     return path
 
 
@@ -199,5 +202,6 @@ def write_motion_png(
     source = Path(assembly.source).name if assembly.source else "the assembly"
     ax.set_title(f"Motion of each part of {source}")
     path = Path(path)
-    figure.savefig(path, dpi=dpi, bbox_inches="tight")
+    with atomic_output(path) as temporary:
+        figure.savefig(temporary, dpi=dpi, bbox_inches="tight")
     return path

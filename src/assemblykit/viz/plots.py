@@ -17,6 +17,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+from assemblykit.io.outputs import atomic_output
+
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
@@ -27,8 +29,11 @@ if TYPE_CHECKING:
 def _save_png(figure: Figure, path: str | Path, dpi: int) -> Path:
     """Write ``figure`` as a PNG cropped to its content, close it and return the path."""
     path = Path(path)
-    figure.savefig(path, dpi=dpi, bbox_inches="tight")
-    plt.close(figure)
+    try:
+        with atomic_output(path) as temporary:
+            figure.savefig(temporary, dpi=dpi, bbox_inches="tight")
+    finally:
+        plt.close(figure)
     return path
 
 
@@ -101,8 +106,11 @@ def exploded_view_png(assembly: Assembly, plan: Plan, path: str | Path, *, dpi: 
         axes.legend(loc="upper left", fontsize="small")
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(target, dpi=dpi)
-    plt.close(figure)
+    try:
+        with atomic_output(target) as temporary:
+            figure.savefig(temporary, dpi=dpi)
+    finally:
+        plt.close(figure)
     return target
 
 

@@ -19,6 +19,7 @@ import numpy as np
 import plotly.graph_objects as go
 from plotly.colors import qualitative
 
+from assemblykit.io.outputs import atomic_output
 from assemblykit.planning.sequence import format_direction
 
 if TYPE_CHECKING:
@@ -250,5 +251,7 @@ def write_report(
     """Write :func:`report_html` to ``path`` (UTF-8) and return the path."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    target.write_text(report_html(assembly, plan, title=title, extra=extra), encoding="utf-8")
+    page = report_html(assembly, plan, title=title, extra=extra)
+    with atomic_output(target) as temporary:
+        temporary.write_text(page, encoding="utf-8")
     return target
