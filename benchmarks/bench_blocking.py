@@ -232,34 +232,13 @@ def bench_rigid() -> None:
 
 def bench_queries() -> None:
     """Query times (Γ_e) on guillotine packings of n boxes."""
-    import trimesh
-
     from assemblykit.blocking.queries import can_extract, parts_to_remove_before
-    from assemblykit.model.assembly import Assembly, Part
+    from assemblykit.model.packings import guillotine_packing
     from assemblykit.planning.sequence import separable_by_translations
 
     print("\nqueries on box packings (CPU seconds)")
     for n in (20, 50, 100):
-        rng = np.random.default_rng(n)
-        cells = [(np.zeros(3), np.full(3, 10.0))]
-        while len(cells) < n:
-            lo, hi = cells.pop(int(np.argmax([np.prod(h - lo) for lo, h in cells])))
-            axis = int(np.argmax((hi - lo) * rng.uniform(0.5, 1.0, 3)))
-            cut = lo[axis] + (hi[axis] - lo[axis]) * rng.uniform(0.3, 0.7)
-            upper, lower = hi.copy(), lo.copy()
-            upper[axis], lower[axis] = cut, cut
-            cells += [(lo, upper), (lower, hi)]
-        parts = [
-            Part(
-                f"b{k}",
-                trimesh.creation.box(
-                    extents=hi - lo,
-                    transform=trimesh.transformations.translation_matrix((lo + hi) / 2),
-                ),
-            )
-            for k, (lo, hi) in enumerate(cells)
-        ]
-        asm = Assembly(parts)
+        asm = guillotine_packing(n, seed=n)
         sep, _, t_sep = timed(separable_by_translations, asm, repeats=1)
         _, _, t_can = timed(can_extract, asm, ["b0"], repeats=1)
         _, _, t_before = timed(parts_to_remove_before, asm, "b0", repeats=1)

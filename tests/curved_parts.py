@@ -11,6 +11,7 @@ import trimesh
 
 import assemblykit
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.packings import box_mesh as box
 
 BALL_JOINT = Path(assemblykit.__file__).parent / "examples" / "motion" / "ball_joint"
 RADIUS = 1.0
@@ -23,13 +24,6 @@ def rod(length: float = ROD_LENGTH) -> trimesh.Trimesh:
     mesh = trimesh.creation.cylinder(radius=RADIUS, height=length, sections=SECTIONS)
     mesh.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [1.0, 0.0, 0.0]))
     return mesh
-
-
-def box(lo: list[float], hi: list[float]) -> trimesh.Trimesh:
-    lo_, hi_ = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
-    return trimesh.creation.box(
-        extents=hi_ - lo_, transform=trimesh.transformations.translation_matrix((lo_ + hi_) / 2)
-    )
 
 
 def rod_in_groove(through: bool) -> Assembly:

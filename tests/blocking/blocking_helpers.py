@@ -56,13 +56,6 @@ def cylinder(axis, inner: str) -> CurvedPatch:
     )
 
 
-def box(lo, hi) -> trimesh.Trimesh:
-    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
-    return trimesh.creation.box(
-        extents=hi - lo, transform=trimesh.transformations.translation_matrix((lo + hi) / 2)
-    )
-
-
 def mesh_assembly(meshes: dict[str, trimesh.Trimesh]) -> Assembly:
     return Assembly([Part(name, mesh) for name, mesh in meshes.items()])
 

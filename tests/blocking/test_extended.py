@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from blocking_helpers import box, mesh_assembly
+from blocking_helpers import mesh_assembly
 
 from assemblykit.blocking.extended import extended_dbg, extended_free, obstacles
 from assemblykit.blocking.free_cones import exact_free_directions
@@ -15,6 +15,7 @@ from assemblykit.blocking.ndbg import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.io.assembly import load_assembly
+from assemblykit.model.packings import box_mesh as box
 from datasets import dataset
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import trimesh
-from blocking_helpers import ContactAssembly, box, cylinder, mesh_assembly, square
+from blocking_helpers import ContactAssembly, cylinder, mesh_assembly, square
 from test_extended import ring
 
 from assemblykit.blocking.extended import extended_dbg, extended_free
@@ -19,6 +19,8 @@ from assemblykit.blocking.queries import (
 )
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import Contact
+from assemblykit.model.packings import box_mesh as box
+from assemblykit.model.packings import guillotine_packing
 from assemblykit.planning.sequence import plan, separable_by_translations
 
 GAP = 0.01
@@ -142,20 +144,6 @@ def test_nested_cups_need_only_the_lid_removed_over_all_directions():
     assert separable_by_translations(asm)
 
 
-def box_packing(n: int, seed: int) -> object:
-    """``n`` touching boxes: a 10-cube cut at random (guillotine cuts, largest first)."""
-    rng = np.random.default_rng(seed)
-    cells = [(np.zeros(3), np.full(3, 10.0))]
-    while len(cells) < n:
-        lo, hi = cells.pop(int(np.argmax([np.prod(h - lo) for lo, h in cells])))
-        axis = int(np.argmax((hi - lo) * rng.uniform(0.5, 1.0, 3)))
-        cut = lo[axis] + (hi[axis] - lo[axis]) * rng.uniform(0.3, 0.7)
-        upper, lower = hi.copy(), lo.copy()
-        upper[axis], lower[axis] = cut, cut
-        cells += [(lo, upper), (lower, hi)]
-    return mesh_assembly({f"b{k}": box(lo, hi) for k, (lo, hi) in enumerate(cells)})
-
-
 def swept_free(asm, moving, rest, direction, threshold: float) -> bool:
     """Independent sweep (manifold3d): the moving parts translated in steps of a quarter
     of their smallest extent along ``direction`` until past the bounding box never share
@@ -187,7 +175,7 @@ def swept_free(asm, moving, rest, direction, threshold: float) -> bool:
 
 @pytest.mark.parametrize(("n", "seed"), [(20, 1), (35, 2), (50, 3)])
 def test_box_packings_plans_and_queries_agree(n, seed):
-    asm = box_packing(n, seed)
+    asm = guillotine_packing(n, seed)
     tol = asm.tolerance()
     result = plan(asm, max_and_or_parts=0)
     assert result.feasible == separable_by_translations(asm)

@@ -4,18 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import trimesh
 
 from assemblykit.errors import UnknownNameError
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.packings import box_mesh as box
 from assemblykit.tolerance import Tolerance, using
-
-
-def box(lo, hi) -> trimesh.Trimesh:
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    return trimesh.creation.box(
-        extents=hi - lo, transform=trimesh.transformations.translation_matrix((lo + hi) / 2)
-    )
 
 
 @pytest.fixture
