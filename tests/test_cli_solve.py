@@ -285,3 +285,80 @@ def test_explain_text_says_where_a_merged_body_ended(capsys):
     text = capsys.readouterr().out
     assert "plate@lifted fixed relative to" in text or "fixed relative to plate@lifted" in text
     assert "offset [0.0, 0.0, 30.0]" in text or "offset [0.0, 0.0, -30.0]" in text
+
+
+V_GROOVE = """\
+# a bar in a 120-degree V-groove, the groove's normals typed with 6-decimal cosines
+units: mm
+bodies:
+  block:
+    fixed: true
+    features:
+      left:  {type: plane, point: [-5, 0, 0], normal: [0.866025, 0, 0.5]}
+      right: {type: plane, point: [5, 0, 0], normal: [-0.866025, 0, 0.5]}
+  bar:
+    features:
+      a: {type: plane, point: [-5, 0, 0], normal: [-0.8660254037844386, 0, -0.5]}
+      b: {type: plane, point: [5, 0, 0], normal: [0.8660254037844386, 0, -0.5]}
+situations:
+  - name: s1
+    relations:
+      - [against, bar.a, block.left]
+      - [against, bar.b, block.right]
+"""
+
+
+def groove_json(tmp_path: Path, capsys, *extra: str) -> dict:
+    path = tmp_path / "groove.yaml"
+    path.write_text(V_GROOVE)
+    assert run(["solve", str(path), "--json", *extra]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+@needs_engine
+def test_rounded_v_groove_is_prismatic_once_the_tolerance_covers_its_angle(tmp_path, capsys):
+    # the typed normals are 120° - 4.04e-7 rad apart (by hand: acos of (1/4 - c²)/(1/4 + c²))
+    strict = groove_json(tmp_path, capsys)
+    assert strict["status"] == "inconsistent"
+    (conflict,) = strict["conflicts"]
+    assert conflict["kind"] == "angle"
+    assert conflict["value"] == pytest.approx(4.0378e-7, rel=1e-4)
+    assert conflict["needed_tolerance"] == 4.1e-7
+    assert strict["suggested_tolerance"] == 4.1e-7
+    loose = groove_json(tmp_path, capsys, "--tolerance", "1e-6")
+    assert loose["status"] == "underconstrained"
+    bar = loose["bodies"]["bar@s1"]
+    assert (bar["dof"], bar["motion"]) == (1, "prismatic")
+    assert "suggested_tolerance" not in loose
+    # --tolerance alone had no effect on angles before: now an explicit angle overrides it
+    held = groove_json(tmp_path, capsys, "--tolerance", "1e-6", "--angle-tolerance", "1e-9")
+    assert held["status"] == "inconsistent"
+    angle_only = groove_json(tmp_path, capsys, "--angle-tolerance", "1e-6")
+    assert angle_only["bodies"]["bar@s1"]["motion"] == "prismatic"
+
+
+@needs_engine
+def test_the_table_says_how_far_to_loosen_the_tolerance(tmp_path, capsys):
+    path = tmp_path / "groove.yaml"
+    path.write_text(V_GROOVE)
+    assert run(["solve", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "nearly consistent: loosen the tolerance to 4.1e-07 (--tolerance 4.1e-07)" in out
+
+
+@needs_engine
+def test_motion_of_a_task_takes_the_angle_tolerance(capsys):
+    task = str(EXAMPLES / "w4_pin.yaml")
+    assert run(["motion", task, "--json", "--tolerance", "1e-6", "--angle-tolerance", "1e-6"]) == 0
+    assert json.loads(capsys.readouterr().out)["parts"]
+
+
+@pytest.mark.parametrize("value", ["abc", "0", "-1", "1", "nan"])
+@pytest.mark.parametrize("option", ["--tolerance", "--angle-tolerance"])
+@pytest.mark.parametrize("command", ["solve", "motion"])
+def test_a_bad_tolerance_exits_2_naming_the_option(command, option, value, capsys):
+    assert run([command, str(EXAMPLES / "w4_pin.yaml"), option, value]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    (line,) = captured.err.splitlines()
+    assert line.startswith(f"assemblykit: {option}: ")

@@ -3,6 +3,20 @@
 * **Lengths** are compared relative to the model's size: ``length = rel_length x scale``
   where ``scale`` is the bounding-box diagonal of the model (1 when unknown).
 * **Angles** are compared absolutely, in radians.
+* **One knob, both kinds**: a relative length error ``e`` over the model's size turns a
+  direction by about ``e`` radians, so when only the relative length tolerance is given
+  (``--tolerance``) the angle tolerance follows it (``angle = rel_length``); an explicit
+  angle tolerance (``--angle-tolerance``) overrides that (:meth:`Tolerance.relative`).
+* **Mixed residuals** (the numeric residue solver) weigh an angle θ as the length
+  ``θ x arm`` with ``arm = length / angle`` (the model's size when the angle follows the
+  length), so one threshold, ``length``, holds lengths and angles to their own tolerance.
+* **Monotone answers**: a looser tolerance only ever accepts more; numeric solvers stop on
+  :attr:`Tolerance.precision`, never looser than the default, so loosening the
+  acceptance never stops a solver short of a solution it found before; numerical
+  decisions (regular or singular systems) use it too, and a numeric solution's dof is
+  measured against its own residual (:meth:`Tolerance.rank`), not the tolerance.
+* **Near misses**: a mismatch within ``NEARLY_CONSISTENT`` times the tolerance is reported
+  with the tolerance that accepts it (:meth:`Tolerance.needed`).
 * Exact input (task files, STEP surfaces) uses the tight defaults (1e-9).
   Approximate input (triangle meshes, fitted surfaces) uses the looser
   ``mesh_rel_length`` / ``mesh_angle``, because coordinates in OBJ/STL files carry only
@@ -38,6 +52,22 @@ MAX_REL_LENGTH = 0.1
 """Largest relative length tolerance a user may ask for: a tenth of the model's size.
 Beyond it whole parts coincide and every answer (contact, blocking, fit) is meaningless."""
 
+MIN_ANGLE = MIN_REL_LENGTH
+"""Smallest angle tolerance (radians) a user may ask for: float64's resolution, as for
+lengths (a unit vector's entries resolve about 1e-16 rad)."""
+
+MAX_ANGLE = MAX_REL_LENGTH
+"""Largest angle tolerance (radians, about 5.7 degrees) a user may ask for: the angle a
+relative length error of ``MAX_REL_LENGTH`` turns a direction by."""
+
+RANK_MARGIN = 10.0
+"""How far above the relative residual of a numeric solution a Jacobian's singular value
+must be to count as a constraint (:meth:`Tolerance.rank`)."""
+
+NEARLY_CONSISTENT = 1000.0
+"""A conflict whose mismatch is within this factor of the tolerance in force is reported
+as *nearly consistent*, with the tolerance that would accept it."""
+
 
 @dataclass(frozen=True)
 class Tolerance:
@@ -65,6 +95,55 @@ class Tolerance:
         """Absolute length tolerance for mesh (approximate) geometry, in model units."""
         return self.mesh_rel_length * self.scale
 
+    @property
+    def arm(self) -> float:
+        """The length an angle of one radian weighs in mixed residuals: ``length / angle``
+        (the model's size when the angle follows the relative length)."""
+        return self.length / self.angle
+
+    @property
+    def precision(self) -> float:
+        """The threshold of numerical decisions: the relative step and cost change at which
+        numeric solvers stop, the conditioning below which a small linear system counts as
+        singular. The tighter of the tolerances and the default, so a looser tolerance
+        never stops a solver earlier nor calls a regular system singular (which would make
+        answers depend on the coordinates, not only on the geometry)."""
+        return min(self.rel_length, self.angle, DEFAULT_REL_LENGTH)
+
+    def rank(self, residual: float = 0.0) -> float:
+        """Relative singular value below which a Jacobian direction counts as free at a
+        numeric solution whose worst residual is ``residual`` (model units): the mesh
+        angle (the numeric solvers' own precision), or ``RANK_MARGIN`` times the relative
+        residual when larger (rounded data perturbs the Jacobian by about as much as it
+        leaves in the residual). It does not depend on the tolerance asked for, so
+        loosening the tolerance never changes a measured dof."""
+        return max(self.mesh_angle, RANK_MARGIN * residual / self.scale)
+
+    @classmethod
+    def relative(cls, rel_length: float | None = None, angle: float | None = None) -> Tolerance:
+        """The policy of the command line's ``--tolerance`` (``rel_length``) and
+        ``--angle-tolerance`` (``angle``, radians): the angle follows the relative length
+        unless given (module docstring); the defaults for what is not given."""
+        base = cls() if rel_length is None else cls(rel_length=rel_length, angle=rel_length)
+        return base if angle is None else replace(base, angle=angle)
+
+    def needed(self, kind: str, value: float) -> float | None:
+        """The relative tolerance (``--tolerance``, the angle following it) at which a
+        mismatch of ``kind`` and size ``value`` is accepted: the mismatch measured (an angle
+        in radians as it is, a length over the model's size) rounded up to two significant
+        digits; ``None`` when it is not within ``NEARLY_CONSISTENT`` times the tolerance in
+        force or beyond ``MAX_REL_LENGTH``."""
+        if kind == "angle":
+            relative, limit = value, self.angle
+        elif kind in LENGTH_MISMATCHES:
+            relative, limit = value / self.scale, self.rel_length
+        else:
+            return None
+        if not (math.isfinite(relative) and 0 < relative <= NEARLY_CONSISTENT * limit):
+            return None
+        suggested = round_up(relative)
+        return suggested if suggested <= MAX_REL_LENGTH else None
+
     def with_scale(self, scale: float) -> Tolerance:
         """The same policy for a model whose bounding-box diagonal is ``scale``."""
         return replace(self, scale=scale if scale > 0 else 1.0)
@@ -72,6 +151,19 @@ class Tolerance:
     def for_mesh(self) -> Tolerance:
         """The policy applied to approximate geometry: mesh thresholds become the exact ones."""
         return replace(self, rel_length=self.mesh_rel_length, angle=self.mesh_angle)
+
+
+LENGTH_MISMATCHES = frozenset({"distance", "radius", "size", "residual"})
+"""Mismatch kinds measured in model units (numeric residuals weigh angles as lengths)."""
+
+
+def round_up(value: float) -> float:
+    """``value`` (positive) rounded up to two significant digits, strictly above it, so
+    that a tolerance of the result accepts a mismatch of ``value``."""
+    step = 10.0 ** (math.floor(math.log10(value)) - 1)
+    # printed with two digits, so that the result reads as the number it is
+    rounded = float(f"{(math.floor(value / step) + 1) * step:.1e}")
+    return rounded if rounded > value else float(f"{rounded + step:.1e}")
 
 
 DEFAULT = Tolerance()

@@ -215,3 +215,28 @@ def test_flat_transporter_reports_the_congruence_failure():
     c = flat_transporter(two, two, group, Tolerance())
     assert isinstance(c, Coset) and c.group is group
     np.testing.assert_allclose(c.rep, np.eye(4), atol=1e-15)
+
+
+@pytest.mark.parametrize("rel", [1e-9, 1e-4, 1e-2, 3e-2, 0.1])
+def test_transporter_of_a_point_and_two_axial_lines_at_any_tolerance(rel):
+    """A point on a line and a second, reversed line along the same axis, 10 apart; the
+    sources are the same tuple moved by T(-5, -5, -10). Their frame systems are regular
+    (eigenvalues 3, 3, 1), so the transporter is that translation (and a rotation about
+    the axis) at every tolerance: a loose tolerance must not call the system singular,
+    whose completed solution would depend on the coordinates."""
+    z = np.array([0.0, 0.0, 1.0])
+    targets = (
+        PointInvariant(np.array([5.0, 5.0, 0.0])),
+        LineInvariant(np.array([5.0, 5.0, 0.0]), z),
+        LineInvariant(np.array([5.0, 5.0, 10.0]), -z),
+    )
+    sources = (
+        PointInvariant(np.array([0.0, 0.0, -10.0])),
+        LineInvariant(np.array([0.0, 0.0, -10.0]), z),
+        LineInvariant(np.array([0.0, 0.0, 0.0]), -z),
+    )
+    tol = Tolerance.relative(rel).with_scale(15.0)
+    found = transporter(targets, sources, tol)
+    assert isinstance(found, Coset)
+    assert found.group.kind is Kind.REVOLUTE
+    assert found.contains(se3.translation(np.array([5.0, 5.0, 10.0])), Tolerance())

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from assemblykit.algebra import Kind, SymmetryGroup, se3
-from assemblykit.algebra.subgroups import _connected_meet, classify_algebra
+from assemblykit.algebra.subgroups import _connected_meet, classify_algebra, psd_solve
 from assemblykit.errors import GroupError
 from assemblykit.tolerance import Tolerance
 
@@ -428,3 +428,11 @@ def _any_group(rng: np.random.Generator) -> SymmetryGroup:
 def test_intersections_with_helical_groups_are_sound_and_equivariant(seed):
     rng = np.random.default_rng(seed)
     assert_meet_sound_and_equivariant(rng, _any_group(rng), _any_group(rng))
+
+
+@pytest.mark.parametrize("rel", [1e-9, 1e-2, 0.1])
+def test_psd_solve_is_regular_whatever_the_tolerance(rel):
+    """diag(3, 3, 1) x = (15, 15, -10) has the one solution (5, 5, -10) (by hand); a loose
+    tolerance must not make it a minimum-norm least-squares answer."""
+    x = psd_solve((3.0, 0.0, 0.0, 3.0, 0.0, 1.0), (15.0, 15.0, -10.0), Tolerance.relative(rel))
+    assert x == pytest.approx((5.0, 5.0, -10.0), abs=1e-12)

@@ -10,10 +10,11 @@ import pytest
 from assemblykit.algebra import se3
 from assemblykit.errors import SchemaError
 from assemblykit.features.primitives import Hole, Plane, Point, Shaft
-from assemblykit.inference.network import WORLD, build_network, instance_key
+from assemblykit.inference.network import WORLD, build_network, instance_key, meet_loci
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Action, Situation, Task
+from assemblykit.tolerance import Tolerance
 
 Z = (0.0, 0.0, 1.0)
 
@@ -133,3 +134,57 @@ def test_coupled_relations_find_their_carrier():
     lonely = Task("mm", gripper, (Situation("s1", (relations[0], relations[2])),))
     with pytest.raises(SchemaError, match="no body is related to both"):
         build_network(lonely)
+
+
+def test_loci_meet_in_a_line_a_point_or_miss_by_their_gap():
+    tol = Tolerance()
+    x_plane = (np.array([1.0, 0, 0]), np.array([1.0, 7, 7]))
+    y_plane = (np.array([0, 1.0, 0]), np.array([3.0, 2, 3]))
+    origin, rows = meet_loci(np.zeros(3), np.zeros((0, 3)), [x_plane, y_plane], tol)
+    # x = 1 and y = 2 meet in the vertical line through (1, 2, 0)
+    np.testing.assert_allclose(origin, [1, 2, 0], atol=1e-15)
+    np.testing.assert_allclose(np.cross(rows[0], rows[1]), [0, 0, 1], atol=1e-15)
+    tilted = (np.array([0, 0.6, 0.8]), np.array([0, 0, 5.0]))
+    point, rows = meet_loci(origin, rows, [tilted], tol)
+    # 0.6·2 + 0.8·z = 4 on that line: z = 3.5
+    np.testing.assert_allclose(point, [1, 2, 3.5], atol=1e-15)
+    assert len(rows) == 3
+    apart = (np.array([-1.0, 0, 0]), np.array([4.0, 0, 0]))
+    assert meet_loci(origin, rows[:2], [apart], tol) == pytest.approx(3.0, abs=1e-15)
+
+
+def test_point_loci_of_one_point_are_folded_into_one_spherical_link():
+    box = Body(
+        "box", {"x": Plane((1, 0, 0), (1, 0, 0)), "y": Plane((0, 2, 0), (0, 1, 0))}, fixed=True
+    )
+    tip = Body("v", {"tip": Point((0, 0, 1)), "rod": Shaft((0, 0, 0), (0, 0, 1), 1.0)})
+    s1 = Situation(
+        "s1",
+        (
+            rel("point_on_plane", "v.tip", "box.x"),
+            rel("point_on_plane", "v.tip", "box.y"),
+            rel("distance", "v.tip", "box.x", distance=0.0),
+            rel("point_on_line", "v.tip", "v.rod"),
+        ),
+    )
+    s2 = Situation("s2", (rel("point_on_plane", "v.tip", "box.x"),), (Action("move", "v"),))
+    net = build_network(Task("mm", {"box": box, "v": tip}, (s1, s2)))
+    # the tip's own rod is no locus of another body: it stays a plain constraint; the
+    # three relations of the tip in s1 meet in the line x = 1, y = 2; s2 keeps the plane
+    kinds = [(c.labels[0].split()[0], len(c.labels)) for c in net.constraints]
+    assert kinds == [("point_on_line", 1), ("point_on_plane", 3), ("point_on_plane", 1)]
+    assert [c.geometry.rank for c in net.constraints[1:]] == [2, 1]
+    np.testing.assert_allclose(net.constraints[1].geometry.origin, [1, 2, 0], atol=1e-15)
+    assert not net.links  # a free move links nothing
+    box_z = Body("box", {**box.features, "z": Plane((0, 0, 3), (0, 0, 1))}, fixed=True)
+    corner = Situation("s1", (*s1.relations[:2], rel("point_on_plane", "v.tip", "box.z")))
+    (link,) = build_network(Task("mm", {"box": box_z, "v": tip}, (corner,))).links
+    # x = 1, y = 2, z = 3: the tip (0, 0, 1) turns about (1, 2, 3)
+    assert (link.source, link.target, link.value.dof, str(link.value.kind)) == (
+        WORLD,
+        ("v", "s1"),
+        3,
+        "spherical",
+    )
+    np.testing.assert_allclose(link.value.rep, se3.translation((1, 2, 2)), atol=1e-15)
+    assert len(link.labels) == 3

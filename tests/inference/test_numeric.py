@@ -259,3 +259,27 @@ def test_two_assembly_modes_are_kept_apart():
     result = solve_residue(problem, tol, starts=8)
     xs = sorted(round(s.poses["a"][0, 3], 6) for s in result.solutions)
     assert xs == [-1.0, 1.0]
+
+
+def test_acceptance_follows_the_tolerance_and_never_loosens_the_solve():
+    """Two ``fixed`` constraints 2e-6 apart along x: the best pose is halfway, each
+    constraint misses by 1e-6 (by hand), i.e. 1e-7 of the scale 10. It is rejected
+    below that and accepted at every looser tolerance, with the same tight residual
+    (the solver stops on ``tol.precision``, not on the acceptance threshold)."""
+    problem = ResidueProblem(
+        ("b",),
+        {"b": np.eye(4)},
+        {},
+        (Constraint(("b",), fixed(shift(0.0))), Constraint(("b",), fixed(shift(2e-6)))),
+    )
+    for rel in (1e-9, 5e-8):
+        result = solve_residue(problem, Tolerance.relative(rel).with_scale(10.0), starts=2)
+        assert not result.found
+        assert result.best_residual == pytest.approx(1e-6, rel=1e-6)
+    for rel in (2e-7, 1e-5, 1e-3, 1e-2, 0.1):
+        result = solve_residue(problem, Tolerance.relative(rel).with_scale(10.0), starts=2)
+        assert result.found
+        (solution,) = result.solutions
+        assert solution.residual == pytest.approx(1e-6, rel=1e-6)
+        assert solution.total_dof == 0
+        np.testing.assert_allclose(solution.poses["b"][:3, 3], [1e-6, 0, 0], atol=1e-12)

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from assemblykit.algebra import se3
 from assemblykit.features.primitives import Ball, Hole, Plane, Point, Prism, Shaft, Socket, Thread
 from assemblykit.inference import solve_numeric_only
+from assemblykit.inference.reduction import model_scale
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Action, Situation, Task
@@ -759,7 +760,7 @@ def test_box_against_table_with_corner_on_wall_has_two_dof():
     inv = b["invariants"]
     assert parallel(inv["normal"], Z) and parallel(inv["direction"], (0, 1, 0))
     np.testing.assert_allclose(inv["point"], [5, 1, 0], atol=1e-9)
-    assert "chain-solve point-on-plane" in [step["rule"] for step in out["trace"]]
+    assert "higher-pair" in [step["rule"] for step in out["trace"]]
     assert "residue" not in [step["rule"] for step in out["trace"]]
 
 
@@ -860,3 +861,16 @@ def test_a_stack_of_equal_cubes_reuses_one_intersection_and_traces_every_step():
         assert np.allclose(out["bodies"][f"{name}@s1"]["pose"], shift(0, 0, k), atol=1e-12)
     steps = [(s["dof_before"], s["dof_after"]) for s in out["trace"] if s["rule"] == "intersect"]
     assert steps == [(3, 1), (1, 0)] * 3
+
+
+def test_model_scale_counts_radii_and_sizes():
+    """A pin of radius 5 and a square of circumradius 3 at the origin: the box is
+    [-5, 5]^3 (the pin reaches furthest), diagonal 10·√3, not 0."""
+    pin = Body("pin", {"shaft": Shaft(point=(0, 0, 0), axis=(0, 0, 1), radius=5.0)})
+    key = Body("key", {"square": Prism(point=(0, 0, 0), axis=(0, 0, 1), sides=4, size=3.0)})
+    flat = Body("flat", {"top": Plane(point=(0, 0, 0), normal=(0, 0, 1))}, fixed=True)
+    situation = (Situation("s1"),)
+    assert model_scale(Task("mm", {"pin": pin, "key": key}, situation)) == pytest.approx(
+        10 * math.sqrt(3)
+    )
+    assert model_scale(Task("mm", {"flat": flat}, situation)) == 1.0  # no extent at all

@@ -13,6 +13,7 @@ from assemblykit.inference.solution import (
     Conflict,
     Solution,
     TraceStep,
+    freedom_words,
     status_of,
 )
 
@@ -75,8 +76,10 @@ def test_conflicts_make_the_answer_inconsistent():
             "kind": "angle",
             "value": 0.1745,
             "message": "10 deg",
+            "needed_tolerance": None,
         }
     ]
+    assert data["suggested_tolerance"] is None
 
 
 @pytest.mark.parametrize(
@@ -124,3 +127,31 @@ def test_trace_only_when_explaining_and_render():
 def test_unknown_motion_is_rejected():
     with pytest.raises(ValueError, match="unknown motion"):
         instance(motion="wobbly")
+
+
+def test_freedom_is_said_in_words_and_only_when_there_is_some():
+    ball = instance(dof=3, motion="spherical", freedom="b@s1 can turn about (0.5, 1, 1.5): 3 dof")
+    assert Solution({ball.key: ball}).to_dict()["bodies"]["b@s1"]["freedom"] == ball.freedom
+    assert "freedom" not in Solution({"b@s1": instance()}).to_dict()["bodies"]["b@s1"]
+    console = Console(width=200, record=True)
+    console.print(Solution({ball.key: ball}).render())
+    assert "b@s1 can turn about (0.5, 1, 1.5): 3 dof" in console.export_text()
+
+
+@pytest.mark.parametrize(
+    ("motion", "dof", "invariants", "expected"),
+    [
+        ("spherical", 3, {"center": [0.5, 1, 1.5]}, "can turn about (0.5, 1, 1.5): 3 dof"),
+        (
+            "revolute",
+            1,
+            {"point": [5, 0, 0], "direction": [0, 0, 1]},
+            "can turn about the axis through (5, 0, 0) along (0, 0, 1): 1 dof",
+        ),
+        ("prismatic", 1, {"direction": [0, -0.0, 1]}, "can slide along (0, 0, 1): 1 dof"),
+        ("fixed", 0, {}, ""),
+        ("mechanism", 2, {}, ""),
+    ],
+)
+def test_freedom_words(motion, dof, invariants, expected):
+    assert freedom_words(motion, dof, invariants) == expected

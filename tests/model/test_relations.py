@@ -419,6 +419,23 @@ def test_residual_of_a_mismatch_never_vanishes():
             tr((9, 0, 0)),
             rx(0.1),
         ),
+        # a cylinder of radius 1 on the plane z = 0: its axis parallel to it, 1 above
+        (
+            "distance",
+            Shaft((0, 0, 1), (1, 0, 0), 1),
+            Plane((0, 0, 0), Z),
+            {"distance": 1},
+            tr((4, 5, 0)) @ rz(1),
+            se3.rot_y(0.1),
+        ),
+        (
+            "distance",
+            Plane((0, 0, 0), Z),
+            Shaft((0, 0, 1), (0, 1, 0), 1),
+            {"distance": 1},
+            rz(0.3),
+            tr((0, 0, 1)),
+        ),
     ],
 )
 def test_non_coset_residuals(kind, first, second, options, good, bad):
@@ -448,6 +465,9 @@ def test_residual_scaling_weighs_angles_by_the_model_scale():
         ("point_on_plane", Point((0, 0, 0)), Plane((0, 0, 0), Z), {}, 1),
         ("distance", Point((0, 0, 0)), Point((0, 0, 0)), {}, 1),
         ("distance", Plane((0, 0, 0), Z), Plane((0, 0, 0), Z), {}, 3),
+        ("distance", Shaft((0, 0, 0), Z, 1), Plane((0, 0, 0), Z), {}, 2),
+        ("distance", Plane((0, 0, 0), Z), Hole((0, 0, 0), Z, 1), {}, 2),
+        ("distance", Cone((0, 0, 0), Z, 0.3), Plane((0, 0, 0), Z), {}, 1),
         ("parallel", Plane((0, 0, 0), Z), Plane((0, 0, 0), Z), {}, 2),
         ("perpendicular", Plane((0, 0, 0), Z), Plane((0, 0, 0), Z), {}, 1),
         ("angle", Plane((0, 0, 0), Z), Plane((0, 0, 0), Z), {}, 1),

@@ -305,6 +305,8 @@ def _frame_columns(
                 r0, r1, r2 = r0 + along * u0, r1 + along * u1, r2 + along * u2
     origin = psd_solve((m00, m01, m02, m11, m12, m22), (r0, r1, r2), tol)
     length, angle = tol.length, tol.angle
+    # offsets below the tolerance are kept aside with their weight (length over scale)
+    faint: list[tuple[float, Vec3]] = []
     for code, p, u in flats:
         if code != _DIRECTION:
             assert p is not None
@@ -312,15 +314,27 @@ def _frame_columns(
             size = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
             if size > length:
                 dirs.append((w0 / size, w1 / size, w2 / size))
+            elif size > 0.0:
+                faint.append((size / tol.scale, (w0 / size, w1 / size, w2 / size)))
     if not dirs:
         return (origin,)
     z0, z1, z2 = z = dirs[0]
     hint = None
+    strongest = tol.precision
     for d0, d1, d2 in dirs[1:]:
         c0, c1, c2 = z1 * d2 - z2 * d1, z2 * d0 - z0 * d2, z0 * d1 - z1 * d0
         if math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) > angle:
             hint = (d0, d1, d2)
             break
+    else:
+        # Nothing clears the tolerance: orient by the strongest direction above rounding
+        # (a pin tilted by rounded numbers), so that two congruent tuples get frames that
+        # correspond; any rotation that the tolerance cannot see is in the stabiliser.
+        for weight, (d0, d1, d2) in [(1.0, d) for d in dirs[1:]] + faint:
+            c0, c1, c2 = z1 * d2 - z2 * d1, z2 * d0 - z0 * d2, z0 * d1 - z1 * d0
+            strength = weight * math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+            if strength > strongest:
+                strongest, hint = strength, (d0, d1, d2)
     return se3.frame_from_floats(origin, z, hint)
 
 

@@ -212,13 +212,18 @@ def psd_solve(m: Sym3, rhs: Vec3, tol: Tolerance) -> Vec3:
     m02, m11, m12, m22), in closed form: Cramer's rule when regular, otherwise completed
     by the null space (rank 2) or the single range direction (rank 1). Plain float
     arithmetic: this is the hot path of every transporter.
+
+    Regularity is a numerical decision (``tol.precision``), not a geometric one: the
+    completed solutions depend on the coordinates, so a regular system called singular
+    under a loose tolerance would give congruent tuples frames that do not correspond.
     """
     a, b, c, e, f, i = m
     trace = a + e + i
-    if trace <= tol.angle:
+    eps = tol.precision
+    if trace <= eps:
         return (0.0, 0.0, 0.0)
     det = a * (e * i - f * f) + b * (c * f - b * i) + c * (b * f - c * e)
-    if abs(det) > tol.angle * trace**3:
+    if abs(det) > eps * trace**3:
         return _cramer(m, rhs, det)
     rows = ((a, b, c), (b, e, f), (c, f, i))
     best, null = 0.0, (0.0, 0.0, 0.0)
@@ -228,7 +233,7 @@ def psd_solve(m: Sym3, rhs: Vec3, tol: Tolerance) -> Vec3:
         size = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
         if size > best:
             best, null = size, (w[0] / size, w[1] / size, w[2] / size)
-    if best > tol.angle * trace**2:
+    if best > eps * trace**2:
         # m + n n^T is regular and maps n to n, so the solution has no null component.
         n0, n1, n2 = null
         full = (a + n0 * n0, b + n0 * n1, c + n0 * n2, e + n1 * n1, f + n1 * n2, i + n2 * n2)

@@ -14,7 +14,10 @@ situation. Fixed bodies are the world: all their instances are the one node
   transform F·Tr(0,0,s)·F⁻¹, ``along f`` without ``by`` the prismatic coset F·T(z)·F⁻¹,
   ``turn b about f by θ`` the fixed F·Rz(θ)·F⁻¹, without ``by`` the revolute coset
   F·R(z)·F⁻¹; a free ``move b`` adds no link;
-* a body that no action of a transition moves keeps its pose: an identity link.
+* a body that no action of a transition moves keeps its pose: an identity link;
+* the higher pairs holding one point of an instance in planes and lines of another are
+  met first: in a single point they become a spherical coset link, otherwise one
+  constraint carrying the met locus (:class:`PointLocus`) for the reduction's closed forms.
 
 Every link also has a residual, so the whole network can be handed to the numeric
 residue solver (:mod:`assemblykit.inference.numeric`).
@@ -22,7 +25,7 @@ residue solver (:mod:`assemblykit.inference.numeric`).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Hashable, MutableMapping
+from collections.abc import Callable, Hashable, MutableMapping, Sequence
 from dataclasses import dataclass
 from functools import partial
 from typing import Any
@@ -30,18 +33,20 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from assemblykit.algebra import Coset, SymmetryGroup, se3
+from assemblykit.algebra import Coset, EmptySet, Mismatch, SymmetryGroup, se3
 from assemblykit.errors import SchemaError
 from assemblykit.inference.numeric import Constraint, gear_residual, mirror_residual
 from assemblykit.model.relations import (
+    AXIAL,
     COUPLED,
+    LINED,
     RELATIONS,
     Relation,
     relation_coset,
     relation_residual,
 )
 from assemblykit.model.task import Action, Situation, Task
-from assemblykit.tolerance import current
+from assemblykit.tolerance import Tolerance, current
 
 Node = tuple[str, str]
 WORLD: Node = ("world", "")
@@ -140,8 +145,9 @@ def relation_label(relation: Any, situation: str) -> str:
 
 
 def _fixed_residual(target: np.ndarray, scale: float) -> Callable[[np.ndarray], np.ndarray]:
-    """Residual of ``X == target``: rotation entries (times the length ``scale``, so every
-    entry is a length, as in :func:`relation_residual`) and translation."""
+    """Residual of ``X == target``: rotation entries (times the length ``scale``, the
+    tolerance's arm, so every entry is a length, as in :func:`relation_residual`) and
+    translation."""
 
     def residual(x: np.ndarray) -> np.ndarray:
         rotation = (x[:3, :3] - target[:3, :3]).ravel() * scale
@@ -191,7 +197,7 @@ def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | No
             if rotate
             else SymmetryGroup.prismatic(frame[:3, 2])
         )
-        residual = partial(_axis_residual, frame, rotate, current().scale)
+        residual = partial(_axis_residual, frame, rotate, current().arm)
         key = (action.kind, _plain_value(frame))
         return Link(prev, nxt, Coset(group, np.eye(4)), (label,), residual, key)
     step = se3.rot_z(action.by) if rotate else se3.translation(np.array([0.0, 0.0, action.by]))
@@ -201,7 +207,7 @@ def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | No
         nxt,
         point_coset(target),
         (label,),
-        partial(_fixed_residual, target, current().scale),
+        partial(_fixed_residual, target, current().arm),
         point_key(target),
     )
 
@@ -237,7 +243,7 @@ def _coupled_constraint(
     carrier = _carrier(situation, (relation.refs[0].body, relation.refs[1].body), node)
     if relation.kind == "gear":
         ratio = float(relation.options["ratio"])
-        residual = gear_residual(*frames, ratio, current().scale)
+        residual = gear_residual(*frames, ratio, current().arm)
         return Constraint((*bodies, carrier), residual, (label,))
     direction = frames[0][:3, 2]
     if first.type_name != "plane":
@@ -254,29 +260,169 @@ def _coupled_constraint(
 
 
 @dataclass(frozen=True)
-class PointOnPlane:
-    """A ``point_on_plane`` relation: the point (in its instance's body frame) lies on the
-    plane through ``origin`` with unit ``normal`` (in the plane instance's body frame)."""
+class PointLocus:
+    """A point of one instance held in an affine locus of another (a higher pair).
+
+    The point ``point`` (in ``point_node``'s body frame) satisfies ``rows @ (y - origin)
+    = 0`` in ``locus_node``'s body frame: ``rows`` are orthonormal normals, one for a
+    plane, two for a line, three for a single point (ALGEBRA.md §3: the contact set of a
+    point and a plane is Tr(plane)·S(point), not a coset)."""
 
     point_node: Node
     point: np.ndarray
+    locus_node: Node
+    origin: np.ndarray
+    rows: np.ndarray
+
+    @property
+    def rank(self) -> int:
+        """Number of independent equations: 1 plane, 2 line, 3 point."""
+        return len(self.rows)
+
+
+def line_normals(direction: np.ndarray) -> np.ndarray:
+    """Two orthonormal normals of a line of unit ``direction``."""
+    basis = np.linalg.svd(direction.reshape(1, 3))[2]
+    return basis[1:]
+
+
+@dataclass(frozen=True)
+class LineOnPlane:
+    """A line of one instance lying parallel to a plane of another, at a signed distance
+    along its normal (a cylinder on a plane: ``distance`` between a line and a plane).
+
+    ``point`` and ``direction`` are in ``line_node``'s body frame, ``origin`` (already
+    offset by the distance) and ``normal`` in ``plane_node``'s (ALGEBRA.md §3: a double
+    coset of dimension 3 + 2 − 1 = 4, not a coset)."""
+
+    line_node: Node
+    point: np.ndarray
+    direction: np.ndarray
     plane_node: Node
     origin: np.ndarray
     normal: np.ndarray
 
 
-def _point_on_plane(
-    kind: str, first: tuple[Node, Any], second: tuple[Node, Any]
-) -> PointOnPlane | None:
-    """The geometry of a ``point_on_plane`` relation (either order), None for other kinds."""
-    if kind != "point_on_plane":
+def _geometry(
+    kind: str, options: dict[str, Any], first: tuple[Node, Any], second: tuple[Node, Any]
+) -> PointLocus | LineOnPlane | None:
+    """The closed-form geometry of a higher pair: the locus of a ``point_on_plane``,
+    ``point_on_line`` or point-plane ``distance`` relation, or the line and plane of a
+    line-plane ``distance`` (either order; a distance offsets the plane along its
+    normal); None for the other kinds and feature pairs."""
+    if kind not in ("point_on_plane", "point_on_line", "distance"):
         return None
-    (point_node, point), (plane_node, plane) = (
-        (first, second) if second[1].type_name == "plane" else (second, first)
-    )
-    frame = np.asarray(plane.frame(), dtype=np.float64)
-    where = np.asarray(point.frame(), dtype=np.float64)[:3, 3]
-    return PointOnPlane(point_node, where, plane_node, frame[:3, 3], frame[:3, 2])
+    types = (first[1].type_name, second[1].type_name)
+    if kind == "distance" and ("plane" not in types or types[0] == types[1]):
+        return None
+    on_second = types[1] in AXIAL if kind == "point_on_line" else types[1] == "plane"
+    (node, feature), (locus_node, locus) = (first, second) if on_second else (second, first)
+    frame = np.asarray(locus.frame(), dtype=np.float64)
+    own = np.asarray(feature.frame(), dtype=np.float64)
+    axis = frame[:3, 2]
+    if kind == "point_on_line":
+        return PointLocus(node, own[:3, 3], locus_node, frame[:3, 3], line_normals(axis))
+    origin = frame[:3, 3] + float(options.get("distance", 0.0)) * axis
+    if feature.type_name in LINED:
+        return LineOnPlane(node, own[:3, 3], own[:3, 2], locus_node, origin, axis)
+    return PointLocus(node, own[:3, 3], locus_node, origin, axis.reshape(1, 3))
+
+
+def meet_loci(
+    origin: np.ndarray,
+    rows: np.ndarray,
+    extra: Sequence[tuple[np.ndarray, np.ndarray]],
+    tol: Tolerance,
+) -> tuple[np.ndarray, np.ndarray] | float:
+    """The intersection of the affine locus ``rows @ (y - origin) = 0`` with the planes
+    ``n @ (y - o) = 0`` of ``extra`` (unit normals ``n``), as ``(origin, rows)`` with
+    orthonormal rows; or, when a plane parallel to the locus misses it, that distance.
+
+    Each plane is met in turn: its normal's part across the current rows (larger than
+    ``tol.angle``) becomes a new row and the origin steps along it onto the plane, so the
+    origin keeps every earlier equation."""
+    basis = [np.asarray(r, dtype=np.float64) for r in rows]
+    point = np.asarray(origin, dtype=np.float64)
+    for normal, through in extra:
+        across = normal - sum((normal @ r) * r for r in basis)
+        gap = float(normal @ (through - point))
+        reach = float(np.linalg.norm(across))
+        if reach <= tol.angle:
+            if abs(gap) > tol.length:
+                return abs(gap)
+            continue
+        point = point + gap / float(normal @ across) * across
+        basis.append(across / reach)
+    return point, np.array(basis).reshape(len(basis), 3)
+
+
+def _fold_point_loci(
+    constraints: list[Constraint], tol: Tolerance
+) -> tuple[list[Link], list[Constraint]]:
+    """Higher pairs of one point met together (ALGEBRA.md §3, §5.2 rule 1 for loci).
+
+    The ``point_on_plane``, ``point_on_line`` and point-plane ``distance`` relations that
+    hold the same point of one instance in loci of the same other instance are
+    intersected in closed form: loci meeting in one point P make the coset
+    S(P)·Tr(P − c) (a spherical link, as ``coincident``); loci missing each other make an
+    empty link (a distance mismatch); a line or a plane stays one constraint carrying the
+    met locus. Returns the new links and the remaining constraints."""
+    pairs: dict[tuple[Node, Node], list[list[Constraint]]] = {}
+    rest: list[Constraint] = []
+    for constraint in constraints:
+        geometry = constraint.geometry
+        if not isinstance(geometry, PointLocus) or geometry.point_node == geometry.locus_node:
+            rest.append(constraint)
+            continue
+        groups = pairs.setdefault((geometry.point_node, geometry.locus_node), [])
+        for group in groups:
+            if np.abs(group[0].geometry.point - geometry.point).max() <= tol.length:
+                group.append(constraint)
+                break
+        else:
+            groups.append([constraint])
+    links: list[Link] = []
+    for group in (group for groups in pairs.values() for group in groups):
+        head = group[0].geometry
+        planes = [(row, c.geometry.origin) for c in group for row in c.geometry.rows]
+        met = meet_loci(np.zeros(3), np.zeros((0, 3)), planes, tol)
+        labels = tuple(label for c in group for label in c.labels)
+        source, target = head.locus_node, head.point_node
+        make = partial(_group_residual, tuple(group), source)
+        if isinstance(met, float):
+            miss = Mismatch("distance", met, "the point's loci are parallel and apart")
+            links.append(Link(source, target, EmptySet(miss), labels, make))
+            continue
+        origin, rows = met
+        if len(rows) == 3:
+            coset = Coset(SymmetryGroup.spherical(origin), se3.translation(origin - head.point))
+            links.append(Link(source, target, coset, labels, make))
+            continue
+        located = PointLocus(target, head.point, source, origin, rows)
+        residual = _group_residual(tuple(group), source)
+        rest.append(
+            Constraint(
+                (source, target),
+                lambda poses, r=residual: r(se3.inverse(poses[0]) @ poses[1]),
+                labels,
+                located,
+            )
+        )
+    return links, rest
+
+
+def _group_residual(
+    group: tuple[Constraint, ...], source: Node
+) -> Callable[[np.ndarray], np.ndarray]:
+    """The residuals of ``group`` together, as a function of X = inv(L_source)·L_target."""
+    eye = np.eye(4)
+
+    def residual(x: np.ndarray) -> np.ndarray:
+        return np.concatenate(
+            [c.residual([eye, x] if c.nodes[0] == source else [x, eye]) for c in group]
+        )
+
+    return residual
 
 
 def _memo_key(feature: Any, memo: MutableMapping[Hashable, Any]) -> Hashable:
@@ -313,7 +459,7 @@ def _relation_part(
             (source, target),
             lambda poses: residual(se3.inverse(poses[0]) @ poses[1]),
             (label,),
-            _point_on_plane(relation.kind, (target, first), (source, second)),
+            _geometry(relation.kind, options, (target, first), (source, second)),
         )
     key = (
         relation.kind,
@@ -346,8 +492,14 @@ def build_network(task: Task) -> Network:
         for relation in situation.relations:
             part = _relation_part(task, situation, relation, node, cosets)
             (links if isinstance(part, Link) else constraints).append(part)
+    folded, constraints = _fold_point_loci(constraints, current())
     return Network(
-        instances, tuple(links), tuple(constraints), situations, tuple(task.bodies), fixed
+        instances,
+        (*links, *folded),
+        tuple(constraints),
+        situations,
+        tuple(task.bodies),
+        fixed,
     )
 
 
@@ -370,7 +522,7 @@ def _transition(
                 (body, situation.name),
                 point_coset(np.eye(4)),
                 (f"stationary {body} @{situation.name}",),
-                partial(_fixed_residual, np.eye(4), current().scale),
+                partial(_fixed_residual, np.eye(4), current().arm),
                 point_key(np.eye(4)),
             )
         )

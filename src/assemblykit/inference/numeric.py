@@ -104,11 +104,13 @@ def _residual_vector(
 
 
 def _local_dof(
-    problem: ResidueProblem, jac: Any, tol: Tolerance
+    problem: ResidueProblem, jac: Any, tol: Tolerance, residual: float = 0.0
 ) -> tuple[dict[Hashable, int], int]:
     """Per-instance and total dof from the null space of the constraint Jacobian at a
-    solution (ALGEBRA.md §2.5 step 5). The local coordinates of each instance differ
+    solution whose worst residual is ``residual`` (ALGEBRA.md §2.5 step 5), with the rank
+    threshold :meth:`Tolerance.rank`. The local coordinates of each instance differ
     from twists at the solution by an invertible map, which keeps every rank."""
+    threshold = tol.rank(residual)
     n = 6 * len(problem.unknowns)
     dense = jac.toarray() if hasattr(jac, "toarray") else np.asarray(jac, dtype=np.float64)
     dense = dense * np.tile(np.concatenate([np.ones(3), np.full(3, tol.scale)]), n // 6)
@@ -116,13 +118,13 @@ def _local_dof(
         null = np.eye(n)
     else:
         _, sv, vt = np.linalg.svd(dense, full_matrices=True)
-        rank = int(np.sum(sv > tol.mesh_angle * max(sv[0], 1.0))) if sv.size else 0
+        rank = int(np.sum(sv > threshold * max(sv[0], 1.0))) if sv.size else 0
         null = vt[rank:].T
     dof = {}
     for i, node in enumerate(problem.unknowns):
         block = null[6 * i : 6 * i + 6]
         sv = np.linalg.svd(block, compute_uv=False) if block.size else np.zeros(0)
-        dof[node] = int(np.sum(sv > tol.mesh_angle))
+        dof[node] = int(np.sum(sv > threshold))
     return dof, null.shape[1]
 
 
@@ -150,15 +152,18 @@ def _same_solution(
     tol: Tolerance,
 ) -> bool:
     """Whether two accepted solutions are one: they are within ``tol.mesh_angle`` (an
-    angle θ weighs like the arc θ·scale, as in the residuals), or the poses halfway
-    between them also satisfy every constraint. Distinct isolated solutions (assembly
-    modes) are separated by violated constraints; two stops of the solver on the same
-    solution are not, however far apart a long, badly conditioned chain lets them be."""
+    angle θ weighs like the arc θ·scale), or the poses halfway between them also satisfy every
+    constraint (within the acceptance threshold, or the mesh length when looser: a
+    midpoint of two stops on a curved continuum leaves it by a second-order amount).
+    Distinct isolated solutions (assembly modes) are separated by violated constraints;
+    two stops of the solver on the same solution are not, however far apart a long,
+    badly conditioned chain lets them be."""
     if _distance(a, b, tol.scale) <= tol.mesh_angle:
         return True
     poses = {**problem.known, **{n: _midpoint(a[n], b[n]) for n in problem.unknowns}}
     parts = [_scaled(c, poses) for c in problem.constraints]
-    return bool(parts) and float(np.abs(np.concatenate(parts)).max()) <= tol.mesh_length
+    limit = max(tol.length, tol.mesh_length)
+    return bool(parts) and float(np.abs(np.concatenate(parts)).max()) <= limit
 
 
 def _sparsity(problem: ResidueProblem, start: Mapping[Hashable, np.ndarray]) -> np.ndarray:
@@ -202,8 +207,11 @@ def solve_residue(
 ) -> ResidueResult:
     """Solve the residue numerically (ALGEBRA.md §2.5 numeric fallback, steps 1-6).
 
-    Solutions are accepted when every residual entry is within ``tol.mesh_length`` (a
-    numeric solution is approximate geometry, like a mesh). Isolated solutions from
+    Solutions are accepted when every residual entry is within ``tol.length``, the
+    tolerance in force (residuals weigh angles by ``tol.arm``, so angles are held to
+    ``tol.angle``); the solver stops on ``tol.precision``, which a looser tolerance
+    never loosens, so a solution accepted at one tolerance is accepted at every looser
+    one (monotone answers, :mod:`assemblykit.tolerance`). Isolated solutions from
     different starts are deduplicated by pose distance; the first solution on a
     continuum (total dof > 0) ends the search and is its representative. Two solutions
     are one when the poses halfway between them satisfy the constraints too. ``tol.scale``
@@ -213,7 +221,7 @@ def solve_residue(
     if not problem.unknowns:
         r, poses = _residual_vector(problem, {}, np.zeros(0))
         worst = float(np.abs(r).max()) if r.size else 0.0
-        sols = (NumericSolution(dict(poses), {}, 0, worst),) if worst <= tol.mesh_length else ()
+        sols = (NumericSolution(dict(poses), {}, 0, worst),) if worst <= tol.length else ()
         return ResidueResult(sols, worst, 1)
     # imported here: a residue with nothing unknown (a check) and every other command
     # start faster without scipy.optimize
@@ -223,6 +231,9 @@ def solve_residue(
     found: list[NumericSolution] = []
     best = np.inf
     points = _start_points(problem, starts, seed, tol.scale)
+    # a radian per rotation entry and the model's size per translation entry: with the
+    # Jacobian's own scaling a free direction (a zero column) would take unbounded steps
+    spread = np.tile(np.concatenate([np.ones(3), np.full(3, tol.scale)]), len(problem.unknowns))
     sparsity = _sparsity(problem, origin)
     for x0 in points:
         moved = {
@@ -234,20 +245,20 @@ def solve_residue(
             np.zeros(x0.size),
             method="trf",
             jac_sparsity=sparsity,
-            x_scale="jac",
-            xtol=tol.rel_length,
-            ftol=tol.rel_length,
-            gtol=tol.rel_length,
+            x_scale=spread,
+            xtol=tol.precision,
+            ftol=tol.precision,
+            gtol=tol.precision,
         )
         r, poses = _residual_vector(problem, moved, fit.x)
         worst = float(np.abs(r).max()) if r.size else 0.0
         best = min(best, worst)
-        if worst > tol.mesh_length:
+        if worst > tol.length:
             continue
         poses = {node: poses[node] for node in problem.unknowns}
         if any(_same_solution(problem, poses, s.poses, tol) for s in found):
             continue
-        dof, total = _local_dof(problem, fit.jac, tol)
+        dof, total = _local_dof(problem, fit.jac, tol, worst)
         found.append(NumericSolution(poses, dof, total, worst))
         if total > 0:  # a continuum: one representative answers for it
             break

@@ -20,6 +20,9 @@ The rules, in the seed's order:
    a coset (product along a tree path from the world), a finite set, or, for what the
    rules cannot express (non-coset relations, unresolved cycles, chains that are not
    cosets), the residue solved numerically (:mod:`assemblykit.inference.numeric`).
+   Higher pairs hanging from the world (a point in a plane or a line, a line on a
+   plane), alone or with one lower pair, are solved in closed form first. A pose is the
+   one of least motion from the pose as written (the identity) that the answer allows.
 
 Work is driven by a worklist (insertions and merges), so a network that merges from the
 world outward is reduced in near-linear time; cycles are searched only at a fixpoint.
@@ -39,7 +42,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from assemblykit.algebra import Coset, EmptySet, se3
+from assemblykit.algebra import Coset, EmptySet, SymmetryGroup, se3
 from assemblykit.inference.loops import (
     Circle,
     LoopPoses,
@@ -50,11 +53,15 @@ from assemblykit.inference.loops import (
 )
 from assemblykit.inference.network import (
     WORLD,
+    LineOnPlane,
     Link,
     Network,
     Node,
+    PointLocus,
     build_network,
     instance_key,
+    line_normals,
+    meet_loci,
     point_coset,
 )
 from assemblykit.inference.numeric import (
@@ -68,6 +75,8 @@ from assemblykit.inference.solution import (
     Conflict,
     Solution,
     TraceStep,
+    freedom_words,
+    point_text,
 )
 from assemblykit.tolerance import Tolerance, current, using
 
@@ -219,11 +228,12 @@ class Reducer:
     def _record_conflict(self, labels: tuple[str, ...], empty: Any) -> None:
         mismatch = empty.mismatch
         self.conflicts.append(
-            Conflict(
+            Conflict.measured(
                 tuple(dict.fromkeys(labels)),
                 str(mismatch.kind),
                 float(mismatch.value),
                 str(mismatch.message),
+                self.tol,
             )
         )
 
@@ -579,6 +589,8 @@ class _Instance:
     solutions: int | None = 1
     alternatives: tuple[np.ndarray, ...] = ()
     invariants: Mapping[str, Any] = field(default_factory=dict)
+    freedom: str = ""
+    mechanism: str = ""
 
 
 def _motion(value: Any) -> tuple[str, Mapping[str, Any]]:
@@ -635,7 +647,10 @@ def _components_of(network: Network, reducer: Reducer) -> list[set[Node]]:
 def _tree_sets(
     reducer: Reducer, component: set[Node], root: Node
 ) -> tuple[dict[Node, np.ndarray], dict[Node, Any]]:
-    """Poses along a BFS tree from ``root`` and the chained set of each node relative to it."""
+    """Poses along a BFS tree from ``root`` and the chained set of each node relative to it.
+
+    Each pose is the one of least motion its link allows: the pose as written (the
+    identity) when the link holds there, the link's representative otherwise."""
     poses = {root: np.eye(4)}
     sets: dict[Node, Any] = {}
     tree = nx.Graph()
@@ -643,7 +658,8 @@ def _tree_sets(
     tree.add_edges_from(tuple(k) for k in reducer.edges if k <= component)
     for parent, child in nx.bfs_edges(tree, root):
         link = reducer.edges[frozenset((parent, child))].oriented(parent)
-        poses[child] = poses[parent] @ np.asarray(link.rep, dtype=np.float64)
+        as_written = link.contains(se3.inverse(poses[parent]), reducer.tol)
+        poses[child] = np.eye(4) if as_written else poses[parent] @ link.rep
         above = sets.get(parent)
         sets[child] = (
             link if above is None else (above.product(link) if isinstance(above, Coset) else above)
@@ -709,70 +725,271 @@ def _solve_component(
             else:
                 out[node] = _Instance(poses.get(node, np.eye(4)), 0, "mechanism")
         return out, []
-    closed = _planar_point_on_plane(network, reducer, component, tol)
+    closed = _higher_pairs(network, reducer, component, tol)
     if closed is not None:
         return closed
     return _numeric_component(network, reducer, component, poses, tol, candidates=sets)
 
 
-def _planar_point_on_plane(
+def _higher_pairs(
     network: Network, reducer: Reducer, component: set[Node], tol: Tolerance
 ) -> tuple[dict[Node, _Instance], list[Conflict]] | None:
-    """A higher pair in closed form (ALGEBRA.md §3, §5.3): one instance on a planar coset
-    G(m)·x0 from the world with one of its points c on a world plane (p, n).
-
-    The orbit of c is the plane through x0·c normal to m. If n ∥ m the relation holds
-    everywhere on the coset or nowhere (a distance mismatch). Otherwise the poses are
-    T(d)·R(L)·x1 = a 2-dof subset of G(m) that is not a coset (§5.3: R(N,u)·T(v) is not a
-    group): x1 is x0 translated by the shortest step along n's part ⊥ m that puts c on the
-    plane (the pose nearest the reference), d = m × n⊥ the slide along the plane and L the
-    line through the placed point along m. None when the pattern does not apply."""
+    """Rule 5 in closed form for a component whose instances hang from the world alone,
+    each by at most one coset link and at most one higher pair (:func:`_point_in_locus`,
+    :func:`_line_on_plane`).
+    None when some instance does not fit that pattern (the residue solver takes it)."""
+    if any(k <= component for k in reducer.deferred):
+        return None
     nodes = component - {WORLD}
-    edge = reducer.edges.get(frozenset((WORLD, *nodes)))
-    own = [c for c in network.constraints if all(reducer.find(n)[0] in component for n in c.nodes)]
-    if len(nodes) != 1 or edge is None or len(own) != 1 or len(reducer.edges) < 1:
-        return None
-    (node,) = nodes
-    geometry, value = own[0].geometry, edge.oriented(WORLD)
-    if geometry is None or value.group.kind != "planar" or _components(value) != 1:
-        return None
+    own: dict[Node, list[Constraint]] = {n: [] for n in nodes}
+    for constraint in network.constraints:
+        reps = {reducer.find(n)[0] for n in constraint.nodes}
+        if not reps <= component:
+            continue
+        closed = isinstance(constraint.geometry, PointLocus | LineOnPlane)
+        if not closed or WORLD not in reps or len(reps) != 2:
+            return None
+        own[next(iter(reps - {WORLD}))].append(constraint)
+    out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
+    conflicts: list[Conflict] = []
+    for node in sorted(nodes):
+        edge = reducer.edges.get(frozenset((WORLD, node)))
+        value = None if edge is None else edge.oriented(WORLD)
+        if reducer.adjacency.get(node, set()) - {WORLD} or len(own[node]) > 1:
+            return None
+        if not own[node]:
+            if not isinstance(value, Coset):
+                return None
+            motion, invariants = _motion(value)
+            pose = _EYE if value.contains(_EYE, tol) else np.asarray(value.rep)
+            out[node] = _Instance(pose, value.dof, motion, _components(value), (), invariants)
+            continue
+        labels = own[node][0].labels if edge is None else edge.labels + own[node][0].labels
+        solve = (
+            _line_on_plane if isinstance(own[node][0].geometry, LineOnPlane) else _point_in_locus
+        )
+        found = solve(reducer, node, own[node][0], value, labels, tol)
+        if found is None:
+            return None
+        out[node], miss = found
+        conflicts.extend(miss)
+    return out, conflicts
+
+
+def _point_in_locus(
+    reducer: Reducer,
+    node: Node,
+    constraint: Constraint,
+    value: Coset | None,
+    labels: tuple[str, ...],
+    tol: Tolerance,
+) -> tuple[_Instance, list[Conflict]] | None:
+    """A point held in a world locus (a plane or a line, :class:`PointLocus`), alone or
+    with a planar coset G(m)·x0 from the world, in closed form (ALGEBRA.md §3, §5.3).
+
+    The pose kept is the one of least motion: the pose as written (the identity, or the
+    coset's representative when the identity is not in it) moved by the shortest
+    translation that puts the point c on its locus (no arbitrary turn).
+
+    * Alone: the poses Tr(locus)·S(c), a plane (5 dof) or a line (4 dof): not a coset,
+      the mechanism is named with its locus as invariants.
+    * With a coset H·x0 whose rotations keep the locus normals' components (a cylinder
+      or revolute along a plane's normal, a prismatic pair, translations): a coset,
+      :func:`_coset_meets_locus` (a peg in a hole resting on a floor: a revolute).
+    * With G(m)·x0 otherwise: c moves in the plane Π through x0·c normal to m; the locus
+      meets Π in a point Q (the revolute coset R(Q, m)·x1, 1 dof), a line (slide along it
+      and turn about m through c: 2 dof, not a coset) or nothing (a distance conflict).
+
+    None when the pattern does not apply."""
+    geometry = constraint.geometry
     point_rep, point_x = reducer.find(geometry.point_node)
-    plane_rep, plane_x = reducer.find(geometry.plane_node)
-    if (point_rep, plane_rep) != (node, WORLD) or any(k <= component for k in reducer.deferred):
+    locus_rep, locus_x = reducer.find(geometry.locus_node)
+    if (point_rep, locus_rep) != (node, WORLD):
         return None
     corner = se3.apply(point_x, geometry.point)
-    origin = se3.apply(plane_x, geometry.origin)
-    normal = plane_x[:3, :3] @ geometry.normal
-    base = _EYE if value.contains(_EYE, tol) else np.asarray(value.rep, dtype=np.float64)
-    m = value.group.axis
-    offset = float(normal @ (se3.apply(base, corner) - origin))
-    across = normal - (normal @ m) * m
-    reach = float(np.linalg.norm(across))
-    out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
-    if reach <= tol.angle:
-        if abs(offset) > tol.length:
-            out[node] = _Instance(base, 0, "mechanism", 0)
-            return out, [Conflict(own[0].labels, "distance", abs(offset), _PARALLEL_MISS)]
-        motion, invariants = _motion(value)
-        out[node] = _Instance(base, value.dof, motion, 1, (), invariants)
-        return out, []
-    pose = se3.translation(-offset / reach**2 * across) @ base
-    slide = np.cross(m, across) / reach
-    invariants = {"normal": m, "direction": slide, "point": se3.apply(pose, corner)}
-    out[node] = _Instance(pose, value.dof - 1, "mechanism", 1, (), invariants)
+    origin = se3.apply(locus_x, geometry.origin)
+    rows = geometry.rows @ locus_x[:3, :3].T
+    base = _EYE
+    name = instance_key(node)
+    if value is not None:
+        if _components(value) != 1:
+            return None
+        base = _EYE if value.contains(_EYE, tol) else np.asarray(value.rep, dtype=np.float64)
+        reached = se3.apply(base, corner)
+        met: Any = _coset_meets_locus(value.group, reached, origin, rows, tol)
+        if isinstance(met, Coset):
+            met = Coset(met.group, met.rep @ base)
+            motion, invariants = _motion(met)
+            found = _Instance(met.rep, met.dof, motion, 1, (), invariants)
+            reducer.trace.append(
+                TraceStep(
+                    "higher-pair",
+                    f"world -> {name} [{'; '.join(labels)}]",
+                    value.dof,
+                    met.dof,
+                    f"the point's locus meets its orbit under the joint: {motion}",
+                )
+            )
+            return found, []
+        if met is None and value.group.kind == "planar":
+            met = meet_loci(origin, rows, [(value.group.axis, reached)], tol)
+        if met is None:
+            return None
+        if isinstance(met, float):
+            miss = Conflict.measured(labels, "distance", met, _PARALLEL_MISS, tol)
+            return _Instance(base, 0, "mechanism", 0), [miss]
+        origin, rows = met
+    elif len(rows) == 3:
+        return None
+    reached = se3.apply(base, corner)
+    target = reached - rows.T @ (rows @ (reached - origin))
+    pose = se3.translation(target - reached) @ base
+    place = point_text(target)
+    if value is not None and len(rows) == 3:
+        motion, invariants = _motion(Coset(SymmetryGroup.revolute(target, value.group.axis), pose))
+        found = _Instance(pose, 1, motion, 1, (), invariants)
+    elif value is not None:
+        m = value.group.axis
+        invariants = {"normal": m, "direction": np.cross(rows[0], rows[1]) + 0.0, "point": target}
+        words = (
+            f"can slide its point {place} along {point_text(invariants['direction'])}"
+            f" and turn about {point_text(m)} through it: 2 dof"
+        )
+        found = _Instance(pose, 2, "mechanism", 1, (), invariants, words, "planar-point-on-line")
+    elif len(rows) == 1:
+        invariants = {"normal": rows[0], "point": target}
+        words = (
+            f"can slide its point {place} in the plane normal to {point_text(rows[0])}"
+            " and turn about it: 5 dof"
+        )
+        found = _Instance(pose, 5, "mechanism", 1, (), invariants, words, "point-in-plane")
+    else:
+        invariants = {"direction": np.cross(rows[0], rows[1]) + 0.0, "point": target}
+        words = (
+            f"can slide its point {place} along {point_text(invariants['direction'])}"
+            " and turn about it: 4 dof"
+        )
+        found = _Instance(pose, 4, "mechanism", 1, (), invariants, words, "point-on-line")
     reducer.trace.append(
         TraceStep(
-            "chain-solve point-on-plane",
-            f"world -> {instance_key(node)} [{'; '.join(edge.labels + own[0].labels)}]",
-            value.dof,
-            value.dof - 1,
-            "slide along the plane and turn about its normal through the point",
+            "higher-pair",
+            f"world -> {name} [{'; '.join(labels)}]",
+            6 if value is None else value.dof,
+            found.dof,
+            f"the point's loci meet in {_LOCI[len(rows)]}",
         )
     )
-    return out, []
+    return found, []
 
 
-_PARALLEL_MISS = "the point moves parallel to the plane at a distance from it"
+def _line_on_plane(
+    reducer: Reducer,
+    node: Node,
+    constraint: Constraint,
+    value: Coset | None,
+    labels: tuple[str, ...],
+    tol: Tolerance,
+) -> tuple[_Instance, list[Conflict]] | None:
+    """A line of an instance lying parallel to a world plane at a distance (a cylinder on a
+    plane, :class:`LineOnPlane`) with nothing else, in closed form (ALGEBRA.md §3).
+
+    The poses form a 4-dof double coset, not a coset: slide in the plane, turn about its
+    normal and about the line. The pose of least motion turns the line's direction a by
+    the smallest rotation onto the plane (about n × a through the line's point), then
+    moves it straight along the normal n to the distance. None with a coset link, a line
+    along the normal (no smallest rotation) or the line on the world."""
+    geometry = constraint.geometry
+    line_rep, line_x = reducer.find(geometry.line_node)
+    plane_rep, plane_x = reducer.find(geometry.plane_node)
+    if value is not None or (line_rep, plane_rep) != (node, WORLD):
+        return None
+    point = se3.apply(line_x, geometry.point)
+    along = line_x[:3, :3] @ geometry.direction
+    normal = plane_x[:3, :3] @ geometry.normal
+    origin = se3.apply(plane_x, geometry.origin)
+    flat = along - (along @ normal) * normal
+    if np.linalg.norm(flat) <= tol.angle:
+        return None
+    flat = flat / np.linalg.norm(flat)
+    turn = np.cross(along, flat)
+    sine = float(np.linalg.norm(turn))
+    pose = _EYE
+    if sine > tol.angle:
+        pose = rotation_about(point, turn / sine, math.atan2(sine, float(along @ flat)))
+    pose = se3.translation(-float(normal @ (point - origin)) * normal) @ pose
+    placed = se3.apply(pose, point)
+    name = instance_key(node)
+    invariants = {"normal": normal, "direction": flat, "point": placed}
+    words = (
+        f"keeps its line through {point_text(placed)} along {point_text(flat)}"
+        f" parallel to the plane normal to {point_text(normal)}: it can slide in the plane"
+        " and turn about the normal and about the line: 4 dof"
+    )
+    found = _Instance(pose, 4, "mechanism", 1, (), invariants, words, "line-on-plane")
+    reducer.trace.append(
+        TraceStep(
+            "higher-pair",
+            f"world -> {name} [{'; '.join(labels)}]",
+            6,
+            4,
+            "a line parallel to a plane at its distance",
+        )
+    )
+    return found, []
+
+
+def _coset_meets_locus(
+    group: SymmetryGroup,
+    reached: np.ndarray,
+    origin: np.ndarray,
+    rows: np.ndarray,
+    tol: Tolerance,
+) -> Coset | float | None:
+    """The members h of a connected ``group`` that put the point at ``reached`` into the
+    locus ``rows @ (y - origin) = 0`` (a plane or a line), when they form a coset.
+
+    When every rotation of the group keeps the locus normals' components (the group lies
+    in X(n) for a plane of normal n, in T3 for a line), h ↦ N·(h·q − q) is N·t_h, a
+    homomorphism: its fibres are cosets of its kernel, the group met with G(n) (a plane)
+    or T(d) (a line along d), ALGEBRA.md §2.4. The fibre reached is K·Tr(t) with t the
+    shortest translation of the group onto the locus (least motion); a locus the
+    translations cannot reach is missed by that distance (returned as a float). None
+    when the group turns the normals or screws (a fibre that is not a coset, or a helical
+    coupling), for the residue solver or another closed form."""
+    helical = {"helical", "pseudo-planar"}
+    keeping = SymmetryGroup.schoenflies(rows[0]) if len(rows) == 1 else SymmetryGroup.translation3()
+    if len(rows) == 3 or not keeping.includes(group, tol):
+        return None
+    kernel_of = (
+        SymmetryGroup.planar(rows[0])
+        if len(rows) == 1
+        else SymmetryGroup.prismatic(np.cross(rows[0], rows[1]))
+    )
+    shifts = _translations(group.intersect(SymmetryGroup.translation3(), tol))
+    need = rows @ (origin - reached)
+    step = np.zeros(3)
+    if len(shifts):
+        solved = np.linalg.lstsq(rows @ shifts.T, need, rcond=tol.precision)[0]
+        step = shifts.T @ solved
+    miss = float(np.linalg.norm(rows @ step - need))
+    if miss > tol.length:
+        return None if str(group.kind) in helical else miss
+    return Coset(group.intersect(kernel_of, tol), se3.translation(step))
+
+
+def _translations(group: SymmetryGroup) -> np.ndarray:
+    """Orthonormal rows spanning a translation group (fixed, prismatic, T2 or T3)."""
+    kind = str(group.kind)
+    if kind == "prismatic":
+        return group.axis.reshape(1, 3)
+    if kind == "translation2":
+        return line_normals(group.axis)
+    return np.eye(3) if kind == "translation3" else np.zeros((0, 3))
+
+
+_LOCI = {1: "a plane", 2: "a line", 3: "a point"}
+
+_PARALLEL_MISS = "the point's orbit under its joint runs parallel to its locus, at a distance"
 
 
 def _numeric_component(
@@ -814,12 +1031,13 @@ def _numeric_component(
     out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
     if not result.found:
         labels = tuple(dict.fromkeys(lb for c in constraints for lb in c.labels))
-        conflict = Conflict(
+        conflict = Conflict.measured(
             labels,
             "residual",
             result.best_residual,
             f"no solution found numerically (best residual {result.best_residual:.3g});"
             " this is not a proof that none exists",
+            tol,
         )
         for n in unknowns:
             out[n] = _Instance(np.asarray(problem.start[n]), 0, "mechanism", 0)
@@ -869,14 +1087,24 @@ def _leaf_report(
             base.solutions,
             tuple(a @ x for a in base.alternatives),
             base.invariants,
+            base.freedom,
+            base.mechanism,
         )
     return out, conflicts
 
 
+def _said(key: str, instance: _Instance) -> str:
+    """The sentence saying what of ``key`` is free (empty when nothing is, or unnamed)."""
+    text = instance.freedom or freedom_words(instance.motion, instance.dof, instance.invariants)
+    return f"{key} {text}" if text else ""
+
+
 def _same_pose(a: np.ndarray, b: np.ndarray, tol: Tolerance) -> bool:
+    """Whether two branches' poses are one: within the numeric solvers' precision (the
+    mesh tolerances) or the tolerance in force when looser."""
     return bool(
-        np.abs(a[:3, :3] - b[:3, :3]).max() <= tol.mesh_angle
-        and np.abs(a[:3, 3] - b[:3, 3]).max() <= tol.mesh_length
+        np.abs(a[:3, :3] - b[:3, :3]).max() <= max(tol.mesh_angle, tol.angle)
+        and np.abs(a[:3, 3] - b[:3, 3]).max() <= max(tol.mesh_length, tol.length)
     )
 
 
@@ -913,6 +1141,8 @@ def _combine(
                 count,
                 tuple(poses[1:]) if first.dof == 0 and count is not None else (),
                 first.invariants,
+                _said(f"{body}@{situation}", first),
+                first.mechanism,
             )
     return bodies, consistent[0][1]
 
@@ -947,20 +1177,30 @@ def solve_network(
     reports = [_leaf_report(network, leaf, tol) for leaf in leaves]
     bodies, conflicts = _combine(network, reports, tol)
     trace = tuple(dict.fromkeys(step for leaf in leaves for step in leaf.trace))
-    return Solution(bodies, tuple(conflicts), trace, explain)
+    free = tuple(
+        TraceStep("free", key, b.dof, b.dof, b.freedom) for key, b in bodies.items() if b.freedom
+    )
+    return Solution(bodies, tuple(conflicts), trace + free, explain)
+
+
+_EXTENTS = ("radius", "size", "major_radius", "minor_radius")
+"""Feature lengths that reach out from the feature's origin (a pin of radius 5 at the
+origin is a model of size 10, not 0)."""
 
 
 def model_scale(task: Any) -> float:
-    """Bounding-box diagonal of all feature origins (the length scale of the tolerances)."""
-    origins = [
-        np.asarray(f.point if hasattr(f, "point") else f.frame()[:3, 3], dtype=np.float64)
-        for body in task.bodies.values()
-        for f in body.features.values()
-    ]
-    if not origins:
+    """Bounding-box diagonal of all feature origins, each grown by its feature's radius or
+    size (the length scale of the tolerances)."""
+    low, high = [], []
+    for body in task.bodies.values():
+        for f in body.features.values():
+            origin = np.asarray(f.point if hasattr(f, "point") else f.frame()[:3, 3], float)
+            reach = sum(float(getattr(f, name, 0.0) or 0.0) for name in _EXTENTS)
+            low.append(origin - reach)
+            high.append(origin + reach)
+    if not low:
         return 1.0
-    points = np.array(origins)
-    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+    diagonal = float(np.linalg.norm(np.max(high, axis=0) - np.min(low, axis=0)))
     return diagonal if diagonal > 0 else 1.0
 
 

@@ -4,12 +4,13 @@ A result that is a set is reported as a set: every body instance ``"<body>@<situ
 has a representative pose, its remaining dof and motion group with invariants in world
 coordinates, and the number of solutions (with the other poses when there are finitely
 many). Inconsistencies are answers, listed as conflicts naming the relations and the
-size of the mismatch.
+size of the mismatch; a mismatch within ``NEARLY_CONSISTENT`` times the tolerance is
+*nearly consistent* and carries the tolerance that accepts it (``needed_tolerance``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -17,6 +18,8 @@ import numpy as np
 from rich.console import Group
 from rich.table import Table
 from rich.text import Text
+
+from assemblykit.tolerance import Tolerance
 
 STATUSES = ("solved", "ambiguous", "underconstrained", "inconsistent")
 
@@ -53,7 +56,10 @@ class BodyInstanceResult:
     """The pose set of one body in one situation.
 
     ``solutions`` is the number of poses (``None`` for an infinite discrete family, a
-    lattice); for a continuum (``dof > 0``) it counts the components found.
+    lattice); for a continuum (``dof > 0``) it counts the components found. ``freedom``
+    says in words what is free; ``mechanism`` names a freedom that is no Hervé family
+    (a higher pair: ``point-in-plane``, ``point-on-line``, ``planar-point-on-line``,
+    ``line-on-plane``).
     """
 
     body: str
@@ -64,6 +70,8 @@ class BodyInstanceResult:
     solutions: int | None = 1
     alternatives: tuple[np.ndarray, ...] = ()
     invariants: Mapping[str, Any] = field(default_factory=dict)
+    freedom: str = ""
+    mechanism: str = ""
 
     def __post_init__(self) -> None:
         if self.motion not in MOTIONS:
@@ -73,6 +81,11 @@ class BodyInstanceResult:
     def key(self) -> str:
         """The instance name ``"<body>@<situation>"``."""
         return f"{self.body}@{self.situation}"
+
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary("BodyInstanceResult", self.key, self.motion, f"{self.dof} dof")
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object of DESIGN.md §5.3 for this instance."""
@@ -87,25 +100,79 @@ class BodyInstanceResult:
                 for k, v in self.invariants.items()
                 if k in INVARIANT_KEYS
             },
+            **({"freedom": self.freedom} if self.freedom else {}),
+            **({"mechanism": self.mechanism} if self.mechanism else {}),
         }
+
+
+def point_text(point: Any) -> str:
+    """``(0.5, 1, 1.5)``: a point or direction as people write it."""
+    return "(" + ", ".join(f"{float(v):.6g}" for v in np.asarray(point, dtype=float) + 0.0) + ")"
+
+
+def freedom_words(motion: str, dof: int, invariants: Mapping[str, Any]) -> str:
+    """What remains free, in words, after the instance's name: ``"can turn about (0.5, 1,
+    1.5): 3 dof"``; empty for a fixed instance and for a mechanism nothing names."""
+    inv = {k: point_text(v) for k, v in invariants.items() if k != "pitch"}
+    phrases = {
+        "revolute": "turn about the axis through {point} along {direction}",
+        "prismatic": "slide along {direction}",
+        "helical": "screw about the axis through {point} along {direction}",
+        "cylindrical": "slide along and turn about the axis through {point} along {direction}",
+        "planar": "slide in the plane normal to {normal} and turn about that normal",
+        "spherical": "turn about {center}",
+        "translation2": "slide in the plane normal to {normal}",
+        "translation3": "slide in every direction",
+        "schoenflies": "slide in every direction and turn about {direction}",
+        "free": "move freely",
+    }
+    phrase = phrases.get(motion)
+    if dof == 0 or phrase is None:
+        return ""
+    try:
+        text = phrase.format(**inv)
+    except KeyError:
+        return f"moves as a {motion} joint: {dof} dof"
+    return f"can {text}: {dof} dof"
 
 
 @dataclass(frozen=True)
 class Conflict:
-    """Relations that cannot hold together, the kind of mismatch and its size."""
+    """Relations that cannot hold together, the kind of mismatch and its size.
+
+    ``needed_tolerance`` is the relative tolerance (``--tolerance``, the angle following
+    it) at which the mismatch is accepted, when it is within ``NEARLY_CONSISTENT`` times
+    the tolerance in force (:meth:`Tolerance.needed`); ``None`` otherwise."""
 
     relations: tuple[str, ...]
     kind: str
     value: float
     message: str
+    needed_tolerance: float | None = None
+
+    @classmethod
+    def measured(
+        cls, relations: tuple[str, ...], kind: str, value: float, message: str, tol: Tolerance
+    ) -> Conflict:
+        """A conflict whose ``needed_tolerance`` is computed from the mismatch and ``tol``."""
+        return cls(relations, kind, value, message, tol.needed(kind, value))
+
+    @property
+    def advice(self) -> str | None:
+        """The sentence telling how far to loosen the tolerance, when nearly consistent."""
+        if self.needed_tolerance is None:
+            return None
+        t = f"{self.needed_tolerance:.2g}"
+        return f"nearly consistent: loosen the tolerance to {t} (--tolerance {t})"
 
     def to_dict(self) -> dict[str, Any]:
-        """``{relations, kind, value, message}``."""
+        """``{relations, kind, value, message, needed_tolerance}``."""
         return {
             "relations": list(self.relations),
             "kind": self.kind,
             "value": float(self.value),
             "message": self.message,
+            "needed_tolerance": self.needed_tolerance,
         }
 
 
@@ -156,13 +223,55 @@ class Solution:
         """``solved``, ``ambiguous``, ``underconstrained`` or ``inconsistent``."""
         return status_of(self.bodies, self.conflicts)
 
+    def __getitem__(self, key: str) -> BodyInstanceResult:
+        return self.bodies[key]
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.bodies
+
+    def __iter__(self) -> Iterator[str]:
+        """The instance names ``"<body>@<situation>"``, as a mapping iterates."""
+        return iter(self.bodies)
+
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary(
+            "Solution",
+            self.status,
+            fmt.count(len(self.bodies), "body instance"),
+            fmt.count(len(self.conflicts), "conflict"),
+        )
+
+    def _repr_html_(self) -> str:
+        """The instances as a table: dof, motion, position (notebooks)."""
+        from assemblykit import formatting as fmt
+
+        rows = [
+            (key, str(b.dof), b.motion, fmt.vector(np.asarray(b.pose)[:3, 3]))
+            for key, b in self.bodies.items()
+        ]
+        return fmt.html_summary(repr(self), ("instance", "dof", "motion", "position"), rows)
+
+    @property
+    def suggested_tolerance(self) -> float | None:
+        """The loosest tolerance any conflict needs, when every conflict is nearly
+        consistent (a looser tolerance may reveal conflicts the first ones hid)."""
+        needed = [c.needed_tolerance for c in self.conflicts]
+        if not needed or any(n is None for n in needed):
+            return None
+        return max(n for n in needed if n is not None)
+
     def to_dict(self) -> dict[str, Any]:
-        """The ``solve`` JSON of DESIGN.md §5.3 (plus ``trace`` when explaining)."""
+        """The ``solve`` JSON of DESIGN.md §5.3 (plus ``suggested_tolerance`` when
+        inconsistent and ``trace`` when explaining)."""
         out: dict[str, Any] = {
             "status": self.status,
             "bodies": {key: b.to_dict() for key, b in self.bodies.items()},
             "conflicts": [c.to_dict() for c in self.conflicts],
         }
+        if self.conflicts:
+            out["suggested_tolerance"] = self.suggested_tolerance
         if self.explain:
             out["trace"] = [step.to_dict() for step in self.trace]
         return out
@@ -181,15 +290,18 @@ class Solution:
             table.add_row(
                 key,
                 str(b.dof),
-                b.motion,
+                f"{b.motion} ({b.mechanism})" if b.mechanism else b.motion,
                 "infinite" if b.solutions is None else str(b.solutions),
                 str(np.round(np.asarray(b.pose)[:3, 3], 6).tolist()),
                 invariants,
             )
         parts: list[Any] = [table]
+        parts.extend(Text(b.freedom) for b in self.bodies.values() if b.freedom)
         for c in self.conflicts:
             parts.append(Text(f"conflict ({c.kind} {c.value:.6g}): {', '.join(c.relations)}"))
             parts.append(Text(f"  {c.message}"))
+            if c.advice is not None:
+                parts.append(Text(f"  {c.advice}"))
         if self.explain:
             # one line per step whatever the width: the trace is read by people and programs
             for step in self.trace:

@@ -13,9 +13,10 @@ numeric residue solver (ALGEBRA.md §2.5, numeric fallback).
 
 Residual scaling: every entry is a length in model units. Lengths enter as they are;
 direction and angle entries (differences of unit vectors, cosines, sines) are multiplied
-by the tolerance's length scale ``tol.scale`` (the model's bounding-box diagonal), so an
-angular error θ weighs like the arc θ·scale it sweeps at the model's size, and one
-threshold ``tol.length`` (or ``tol.mesh_length``) applies to every entry.
+by the tolerance's arm ``tol.arm = tol.length / tol.angle`` (the model's bounding-box
+diagonal when the angle tolerance follows the relative length, :mod:`assemblykit.tolerance`),
+so an angular error θ weighs like the arc θ·arm, and one threshold ``tol.length`` holds
+lengths to the length tolerance and angles to the angle tolerance.
 """
 
 from __future__ import annotations
@@ -56,6 +57,8 @@ POINTED = frozenset({"point", "ball", "socket", "cone", "torus", "frame"})
 """Feature types carrying a distinguished point (the frame origin: centre or apex)."""
 DIRECTED = AXIAL | {"plane"}
 """Feature types carrying a direction (normal or axis, the frame +z)."""
+LINED = AXIAL - POINTED
+"""Feature types that are a line and nothing more (no distinguished point on it)."""
 
 
 @dataclass(frozen=True)
@@ -131,6 +134,7 @@ RELATIONS: Mapping[str, RelationSpec] = MappingProxyType(
                 2,
                 _pairs(POINTED, POINTED)
                 | _either(POINTED, {"plane"})
+                | _either(LINED, {"plane"})
                 | _pairs({"plane"}, {"plane"}),
                 frozenset({"distance"}),
                 frozenset({"distance"}),
@@ -441,11 +445,13 @@ def relation_residual(
     """The residual r(X) of ``[kind, first, second]``: zero iff X = L_second⁻¹·L_first
     satisfies the relation (the coset of :func:`relation_coset` for coset kinds).
 
-    Entries are lengths; direction terms are scaled by ``tol.scale`` (module docstring).
+    Entries are lengths; direction terms are scaled by ``tol.arm`` (module docstring).
     The meaning of each non-coset kind: ``perpendicular`` d₂·d₁ = 0; ``angle`` d₂·d₁ =
     cos(angle); ``point_on_plane`` n·(c − p) = 0; ``point_on_line`` the offset of c from
     the line is 0; ``distance`` ‖c₂ − c₁‖ = d (points), n·(c − p) = d (point and plane,
-    signed along the normal), planes parallel with n₁·(p₂ − p₁) = d (two planes). Here d
+    signed along the normal), the line parallel to the plane with n·(o − p) = d (a line
+    and a plane: a cylinder of radius d lying on the plane, ALGEBRA.md §3), planes
+    parallel with n₁·(p₂ − p₁) = d (two planes). Here d
     is a normal or axis, c a feature's point (centre, apex), p a plane point. Coupled
     kinds (``gear``, ``mirror``) raise :class:`FeatureError`: they are defined on the
     network (``assemblykit.inference.numeric``).
@@ -455,34 +461,34 @@ def relation_residual(
     values = _option_values(kind, options or {}, None)
     if kind in COUPLED:
         raise FeatureError(f"{kind} couples motions through the network; it has no pair residual")
-    scale = tol.scale
+    arm = tol.arm
     f1, f2 = second.frame(), first.frame()
     d1, o1 = f1[:3, 2], f1[:3, 3]
     fits: Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]] | None = None
     if kind in ("fits", "coaxial"):
         pair = (first, second) if kind == "fits" else (_axis_of(first), _axis_of(second))
         directed = _is_directed(pair[0]) and _is_directed(pair[1])
-        fits = _fits_residual(pair[0], pair[1], directed, scale)
+        fits = _fits_residual(pair[0], pair[1], directed, arm)
 
     def residual(x: NDArray[np.float64]) -> NDArray[np.float64]:
         moved = np.asarray(x, dtype=np.float64) @ f2
         d2, o2 = moved[:3, 2], moved[:3, 3]
         match kind:
             case "against":
-                return np.append((d2 + d1) * scale, d1 @ (o2 - o1) - values["offset"])
+                return np.append((d2 + d1) * arm, d1 @ (o2 - o1) - values["offset"])
             case "coplanar":
-                return np.append((d2 - d1) * scale, d1 @ (o2 - o1))
+                return np.append((d2 - d1) * arm, d1 @ (o2 - o1))
             case "fits" | "coaxial":
                 assert fits is not None
                 return fits(moved)
             case "fixed":
-                return np.concatenate([(moved[:3, :3] - f1[:3, :3]).ravel() * scale, o2 - o1])
+                return np.concatenate([(moved[:3, :3] - f1[:3, :3]).ravel() * arm, o2 - o1])
             case "parallel":
-                return np.cross(d2, d1) * scale
+                return np.cross(d2, d1) * arm
             case "perpendicular":
-                return np.array([d2 @ d1 * scale])
+                return np.array([d2 @ d1 * arm])
             case "angle":
-                return np.array([(d2 @ d1 - math.cos(values["angle"])) * scale])
+                return np.array([(d2 @ d1 - math.cos(values["angle"])) * arm])
             case "coincident":
                 return o2 - o1
             case "point_on_plane":
@@ -495,7 +501,11 @@ def relation_residual(
                 return _perpendicular_part(point - line_o, line_d)
         distance = values["distance"]
         if isinstance(first, Plane) and isinstance(second, Plane):
-            return np.append(np.cross(d2, d1) * scale, d1 @ (o2 - o1) - distance)
+            return np.append(np.cross(d2, d1) * arm, d1 @ (o2 - o1) - distance)
+        if isinstance(second, Plane) and first.type_name in LINED:
+            return np.array([d2 @ d1 * arm, d1 @ (o2 - o1) - distance])
+        if isinstance(first, Plane) and second.type_name in LINED:
+            return np.array([d1 @ d2 * arm, d2 @ (o1 - o2) - distance])
         if isinstance(second, Plane):
             return np.array([d1 @ (o2 - o1) - distance])
         if isinstance(first, Plane):
@@ -532,12 +542,15 @@ _DOF = {
 def relation_dof_removed(kind: str, first: Feature, second: Feature) -> int:
     """The generic number of dof ``[kind, first, second]`` removes from X: 6 minus the dof
     of its coset for coset kinds (fits: C 4, S 3, R 5, H 5, T⋊Cₙ 5), and the number of
-    independent scalar equations otherwise (distance: 1, or 3 between two planes)."""
+    independent scalar equations otherwise (distance: 1, 2 between a line and a plane,
+    3 between two planes)."""
     _check(kind, first, second, None)
     if kind in COUPLED:
         raise FeatureError(f"{kind} couples motions through the network; it has no pair dof")
     if kind == "fits":
         return _FITS_DOF[second.type_name]
     if kind == "distance":
-        return 3 if isinstance(first, Plane) and isinstance(second, Plane) else 1
+        if isinstance(first, Plane) and isinstance(second, Plane):
+            return 3
+        return 2 if LINED & {first.type_name, second.type_name} else 1
     return _DOF[kind]

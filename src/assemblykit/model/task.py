@@ -83,6 +83,27 @@ class Task:
 
     __hash__ = None  # type: ignore[assignment]
 
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary(
+            "Task",
+            fmt.count(len(self.bodies), "body", "bodies"),
+            fmt.count(len(self.situations), "situation"),
+            self.units,
+            fmt.file_name(self.source),
+        )
+
+    def _repr_html_(self) -> str:
+        """The bodies as a table (notebooks)."""
+        from assemblykit import formatting as fmt
+
+        rows = [
+            (name, "yes" if body.fixed else "", ", ".join(body.features))
+            for name, body in self.bodies.items()
+        ]
+        return fmt.html_summary(repr(self), ("body", "fixed", "features"), rows)
+
     def canonical(self) -> tuple[Any, ...]:
         """The model as plain nested values, without file names or places in files."""
         bodies = tuple(
