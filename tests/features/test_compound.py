@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from assemblykit.algebra import se3
+from assemblykit.algebra.subgroups import Kind
 from assemblykit.errors import FeatureError
 from assemblykit.features import (
     Axis,
@@ -26,6 +27,7 @@ from assemblykit.features import (
     compound_group,
     relationship,
 )
+from assemblykit.tolerance import Tolerance
 
 D, ONE, TWO, COMP = (
     Relationship.DISTINCT,
@@ -160,3 +162,24 @@ def test_gearbox_gear_hub_is_revolute():
 def test_empty_compound_is_an_error():
     with pytest.raises(FeatureError):
         compound_group([])
+
+
+@pytest.mark.parametrize("tilt", [1e-8, 1e-6, 1e-3])
+def test_a_plane_and_a_bore_tilted_beyond_the_angle_tolerance_keep_only_the_identity(tilt):
+    # the turns about the bore are not turns about the plane's normal, and its slides
+    # leave the plane: the compound is rigid (the identity permutation always transports)
+    plane = Plane(point=[0, 0, 0], normal=[0, 0, -1])
+    bore = Hole(point=[0, 0, 0], axis=[0, tilt, 1], radius=2, directed=True)
+    pin = Shaft(point=[10, 0, 2], axis=[0, 0, 1], radius=1.5, directed=True)
+    top = Plane(point=[0, 0, 2], normal=[0, 0, 1])
+    tol = Tolerance(scale=19.0)
+    assert compound_group((bore, plane), tol).kind is Kind.FIXED
+    assert compound_group((bore, plane, pin, top), tol).kind is Kind.FIXED
+
+
+@pytest.mark.parametrize("tilt", [1e-8, 1e-6])
+def test_a_bore_tilted_within_the_angle_tolerance_turns_about_the_plane_normal(tilt):
+    plane = Plane(point=[0, 0, 0], normal=[0, 0, -1])
+    bore = Hole(point=[0, 0, 0], axis=[0, tilt, 1], radius=2, directed=True)
+    group = compound_group((bore, plane), Tolerance(scale=19.0, angle=1e-5))
+    assert group.kind is Kind.REVOLUTE

@@ -14,6 +14,7 @@ import trimesh
 from assemblykit.geometry.contacts import candidate_pairs, find_contacts
 from assemblykit.io.compas import load_compas
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.tolerance import Tolerance
 from datasets import dataset
 
 
@@ -148,3 +149,47 @@ def test_touching_pairs_and_areas_agree_with_compas_assembly(name, measured, jac
     assert len(found.keys() & ref.keys()) / len(found.keys() | ref.keys()) >= jaccard
     for pair in found.keys() & ref.keys():
         assert found[pair] == pytest.approx(ref[pair], rel=1e-6)
+
+
+def _square(half: float) -> np.ndarray:
+    return np.array([[-half, -half, 0], [half, -half, 0], [half, half, 0], [-half, half, 0]])
+
+
+@pytest.mark.parametrize(("scatter", "snapped_to"), [(1e-5, 0), (0.0, 1)])
+def test_a_normal_snaps_when_turning_it_moves_within_the_scatter(scatter, snapped_to):
+    from assemblykit.geometry.contacts import snap_classes
+
+    # two unit squares, normals 2e-5 rad apart (about x): turning the second onto the
+    # first moves its edge at y = +-0.5 by 1e-5, within twice their scatter (4e-5) and
+    # the tolerance (1e-4); faces without scatter are exact and keep their normals
+    tilt = 2e-5
+    directions = np.array([[0, 0, 1.0], [0, -np.sin(tilt), np.cos(tilt)]])
+    tol = Tolerance(scale=1.0, rel_length=1e-4)
+    leader, sign = snap_classes(
+        directions, [_square(0.5), _square(0.5)], np.array([scatter, scatter]), tol
+    )
+    assert leader.tolist() == [0, snapped_to] and sign.tolist() == [1.0, 1.0]
+
+
+def test_a_normal_turned_further_than_the_tolerance_leads_its_own_class():
+    from assemblykit.geometry.contacts import snap_classes
+
+    # 4e-4 rad over a half-width of 0.5 moves the edge by 2e-4 > 1e-4
+    tilt = 4e-4
+    directions = np.array([[0, 0, 1.0], [0, -np.sin(tilt), -np.cos(tilt)]])
+    tol = Tolerance(scale=1.0, rel_length=1e-4)
+    leader, _ = snap_classes(directions, [_square(0.5)] * 2, np.array([1e-4, 1e-4]), tol)
+    assert leader.tolist() == [0, 1]
+
+
+def test_the_pieces_of_one_face_make_one_patch():
+    # part a is two boxes side by side with a crack of 1e-9 (far below the tolerance,
+    # 1e-6 x 2.45) between them: two coplanar faces under box c, joined into one patch,
+    # the unit square (the crack closed)
+    halves = trimesh.util.concatenate(
+        [box([0, 0, 0], [0.5 - 1e-9, 1, 1]), box([0.5, 0, 0], [1, 1, 1])]
+    )
+    (contact,) = find_contacts(assembly(a=halves, c=box([0, 0, 1], [1, 1, 2])))
+    (patch,) = contact.planar
+    assert patch.area == pytest.approx(1.0, abs=1e-8)
+    np.testing.assert_allclose(patch.normal, [0, 0, 1], atol=1e-12)

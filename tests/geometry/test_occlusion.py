@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import manifold3d
 import numpy as np
+import pytest
 import trimesh
 
 from assemblykit.geometry.interference import interferes, solid
@@ -91,3 +92,12 @@ def test_agrees_with_swept_volumes():
             if i != j and interferes(swept(meshes[i], d, 20.0), meshes[j], TOL.for_mesh())
         }
         assert blocked(meshes, d) == expected, d
+
+
+@pytest.mark.parametrize(("scale", "kept"), [(100.0, 0), (1.0, 1)])
+def test_a_side_face_whose_shadow_is_thinner_than_the_tolerance_casts_none(scale, kept):
+    # tilted 5e-5 off the view direction (beyond the angle tolerance 1e-5), the triangle
+    # projects to a sliver 5e-5 wide: below the tolerance 1e-6 x 100, above 1e-6 x 1
+    triangle = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 5e-5, 1]], [[0, 1, 2]], process=False)
+    view = shadows([triangle], [0, 0, 1], Tolerance(scale=scale).for_mesh())
+    assert len(view.owner) == kept

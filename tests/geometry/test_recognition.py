@@ -123,3 +123,50 @@ def test_asap_beam_fillets_are_found():
     for s in cylinders + spheres:
         assert s.radius == pytest.approx(0.0762, abs=2e-3)
         assert s.convex
+
+
+def _sliver_and_triangle(lift: float) -> tuple[np.ndarray, np.ndarray]:
+    """A sliver A B C (10 long, 0.02 wide) and a wide triangle A C D sharing A C, all in
+    z = 0 but C lifted by ``lift`` (vertex noise)."""
+    vertices = np.array([[0, 0, 0], [10, 0, 0], [10, 0.02, lift], [0, 10, 0]], dtype=float)
+    return vertices, np.array([[0, 1, 2], [0, 2, 3]])
+
+
+def test_a_noisy_sliver_stays_in_its_face():
+    # tolerance 1e-5; C lifted 5e-6 tilts the sliver's plane by 5e-6 / 0.02 = 2.5e-4 rad,
+    # putting D 10 x 2.5e-4 = 2.5e-3 off it, while B lies 10 x 5e-7 = 5e-6 off the wide
+    # triangle's plane z = 5e-7 x: one flat face, as all four points are within 1e-5 of
+    # a plane; the strict test (both ways) splits it
+    vertices, faces = _sliver_and_triangle(5e-6)
+    tol = Tolerance(scale=10.0, rel_length=1e-6)
+    seg = segment(vertices, faces, tol)
+    assert seg.group[0] == seg.group[1] and seg.flat.all()
+    assert seg.deviation[0] <= 5e-6
+    strict = segment(vertices, faces, tol, strict=True)
+    assert strict.group[0] != strict.group[1]
+
+
+def test_a_sliver_lifted_beyond_the_tolerance_is_its_own_face():
+    # C lifted 2e-4: B lies 10 x 2e-5 = 2e-4 off the wide triangle's plane
+    vertices, faces = _sliver_and_triangle(2e-4)
+    seg = segment(vertices, faces, Tolerance(scale=10.0, rel_length=1e-6))
+    assert seg.group[0] != seg.group[1]
+
+
+def test_points_within_the_tolerance_of_a_plane_are_never_a_huge_cylinder():
+    # a flat disc of 32 fan triangles with vertex noise 1e-9: a cylinder of enormous
+    # radius fits it within the tolerance, but it is a plane
+    angles = np.linspace(0, 2 * np.pi, 33)[:-1]
+    rim = np.column_stack([np.cos(angles), np.sin(angles), 1e-9 * np.sin(5 * angles)])
+    vertices = np.vstack([[0, 0, 0], rim])
+    faces = np.array([[0, 1 + k, 1 + (k + 1) % 32] for k in range(32)])
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    from assemblykit.geometry.recognition import fit_surface
+
+    tri = mesh.triangles
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normals = cross / np.linalg.norm(cross, axis=1)[:, None]
+    areas = np.linalg.norm(cross, axis=1) / 2
+    tol = Tolerance(scale=2.0).for_mesh()
+    found = fit_surface(vertices, faces, normals, areas, tol, np.arange(32), ("cylinder",))
+    assert found is None

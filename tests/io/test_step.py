@@ -93,3 +93,69 @@ def test_unreadable_step_names_the_file(tmp_path):
     path.write_text("this is not ISO-10303-21\n")
     with pytest.raises(GeometryError, match=r"junk\.step"):
         load_assembly(path)
+
+
+@pytest.fixture(scope="module")
+def damaged_step(tmp_path_factory):
+    """Two stacked boxes written by OCP, the second one's shell cut short (its closing
+    bracket lost): OCP reads the first and drops the second, printing parse errors."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+
+    folder = tmp_path_factory.mktemp("damaged")
+    good = folder / "two.step"
+    write_step(
+        good,
+        BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 10, 10, 10).Shape(),
+        BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 10), 10, 10, 5).Shape(),
+    )
+    lines = good.read_text().splitlines()
+    solids = [i for i, line in enumerate(lines) if "MANIFOLD_SOLID_BREP" in line]
+    assert len(solids) == 2
+    label = lines[solids[1]].split("=")[0].strip()
+    shell = solids[1] + 1
+    assert "CLOSED_SHELL" in lines[shell]
+    lines[shell] = lines[shell].replace("));", ");")
+    damaged = folder / "damaged.step"
+    damaged.write_text("\n".join(lines) + "\n")
+    return damaged, label
+
+
+def test_a_damaged_solid_is_listed_as_skipped(damaged_step):
+    path, label = damaged_step
+    asm = load_assembly(path)
+    assert list(asm.parts) == ["solid1"]
+    assert [s.item for s in asm.skipped] == [f"{label} MANIFOLD_SOLID_BREP"]
+    assert any("Incorrect Syntax" in w for w in asm.warnings)
+    assert all("\x1b" not in w for w in asm.warnings)
+
+
+def test_a_damaged_step_still_gives_json_that_parses_and_says_what_was_skipped(damaged_step):
+    import json
+    import subprocess
+    import sys
+
+    path, label = damaged_step
+    # a child process: OCP writes on the process's descriptor 1, which only a real
+    # stdout shows
+    entry = "from assemblykit.cli import main; main()"
+    done = subprocess.run(
+        [sys.executable, "-c", entry, "contacts", str(path), "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    data = json.loads(done.stdout)
+    assert list(data["parts"]) == ["solid1"]
+    assert data["skipped"] == [
+        {
+            "item": f"{label} MANIFOLD_SOLID_BREP",
+            "reason": "its shell could not be read; the solid is left out",
+        }
+    ]
+    assert f"skipped {label} MANIFOLD_SOLID_BREP" in done.stderr
+
+
+def test_an_intact_step_skips_nothing(step_file):
+    asm = load_assembly(step_file)
+    assert asm.skipped == () and asm.warnings == ()

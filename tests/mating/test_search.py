@@ -344,3 +344,82 @@ def test_cylindrical_bodies_are_judged_over_both_parameters() -> None:
         tol,
     )
     assert clearance.judge_pair(turning[0], apart, tol).verdict is clearance.Verdict.CLEAR
+
+
+EXAMPLE2_ANSWER = {
+    frozenset({(1, "b3", "comp1", "b1", "comp2"), (2, "b3", "comp2", "b2", "comp2"),
+               (3, "b1", "comp1", "b2", "comp1")}),
+    frozenset({(1, "b3", "comp2", "b1", "comp2"), (2, "b3", "comp1", "b2", "comp2"),
+               (3, "b1", "comp1", "b2", "comp1")}),
+}  # fmt: skip
+
+
+def _tilted(data: dict, tilt: float) -> dict:
+    """example2 with b1's bore axis tilted by ``tilt`` radians (about x)."""
+    tilted = copy.deepcopy(data)
+    tilted["bodies"]["b1"]["features"]["bore"]["axis"] = [0.0, tilt, 1.0]
+    return tilted
+
+
+@pytest.mark.parametrize("tilt", [1e-8, 1e-6])
+def test_a_bore_tilted_within_the_angle_tolerance_mates_as_the_exact_one(
+    example2_data: dict, tilt: float
+) -> None:
+    result = mate(parse_problem(_tilted(example2_data, tilt), tol=Tolerance(angle=1e-5)))
+    assert _answer(result) == EXAMPLE2_ANSWER
+    assert result.count == 2
+
+
+def test_a_bore_tilted_beyond_the_angle_tolerance_is_an_answer_not_a_crash(
+    example2_data: dict,
+) -> None:
+    # 1e-8 rad is beyond the exact default (1e-9): b1's plane and bore no longer share
+    # a turn, so no fit of a turning pin exists
+    result = mate(parse_problem(_tilted(example2_data, 1e-8)))
+    assert result.to_dict()["status"] == "no solution" and result.count == 0
+
+
+def test_a_free_pose_search_cut_short_says_so(mating_examples: Path, monkeypatch) -> None:
+    # the peg must slide 2 out of the base: one check cannot find that position
+    monkeypatch.setattr(search, "WITNESS_CHECKS", 1)
+    result = mate(load_problem(mating_examples / "shaft_fit.yaml"))
+    assert result.count == 0
+    (rejection,) = result.rejections
+    assert not rejection.proven
+    assert rejection.reason == (
+        "no collision-free position found for base, peg within 1 checks (search cut short)"
+    )
+
+
+def test_a_free_pose_search_that_ends_finds_the_slide(mating_examples: Path) -> None:
+    result = mate(load_problem(mating_examples / "shaft_fit.yaml"))
+    assert result.count == 1 and result.rejections == ()
+
+
+@pytest.mark.parametrize("sides", [6, 65, 100])
+def test_a_prism_key_fits_its_socket_once_whatever_its_sides(sides: int) -> None:
+    # the key's own symmetry maps each of the n turned fits onto the others: one
+    # configuration (no cap on the number of sides)
+    prism = {"type": "prism", "sides": sides, "size": 2, "point": [0, 0, 0], "axis": [0, 0, -1]}
+    data = {
+        "units": "mm",
+        "bodies": {
+            "base": {
+                "features": {
+                    "top": {"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1]},
+                    "socket": {**prism, "male": False},
+                },
+                "compound": {"c": ["top", "socket"]},
+            },
+            "key": {
+                "features": {
+                    "bottom": {"type": "plane", "point": [0, 0, 0], "normal": [0, 0, -1]},
+                    "stem": {**prism, "male": True},
+                },
+                "compound": {"c": ["bottom", "stem"]},
+            },
+        },
+        "goals": [["fit", "key", "base"]],
+    }
+    result = mate(parse_problem(data))
+    assert result.to_dict()["status"] == "solved" and result.count == 1

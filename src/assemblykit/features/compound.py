@@ -10,6 +10,7 @@ the union, over the class-preserving permutations π, of the non-empty transport
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
@@ -219,8 +220,9 @@ def _differ(a: NDArray, b: NDArray, limit: float) -> bool:
 
 def _transporters(
     features: Sequence[Feature], classes: Sequence[int], tol: Tolerance
-) -> Iterable[Coset]:
-    """The non-empty cosets {g : g(Fᵢ) = F_π(i) ∀i} over class-preserving permutations π.
+) -> Iterable[tuple[tuple[int, ...], Coset]]:
+    """The non-empty cosets {g : g(Fᵢ) = F_π(i) ∀i} over class-preserving permutations π,
+    each with its π.
 
     Depth-first over the assignments π(0), π(1), ...; an empty partial intersection
     prunes every permutation that extends it (ALGEBRA.md §4.1 steps 2-3). Before
@@ -231,10 +233,12 @@ def _transporters(
     membership test of that motion."""
     cosines, offsets = _plane_invariants(features, tol)
 
-    def extend(index: int, assigned: tuple[int, ...], partial: Coset | None) -> Iterable[Coset]:
+    def extend(
+        index: int, assigned: tuple[int, ...], partial: Coset | None
+    ) -> Iterable[tuple[tuple[int, ...], Coset]]:
         if index == len(features):
             assert partial is not None
-            yield partial
+            yield assigned, partial
             return
         for target in range(len(features)):
             if target in assigned or classes[target] != classes[index]:
@@ -261,22 +265,34 @@ def compound_group(features: Sequence[Feature], tol: Tolerance | None = None) ->
     """The symmetry group of a compound feature (seed 003 Props 3.2.6-3.2.8, 5.0.9).
 
     ALGEBRA.md §4.1: the union of the non-empty transporters over class-preserving
-    permutations. The identity permutation gives G₁ ∩ ... ∩ Gₙ (Props 3.2.6, 3.2.7);
-    the others add the swaps g_ij of 2-congruent features and their products (Props
-    3.2.8, 5.0.9), each a coset of that intersection. When no two features are the same
-    surface, these cosets are disjoint and already form the group, so their components
-    are listed directly instead of closing them again under composition.
+    permutations. The identity permutation gives G₁ ∩ ... ∩ Gₙ (Props 3.2.6, 3.2.7),
+    computed as the meet of the groups (it always holds the identity, also for axes
+    just beyond the angle tolerance of parallel, where a meet of cosets may find no
+    common point); the others add the swaps g_ij of 2-congruent features and their
+    products (Props 3.2.8, 5.0.9), each a coset of that intersection. When no two
+    features are the same surface, these cosets are disjoint and already form the group,
+    so their components are listed directly instead of closing them again under
+    composition.
     """
     tol = tol or current()
     if not features:
         raise FeatureError("a compound feature needs at least one primitive feature")
-    cosets = list(_transporters(features, _congruence_classes(features, tol), tol))
-    base = cosets[0].group
-    swaps = [coset.rep for coset in cosets[1:]]
+    identity_order = tuple(range(len(features)))
+    cosets = [
+        coset
+        for order, coset in _transporters(features, _congruence_classes(features, tol), tol)
+        if order != identity_order
+    ]
+    base = functools.reduce(
+        lambda group, feature: group.intersect(feature.group(), tol),
+        features[1:],
+        features[0].group(),
+    )
+    swaps = [coset.rep for coset in cosets]
     if not swaps:
         return base
     identity = np.eye(4)
-    if base.lattice or any(coset.contains(identity, tol) for coset in cosets[1:]):
+    if base.lattice or any(coset.contains(identity, tol) for coset in cosets):
         return base.extended_by(swaps, tol=tol)
     # Pairwise distinct features: the transporters of distinct permutations are
     # disjoint, and together they are the whole group, closed already; each is

@@ -24,7 +24,7 @@ into ``b`` across a planar patch iff ``d . normal > 0`` (seed 004, DBG arcs).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
@@ -37,6 +37,7 @@ from assemblykit.geometry.curved import (
     CONE_AZIMUTHS,
     TURN,
     arc_angles,
+    axis_frame,
     cone_generators,
     covered_arcs,
     intersect_arcs,
@@ -60,6 +61,9 @@ class PlanarPatch:
     normal: NDArray[np.float64]
     polygon: NDArray[np.float64]
     area: float
+    scatter: float = 0.0
+    """How far the vertices of the two faces lie from their planes: the noise that makes
+    the normal unsure (0 for exact faces)."""
 
     @property
     def centroid(self) -> NDArray[np.float64]:
@@ -361,6 +365,7 @@ def _planar_patches(
     table = np.full((len(matched), int(rank.max()) + 1 if len(rank) else 0), None, dtype=object)
     table[slot, rank] = pieces
     merged = shapely.union_all(table, axis=1) if len(matched) else np.array([], dtype=object)
+    merged = _closed(merged, tol.length)
     polygons, which = shapely.get_parts(merged, return_index=True)
     polygons = shapely.simplify(polygons, 0.0)
     wide = shapely.is_valid(polygons) & (shapely.get_type_id(polygons) == 3)
@@ -379,15 +384,42 @@ def _planar_patches(
     world = coords[:, :1] * u[at] + coords[:, 1:] * v[at] + height[at, None] * normal[at]
     bounds = np.searchsorted(ring, np.arange(len(polygons) + 1))
     areas = shapely.area(polygons)
+    scatter = (
+        np.zeros(len(g))
+        if seg.deviation is None
+        else np.maximum(seg.deviation[g], seg.deviation[h])
+    )
     patches = [
         PlanarPatch(
             normal=normal[k[n]].copy(),
             polygon=world[bounds[n] : bounds[n + 1]],
             area=float(areas[n]),
+            scatter=float(scatter[k[n]]),
         )
         for n in range(len(polygons))
     ]
     return k, patches
+
+
+def _openings(shapes: NDArray[Any]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Per (multi)polygon, how many pieces and how many holes it has."""
+    parts, which = shapely.get_parts(shapes, return_index=True)
+    holes = np.bincount(which, weights=shapely.get_num_interior_rings(parts), minlength=len(shapes))
+    return shapely.get_num_geometries(shapes), holes.astype(np.int64)
+
+
+def _closed(shapes: NDArray[Any], width: float) -> NDArray[Any]:
+    """``shapes`` (polygons) with cracks and holes narrower than ``width`` closed: vertex
+    noise leaves such cracks between the pieces of one face. A morphological closing
+    (square corners kept) is used where it joins something; elsewhere the exact shape
+    stays."""
+    shapes = np.asarray(shapes, dtype=object)
+    closed = shapely.buffer(
+        shapely.buffer(shapes, width, join_style="mitre"), -width, join_style="mitre"
+    )
+    (pieces, holes), (closed_pieces, closed_holes) = _openings(shapes), _openings(closed)
+    joins = (closed_pieces < pieces) | ((closed_pieces == pieces) & (closed_holes < holes))
+    return np.where(joins, closed, shapes)
 
 
 def _axial_overlap(
@@ -450,21 +482,27 @@ def curved_contact(
     axis = first.axis
     assert axis is not None and second.axis is not None
     aligned = float(axis @ second.axis)
-    if np.linalg.norm(np.cross(axis, second.axis)) > tol.angle:
+    # a direction fitted on a mesh is as sure as the tolerance over the surface's size:
+    # the smaller surface, turned onto the other's axis, moves by at most the tolerance
+    reach = direction_reach(tol, min(surface_size(first), surface_size(second)))
+    if np.linalg.norm(np.cross(axis, second.axis)) > reach:
         return None
     offset = second.point - first.point
-    off_axis = np.linalg.norm(offset - (offset @ axis) * axis)
-    if first.kind == "cylinder":
-        if off_axis > tol.length or abs(first.radius - second.radius) > tol.length:
-            return None
-    elif (
+    if first.kind == "cone" and (
         aligned < 0
         or np.linalg.norm(offset) > tol.length
-        or abs(first.half_angle - second.half_angle) > tol.angle
+        or abs(first.half_angle - second.half_angle) > reach
     ):
+        return None
+    if first.kind == "cylinder" and abs(first.radius - second.radius) > tol.length:
         return None
     lo, hi = _axial_overlap(first, second, axis, first.point)
     if hi - lo <= tol.length:
+        return None
+    # the second axis stays within the tolerance of the first along their common part
+    along = (np.array([lo, hi]) - offset @ axis) / aligned
+    ends = offset + np.outer(along, second.axis)
+    if np.max(np.linalg.norm(ends - np.outer(ends @ axis, axis), axis=1)) > tol.length:
         return None
     every = np.vstack([t.reshape(-1, 3) for t in triangles])
     rel = every - first.point
@@ -499,6 +537,18 @@ def curved_contact(
     )
 
 
+def direction_reach(tol: Tolerance, size: float) -> float:
+    """The largest angle between two directions of a surface of diameter ``size`` that the
+    tolerance cannot tell apart: turning it by ``tol.length / size`` moves none of its
+    points further than the length tolerance (never below the angle tolerance)."""
+    return max(tol.angle, tol.length / max(size, tol.length))
+
+
+def surface_size(surface: Surface) -> float:
+    """The diameter of a curved surface: the diagonal of its axial extent and diameter."""
+    return math.hypot(surface.extent[1] - surface.extent[0], 2.0 * surface.radius)
+
+
 def _surface_triangles(assembly: Assembly, name: str, surface: Surface) -> NDArray[np.float64]:
     mesh = assembly.parts[name].mesh
     faces = np.asarray(mesh.faces, dtype=np.int64)[surface.faces]
@@ -510,7 +560,10 @@ def find_contacts(
 ) -> list[Contact]:
     """The contacts between the touching parts of ``assembly``, in part order (module
     docstring); with ``only``, just the contacts of that part. ``tol`` is a policy that
-    :meth:`Assembly.tolerance` scales to the model."""
+    :meth:`Assembly.tolerance` scales to the model. Directions are snapped
+    (:func:`snapped`) within the policy alone: a measured joint mismatch says where
+    faces may meet, not that their directions are one."""
+    policy = assembly.policy_tolerance(tol)
     tol = assembly.tolerance(tol)
     names = list(assembly.parts)
     if len(names) < 2:
@@ -557,9 +610,153 @@ def find_contacts(
                 if patch is not None:
                     curved.setdefault((int(a), int(b)), []).append(patch)
 
-    return [
+    found = [
         Contact(names[a], names[b], tuple(planar.get(key, ())), tuple(curved.get(key, ())))
         for key in sorted(set(planar) | set(curved))
         for a, b in [key]
         if planar.get(key) or curved.get(key)
     ]
+    return snapped(found, policy)
+
+
+def _spread(patch: PlanarPatch | CurvedPatch) -> NDArray[np.float64]:
+    """Points of a patch relative to its middle that bound where turning its direction
+    moves it: a planar polygon's vertices; a cylinder's or cone's end circles, sampled
+    at four azimuths each."""
+    if isinstance(patch, PlanarPatch):
+        return patch.polygon - patch.polygon.mean(axis=0)
+    assert patch.axis is not None
+    axis = patch.axis / np.linalg.norm(patch.axis)
+    e1, e2 = axis_frame(axis)
+    lo, hi = patch.extent if patch.extent is not None else (0.0, 0.0)
+    ends = []
+    for t in (lo, hi):
+        r = patch.radius if patch.kind == "cylindrical" else abs(t) * math.tan(patch.half_angle)
+        ends += [t * axis + r * e for e in (e1, -e1, e2, -e2)]
+    ends_array = np.array(ends)
+    return ends_array - ends_array.mean(axis=0)
+
+
+def snap_classes(
+    directions: NDArray[np.float64],
+    spreads: list[NDArray[np.float64]],
+    scatter: NDArray[np.float64],
+    tol: Tolerance,
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Per unit direction (rows) of a patch whose points relative to its middle are
+    ``spreads[i]`` and whose faces' vertices lie up to ``scatter[i]`` from their planes,
+    the index of the direction it is snapped to and the sign (+1, -1) that turns that
+    one into it. Each direction, widest patch first (by the second largest extent of its
+    points: a long thin strip's normal is unsure), joins the leader nearest to it if
+    turning the patch onto it (about their common perpendicular, through the patch's
+    middle) moves no point further than the two patches' scatter, and never further
+    than the length tolerance; else it leads. Exact faces (no scatter) keep their
+    directions: their differences are the geometry's, not noise. Snapping moves each
+    patch within the tolerance, whatever the others' sizes."""
+    width = np.array(
+        [
+            np.linalg.svd(p, compute_uv=False)[1] / math.sqrt(len(p)) if len(p) > 1 else 0.0
+            for p in spreads
+        ]
+    )
+    order = np.argsort(-width, kind="stable")
+    leader = np.arange(len(directions), dtype=np.int64)
+    sign = np.ones(len(directions))
+    leaders: list[int] = []
+    for i in order:
+        if leaders:
+            facing = np.where(directions[leaders] @ directions[i] < 0, -1.0, 1.0)
+            stack = directions[leaders] * facing[:, None]
+            turn = np.cross(directions[i], stack)
+            sines = np.linalg.norm(turn, axis=1)
+            hinge = turn / np.maximum(sines, np.finfo(float).tiny)[:, None]
+            # how far each point is from each turning axis through the middle
+            lever = np.linalg.norm(np.cross(hinge[:, None, :], spreads[i][None]), axis=2)
+            moved = sines * (lever.max(axis=1) if lever.size else 0.0)
+            allowed = np.minimum(2.0 * (scatter[i] + scatter[leaders]), tol.length)
+            ok = (moved <= allowed) & (sines > 0)
+            if ok.any():
+                k = int(np.flatnonzero(ok)[np.argmin(sines[ok])])
+                leader[i] = leaders[k]
+                sign[i] = facing[k]
+                continue
+        leaders.append(int(i))
+    return leader, sign
+
+
+def snapped(contacts: list[Contact], tol: Tolerance) -> list[Contact]:
+    """``contacts`` with every planar normal and curved axis that is parallel, within the
+    tolerance, to that of a larger patch replaced by it (:func:`snap_classes`), then
+    the planar patches of one face joined (:func:`_joined`): noisy normals of one
+    direction become one direction, and what compares them afterwards (motion groups,
+    blocking arrangements) sees it exactly."""
+    patches: list[PlanarPatch | CurvedPatch] = [p for c in contacts for p in c.planar]
+    patches += [p for c in contacts for p in c.curved if p.axis is not None]
+    if not patches:
+        return contacts
+    directions = np.array(
+        [p.normal if isinstance(p, PlanarPatch) else p.axis for p in patches], dtype=np.float64
+    )
+    # a fitted axis is as sure as the tolerance its surface was fitted to
+    scatter = np.array([p.scatter if isinstance(p, PlanarPatch) else tol.length for p in patches])
+    leader, sign = snap_classes(directions, [_spread(p) for p in patches], scatter, tol)
+    new = directions[leader] * sign[:, None]
+    turned: dict[int, Any] = {
+        id(p): _turned(p, new[k]) if isinstance(p, PlanarPatch) else replace(p, axis=new[k].copy())
+        for k, p in enumerate(patches)
+    }
+    return [
+        replace(
+            c,
+            planar=_joined([turned[id(p)] for p in c.planar], tol),
+            curved=tuple(turned.get(id(p), p) for p in c.curved),
+        )
+        for c in contacts
+    ]
+
+
+def _turned(patch: PlanarPatch, normal: NDArray[np.float64]) -> PlanarPatch:
+    """``patch`` turned about its middle onto the plane of normal ``normal``."""
+    middle = patch.centroid
+    polygon = patch.polygon - np.outer((patch.polygon - middle) @ normal, normal)
+    return replace(patch, normal=normal.copy(), polygon=polygon)
+
+
+def _joined(patches: list[PlanarPatch], tol: Tolerance) -> tuple[PlanarPatch, ...]:
+    """Planar ``patches`` of one contact with one (snapped) normal and heights within the
+    tolerance joined where they touch or overlap (:func:`_closed`): the pieces of one
+    face that vertex noise split into several coplanar groups."""
+    joined: list[PlanarPatch] = []
+    by_normal: dict[tuple[float, ...], list[PlanarPatch]] = {}
+    for patch in patches:
+        by_normal.setdefault(tuple(patch.normal.tolist()), []).append(patch)
+    for same in by_normal.values():
+        normal = same[0].normal
+        heights = np.array([float(normal @ p.centroid) for p in same])
+        order = np.argsort(heights, kind="stable")
+        layers = np.split(order, np.flatnonzero(np.diff(heights[order]) > tol.length) + 1)
+        for layer in layers:
+            if len(layer) == 1:
+                joined.append(same[int(layer[0])])
+                continue
+            joined.extend(_layer_patches([same[int(k)] for k in layer], normal, tol))
+    return tuple(joined)
+
+
+def _layer_patches(
+    patches: list[PlanarPatch], normal: NDArray[np.float64], tol: Tolerance
+) -> list[PlanarPatch]:
+    """The union of coplanar ``patches`` (normal ``normal``) as patches, one per piece."""
+    u, v = (w[0] for w in _frames(normal[None]))
+    height = float(np.mean([normal @ p.centroid for p in patches]))
+    flat = [shapely.Polygon(np.column_stack([p.polygon @ u, p.polygon @ v])) for p in patches]
+    union = _closed(np.array([shapely.union_all(flat)], dtype=object), tol.length)[0]
+    pieces = shapely.get_parts(shapely.orient_polygons(union))
+    found = []
+    for piece in pieces[~shapely.is_empty(pieces)]:
+        ring = shapely.get_coordinates(piece.exterior)[:-1]
+        polygon = ring[:, :1] * u + ring[:, 1:] * v + height * normal
+        found.append(
+            PlanarPatch(normal.copy(), polygon, float(piece.area), max(p.scatter for p in patches))
+        )
+    return found

@@ -17,7 +17,9 @@ their rounding error divided by that cosine, not by an overlap. The broad phase 
 shapely's STRtree with an affine depth bound, the overlaps one vectorised shapely
 intersection; overlaps thinner than the length tolerance (shared
 edges) have no area and are left out. Triangles within the angle tolerance of parallel
-to ``d`` project to nothing and are skipped. Meshes that do not bound a volume (open or
+to ``d`` project to nothing and are skipped, and so are those whose projection is
+thinner than the length tolerance (a side face tilted by vertex noise): every overlap
+with them would be too thin to count. Meshes that do not bound a volume (open or
 inconsistently wound) use all their triangles on both sides, which is still exact, only
 slower.
 """
@@ -91,6 +93,14 @@ class Shadows:
         return np.clip(z, self.low[triangles], self.high[triangles])
 
 
+def _shadow_width(flat: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The smallest altitude of each projected triangle (t x 3 x 2)."""
+    edges = np.roll(flat, -1, axis=1) - flat
+    double_area = np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
+    longest = np.linalg.norm(edges, axis=2).max(axis=1)
+    return double_area / np.where(longest > 0, longest, 1.0)
+
+
 def shadows(
     meshes: Sequence[trimesh.Trimesh], direction: ArrayLike, tol: Tolerance | None = None
 ) -> Shadows:
@@ -100,7 +110,8 @@ def shadows(
     owner, facing, corners, normals = [], [], [], []
     for k, mesh in enumerate(meshes):
         cos = mesh.face_normals @ frame[2]
-        keep = np.abs(cos) > tol.mesh_angle
+        flat = np.asarray(mesh.triangles, dtype=np.float64) @ frame[:2].T
+        keep = (np.abs(cos) > tol.mesh_angle) & (_shadow_width(flat) > tol.length)
         owner.append(np.full(int(keep.sum()), k, dtype=np.int64))
         # without a consistent outside every triangle may bound the part on either side
         facing.append(np.sign(cos[keep]).astype(np.int8) * np.int8(mesh.is_volume))

@@ -3,12 +3,20 @@ oriented primitive features), recognised on triangle meshes or read exactly from
 
 Method on meshes (all thresholds from the tolerance policy):
 
-1. **Coplanar groups.** Two adjacent triangles are coplanar when each one's unshared
-   vertex lies within the length tolerance of the other's plane and their normals point
-   the same way; groups are the connected components of that relation. A group is
-   *flat* when all its vertices lie within the length tolerance of its area-weighted
-   plane. This length test does not depend on triangle size, so slivers with noisy
-   normals merge into their face.
+1. **Coplanar groups.** Two adjacent triangles are coplanar when the unshared vertex
+   of one lies within the length tolerance of the plane of the other, the one with the
+   larger smallest altitude, and their normals point the same way (or one is thinner
+   than the tolerance); groups are the connected components of that relation. Vertex
+   noise ``e`` tilts a triangle's normal by about ``e / altitude``: a long thin
+   triangle's plane swings far at its neighbour's vertex, while the neighbour's plane
+   is sure, so noisy slivers still merge into their face. A group's plane is the
+   least-squares plane of its vertices (it rests on the whole face, not on the tilts of
+   its triangles), and the group is *flat* when all its vertices lie within the length
+   tolerance of it. A group that is not flat (a sliver thinner than the tolerance lies
+   in both faces of an edge and joins them) falls back to the *strict* groups, where
+   each unshared vertex must lie within the tolerance of the other triangle's plane.
+   Curved surfaces are recognised on the strict groups (the strips of a finely
+   tessellated surface stay apart), planes on the others.
 2. **Smooth regions.** Adjacent triangles whose normals differ by at most
    ``smooth_angle`` (30° by default: tessellators keep the angular deflection of curved
    faces below this, and mechanical edges are sharper) are joined; a region containing
@@ -145,6 +153,9 @@ class Segmentation:
     order: NDArray[np.int64]
     start: NDArray[np.int64]
     curved: NDArray[np.bool_]
+    deviation: NDArray[np.float64] | None = None
+    """Per group, the largest distance of its vertices from its plane (``None``: not
+    measured): how far noise scatters a face about its plane."""
 
     def faces_of(self, g: int) -> NDArray[np.int64]:
         """The faces of group ``g``."""
@@ -161,8 +172,13 @@ def segment(
     faces: NDArray[np.int64],
     tol: Tolerance,
     smooth_angle: float = SMOOTH_ANGLE,
+    *,
+    strict: bool = False,
 ) -> Segmentation:
     """Coplanar groups and smooth regions of the mesh ``(vertices, faces)`` (steps 1-2).
+    ``strict``: each unshared vertex must lie within the tolerance of the other
+    triangle's plane, however thin that one is (the strips of a finely tessellated
+    curved surface stay apart; curved surfaces are recognised on these groups).
 
     Works on several parts stacked into one array: parts sharing no vertex index never
     share a group or region."""
@@ -177,11 +193,20 @@ def segment(
     f0, f1 = adjacency[:, 0], adjacency[:, 1]
     unshared0 = faces[f0].sum(axis=1) - edges.sum(axis=1)
     unshared1 = faces[f1].sum(axis=1) - edges.sum(axis=1)
+    # each triangle's smallest altitude: vertex noise tilts its normal by about
+    # noise / altitude, so of two neighbours the one with the larger altitude has the
+    # surer plane, and the other's unshared vertex is measured against it (unless strict)
+    longest = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+    altitude = double_area / np.where(longest > 0, longest, 1.0)
     on_edge = vertices[edges[:, 0]]
     dist1 = np.abs(np.einsum("ij,ij->i", normals[f0], vertices[unshared1] - on_edge))
     dist0 = np.abs(np.einsum("ij,ij->i", normals[f1], vertices[unshared0] - on_edge))
+    surer = np.where(altitude[f0] >= altitude[f1], dist1, dist0)
     cosine = np.einsum("ij,ij->i", normals[f0], normals[f1])
-    coplanar = (dist0 <= tol.length) & (dist1 <= tol.length) & (cosine > 0)
+    # a triangle thinner than the tolerance has no direction of its own
+    thin = np.minimum(altitude[f0], altitude[f1]) <= tol.length
+    both = (np.maximum(dist0, dist1) <= tol.length) & (cosine > 0)
+    coplanar = both if strict else (surer <= tol.length) & ((cosine > 0) | thin)
     smooth = coplanar | (cosine >= np.cos(smooth_angle))
     n_faces = len(faces)
     group = _components(n_faces, adjacency[coplanar])
@@ -189,25 +214,88 @@ def segment(
     n_regions = int(region.max()) + 1 if n_faces else 0
     curved = np.zeros(n_regions, dtype=bool)
     curved[region[f0[smooth & ~coplanar]]] = True
+    planes = _group_planes(corners, normals, areas, group)
+    if not strict and not (planes[-1] <= tol.length).all():
+        # a sliver thinner than the tolerance lies in both faces of an edge and would
+        # join them: where a group is not flat, its faces keep their strict groups
+        bent = planes[-1][group] > tol.length
+        strict_group = _components(n_faces, adjacency[both])
+        group = np.unique(np.where(bent, strict_group + n_faces, group), return_inverse=True)[1]
+        planes = _group_planes(corners, normals, areas, group.astype(np.int64))
+    normal, point, area, lo, hi, order, start, deviation = planes
+    flat = deviation <= tol.length
+    return Segmentation(
+        group,
+        region,
+        normals,
+        areas,
+        normal,
+        point,
+        area,
+        lo,
+        hi,
+        flat,
+        order,
+        start,
+        curved,
+        deviation,
+    )
 
-    n_groups = int(group.max()) + 1 if n_faces else 0
+
+def _group_planes(
+    corners: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    areas: NDArray[np.float64],
+    group: NDArray[np.int64],
+) -> tuple[NDArray[Any], ...]:
+    """Per group of triangles (``corners``, unit ``normals``, ``areas``): its normal,
+    area-weighted point, area, bounds, the faces sorted by group with each group's start,
+    and the largest distance of its vertices from its plane (flat when within the length
+    tolerance, method step 1)."""
+    n_groups = int(group.max()) + 1 if len(group) else 0
     weighted = np.zeros((n_groups, 3))
     np.add.at(weighted, group, normals * areas[:, None])
     area = np.bincount(group, weights=areas, minlength=n_groups)
-    normal = weighted / np.maximum(np.linalg.norm(weighted, axis=1), np.finfo(float).tiny)[:, None]
     moment = np.zeros((n_groups, 3))
     np.add.at(moment, group, corners.mean(axis=1) * areas[:, None])
     point = moment / np.where(area > 0, area, 1.0)[:, None]
+    normal = _group_normals(corners - point[group][:, None], group, areas, weighted)
     order = np.argsort(group, kind="stable")
     start = np.searchsorted(group[order], np.arange(n_groups + 1))
     heads = start[:-1]
     lo = np.minimum.reduceat(corners.min(axis=1)[order], heads) if n_groups else np.zeros((0, 3))
     hi = np.maximum.reduceat(corners.max(axis=1)[order], heads) if n_groups else np.zeros((0, 3))
     offsets = np.abs(np.einsum("fkj,fj->fk", corners - point[group][:, None], normal[group]))
-    flat = np.maximum.reduceat(offsets.max(axis=1)[order], heads) <= tol.length
-    return Segmentation(
-        group, region, normals, areas, normal, point, area, lo, hi, flat, order, start, curved
+    deviation = np.maximum.reduceat(offsets.max(axis=1)[order], heads) if n_groups else area
+    return normal, point, area, lo, hi, order, start, deviation
+
+
+def plane_deviation(points: NDArray[np.float64]) -> float:
+    """The largest distance of ``points`` (k x 3) from their least-squares plane."""
+    centred = points - points.mean(axis=0)
+    normal = np.linalg.eigh(centred.T @ centred)[1][:, 0]
+    return float(np.abs(centred @ normal).max())
+
+
+def _group_normals(
+    centred: NDArray[np.float64],
+    group: NDArray[np.int64],
+    areas: NDArray[np.float64],
+    weighted: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Per group, the unit normal of the least-squares plane of its triangles' corners
+    (``centred`` on the group's point, weighted by their triangle's area), turned along
+    the area-weighted triangle normal ``weighted``: it rests on the whole extent of the
+    face, not on the tilts of its triangles. Groups of zero area keep ``weighted``."""
+    scatter = np.zeros((len(weighted), 3, 3))
+    np.add.at(scatter, group, np.einsum("fki,fkj,f->fij", centred, centred, areas))
+    _, vectors = np.linalg.eigh(scatter)
+    normal = (
+        vectors[:, :, 0]
+        * np.where(np.einsum("ij,ij->i", vectors[:, :, 0], weighted) < 0, -1.0, 1.0)[:, None]
     )
+    empty = np.bincount(group, weights=areas, minlength=len(weighted)) == 0
+    return np.where(empty[:, None], weighted, normal)
 
 
 def _circle_fit(xy: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
@@ -317,7 +405,8 @@ def fit_surface(
     the tolerance."""
     used = np.unique(faces)
     points = vertices[used]
-    if len(points) < 4:
+    # points within the tolerance of one plane are a plane, whatever else fits them
+    if len(points) < 4 or plane_deviation(points) <= tol.length:
         return None
     for fit in (FITS[kind] for kind in kinds):
         found = fit(points, normals, areas, tol)
@@ -367,14 +456,14 @@ def recognise(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surf
     tol = tol or current()
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
-    seg = segment(vertices, faces, tol)
+    seg = segment(vertices, faces, tol, strict=True)
     candidates = np.flatnonzero(seg.curved)
     curved = curved_surfaces(vertices, faces, seg, tol, candidates)
     fitted = np.isin(candidates, seg.region[[int(c.faces[0]) for c in curved]])
     unfit = np.isin(seg.region, candidates[~fitted])
     if unfit.any():
         curved += split_surfaces(vertices, faces, seg, tol, unfit)
-    return curved + planes(seg, faces_on(curved, len(faces)))
+    return curved + planes(segment(vertices, faces, tol), faces_on(curved, len(faces)))
 
 
 def curved_surfaces(
@@ -419,6 +508,8 @@ def split_surfaces(
     sines = np.linalg.norm(axes, axis=1)
     bent &= sines > tol.angle
     adjacency, edges = adjacency[bent], edges[bent]
+    if not len(adjacency):
+        return ()  # no edge turns about an axis: nothing curved to split
     axes = axes[bent] / sines[bent, None]
     cluster = line_classes(axes, np.sin(AXIS_ANGLE))[1]
     # coplanar groups (a cylinder's strips) joined by edges of one axis: one node per

@@ -10,11 +10,26 @@ surface types are only tessellated. OCP reads STEP lengths in millimetres.
 Tessellation: linear deflection ``LINEAR_DEFLECTION`` x the solid's bounding-box
 diagonal and angular deflection ``ANGULAR_DEFLECTION`` (below the smooth-edge angle of
 :mod:`assemblykit.geometry.recognition`).
+
+A damaged file is read as far as OCP can, and what it dropped is said: the solid
+entities declared in the file (``MANIFOLD_SOLID_BREP``, ``BREP_WITH_VOIDS``,
+``FACETED_BREP``) that OCP could not read, or whose shell lost its faces, are listed in
+the assembly's ``skipped`` items. OCP prints its parse errors on the process's own
+standard output (file descriptor 1, with terminal colour codes), where they would break
+``--json`` output: descriptor 1 is redirected to a temporary file while OCP reads, and
+what it said becomes the assembly's ``warnings``.
 """
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import importlib
+import os
+import re
+import sys
+import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -25,11 +40,21 @@ from numpy.typing import NDArray
 
 from assemblykit.errors import GeometryError, MissingExtraError
 from assemblykit.geometry.recognition import Surface, is_convex
-from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.assembly import Assembly, Part, Skipped
 from assemblykit.tolerance import Tolerance
 
 LINEAR_DEFLECTION = 1e-3
 ANGULAR_DEFLECTION = 0.2
+SOLID_ENTITIES = ("MANIFOLD_SOLID_BREP", "BREP_WITH_VOIDS", "FACETED_BREP")
+_SOLID_TYPES = {
+    "StepShape_ManifoldSolidBrep",
+    "StepShape_BrepWithVoids",
+    "StepShape_FacetedBrep",
+}
+_DECLARED = re.compile(
+    r"#(\d+)\s*=\s*(" + "|".join(SOLID_ENTITIES) + r")\s*\(\s*'((?:[^']|'')*)'", re.IGNORECASE
+)
+_ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
 
 
 _OCP_NAMES = {
@@ -204,16 +229,97 @@ def _solid_part(ocp: Any, solid: Any, name: str, source: str) -> Part:
     return Part(name, mesh, np.eye(4), tuple(surfaces), source)
 
 
+def _flush_c_streams() -> None:
+    """Flush the C library's output buffers (where OCP's messages wait), if it has any."""
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None).fflush(None)
+
+
+@contextlib.contextmanager
+def _captured_stdout() -> Iterator[list[str]]:
+    """Redirect file descriptor 1 to a temporary file inside the block; the list yielded
+    receives what was written there, without terminal colour codes, line by line."""
+    sys.stdout.flush()
+    _flush_c_streams()
+    said: list[str] = []
+    saved = os.dup(1)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 1)
+        try:
+            yield said
+        finally:
+            _flush_c_streams()
+            os.dup2(saved, 1)
+            os.close(saved)
+            sink.seek(0)
+            text = _ANSI.sub("", sink.read().decode("utf-8", errors="replace"))
+            lines = (" ".join(line.strip(" *").split()) for line in text.splitlines())
+            said.extend(dict.fromkeys(line for line in lines if line))
+
+
+def declared_solids(text: str) -> list[tuple[str, str, str]]:
+    """The solid entities a STEP file's text declares, in file order: ``(label, type,
+    name)``, e.g. ``("#386", "MANIFOLD_SOLID_BREP", "")``."""
+    return [
+        (f"#{m.group(1)}", m.group(2).upper(), m.group(3).replace("''", "'"))
+        for m in _DECLARED.finditer(text)
+    ]
+
+
+def _readable(entity: Any) -> bool:
+    """Whether a solid entity of the STEP model has a shell with faces."""
+    try:
+        shell = entity.Outer()
+        return shell is not None and shell.NbCfsFaces() > 0
+    except (AttributeError, RuntimeError):
+        return False
+
+
+def _skipped_solids(
+    declared: list[tuple[str, str, str]], model: Any, transferred: int
+) -> list[Skipped]:
+    """The declared solids OCP dropped: those whose entity in the model has no readable
+    shell (matched to the declarations in file order), and, when fewer solids came out
+    than were declared without such a culprit, the missing count."""
+    entities = [
+        model.Value(i)
+        for i in range(1, model.NbEntities() + 1)
+        if model.Value(i).DynamicType().Name() in _SOLID_TYPES
+    ]
+    skipped = []
+    if len(entities) == len(declared):
+        for (label, kind, name), entity in zip(declared, entities, strict=True):
+            if not _readable(entity):
+                item = f"{label} {kind}" + (f" '{name}'" if name else "")
+                skipped.append(Skipped(item, "its shell could not be read; the solid is left out"))
+    missing = len(declared) - transferred
+    if missing > len(skipped):
+        skipped.append(
+            Skipped(
+                f"{missing - len(skipped)} of {len(declared)} declared solids",
+                "not transferred by the STEP reader; they are left out",
+            )
+        )
+    return skipped
+
+
 def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
-    """An assembly with one part per solid of the STEP file at ``path`` (module docstring)."""
+    """An assembly with one part per solid of the STEP file at ``path`` (module
+    docstring): the solids it could not read are in its ``skipped`` items, and what the
+    reader printed in its ``warnings``."""
     ocp = _ocp()
     source = str(Path(path))
     if not Path(path).is_file():
         raise GeometryError("STEP file not found", source=source)
+    declared = declared_solids(Path(path).read_bytes().decode("latin-1"))
     reader = ocp.STEPControl_Reader()
-    if reader.ReadFile(source) != ocp.IFSelect_ReturnStatus.IFSelect_RetDone:
-        raise GeometryError("cannot read STEP file", source=source)
-    reader.TransferRoots()
+    with _captured_stdout() as warnings:
+        status = reader.ReadFile(source)
+        if status == ocp.IFSelect_ReturnStatus.IFSelect_RetDone:
+            reader.TransferRoots()
+    if status != ocp.IFSelect_ReturnStatus.IFSelect_RetDone:
+        said = f": {'; '.join(warnings)}" if warnings else ""
+        raise GeometryError(f"cannot read STEP file{said}", source=source)
     shape = reader.OneShape()
     explorer = ocp.TopExp_Explorer(shape, ocp.TopAbs_ShapeEnum.TopAbs_SOLID)
     parts = []
@@ -222,5 +328,15 @@ def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         parts.append(_solid_part(ocp, solid, f"solid{len(parts) + 1}", source))
         explorer.Next()
     if not parts:
-        raise GeometryError("no solids in STEP file", source=source)
-    return Assembly(parts, units="mm", units_source="file", source=source, exact=True, policy=tol)
+        said = f": {'; '.join(warnings)}" if warnings else ""
+        raise GeometryError(f"no solids in STEP file{said}", source=source)
+    return Assembly(
+        parts,
+        units="mm",
+        units_source="file",
+        source=source,
+        exact=True,
+        policy=tol,
+        skipped=_skipped_solids(declared, reader.Model(), len(parts)),
+        warnings=warnings,
+    )

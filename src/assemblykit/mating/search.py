@@ -532,11 +532,16 @@ def _spatial(
             if verdict is not Verdict.CLEAR:
                 open_pairs.append((a, b))
     moving = [u for u in units if any(movers.get(n) and movers[n].span for n in u)]
-    chosen = _joint_witness(movers, moving, open_pairs, tol)
+    chosen, exhausted = _joint_witness(movers, moving, open_pairs, tol)
     if chosen is None:
         bodies = tuple(sorted({n for pair in open_pairs for n in pair}))
+        # a search cut short says so: the configuration may still have a free position
+        cut = f" within {WITNESS_CHECKS} checks (search cut short)" if exhausted else ""
         return Rejection(
-            pairs, bodies, "no collision-free position found for " + ", ".join(bodies), False
+            pairs,
+            bodies,
+            "no collision-free position found for " + ", ".join(bodies) + cut,
+            False,
         )
     poses = {name: coset.rep for name, coset in world.items()}
     motions: dict[str, Motion] = {}
@@ -569,10 +574,12 @@ def _joint_witness(
     units: Sequence[list[str]],
     open_pairs: Sequence[tuple[str, str]],
     tol: Tolerance,
-) -> list[tuple[float, ...]] | None:
+) -> tuple[list[tuple[float, ...]] | None, bool]:
     """Parameters of every moving unit such that no open pair interferes (exact checks),
     by backtracking over candidate values; each unit's value is then pulled back towards
-    its representative by bisection along the segment, staying free."""
+    its representative by bisection along the segment, staying free. With them, whether
+    the :data:`WITNESS_CHECKS` budget ran out (``None`` then does not prove that no
+    free position exists)."""
     owner = {name: i for i, unit in enumerate(units) for name in unit}
     leads = [next(movers[n] for n in unit if n in movers and movers[n].span) for unit in units]
     budget = [WITNESS_CHECKS]
@@ -613,7 +620,7 @@ def _joint_witness(
 
     found = search(0, {})
     if found is None:
-        return None
+        return None, budget[0] <= 0
     for index in range(len(units)):
         value = np.asarray(found[index])
         others = {k: v for k, v in found.items() if k != index}
@@ -628,7 +635,7 @@ def _joint_witness(
             else:
                 near = middle
         found[index] = tuple(float(x) for x in far * value)
-    return [found[i] for i in range(len(units))]
+    return [found[i] for i in range(len(units))], False
 
 
 def _ranges(

@@ -29,6 +29,20 @@ if TYPE_CHECKING:
     from assemblykit.geometry.recognition import Surface
 
 
+@dataclass(frozen=True)
+class Skipped:
+    """An item of the input the loader could not use: ``item`` names it (e.g. a STEP
+    entity ``#386 MANIFOLD_SOLID_BREP``) and ``reason`` says why. Answers about the
+    assembly list these, so that a dropped part is never silent."""
+
+    item: str
+    reason: str
+
+    def to_dict(self) -> dict[str, str]:
+        """JSON form: ``item`` and ``reason``."""
+        return {"item": self.item, "reason": self.reason}
+
+
 @dataclass(eq=False)
 class Part:
     """One rigid part: ``mesh`` in world (assembled) position, ``pose`` the 4x4 transform
@@ -60,6 +74,8 @@ class Assembly:
     is the tolerance policy given when loading (the current one when ``None``).
     ``precision`` is the input's own precision measured by the loader
     (:mod:`assemblykit.geometry.precision`); lengths are never compared more finely.
+    ``skipped`` lists what the loader could not read (:class:`Skipped`) and ``warnings``
+    what the reader reported while reading.
     """
 
     def __init__(
@@ -73,6 +89,8 @@ class Assembly:
         scale: float | None = None,
         policy: Tolerance | None = None,
         precision: Precision | None = None,
+        skipped: Iterable[Skipped] = (),
+        warnings: Iterable[str] = (),
     ) -> None:
         items = parts.values() if isinstance(parts, Mapping) else parts
         self.parts: dict[str, Part] = {p.name: p for p in items}
@@ -83,6 +101,8 @@ class Assembly:
         self._scale = scale
         self.policy = policy
         self.precision = precision
+        self.skipped = tuple(skipped)
+        self.warnings = tuple(warnings)
         self._contacts: dict[Tolerance, list[Contact]] = {}
         self._surfaces: dict[tuple[str, Tolerance], tuple[Surface, ...]] = {}
 
@@ -94,6 +114,28 @@ class Assembly:
 
     def __getitem__(self, name: str) -> Part:
         return self.part(name)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.parts
+
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary(
+            "Assembly", fmt.count(len(self), "part"), self.units, fmt.file_name(self.source)
+        )
+
+    def _repr_html_(self) -> str:
+        """The parts as a table: triangles and volume (notebooks)."""
+        from assemblykit import formatting as fmt
+
+        units = self.units if self.units_source != "default" else None
+        rows = [
+            (name, str(len(p.mesh.faces)), fmt.number(p.volume, self.tolerance()))
+            for name, p in self.parts.items()
+        ]
+        volume = fmt.header("volume", f"{units}³" if units else None)
+        return fmt.html_summary(repr(self), ("part", "triangles", volume), rows)
 
     @property
     def names(self) -> list[str]:
@@ -203,6 +245,8 @@ class Assembly:
             scale=scale,
             policy=self.policy,
             precision=self.precision,
+            skipped=self.skipped,
+            warnings=self.warnings,
         )
 
     def subset(self, names: Iterable[str]) -> Assembly:
@@ -241,7 +285,8 @@ class Assembly:
 
     def to_dict(self) -> dict[str, Any]:
         """Summary: source, units, scale and per-part triangle count, volume, bounds,
-        source file and the ``settled`` translation of its pose (``None`` if as read)."""
+        source file and the ``settled`` translation of its pose (``None`` if as read);
+        the items the loader ``skipped`` and its ``warnings``."""
         return {
             "source": self.source,
             "units": self.units,
@@ -257,4 +302,6 @@ class Assembly:
                 }
                 for name, p in self.parts.items()
             },
+            "skipped": [item.to_dict() for item in self.skipped],
+            "warnings": list(self.warnings),
         }
