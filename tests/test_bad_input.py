@@ -161,6 +161,28 @@ def on_folder(config: str | bytes) -> Callable[[Path], list[str]]:
     return build
 
 
+def on_link(command: str, option: str, name: str, dangling: bool = False):
+    """``command asm.yaml option LINK``, LINK a symbolic link to a file (or to nothing)."""
+
+    def build(folder: Path) -> list[str]:
+        argv = on_assembly(command)(folder)
+        target = folder / f"real{Path(name).suffix}"
+        if not dangling:
+            target.write_text("not to be replaced\n")
+        (folder / name).symlink_to(target)
+        return [*argv, option, str(folder / name)]
+
+    return build
+
+
+def latin1_comment_obj(folder: Path) -> list[str]:
+    """``contacts asm.yaml`` where ``b.obj`` opens with a Latin-1 comment (trimesh
+    guesses the encoding of mesh text with charset_normalizer)."""
+    path = write_assembly(folder)
+    (folder / "b.obj").write_bytes("# caf\u00e9\n".encode("latin-1") + cube_obj(0, 0).encode())
+    return ["contacts", str(path)]
+
+
 def self_relation(text: str) -> str:
     return text.replace("[against, block.bottom, table.top]", "[against, block.bottom, block.bore]")
 
@@ -207,6 +229,7 @@ CASES: list[Case] = [
         ("p.png", "p.html"),
     ),
     Case("blocking polygons ok", on("blocking", "g.yaml", POLYGONS), None),
+    Case("contacts latin-1 mesh comment ok", latin1_comment_obj, None),
     # files that are not UTF-8, in every loader
     *[Case(f"solve {k}", on("solve", "t.yaml", v), "t.yaml") for k, v in NOT_UTF8.items()],
     *[Case(f"solve rapt {k}", on("solve", "t.rapt", v), "t.rapt") for k, v in NOT_UTF8.items()],
@@ -377,6 +400,13 @@ CASES: list[Case] = [
     Case("plan png folder named .png", on_assembly("plan", "--png", "@d.png/"), "is a folder"),
     Case("plan png missing folder", on_assembly("plan", "--png", "@no/x.png"), "--png"),
     Case("plan png extension", on_assembly("plan", "--png", "@x.gif"), "--png"),
+    Case("plan png no extension", on_assembly("plan", "--png", "@x"), "/x: --png"),
+    Case("plan png symlink", on_link("plan", "--png", "p.png"), "symbolic link"),
+    Case("plan html symlink", on_link("plan", "--html", "p.html"), "symbolic link"),
+    Case("contacts png symlink", on_link("contacts", "--png", "c.png"), "symbolic link"),
+    Case("blocking png dangling symlink", on_link("blocking", "--png", "b.png", True), "--png"),
+    Case("motion html symlink", on_link("motion", "--html", "m.html"), "symbolic link"),
+    Case("batch out symlink", on_link("batch", "--out", "r.jsonl"), "symbolic link"),
     Case("plan html under a file", on_assembly("plan", "--html", "@a.obj/x.html"), "--html"),
     Case("plan html folder", on_assembly("plan", "--html", "@"), "--html"),
     Case("contacts png missing folder", on_assembly("contacts", "--png", "@no/c.png"), "--png"),
@@ -464,6 +494,17 @@ def test_output_in_a_read_only_folder_is_refused(
     finally:
         locked.chmod(0o700)
     assert code == 2 and "--png" in err and "permission" in err
+
+
+def test_png_message_names_the_file_written(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the suffix is the writer's (any case); the file is written under exactly that name
+    code, _, err = run(on_assembly("plan", "--png", "@view.PNG")(tmp_path), capsys)
+    assert code == 0, err
+    assert err.strip() == f"wrote {tmp_path / 'view.PNG'}"
+    assert (tmp_path / "view.PNG").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not (tmp_path / "view.PNG.png").exists()
 
 
 def test_a_failed_write_leaves_nothing_behind(tmp_path: Path) -> None:

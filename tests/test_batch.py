@@ -1,9 +1,17 @@
 """Tests of batch runs: one JSON line per assembly, errors and timeouts recorded, reruns
-skip finished work, and the local and Dask engines agree."""
+skip answered work (by command, absolute path and content) and retry the rest, a line cut
+short is dropped, and the local and Dask engines agree.
+
+The resumption tests replace the Python of the batch's children by a shell script
+(``sys.executable``) that answers at once, dies, or says which inputs it ran, so that
+they test the bookkeeping without planning anything.
+"""
 
 from __future__ import annotations
 
+import hashlib
 import json
+import sys
 from pathlib import Path
 
 import pytest
@@ -72,17 +80,141 @@ def test_timeout_is_recorded_and_retried(tmp_path):
     assert summary.statuses == {"timeout": 1}
     record = lines(out)[str(DEMO)]
     assert record["status"] == "timeout"
+    assert record["retry"] is True
     assert "result" not in record
     assert finished_inputs(out) == set()  # timed-out inputs run again next time
 
 
-def test_finished_inputs_tolerates_a_cut_last_line_only(tmp_path):
+def sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def test_finished_inputs_are_answers_keyed_by_command_path_and_content(tmp_path):
     out = tmp_path / "results.jsonl"
-    out.write_text('{"input": "a.json", "status": "ok"}\n{"input": "b.js')
-    assert finished_inputs(out) == {str(Path("a.json").resolve())}
+    key = {"command": "plan", "path": "/data/a.json", "sha256": sha256(b"a")}
+    records = [
+        {"input": "a.json", "status": "ok", **key},
+        {"input": "b.json", "status": "error", **key, "path": "/data/b.json"},
+        {"input": "c.json", "status": "error", "retry": True, **key, "path": "/data/c.json"},
+        {"input": "d.json", "status": "timeout", "retry": True, **key, "path": "/data/d.json"},
+        {"input": "e.json", "status": "ok"},  # no path nor digest: answers nothing
+    ]
+    out.write_text("".join(json.dumps(r) + "\n" for r in records) + '{"input": "f.js')
+    assert finished_inputs(out) == {
+        ("plan", "/data/a.json", sha256(b"a")),
+        ("plan", "/data/b.json", sha256(b"a")),
+    }
     out.write_text('{"input": "a.json"\n{"input": "b.json", "status": "error"}\n')
     with pytest.raises(InputError, match="line 1"):
         finished_inputs(out)
+
+
+FAKE_PYTHON = """#!/bin/sh
+# the Python of a batch's children: $3 is the command, $4 the input's absolute path
+echo "$4" >> "$(dirname "$0")/ran.txt"
+case "$4" in
+  *die*) kill -9 $$ ;;
+  *bad*) echo '{"status": "error", "error": "'"$4"': not an assembly"}' ;;
+  *) echo '{"status": "ok", "result": {"ran": "'"$4"'"}}' ;;
+esac
+"""
+
+
+@pytest.fixture
+def fake_python(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """The children's Python replaced by :data:`FAKE_PYTHON`; returns its log of inputs."""
+    script = tmp_path / "bin" / "python"
+    script.parent.mkdir()
+    script.write_text(FAKE_PYTHON)
+    script.chmod(0o755)
+    monkeypatch.setattr(sys, "executable", str(script))
+    return script.parent / "ran.txt"
+
+
+def ran(log: Path) -> list[str]:
+    """The inputs the children were started on, and empties the log."""
+    names = log.read_text().splitlines() if log.exists() else []
+    log.unlink(missing_ok=True)
+    return names
+
+
+def whole_lines(out: Path) -> list[dict]:
+    text = out.read_text()
+    assert text.endswith("\n")
+    return [json.loads(line) for line in text.splitlines()]
+
+
+def test_a_cut_last_line_is_dropped_and_its_input_run_again(tmp_path, fake_python):
+    a, b = tmp_path / "a.yaml", tmp_path / "b.yaml"
+    a.write_text("a\n")
+    b.write_text("b\n")
+    out = tmp_path / "results.jsonl"
+    run_batch([a], out)
+    assert ran(fake_python) == [str(a)]
+    with out.open("a") as sink:  # a run killed while writing b's line
+        sink.write('{"input": "' + str(b) + '", "status": "ok", "res')
+    notices = []
+    summary = run_batch([a, b], out, notice=notices.append)
+    assert notices == [f"{out}: dropped line 2, cut short by an interrupted run"]
+    assert (summary.skipped, summary.statuses) == (1, {"ok": 1})
+    assert ran(fake_python) == [str(b)]
+    records = whole_lines(out)
+    answered = [(r["input"], r["result"]["ran"]) for r in records]
+    assert answered == [(str(a), str(a)), (str(b), str(b))]
+    assert records[1]["path"] == str(b) and records[1]["sha256"] == sha256(b"b\n")
+    assert run_batch([a, b], out, notice=notices.append).skipped == 2
+    assert len(notices) == 1 and ran(fake_python) == []
+
+
+def test_same_relative_path_in_two_folders_is_two_jobs(tmp_path, fake_python, monkeypatch):
+    out = tmp_path / "results.jsonl"
+    one, two = tmp_path / "one", tmp_path / "two"
+    for folder in (one, two):
+        folder.mkdir()
+        (folder / "x.yaml").write_text("the same text\n")
+    for folder in (one, two):
+        monkeypatch.chdir(folder)
+        assert run_batch(["x.yaml"], out).skipped == 0
+        assert ran(fake_python) == [str(folder / "x.yaml")]
+    assert [(r["input"], r["path"]) for r in whole_lines(out)] == [
+        ("x.yaml", str(one / "x.yaml")),
+        ("x.yaml", str(two / "x.yaml")),
+    ]
+    assert run_batch(["x.yaml"], out).skipped == 1  # answered for this folder already
+    (two / "x.yaml").write_text("edited\n")
+    assert run_batch(["x.yaml"], out).skipped == 0  # same path, new content: run again
+    assert run_batch(["x.yaml"], out, command="motion").skipped == 0  # another command
+    assert ran(fake_python) == [str(two / "x.yaml")] * 2
+
+
+def test_a_folder_digest_covers_its_files(tmp_path, fake_python):
+    out = tmp_path / "results.jsonl"
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    (folder / "a.obj").write_text("v 0 0 0\n")
+    run_batch([folder], out)
+    assert run_batch([folder], out).skipped == 1
+    (folder / "b.obj").write_text("v 1 0 0\n")
+    assert run_batch([folder], out).skipped == 0
+    assert ran(fake_python) == [str(folder)] * 2
+
+
+def test_dead_workers_are_retried_and_answers_are_not(tmp_path, fake_python):
+    out = tmp_path / "results.jsonl"
+    inputs = [tmp_path / name for name in ("ok.yaml", "bad.yaml", "die.yaml")]
+    for path in inputs:
+        path.write_text(path.name)
+    summary = run_batch(inputs, out)
+    assert summary.statuses == {"ok": 1, "error": 2}
+    records = {Path(r["input"]).name: r for r in whole_lines(out)}
+    assert records["die.yaml"]["error"] == "worker died: killed by SIGKILL"
+    assert records["die.yaml"]["retry"] is True
+    assert "retry" not in records["bad.yaml"] and "retry" not in records["ok.yaml"]
+    assert sorted(ran(fake_python)) == sorted(map(str, inputs))
+    # the next run retries only the worker that died (it dies again here)
+    again = run_batch(inputs, out)
+    assert (again.skipped, again.statuses) == (2, {"error": 1})
+    assert ran(fake_python) == [str(inputs[2])]
 
 
 def test_bad_engine_is_an_input_error(tmp_path):

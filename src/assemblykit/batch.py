@@ -8,18 +8,39 @@ scheduler address is given), whose tasks start the same child. Both engines ther
 give the same answers.
 
 The output is JSON Lines, one line per assembly, appended as soon as it is known:
-``input``, ``status`` (``ok``, ``error`` or ``timeout``), ``result`` (the command's JSON)
-or ``error`` (one line), and ``seconds``. A rerun reads the file first and skips the
-inputs already finished (``ok`` or ``error``); timed-out inputs are tried again. An input
-that does not exist is not run and not written: the summary lists it with the other
-failures, and the next run tries it again.
+``input`` (as given), ``status`` (``ok``, ``error`` or ``timeout``), ``result`` (the
+command's JSON) or ``error`` (one line), ``seconds``, and what identifies the work done:
+``command``, ``path`` (absolute) and ``sha256`` (of the file, or of every file in a
+folder). A line is written whole, by one write followed by ``fsync``, so a run that is
+killed leaves at most its last line cut short; the next run drops that line (saying so)
+before appending.
+
+A rerun skips an input when the file holds an answer for the same command, absolute path
+and content: ``ok`` (including answers such as *infeasible*) or an ``error`` the child
+reported (bad input, or a fault of assemblykit on that input). Outcomes that are not
+answers carry ``"retry": true`` and are tried again: a worker that died (out of memory,
+killed) and a timeout. An input that does not exist (or cannot be read) is not run and
+not written: the summary lists it with the other failures, and the next run tries it
+again.
+
+Ctrl-C stops a run at once: no new child is started, the running ones are killed and
+their (missing) answers are not recorded, the lines already written stay, and
+:class:`KeyboardInterrupt` propagates to the caller. With a remote Dask scheduler the
+assemblies already running finish on their workers, unrecorded.
 """
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
+import io
 import json
+import logging
+import os
+import signal
 import subprocess
 import sys
+import threading
 import time
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
@@ -33,22 +54,35 @@ from rich.table import Table
 from rich.text import Text
 
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
-from assemblykit.io.documents import read_text
 
 Engine = Literal["local", "dask"]
 Command = Literal["plan", "motion"]
 Status = Literal["ok", "error", "timeout"]
 FINISHED: frozenset[str] = frozenset({"ok", "error"})
 
+Key = tuple[str, str, str]
+"""What a result answers: the command, the input's absolute path and its ``sha256``."""
+
+INTERRUPTED_CODES = (130, -signal.SIGINT)
+"""Exit codes of a child ended by Ctrl-C (it exits 130; killed by SIGINT, -2)."""
+
 
 @dataclass(frozen=True)
 class Job:
-    """One assembly to process: its path, the command, and the relative tolerance."""
+    """One assembly to process: its path (as given), the command, the timeout, the
+    relative tolerance, and its absolute path and content digest (:func:`input_key`)."""
 
     input: str
     command: Command
     timeout: float | None = None
     rel_tolerance: float | None = None
+    path: str = ""
+    sha256: str = ""
+
+    @property
+    def key(self) -> Key:
+        """The key of this job's result."""
+        return (self.command, self.path, self.sha256)
 
 
 @dataclass(frozen=True)
@@ -126,71 +160,209 @@ def compute(command: Command, path: str, rel_tolerance: float | None = None) -> 
     return cast(dict[str, Any], jsonable(result.to_dict(), assembly.tolerance(tol)))
 
 
+class _Stopped(Exception):
+    """A job whose child was ended by an interruption: it has no outcome to record."""
+
+
+class _Children:
+    """The child processes of the jobs running in this process, so that an interruption
+    ends them at once instead of waiting for work that would not be recorded."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._running: set[subprocess.Popen[str]] = set()
+        self._stopping = False
+
+    def start(self, command: list[str]) -> subprocess.Popen[str]:
+        """A child running ``command``; :class:`_Stopped` while stopping."""
+        with self._lock:
+            if self._stopping:
+                raise _Stopped(command[-1])
+            child = subprocess.Popen(
+                command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+            )
+            self._running.add(child)
+            return child
+
+    def finish(self, child: subprocess.Popen[str]) -> bool:
+        """Forget ``child``; whether it ended while stopping (its outcome is void)."""
+        with self._lock:
+            self._running.discard(child)
+            return self._stopping
+
+    @contextlib.contextmanager
+    def stopping(self) -> Iterator[None]:
+        """Kill the running children, and start none until the block ends."""
+        with self._lock:
+            self._stopping = True
+            for child in self._running:
+                child.kill()
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._stopping = False
+
+
+_CHILDREN = _Children()
+
+
 def run_job(job: Job) -> dict[str, Any]:
     """Run one job in a child process and return its JSON line (as a dict).
 
     The child prints ``{"status": ..., "result"|"error": ...}``; a child that exceeds
     ``job.timeout`` seconds is killed (status ``timeout``); one that dies without an
-    answer is an ``error`` carrying the last line of its stderr.
+    answer is an ``error`` carrying the last line of its stderr or the signal that killed
+    it; both carry ``"retry": true``. A child ended by an interruption (Ctrl-C, or the
+    batch stopping) raises :class:`_Stopped`.
     """
-    command = [sys.executable, "-m", "assemblykit.batch", job.command, job.input]
+    command = [sys.executable, "-m", "assemblykit.batch", job.command, job.path or job.input]
     if job.rel_tolerance is not None:
         command.append(repr(job.rel_tolerance))
     start = time.perf_counter()
+    child = _CHILDREN.start(command)
     try:
-        done = subprocess.run(command, capture_output=True, text=True, timeout=job.timeout)
+        outcome = _outcome(child, job.timeout)
+    finally:
+        stopped = _CHILDREN.finish(child)
+    if stopped or child.returncode in INTERRUPTED_CODES:
+        raise _Stopped(job.input)
+    return _line(job, outcome, start)
+
+
+def _outcome(child: subprocess.Popen[str], timeout: float | None) -> dict[str, Any]:
+    """What ``child`` printed, or why it printed nothing (run again: ``retry``)."""
+    try:
+        stdout, stderr = child.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
-        return _line(job, {"status": "timeout", "error": f"over {job.timeout} s"}, start)
-    lines = done.stdout.strip().splitlines()
-    if done.returncode == 0 and lines:
-        return _line(job, json.loads(lines[-1]), start)
-    reason = (done.stderr.strip().splitlines() or [f"exit code {done.returncode}"])[-1]
-    return _line(job, {"status": "error", "error": f"worker died: {reason}"}, start)
+        child.kill()
+        child.communicate()
+        return {"status": "timeout", "error": f"over {timeout} s", "retry": True}
+    lines = stdout.strip().splitlines()
+    if child.returncode == 0 and lines:
+        return cast(dict[str, Any], json.loads(lines[-1]))
+    code = child.returncode
+    last = stderr.strip().splitlines()
+    if last:
+        reason = last[-1]
+    elif code < 0:
+        reason = f"killed by {signal.Signals(-code).name}"
+    else:
+        reason = f"exit code {code}"
+    return {"status": "error", "error": f"worker died: {reason}", "retry": True}
 
 
 def _line(job: Job, outcome: dict[str, Any], start: float) -> dict[str, Any]:
-    return {"input": job.input, **outcome, "seconds": round(time.perf_counter() - start, 3)}
+    return {
+        "input": job.input,
+        **outcome,
+        "seconds": round(time.perf_counter() - start, 3),
+        "command": job.command,
+        "path": job.path,
+        "sha256": job.sha256,
+    }
 
 
-def finished_inputs(out: Path) -> set[str]:
-    """Inputs already finished (``ok`` or ``error``) in an existing JSON Lines file, as
-    resolved paths; a truncated last line (an interrupted run) is ignored."""
+def content_digest(path: Path) -> str:
+    """SHA-256 (hex) of a file's bytes, or of a folder's files (each one's name relative
+    to the folder, then its digest, in sorted order): an edited input is run again."""
+    if not path.is_dir():
+        return _file_sha256(path).hex()
+    digest = hashlib.sha256()
+    for file in sorted(p for p in path.rglob("*") if p.is_file()):
+        digest.update(file.relative_to(path).as_posix().encode() + b"\0")
+        digest.update(_file_sha256(file))
+    return digest.hexdigest()
+
+
+def _file_sha256(path: Path) -> bytes:
+    with path.open("rb") as handle:
+        return hashlib.file_digest(handle, "sha256").digest()
+
+
+@dataclass(frozen=True)
+class ResultsFile:
+    """What an existing results file holds: the keys of its answers (``ok`` or ``error``
+    lines without ``retry``), the length in bytes of its whole lines, and the number of
+    its last line when that one was cut short (0 when it was not)."""
+
+    finished: frozenset[Key]
+    whole: int
+    torn_line: int = 0
+
+
+def read_results(out: Path) -> ResultsFile:
+    """The results file ``out`` (empty when missing). :class:`InputError` naming the line
+    when a whole line is not a JSON object with ``input``. Lines without ``command``,
+    ``path`` and ``sha256`` answer nothing (their inputs run again)."""
     if not out.exists():
-        return set()
-    done = set()
-    lines = read_text(out, "results file").splitlines()
-    for number, text in enumerate(lines, start=1):
-        if not text.strip():
+        return ResultsFile(frozenset(), 0)
+    try:
+        data = out.read_bytes()
+    except OSError as error:
+        reason = error.strerror or type(error).__name__
+        raise InputError(f"cannot read the results file: {reason}", source=str(out)) from None
+    whole = data.rfind(b"\n") + 1
+    lines = data[:whole].split(b"\n")[:-1]
+    finished = set()
+    for number, raw in enumerate(lines, start=1):
+        record = _record(raw, out, number)
+        if record is None or record.get("status") not in FINISHED or record.get("retry"):
             continue
+        key = (record.get("command"), record.get("path"), record.get("sha256"))
+        if all(isinstance(part, str) for part in key):
+            finished.add(cast(Key, key))
+    return ResultsFile(frozenset(finished), whole, len(lines) + 1 if whole < len(data) else 0)
+
+
+def _record(raw: bytes, out: Path, number: int) -> dict[str, Any] | None:
+    """Line ``number`` of ``out`` as a record, None when blank."""
+    try:
+        text = raw.decode("utf-8")
+        if not text.strip():
+            return None
+        record = json.loads(text)
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        raise InputError("not a JSON line", source=str(out), where=f"line {number}") from None
+    if not (isinstance(record, dict) and isinstance(record.get("input"), str)):
+        raise InputError(
+            "not a result line (an object with 'input')", source=str(out), where=f"line {number}"
+        )
+    return record
+
+
+def finished_inputs(out: Path) -> set[Key]:
+    """The keys (:data:`Key`) of the answers already in the results file ``out``."""
+    return set(read_results(out).finished)
+
+
+def _answers(futures: Iterable[Any]) -> Iterator[dict[str, Any]]:
+    """The lines of futures as they finish; a job ended by an interruption has none."""
+    for future in futures:
         try:
-            record = json.loads(text)
-        except json.JSONDecodeError:
-            if number == len(lines):
-                continue
-            raise InputError("not a JSON line", source=str(out), where=f"line {number}") from None
-        if not (isinstance(record, dict) and isinstance(record.get("input"), str)):
-            raise InputError(
-                "not a result line (an object with 'input')",
-                source=str(out),
-                where=f"line {number}",
-            )
-        if record.get("status") in FINISHED:
-            done.add(_key(record["input"]))
-    return done
-
-
-def _key(path: str) -> str:
-    return str(Path(path).resolve())
-
-
-def _local(jobs: Sequence[Job], workers: int) -> Iterator[dict[str, Any]]:
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(run_job, job) for job in jobs]
-        for future in as_completed(futures):
             yield future.result()
+        except _Stopped:
+            continue
 
 
-def _dask(jobs: Sequence[Job], workers: int, scheduler: str | None) -> Iterator[dict[str, Any]]:
+@contextlib.contextmanager
+def _local(jobs: Sequence[Job], workers: int) -> Iterator[Iterator[dict[str, Any]]]:
+    """Lines of ``jobs`` as they finish, from ``workers`` threads each waiting on one
+    child; leaving the block early kills the children still running."""
+    pool = ThreadPoolExecutor(max_workers=workers)
+    futures = [pool.submit(run_job, job) for job in jobs]
+    try:
+        yield _answers(as_completed(futures))
+    finally:
+        with _CHILDREN.stopping():
+            pool.shutdown(cancel_futures=True)
+
+
+@contextlib.contextmanager
+def _dask(
+    jobs: Sequence[Job], workers: int, scheduler: str | None
+) -> Iterator[Iterator[dict[str, Any]]]:
+    """As :func:`_local`, with the jobs run as Dask tasks."""
     try:
         from dask.distributed import Client, LocalCluster
         from dask.distributed import as_completed as dask_completed
@@ -206,13 +378,37 @@ def _dask(jobs: Sequence[Job], workers: int, scheduler: str | None) -> Iterator[
         cluster = None
         client = Client(scheduler)
     try:
-        futures = [client.submit(run_job, job, pure=False) for job in jobs]
-        for future in dask_completed(futures):
-            yield future.result()
+        yield _answers(dask_completed([client.submit(run_job, j, pure=False) for j in jobs]))
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        with _CHILDREN.stopping(), _quiet_logger("distributed"):
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+@contextlib.contextmanager
+def _quiet_logger(name: str) -> Iterator[None]:
+    """Only errors from logger ``name`` in the block: Dask warns about each running task
+    that closing cancels, and an interrupted run closes with tasks running."""
+    logger = logging.getLogger(name)
+    level = logger.level
+    logger.setLevel(logging.ERROR)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
+
+
+def _append(sink: io.FileIO, record: dict[str, Any]) -> None:
+    """Append ``record`` as one whole line: a single write, then ``fsync``."""
+    line = (json.dumps(record) + "\n").encode("utf-8")
+    if sink.write(line) != len(line):
+        raise InputError("cannot write a whole line (is the disk full?)", source=str(sink.name))
+    os.fsync(sink.fileno())
+
+
+def _stderr_line(message: str) -> None:
+    sys.stderr.write(message + "\n")
 
 
 def run_batch(
@@ -226,11 +422,14 @@ def run_batch(
     scheduler: str | None = None,
     rel_tolerance: float | None = None,
     progress: Callable[[int, int], None] | None = None,
+    notice: Callable[[str], None] = _stderr_line,
 ) -> BatchSummary:
     """Run ``command`` over ``inputs`` and append one JSON line per assembly to ``out``.
 
-    Inputs already finished in ``out`` are skipped; ``progress(done, total)`` is called
-    after each assembly.
+    Inputs already answered in ``out`` are skipped (module docstring); a last line cut
+    short is dropped first and ``notice`` is told so; ``progress(done, total)`` is called
+    after each assembly. Ctrl-C ends the run with :class:`KeyboardInterrupt`, keeping the
+    lines written.
     """
     if engine not in ("local", "dask"):
         raise InputError(f"unknown engine {engine!r} (use local or dask)", where="--engine")
@@ -238,21 +437,29 @@ def run_batch(
         raise InputError(f"workers must be at least 1, got {workers}", where="--workers")
     target = Path(out)
     names = [str(path) for path in inputs]
-    done = finished_inputs(target)
-    pending = [name for name in names if _key(name) not in done]
-    failed = [
-        Failure(name, "missing", "no such file or folder")
-        for name in pending
-        if not Path(name).exists()
-    ]
-    todo = [Job(name, command, timeout, rel_tolerance) for name in pending if Path(name).exists()]
+    results = read_results(target)
+    failed: list[Failure] = []
+    todo: list[Job] = []
+    for name in names:
+        try:
+            path = Path(name).resolve(strict=True)
+            job = Job(name, command, timeout, rel_tolerance, str(path), content_digest(path))
+        except FileNotFoundError:
+            failed.append(Failure(name, "missing", "no such file or folder"))
+        except OSError as error:
+            failed.append(Failure(name, "missing", f"cannot read: {error.strerror}"))
+        else:
+            if job.key not in results.finished:
+                todo.append(job)
     target.parent.mkdir(parents=True, exist_ok=True)
-    lines = _local(todo, workers) if engine == "local" else _dask(todo, workers, scheduler)
+    if results.torn_line:
+        os.truncate(target, results.whole)
+        notice(f"{target}: dropped line {results.torn_line}, cut short by an interrupted run")
     statuses: Counter[str] = Counter()
-    with target.open("a", encoding="utf-8") as sink:
+    runs = _local(todo, workers) if engine == "local" else _dask(todo, workers, scheduler)
+    with target.open("ab", buffering=0) as sink, runs as lines:
         for record in lines:
-            sink.write(json.dumps(record) + "\n")
-            sink.flush()
+            _append(sink, record)
             statuses[record["status"]] += 1
             if record["status"] != "ok":
                 failed.append(Failure(record["input"], record["status"], record["error"]))
@@ -260,9 +467,8 @@ def run_batch(
                 progress(sum(statuses.values()), len(todo))
     order = {name: i for i, name in enumerate(names)}
     failed.sort(key=lambda f: order[f.input])
-    return BatchSummary(
-        str(target), len(names), len(names) - len(pending), dict(statuses), tuple(failed)
-    )
+    skipped = len(names) - len(todo) - sum(f.status == "missing" for f in failed)
+    return BatchSummary(str(target), len(names), skipped, dict(statuses), tuple(failed))
 
 
 def _child(argv: Sequence[str]) -> int:
@@ -278,6 +484,8 @@ def _child(argv: Sequence[str]) -> int:
         outcome = {"status": "error", "error": str(failure)}
     except Exception as bug:  # recorded, never fatal to the batch
         outcome = {"status": "error", "error": f"{type(bug).__name__}: {bug}"}
+    except KeyboardInterrupt:  # Ctrl-C reaches the whole process group; the batch stops
+        return INTERRUPTED_CODES[0]
     sys.stdout.write(json.dumps(outcome) + "\n")
     return 0
 

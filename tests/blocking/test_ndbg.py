@@ -7,8 +7,9 @@ import pytest
 from blocking_helpers import ContactAssembly, compas_folder, cylinder, random_box_contacts, square
 
 from assemblykit.blocking.ndbg import blocking_graph
-from assemblykit.blocking.polygons import PolygonAssembly, load_polygons
+from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.geometry.contacts import Contact
+from assemblykit.io.polygons import load_polygons
 
 
 def crossing_equals_direct(g) -> None:

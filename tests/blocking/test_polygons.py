@@ -3,15 +3,20 @@ on hand-drawn parts whose blocked arcs are derived from their vertices."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph, blocking_graph
 from assemblykit.blocking.planar import blocked_normals, convex_pieces
-from assemblykit.blocking.polygons import PolygonAssembly, load_polygons
+from assemblykit.blocking.polygons import PolygonAssembly, counter_clockwise
+from assemblykit.errors import GeometryError
+from assemblykit.io.polygons import load_polygons
 from assemblykit.tolerance import Tolerance
 
 PLANAR = Path(__file__).resolve().parents[2] / "src" / "assemblykit" / "examples" / "planar"
@@ -105,3 +110,28 @@ def test_extended_blocking_sees_parts_that_do_not_touch():
     assert local.dbg([0, 1]).is_free(frozenset({"box"}))
     assert grown.dbg([0, 1]).arcs >= {("box", "roof")}
     assert grown.dbg([1, 0]).is_free(frozenset({"box"}))
+
+
+def test_clockwise_points_are_turned_and_self_crossing_ones_refused():
+    clockwise = np.array([[0, 0], [0, 1], [1, 1], [1, 0]], dtype=float)
+    turned = counter_clockwise(clockwise, "a")
+    x, y = turned[:, 0], turned[:, 1]
+    assert 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) == 1.0  # shoelace: +1
+    assert {tuple(p) for p in turned} == {tuple(p) for p in clockwise}
+    bow_tie = np.array([[0, 0], [1, 1], [1, 0], [0, 1]], dtype=float)
+    with pytest.raises(GeometryError, match=r"parts\.tie"):
+        counter_clockwise(bow_tie, "tie", "f.yaml")
+
+
+def test_blocking_imports_nothing_from_io():
+    # a fresh interpreter: every blocking module
+    code = (
+        "import importlib, pkgutil, sys\n"
+        "import assemblykit.blocking as b\n"
+        "for m in pkgutil.iter_modules(b.__path__):\n"
+        "    importlib.import_module('assemblykit.blocking.' + m.name)\n"
+        "print(sorted(n for n in sys.modules if n.startswith('assemblykit.io')))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == ["[]"]

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from assemblykit.blocking.planar import convex_pieces
-from assemblykit.blocking.polygons import PolygonAssembly, load_polygons
+from assemblykit.blocking.polygons import PolygonAssembly
+from assemblykit.io.polygons import load_polygons
 from assemblykit.planning.hands import hands_needed, partitions
 from assemblykit.planning.sequence import plan
 

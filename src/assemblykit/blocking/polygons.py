@@ -1,19 +1,19 @@
 """Planar assemblies of polygonal parts (seed 004, "2D case").
 
 Parts are simple polygons in the plane z = 0, in assembled position: read from a small
-YAML file (``parts: {name: [[x, y], ...]}``) or cut from 3D meshes by a plane (trimesh
-``section``). Two parts are in contact along a segment where an edge of one lies on an
-edge of the other with opposite outward normals and the two overlap with positive
-length. Each contact segment becomes a :class:`PlanarPatch` with its in-plane normal
-(from part ``a`` into part ``b``), its two endpoints (z = 0) and its length as area, so
-that the NDBG machinery treats the planar case on the circle of directions S¹.
+YAML file (``parts: {name: [[x, y], ...]}``, by :mod:`assemblykit.io.polygons`) or cut
+from 3D meshes by a plane (trimesh ``section``). Two parts are in contact along a segment
+where an edge of one lies on an edge of the other with opposite outward normals and the
+two overlap with positive length. Each contact segment becomes a :class:`PlanarPatch`
+with its in-plane normal (from part ``a`` into part ``b``), its two endpoints (z = 0) and
+its length as area, so that the NDBG machinery treats the planar case on the circle of
+directions S¹.
 """
 
 from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import trimesh
@@ -21,9 +21,8 @@ from numpy.typing import NDArray
 from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
-from assemblykit.errors import GeometryError, InputError, SchemaError, UnknownNameError
+from assemblykit.errors import GeometryError, UnknownNameError
 from assemblykit.geometry.contacts import Contact, PlanarPatch
-from assemblykit.io.documents import read_text, read_yaml
 from assemblykit.tolerance import Tolerance, current
 
 
@@ -71,49 +70,18 @@ class PolygonAssembly:
         )
 
 
-def _ccw(points: NDArray[np.float64], name: str, source: str | None) -> NDArray[np.float64]:
+def counter_clockwise(
+    points: NDArray[np.float64], name: str, source: str | None = None
+) -> NDArray[np.float64]:
+    """``points`` (k x 2) as a counter-clockwise polygon without its closing vertex;
+    :class:`GeometryError` naming part ``name`` when they are not a simple polygon of
+    positive area."""
     poly = Polygon(points)
     if not poly.is_valid or poly.area <= 0:
         raise GeometryError(
             "not a simple polygon of positive area", source=source, where=f"parts.{name}"
         )
     return np.asarray(orient(poly, 1.0).exterior.coords, dtype=np.float64)[:-1]
-
-
-def _points(value: object) -> NDArray[np.float64]:
-    """``value`` as an array of numbers, or an empty one when it is not a list of lists
-    of numbers (booleans and strings are not coordinates)."""
-    if not isinstance(value, list) or not all(
-        isinstance(p, list)
-        and all(isinstance(c, int | float) and not isinstance(c, bool) for c in p)
-        for p in value
-    ):
-        return np.zeros(0)
-    try:
-        return np.asarray(value, dtype=np.float64)
-    except ValueError:  # ragged rows
-        return np.zeros(0)
-
-
-def load_polygons(path: str | Path) -> PolygonAssembly:
-    """Read ``parts: {name: [[x, y], ...]}`` from a YAML file."""
-    path = Path(path)
-    data = read_yaml(read_text(path, "polygon file"), str(path))
-    if not isinstance(data, dict) or not isinstance(data.get("parts"), dict):
-        raise SchemaError(
-            "expected a mapping 'parts: {name: [[x, y], ...]}'", source=str(path), where="parts"
-        )
-    polygons = {}
-    for name, pts in data["parts"].items():
-        arr = _points(pts)
-        if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3 or not np.isfinite(arr).all():
-            raise SchemaError(
-                "a polygon is a list of at least three [x, y] points of finite numbers",
-                source=str(path),
-                where=f"parts.{name}",
-            )
-        polygons[str(name)] = _ccw(arr, str(name), str(path))
-    return PolygonAssembly(polygons, str(path))
 
 
 def section_polygons(
@@ -140,7 +108,7 @@ def section_polygons(
         if regions:
             # the triangulation leaves collinear vertices on the section's edges
             biggest = max(regions, key=lambda p: p.area).simplify(0)
-            polygons[name] = _ccw(np.asarray(biggest.exterior.coords)[:-1], name, None)
+            polygons[name] = counter_clockwise(np.asarray(biggest.exterior.coords)[:-1], name)
     return PolygonAssembly(polygons)
 
 
@@ -176,16 +144,3 @@ def edge_contacts(polygons: dict[str, NDArray[np.float64]], tol: Tolerance) -> l
         if patches:
             contacts.append(Contact(a, b, planar=tuple(patches)))
     return contacts
-
-
-def is_polygon_file(path: str | Path) -> bool:
-    """Whether ``path`` is a YAML file of polygons (``parts`` a mapping of point lists,
-    where an assembly manifest has a list)."""
-    path = Path(path)
-    if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
-        return False
-    try:
-        data = read_yaml(read_text(path), str(path))
-    except InputError:
-        return False  # not readable as polygons: the assembly loaders name the fault
-    return isinstance(data, dict) and isinstance(data.get("parts"), dict)

@@ -2,11 +2,13 @@
 starts, and written whole or not at all.
 
 :func:`checked_output` refuses, with an :class:`InputError` naming the path and the
-option, a target that is a folder, lies in a missing folder or one that cannot be written,
-or has a suffix the writer cannot produce: minutes of computation must not end in a
-failed write. :func:`atomic_output` writes to a temporary file beside the target and
-renames it over the target (``os.replace``, atomic on one file system), so that an
-interrupted or failed write leaves no truncated file behind.
+option, a target that is a folder or a symbolic link, lies in a missing folder or one
+that cannot be written, or has a suffix the writer cannot produce: minutes of computation
+must not end in a failed write. A symbolic link is refused rather than followed or
+replaced, because writing through it changes a file the command was not given and
+renaming over it silently turns the link into a file. :func:`atomic_output` writes to a
+temporary file beside the target and renames it over the target (``os.replace``, atomic
+on one file system), so that an interrupted or failed write leaves no truncated file.
 """
 
 from __future__ import annotations
@@ -32,6 +34,8 @@ def checked_output(path: str | Path, option: str, suffixes: Sequence[str] = ()) 
     ``suffixes`` accepts any name."""
     target = Path(path)
     source = str(path)
+    if target.is_symlink():
+        raise InputError("is a symbolic link: name the file itself", source=source, where=option)
     if target.is_dir():
         raise InputError("is a folder, not a file", source=source, where=option)
     if suffixes and target.suffix.lower() not in suffixes:
