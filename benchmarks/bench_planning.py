@@ -6,6 +6,10 @@ Run ``python benchmarks/bench_planning.py``. Each figure is the median wall time
 the beam, the crossvault (184 blocks) and the dome (527 blocks, candidate directions from
 each block's own arrangement) run once. The dome is skipped unless ``$ASSEMBLYKIT_DATA``
 holds ``compas_assembly/dome_assembly.json``.
+
+Puzzles: multi-move plans (``plan --moves multi``) of BurrTools' example puzzles, with the
+level each stored and the ``time`` BurrTools recorded for the problem, and all 314 solid
+six-piece burrs (skipped unless ``burrtools/`` is found like the other data).
 """
 
 from __future__ import annotations
@@ -18,13 +22,16 @@ from pathlib import Path
 import trimesh
 
 from assemblykit.io.assembly import load_assembly
+from assemblykit.io.burrtools import load_puzzle, solution_count
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning.multimove import MultiMovePlan, plan_voxels
 from assemblykit.planning.sequence import Plan, plan
 from datasets import dataset
 
 ROOT = Path(__file__).resolve().parents[1]
 REPEATS = 3
 STACK_SIZES = (5, 10, 20, 40, 80)
+PUZZLES = ("CubeInCage", "DraculasDentalDesaster", "PelikanBurr", "AlPackino")
 
 
 def stack(n: int) -> Assembly:
@@ -57,7 +64,53 @@ def row(name: str, parts: int, seconds: float, result: Plan) -> None:
     )
 
 
+def multi_move(path: Path, solution: int = 0) -> tuple[float, MultiMovePlan]:
+    """Seconds of the multi-move plan of one stored solution (loading excluded)."""
+    puzzle = load_puzzle(path, solution=solution)
+    start = time.perf_counter()
+    result = plan_voxels(
+        puzzle.names,
+        [p.voxels for p in puzzle.pieces],
+        [p.group for p in puzzle.pieces],
+        reference_level=puzzle.level,
+    )
+    return time.perf_counter() - start, result
+
+
+def puzzles() -> None:
+    """Multi-move plans of the BurrTools puzzles, then of all 314 six-piece burrs."""
+    print("puzzles (--moves multi, one run each)")
+    for name in PUZZLES:
+        path = dataset(f"burrtools/{name}.xmpuzzle")
+        if path is None:
+            print(f"{name:<28} skipped (not found)")
+            continue
+        seconds, result = multi_move(path)
+        stored = load_puzzle(path)
+        print(
+            f"{name:<28} {len(result.parts):>5} parts {seconds:>8.3f} s  level {result.level}"
+            f"  (stored {stored.level}, BurrTools time {stored.time} s)  {result.states} states"
+        )
+    path = dataset("burrtools/SolidSixPieceBurrs.xmpuzzle")
+    if path is None:
+        print("six-piece burrs              skipped (not found)")
+        return
+    total, solved, multi = 0.0, 0, 0
+    count = solution_count(path)
+    for solution in range(count):
+        seconds, result = multi_move(path, solution)
+        total += seconds
+        solved += result.feasible
+        multi += result.root is not None and max(result.root.levels()) > 1
+    print(
+        f"six-piece burrs: {solved} of {count} taken apart, {multi} need several moves for "
+        f"a separation, {total:.2f} s in all ({total / count * 1000:.1f} ms each; "
+        f"BurrTools time {load_puzzle(path).time} s)"
+    )
+
+
 def main() -> None:
+    puzzles()
     print("planning (median wall time; loading excluded, contacts and blocking included)")
     demo = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
     cases = [("gearbox demo", demo, REPEATS)]

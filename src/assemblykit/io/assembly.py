@@ -3,6 +3,8 @@
 * a folder → mesh folder (:func:`assemblykit.io.meshes.load_mesh_folder`);
 * ``.yaml`` / ``.yml``, or ``.json`` with a top-level ``parts`` list → manifest;
 * ``.step`` / ``.stp`` → STEP (:func:`assemblykit.io.step.load_step`, extra ``cad``);
+* ``.xmpuzzle`` → BurrTools puzzle, as its first stored solution
+  (:func:`assemblykit.io.burrtools.load_burrtools`);
 * other ``.json`` → COMPAS (:func:`assemblykit.io.compas.load_compas`);
 * a single mesh file → a one-part assembly.
 
@@ -54,6 +56,10 @@ def load_assembly(path: str | Path, tol: Tolerance | None = None, settle: bool =
         from assemblykit.io.step import load_step
 
         return load_step(path, tol)
+    if suffix == ".xmpuzzle":
+        from assemblykit.io.burrtools import load_burrtools
+
+        return load_burrtools(path, tol)
     if suffix in MESH_SUFFIXES:
         part = Part(path.stem, read_mesh(path), source=str(path))
         return Assembly(
@@ -63,7 +69,8 @@ def load_assembly(path: str | Path, tol: Tolerance | None = None, settle: bool =
             precision=coordinate_precision(part.mesh.vertices),
         )
     raise GeometryError(
-        "unknown assembly kind (expected a mesh folder, .yaml manifest, .step or COMPAS .json)",
+        "unknown assembly kind (expected a mesh folder, .yaml manifest, .step, COMPAS .json "
+        "or .xmpuzzle)",
         source=str(path),
     )
 

@@ -1,0 +1,250 @@
+"""Rotations in plans: finite screw motions that free what no translation frees.
+
+Seed 004 ("Infinitesimal rigid motions") blocks twists ``xi = (omega; v)`` at each
+contact point ``p`` with normal ``n`` (from the moving set into the rest) unless
+``w . xi <= 0`` for ``w = (p x n; n)``: Γ_g tells which sets an infinitesimal rigid
+motion may free, a necessary condition only. When the translation planner stops at an
+interlocked set that Γ_g may free, this module looks for a *finite* motion:
+
+* candidates: rotations about lines through the set's contact points, along the
+  coordinate axes and the cross products of its contact normals (the hinge lines a
+  part can pivot on), both ways; a candidate must pass Γ_g's first-order test (no
+  contact pushed into, at least one left);
+* each is followed as a screw (pitch 0) in ``samples`` steps up to ``max_angle``; every
+  sampled pose is checked with manifold3d: the moved set may share with the rest no
+  more than the interference threshold (:mod:`assemblykit.geometry.interference`);
+* at each pose the set must then leave by a straight translation along a coordinate
+  axis: the convex hull of the set before and after a translation longer than the
+  model contains the whole sweep, so a hull that meets nothing is a sound exit.
+
+A found motion is a plan step with its axis (a point and a direction), its angle and
+the exit direction that follows. Only sampled poses are checked during the turn: the
+step between samples is ``max_angle / samples``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import manifold3d
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+from rich.table import Table
+
+from assemblykit.algebra import se3
+from assemblykit.blocking.rigid import RigidBlockingGraph
+from assemblykit.geometry.interference import interference_threshold, solid
+from assemblykit.model.assembly import Assembly
+from assemblykit.planning.sequence import Plan, plan
+from assemblykit.tolerance import Tolerance
+
+MAX_ANGLE = math.pi / 2
+"""Largest turn tried: a quarter turn frees the hooks and latches this looks for."""
+
+SAMPLES = 90
+"""Poses checked over ``MAX_ANGLE`` (one degree apart)."""
+
+_EXITS = np.vstack([np.eye(3), -np.eye(3)])
+
+
+@dataclass(frozen=True, eq=False)
+class ScrewStep:
+    """``parts`` turn by ``angle`` (radians, right-handed) about the line through
+    ``point`` along unit ``axis``, away from ``rest``, then translate along ``exit`` to
+    infinity."""
+
+    parts: tuple[str, ...]
+    rest: tuple[str, ...]
+    point: NDArray[np.float64]
+    axis: NDArray[np.float64]
+    angle: float
+    exit: NDArray[np.float64]
+    motion: str = "screw"
+
+    def pose(self, fraction: float) -> NDArray[np.float64]:
+        """The transform of the moved parts after ``fraction`` of the turn."""
+        return se3.screw(self.point, self.axis, 0.0, self.angle * fraction)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``parts``, ``rest``, ``motion`` (``screw``), ``axis`` (``point``,
+        ``direction``), ``angle`` (radians), ``angle_deg``, ``pitch`` (0) and ``exit``."""
+        return {
+            "parts": list(self.parts),
+            "rest": list(self.rest),
+            "motion": self.motion,
+            "axis": {"point": self.point.tolist(), "direction": self.axis.tolist()},
+            "angle": self.angle,
+            "angle_deg": math.degrees(self.angle),
+            "pitch": 0.0,
+            "direction": self.exit.tolist(),
+            "exit": self.exit.tolist(),
+        }
+
+
+def _candidates(
+    points: NDArray[np.float64], normals: NDArray[np.float64], tol: Tolerance
+) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """Rotation lines ``(point, signed axis)`` that pass Γ_g's first-order test."""
+    directions = [*np.eye(3)]
+    for a in range(len(normals)):
+        for b in range(a + 1, len(normals)):
+            c = np.cross(normals[a], normals[b])
+            if np.linalg.norm(c) > tol.angle:
+                directions.append(c / np.linalg.norm(c))
+    axes: list[NDArray[np.float64]] = []
+    for d in directions:
+        if all(abs(abs(float(d @ e)) - 1.0) > tol.angle for e in axes):
+            axes.append(d)
+    # one pivot per contact point, told apart at the length tolerance, kept exact
+    _, first = np.unique(np.round(points / tol.length), axis=0, return_index=True)
+    pivots = points[np.sort(first)]
+    found = []
+    for axis in axes:
+        for sign in (1.0, -1.0):
+            omega = sign * axis
+            for pivot in pivots:
+                # velocity of each contact point; it must not push along its normal
+                push = np.einsum("ij,ij->i", np.cross(omega, points - pivot), normals)
+                if push.max() <= tol.length and push.min() < -tol.length:
+                    found.append((pivot, omega))
+    return found
+
+
+def _placed(body: manifold3d.Manifold, pose: NDArray[np.float64]) -> manifold3d.Manifold:
+    return body.transform(np.ascontiguousarray(pose[:3, :4]))
+
+
+def _exit(
+    body: manifold3d.Manifold, rest: manifold3d.Manifold, reach: float, limit: float
+) -> NDArray[np.float64] | None:
+    """A coordinate direction along which ``body`` leaves ``rest`` for good (module
+    docstring), or None."""
+    corners = np.asarray(body.to_mesh().vert_properties, dtype=np.float64)[:, :3]
+    for direction in _EXITS:
+        sweep = manifold3d.Manifold.hull_points(np.vstack([corners, corners + reach * direction]))
+        if (sweep ^ rest).volume() <= limit:
+            return direction
+    return None
+
+
+def screw_removal(
+    assembly: Assembly,
+    parts: Iterable[str],
+    tol: Tolerance | None = None,
+    max_angle: float = MAX_ANGLE,
+    samples: int = SAMPLES,
+) -> ScrewStep | None:
+    """A turn that takes ``parts`` out of the rest of ``assembly`` followed by a straight
+    exit (module docstring), or None when no candidate works."""
+    moving = tuple(p for p in assembly.names if p in set(parts))
+    rest = tuple(p for p in assembly.names if p not in set(moving))
+    if not moving or not rest:
+        return None
+    tol = assembly.tolerance(tol)
+    graph = RigidBlockingGraph(tuple(assembly.names), tuple(assembly.contacts(tol)), tol)
+    points, normals = graph.constraints(moving)
+    if len(points) == 0:
+        return None
+    moving_mesh = trimesh.util.concatenate([assembly[n].mesh for n in moving])
+    rest_mesh = trimesh.util.concatenate([assembly[n].mesh for n in rest])
+    body, others = solid(moving_mesh), solid(rest_mesh)
+    limit = interference_threshold(moving_mesh, rest_mesh, tol)
+    reach = 2.0 * assembly.scale
+    for pivot, omega in _candidates(points, normals, tol):
+        axis = omega / np.linalg.norm(omega)
+        for k in range(1, samples + 1):
+            angle = max_angle * k / samples
+            moved = _placed(body, se3.screw(pivot, axis, 0.0, angle))
+            if (moved ^ others).volume() > limit:
+                break
+            leave = _exit(moved, others, reach, limit)
+            if leave is not None:
+                # + 0.0: no negative zeros in what is printed
+                return ScrewStep(moving, rest, pivot + 0.0, axis + 0.0, angle, leave + 0.0)
+    return None
+
+
+@dataclass(frozen=True, eq=False)
+class ScrewPlan:
+    """A translation plan (seed 004) extended by turns: ``stages[0]`` plans the whole;
+    where it stops, ``screws[k]`` takes one part of the stuck set out by a turn and
+    ``stages[k + 1]`` plans what remains of that set."""
+
+    stages: tuple[Plan, ...]
+    screws: tuple[ScrewStep, ...]
+
+    @property
+    def feasible(self) -> bool:
+        """True when the last stage takes everything apart."""
+        return self.stages[-1].feasible
+
+    def to_dict(self) -> dict[str, Any]:
+        """The plan keys of DESIGN.md §5.3 (``feasible``, ``steps``, ``stuck``) with the
+        turns among the ``steps`` (``motion``: ``screw``), plus ``screws``."""
+        steps: list[dict[str, Any]] = []
+        for k, stage in enumerate(self.stages):
+            steps += [s.to_dict() for s in stage.steps]
+            if k < len(self.screws):
+                steps.append(self.screws[k].to_dict())
+        return {
+            "feasible": self.feasible,
+            "steps": steps,
+            "stuck": list(self.stages[-1].stuck),
+            "screws": [s.to_dict() for s in self.screws],
+            "moves": "rigid",
+        }
+
+    def render(self) -> Table:
+        """One row per step, turns with their axis and angle."""
+        verdict = "feasible" if self.feasible else "infeasible"
+        table = Table(title=f"Disassembly plan with turns ({verdict})")
+        for column in ("step", "move", "motion", "axis (point; direction)", "then along"):
+            table.add_column(column)
+        number = 0
+        for k, stage in enumerate(self.stages):
+            for step in stage.steps:
+                number += 1
+                direction = ", ".join(f"{x:.3g}" for x in step.direction)
+                table.add_row(str(number), ", ".join(step.parts), step.motion, "-", direction)
+            if k < len(self.screws):
+                turn = self.screws[k]
+                number += 1
+                axis = (
+                    "("
+                    + ", ".join(f"{x:.3g}" for x in turn.point)
+                    + "; "
+                    + ", ".join(f"{x:.3g}" for x in turn.axis)
+                    + ")"
+                )
+                table.add_row(
+                    str(number),
+                    ", ".join(turn.parts),
+                    f"turn {math.degrees(turn.angle):.1f} deg",
+                    axis,
+                    ", ".join(f"{x:.3g}" for x in turn.exit),
+                )
+        if not self.feasible:
+            table.caption = "stuck: " + ", ".join(self.stages[-1].stuck)
+        return table
+
+
+def plan_with_screws(assembly: Assembly, tol: Tolerance | None = None) -> ScrewPlan:
+    """:func:`~assemblykit.planning.sequence.plan`, then, while it stops at a stuck set,
+    a turn (:func:`screw_removal`) of one of its parts and a plan of the others."""
+    stages = [plan(assembly, tol=tol)]
+    screws: list[ScrewStep] = []
+    while not stages[-1].feasible:
+        stuck = assembly.subset(stages[-1].stuck)
+        turn = next(
+            (t for name in stuck.names if (t := screw_removal(stuck, [name], tol)) is not None),
+            None,
+        )
+        if turn is None:
+            break
+        screws.append(turn)
+        stages.append(plan(stuck.subset(turn.rest), tol=tol))
+    return ScrewPlan(tuple(stages), tuple(screws))
