@@ -224,6 +224,19 @@ def test_gearbox_plan_lifts_pins_and_cover_first():
     assert result.and_or is None
 
 
+def test_the_assembly_order_reverses_the_gearbox_plan():
+    data = plan(load_assembly(DEMO), max_and_or_parts=0, max_hands=2).to_dict()
+    assembly_steps = data["assembly_steps"]
+    assert len(assembly_steps) == len(data["steps"])
+    last = assembly_steps[-1]
+    # the pins and cover come off first, so they go on last, downwards, each one held
+    assert sorted(last["parts"]) == ["cover", "pin_1", "pin_2", "pin_3", "pin_4"]
+    assert np.allclose(last["direction"], DOWN) and last["held"] == last["parts"]
+    assert last["reverses"] == 1 and "base" in last["onto"]
+    assert [step["parts"] for step in assembly_steps] == data["order"]
+    assert data["gravity"] is None and "held" not in data["steps"][0]
+
+
 @pytest.mark.parametrize(
     "path", ["compas_assembly/stack_assembly.json", "compas_assembly/arch_assembly.json"]
 )
@@ -328,7 +341,7 @@ PLANAR = ROOT / "src" / "assemblykit" / "examples" / "planar"
 
 
 def test_planar_peg_leaves_the_hook_at_the_low_end_of_its_free_arc():
-    from assemblykit.blocking.polygons import load_polygons
+    from assemblykit.io.polygons import load_polygons
 
     # the peg is free on [atan(1/3), 45 deg] (tests/blocking/test_polygons.py); of the
     # regions there, the end point (3, 1)/sqrt(10) is the closest to a coordinate axis
@@ -342,7 +355,7 @@ def test_planar_peg_leaves_the_hook_at_the_low_end_of_its_free_arc():
 
 
 def test_stuck_lists_the_part_trapped_behind_an_interlock():
-    from assemblykit.blocking.polygons import load_polygons
+    from assemblykit.io.polygons import load_polygons
 
     # bottle and plug interlock (the foot is wider than the neck, the stem fills it);
     # the block leaves the bottle alone (up the neck) and the plug alone (down), but

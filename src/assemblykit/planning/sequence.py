@@ -37,24 +37,29 @@ every two-handed partition accepted by Γ_e is built too, and its plans are coun
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from typing import TYPE_CHECKING, Any, Literal
 
 import networkx as nx
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from rich.console import Group
 from rich.table import Table
 
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.extended import extended_arcs
+from assemblykit.errors import InputError
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
     from assemblykit.planning.hands import Hands
+    from assemblykit.planning.stability import Gravity, GravityReport, StepStability
 
 Progress = Callable[[str, int, int], None]
+Narrow = Callable[[int, int, list[int]], list[int]]
+"""``narrow(members, k, sets)``: the free sets (bit masks) of direction ``k`` to move."""
 LOOK_AHEAD = 12
 """Candidate directions still examined after the first removal Γ_e accepts."""
 
@@ -259,6 +264,16 @@ class Step:
     rest: tuple[str, ...]
     blocking: tuple[tuple[str, str], ...]
     motion: MotionKind = "translation"
+    stability: StepStability | None = None
+    """Under gravity: the parts held, those that would fall without the holds, the
+    least friction needed (:mod:`assemblykit.planning.stability`)."""
+
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary(
+            "Step", f"{fmt.name_list(self.parts)} along {fmt.direction(self.direction)}"
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON form (DESIGN.md §5.3): ``parts``, ``direction``, ``motion`` and ``rest``."""
@@ -268,6 +283,7 @@ class Step:
             "motion": self.motion,
             "rest": list(self.rest),
             "blocking": [list(arc) for arc in self.blocking],
+            **({} if self.stability is None else self.stability.to_dict()),
         }
 
 
@@ -340,6 +356,9 @@ class Plan:
     and_or: AndOrGraph | None
     directions: int
     hands: Hands | None = None
+    gravity: GravityReport | None = None
+    """Set when planned under gravity: the settings, whether the whole assembly stands
+    and whether every state of the plan stands with its holds."""
 
     @property
     def feasible(self) -> bool:
@@ -360,6 +379,21 @@ class Plan:
     def order(self) -> tuple[tuple[str, ...], ...]:
         """Assembly order: the moved sets of the steps, last removed first inserted."""
         return tuple(step.parts for step in reversed(self.steps))
+
+    @property
+    def assembly_steps(self) -> tuple[AssemblyStep, ...]:
+        """The assembly plan: the steps reversed, each inserting its parts along minus
+        the removal direction, holding what the disassembly step held."""
+        return tuple(
+            AssemblyStep(
+                parts=step.parts,
+                direction=-np.asarray(step.direction, dtype=np.float64),
+                onto=step.rest,
+                held=step.parts if step.stability is None else step.stability.held,
+                reverses=len(self.steps) - k,
+            )
+            for k, step in enumerate(reversed(self.steps))
+        )
 
     def exploded(self, distance: float) -> tuple[dict[str, NDArray[np.float64]], ...]:
         """Offsets of an exploded view, one mapping per frame (frame 0 is the assembly,
@@ -387,24 +421,78 @@ class Plan:
             "directions": self.directions,
             "and_or": None if self.and_or is None else self.and_or.to_dict(),
             "hands": None if self.hands is None else self.hands.to_dict(),
+            "assembly_steps": [step.to_dict() for step in self.assembly_steps],
+            "gravity": None if self.gravity is None else self.gravity.to_dict(),
         }
 
-    def render(self) -> Table:
-        """A rich table of the steps (and the interlocked sets when infeasible)."""
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary(
+            "Plan",
+            "feasible" if self.feasible else f"infeasible, stuck: {fmt.name_list(self.stuck)}",
+            fmt.count(len(self.steps), "step"),
+            fmt.count(len(self.parts), "part"),
+        )
+
+    def _repr_html_(self) -> str:
+        """The steps as a table (notebooks)."""
+        from assemblykit import formatting as fmt
+
+        rows = [
+            (
+                str(k),
+                fmt.name_list(s.parts, 8),
+                fmt.direction(s.direction),
+                s.motion,
+                fmt.count(len(s.rest), "part"),
+            )
+            for k, s in enumerate(self.steps, start=1)
+        ]
+        headers = ("step", "move", "direction", "motion", "away from")
+        return fmt.html_summary(repr(self), headers, rows)
+
+    def render(self) -> Group:
+        """Rich tables of the disassembly steps (and the interlocked sets when
+        infeasible) and of the assembly order."""
+        return Group(self._disassembly_table(), self._assembly_table())
+
+    def _assembly_table(self) -> Table:
+        table = Table(title="Assembly order")
+        for column in ("step", "insert", "direction", "held"):
+            table.add_column(column)
+        for number, step in enumerate(self.assembly_steps, start=1):
+            table.add_row(
+                str(number),
+                ", ".join(step.parts),
+                format_direction(step.direction),
+                _abbreviate(step.held),
+            )
+        return table
+
+    def _disassembly_table(self) -> Table:
         title = "feasible" if self.feasible else "infeasible"
         if self.and_or is not None:
             title += f", {self.and_or.plans} plan(s) in the AND/OR graph"
+        if self.gravity is not None:
+            title += ", " + self.gravity.summary()
         table = Table(title=f"Disassembly plan ({title})")
-        for column in ("step", "move", "direction", "motion", "away from"):
+        columns = ["step", "move", "direction", "motion", "away from"]
+        if self.gravity is not None:
+            columns += ["held", "would fall", "friction needed"]
+        for column in columns:
             table.add_column(column)
         for number, step in enumerate(self.steps, start=1):
-            table.add_row(
+            cells = [
                 str(number),
                 ", ".join(step.parts),
                 format_direction(step.direction),
                 step.motion,
                 _abbreviate(step.rest),
-            )
+            ]
+            if step.stability is not None:
+                cells += step.stability.cells()
+            table.add_row(*cells)
         for lock in self.interlocked:
             freed = "rigid motion may free" if lock.rigid_may_free else "locked"
             table.add_row("-", ", ".join(lock.parts), "-", f"interlocked ({freed})", "-")
@@ -425,6 +513,30 @@ class Plan:
         elif self.hands is not None and self.hands.needed is None:
             table.caption = f"needs {self.hands.summary()}"
         return table
+
+
+@dataclass(frozen=True, eq=False)
+class AssemblyStep:
+    """One assembly step, the disassembly step ``reverses`` (1-based) run backwards:
+    ``parts`` are inserted along unit ``direction`` (minus the removal direction) onto
+    ``onto`` while ``held`` are held (the inserted parts, and under gravity the parts
+    that would fall otherwise)."""
+
+    parts: tuple[str, ...]
+    direction: NDArray[np.float64]
+    onto: tuple[str, ...]
+    held: tuple[str, ...]
+    reverses: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``parts``, ``direction``, ``onto``, ``held``, ``reverses``."""
+        return {
+            "parts": list(self.parts),
+            "direction": [float(x) + 0.0 for x in self.direction],
+            "onto": list(self.onto),
+            "held": list(self.held),
+            "reverses": self.reverses,
+        }
 
 
 def format_direction(direction: Sequence[float]) -> str:
@@ -551,23 +663,29 @@ def _choose_removal(
     members: int,
     volumes: Sequence[float],
     previous: int | None,
+    narrow: Narrow | None = None,
 ) -> tuple[int, list[int]] | None:
     """The direction index and the free sets of Γ_e it removes from ``members``.
 
     Single parts first: where Γ_t lets single parts leave (counted for all directions at
     once), only those parts are tested against Γ_e. When none leaves alone, the sink
-    components of Γ_e, so that groups that must leave together can.
+    components of Γ_e, so that groups that must leave together can. ``narrow(members,
+    k, sets)``, when given, picks among the free sets of direction ``k`` those to move
+    (one at a time, or only removals that leave stable states).
     """
     free = translations.free_parts(members)
     free[:, _base(members, volumes)] = False
     counts = free.sum(axis=1)
 
+    def chosen(k: int, sets: list[int]) -> list[int]:
+        return sets if narrow is None or not sets else narrow(members, k, sets)
+
     def singles(k: int) -> list[int]:
         held = extended.blockers(k, _mask(np.flatnonzero(free[k])), members)
-        return [1 << i for i, mask in held.items() if not mask]
+        return chosen(k, [1 << i for i, mask in held.items() if not mask])
 
     def groups(k: int) -> list[int]:
-        return _removal(_sinks(extended, k, members), members, volumes)
+        return chosen(k, _removal(_sinks(extended, k, members), members, volumes))
 
     choice = None
     if counts.any():
@@ -624,6 +742,26 @@ class _Search:
     locked: list[int]
     exact: Callable[[int], NDArray[np.float64]] | None = None
     add_translations: Callable[[NDArray[np.float64]], NDArray[np.bool_]] | None = None
+    narrowers: tuple[Narrow, ...] = ()
+    """Ways to pick the free sets a step moves, tried in turn (none: every free set)."""
+    judge: Callable[[int, int], StepStability] | None = None
+    """The stability of moving a set out of a set (planning under gravity)."""
+
+    def _choose(self, members: int, previous: int | None) -> tuple[int, list[int]] | None:
+        """The next removal from ``members``: each narrower in turn, then the same once
+        more with the directions of the exact free sets when the sampled ones free
+        nothing."""
+        narrowers: tuple[Narrow | None, ...] = self.narrowers or (None,)
+        for refine in (False, True):
+            if refine and not self._refined(members):
+                return None
+            for narrow in narrowers:
+                choice = _choose_removal(
+                    self.translations, self.extended, members, self.volumes, previous, narrow
+                )
+                if choice is not None:
+                    return choice
+        return None
 
     def _refined(self, members: int) -> bool:
         """Add the directions of the exact free sets of ``members`` (:func:`exact_candidates`)
@@ -644,14 +782,7 @@ class _Search:
         while pending:
             current = pending.pop()
             while _several(current):
-                choice = _choose_removal(
-                    self.translations, self.extended, current, self.volumes, previous
-                )
-                if choice is None and self._refined(current):
-                    # the sampled candidates free nothing: those of the exact free sets
-                    choice = _choose_removal(
-                        self.translations, self.extended, current, self.volumes, previous
-                    )
+                choice = self._choose(current, previous)
                 if choice is None:
                     self.locked.append(current)
                     break
@@ -673,9 +804,16 @@ class _Search:
                 direction=self.translations.directions[k],
                 rest=tuple(names[i] for i in _bits(rest)),
                 blocking=tuple((names[i], names[j]) for i, j in arcs),
+                stability=None if self.judge is None else self.judge(members, moved),
             )
         )
         self.progress("planning", len(self.steps), len(names))
+
+
+def one_set(members: int, k: int, sets: list[int]) -> list[int]:
+    """The narrower of one-at-a-time planning: the free set with the fewest parts (the
+    lowest-numbered of those)."""
+    return [min(sets, key=lambda mask: (_count(mask), mask & -mask))]
 
 
 def minimal_interlocked(table: DirectionTable, members: int) -> int:
@@ -865,6 +1003,9 @@ def plan(
     max_and_or_parts: int = 8,
     progress: Progress | None = None,
     max_hands: int = 4,
+    *,
+    gravity: Gravity | None = None,
+    one_at_a_time: bool = False,
 ) -> Plan:
     """Plan the disassembly of ``assembly`` by extended translations (seed 004).
 
@@ -874,6 +1015,13 @@ def plan(
     (module doc), and ``hands`` whether up to ``max_hands`` hands take them apart
     (:mod:`assemblykit.planning.hands`). A polygon assembly is planned in the plane
     (:mod:`assemblykit.planning.planar`).
+
+    ``one_at_a_time`` moves one free set per step. Under ``gravity``
+    (:mod:`assemblykit.planning.stability`) every step moves one free set too, the
+    ground's fixed parts stay, and a step is taken only when what remains (and the
+    moved set, held at its base) stands with at most ``gravity.holds`` parts held; when
+    no step does, the one leaving the fewest parts falling is taken and reported as not
+    standing.
     """
     tol = assembly.tolerance(tol)
     names = tuple(assembly.names)
@@ -881,6 +1029,9 @@ def plan(
     report("blocking graph (infinitesimal translations)", 0, len(names))
     if getattr(assembly, "dimension", 3) == 2:
         from assemblykit.planning.planar import planar_search
+
+        if gravity is not None or one_at_a_time:
+            raise InputError("--gravity and --one-at-a-time need 3D parts, not 2D polygons")
 
         planar = planar_search(assembly, tol, report)
         return finish_plan(assembly, planar, tol, max_and_or_parts, max_hands, report)
@@ -896,9 +1047,67 @@ def plan(
         [],
         exact_candidates(assembly, tol),
         translation_slots(assembly, translations, tol),
+        (one_set,) if one_at_a_time else (),
     )
-    search.disassemble(_mask(range(len(names))))
-    return finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
+    if gravity is None:
+        search.disassemble(_mask(range(len(names))))
+        return finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
+    return _plan_under_gravity(assembly, search, gravity, tol, max_and_or_parts, max_hands)
+
+
+def _plan_under_gravity(
+    assembly: Assembly,
+    search: _Search,
+    gravity: Gravity,
+    tol: Tolerance,
+    max_and_or_parts: int,
+    max_hands: int,
+) -> Plan:
+    """:func:`plan` under gravity: the fixed parts outweigh every other so that one of
+    them is the base that stays, and :class:`~assemblykit.planning.stability.StateJudge`
+    picks and judges the steps."""
+    from assemblykit.planning.stability import GravityReport, StateJudge, equilibrium_model
+
+    search.progress("equilibrium equations", 0, 1)
+    model = equilibrium_model(
+        assembly,
+        gravity.direction,
+        gravity.friction,
+        gravity.fixed,
+        dict(gravity.densities),
+        tol,
+    )
+    fixed = set(model.fixed)
+    total = sum(search.volumes)
+    search.volumes = tuple(
+        v + total if name in fixed else v
+        for name, v in zip(model.names, search.volumes, strict=True)
+    )
+    everything = _mask(range(len(model.names)))
+    judge = StateJudge(
+        model,
+        gravity.holds,
+        search.translations.vector,
+        lambda members: _base(members, search.volumes),
+        _base(everything, search.volumes),
+    )
+    search.narrowers = (judge.stable, judge.fewest_falling)
+    search.judge = judge.judge
+    search.disassemble(everything)
+    result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
+    whole = model.check()
+    present = model.mask(None)
+    return replace(
+        result,
+        gravity=GravityReport(
+            settings=gravity,
+            fixed=model.fixed,
+            whole=whole,
+            friction_needed=model.friction_needed(present, present & judge.fixed),
+            stable=whole.stands
+            and all(step.stability is None or step.stability.stands for step in search.steps),
+        ),
+    )
 
 
 def finish_plan(

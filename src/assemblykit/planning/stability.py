@@ -1,0 +1,629 @@
+"""Static equilibrium of rigid parts under gravity, decided by a linear program.
+
+The model is the rigid-block equilibrium analysis of masonry (Whiting, Ochsendorf and
+Durand 2009, "Procedural modeling of structurally-sound masonry buildings"; the RBE
+of compas_cra), on the contacts the project already finds
+(:mod:`assemblykit.geometry.contacts`). Planning assembly as reversed disassembly that
+keeps every intermediate state standing, with temporary supports where it cannot, is
+the approach of Kao et al. 2017 ("Assembly-aware design of masonry shell structures"),
+who judged the states by rigid-body simulation instead.
+
+* every part is rigid; its weight (``density x volume``, uniform density unless given per
+  part) acts at its volume centroid along the gravity direction;
+* a planar contact transmits forces only at the vertices of its contact polygon; a
+  curved contact at its sample points (:meth:`CurvedPatch.samples`). A pressure
+  distribution over a polygon has its resultant inside the polygon's convex hull, which
+  the vertex forces span, so nothing is lost in the normal direction; friction at the
+  vertices resists twisting about the normal somewhat more than distributed friction
+  would (the usual approximation of the method);
+* each force is compressive along the contact normal, with friction inside a Coulomb
+  cone of coefficient ``mu`` linearised as a pyramid of ``CONE_SIDES`` generators
+  ``n + mu (cos t u + sin t v)`` inscribed in the cone (conservative: never stands where
+  the true cone would not). ``u`` is the downhill direction of the contact plane, so a
+  block sliding down a slope meets the exact cone;
+* fixed parts (ground, fixture) and held parts take any wrench.
+
+A set of parts stands when non-negative generator weights balance every free part's
+weight (six equations per part). The program minimises the absolute residuals
+(slacks) of those equations, each scaled by the part's weight and the model's size: it
+is always feasible, the state stands when every residual is within the tolerance, and
+the parts left with a residual are those that cannot be in equilibrium (they would
+fall). Loads are homogeneous in rigid-block equilibrium (scaling gravity scales every
+force), so the margin reported is the least friction coefficient with which the state
+stands, found by bisection.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import linprog
+
+from assemblykit.errors import InputError, NumericError
+from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
+
+FRICTION = 0.5
+"""Default Coulomb friction coefficient."""
+
+CONE_SIDES = 8
+"""Generators of the linearised friction cone (an inscribed 8-sided pyramid)."""
+
+FRICTION_STEPS = 5
+"""Bisection steps for the least friction coefficient: resolution ``mu / 2**5``."""
+
+LP_FEASIBILITY = 1e-7
+"""HiGHS's primal feasibility tolerance (its default, passed explicitly): residuals below
+it are the solver's rounding, not a fall."""
+
+DOWN = (0.0, 0.0, -1.0)
+
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def gravity_direction(value: str | ArrayLike) -> NDArray[np.float64]:
+    """The unit gravity direction from ``-z``, ``+y``, ``x`` or a vector (``0,0,-1``, a
+    sequence of three numbers); :class:`InputError` naming ``--gravity`` otherwise."""
+    if isinstance(value, str):
+        text = value.strip().lower()
+        sign = -1.0 if text.startswith("-") else 1.0
+        axis = text.lstrip("+-")
+        if axis in _AXES:
+            vector = np.zeros(3)
+            vector[_AXES[axis]] = sign
+            return vector
+        try:
+            numbers = [float(x) for x in text.replace(",", " ").split()]
+        except ValueError:
+            numbers = []
+    else:
+        numbers = [float(x) for x in np.asarray(value, dtype=np.float64).ravel()]
+    vector = np.asarray(numbers, dtype=np.float64)
+    norm = float(np.linalg.norm(vector)) if vector.shape == (3,) else 0.0
+    if not (math.isfinite(norm) and norm > 0):
+        raise InputError(
+            f"expected -z, +y, x or three numbers such as 0,0,-1, got {value!r}", where="--gravity"
+        )
+    return vector / norm
+
+
+@dataclass(frozen=True)
+class Gravity:
+    """The settings of stability-aware planning: unit ``direction`` of gravity,
+    ``friction`` coefficient, ``holds`` (hands or fixtures per step, the one holding the
+    moved parts included), ``fixed`` parts (``None``: those touching the lowest plane,
+    :func:`lowest_parts`) and per-part ``densities`` (others 1)."""
+
+    direction: tuple[float, float, float] = DOWN
+    friction: float = FRICTION
+    holds: int = 1
+    fixed: tuple[str, ...] | None = None
+    densities: tuple[tuple[str, float], ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``direction``, ``friction``, ``holds``."""
+        return {
+            "direction": [float(x) + 0.0 for x in self.direction],
+            "friction": self.friction,
+            "holds": self.holds,
+        }
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """Whether the parts ``parts`` stand with ``fixed`` parts immobile: ``would_fall``
+    lists the free parts that cannot be in equilibrium (residual beyond the tolerance),
+    ``residuals`` the largest scaled residual per free part."""
+
+    parts: tuple[str, ...]
+    fixed: tuple[str, ...]
+    would_fall: tuple[str, ...]
+    residuals: tuple[float, ...]
+
+    @property
+    def stands(self) -> bool:
+        """True when every free part is in equilibrium."""
+        return not self.would_fall
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``stands``, ``parts``, ``fixed``, ``would_fall``."""
+        return {
+            "stands": self.stands,
+            "parts": list(self.parts),
+            "fixed": list(self.fixed),
+            "would_fall": list(self.would_fall),
+        }
+
+
+def lowest_parts(assembly: Assembly, direction: ArrayLike, tol: Tolerance) -> tuple[str, ...]:
+    """The parts touching the lowest plane across ``direction`` (gravity): those whose
+    lowest point along it is the assembly's lowest, within the length tolerance."""
+    down = np.asarray(direction, dtype=np.float64)
+    depth = np.array([float((p.mesh.vertices @ down).max()) for p in assembly.parts.values()])
+    return tuple(
+        name for name, d in zip(assembly.names, depth, strict=True) if d >= depth.max() - tol.length
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class ContactPoints:
+    """The force points of an assembly's contacts: ``points`` (P x 3) where part
+    ``first[p]`` pushes part ``second[p]`` along unit ``normals[p]``, and the contact
+    plane's tangents ``u`` (downhill when gravity is not along the normal) and ``v``."""
+
+    points: NDArray[np.float64]
+    normals: NDArray[np.float64]
+    first: NDArray[np.int64]
+    second: NDArray[np.int64]
+    u: NDArray[np.float64]
+    v: NDArray[np.float64]
+
+
+def contact_points(
+    assembly: Assembly, direction: ArrayLike, tol: Tolerance | None = None
+) -> ContactPoints:
+    """Polygon vertices of the planar contacts and sample points of the curved ones, with
+    normals from the pushing part into the pushed one (contacts.py's convention: from
+    ``a`` into ``b``; curved: from the inner part outward), and tangent frames."""
+    index = {name: i for i, name in enumerate(assembly.names)}
+    points, normals, first, second = [], [], [], []
+    for contact in assembly.contacts(tol):
+        a, b = index[contact.a], index[contact.b]
+        for patch in contact.planar:
+            count = len(patch.polygon)
+            points.append(np.asarray(patch.polygon, dtype=np.float64))
+            normals.append(np.tile(patch.normal, (count, 1)))
+            first.append(np.full(count, a))
+            second.append(np.full(count, b))
+        for curved in contact.curved:
+            at, outward = curved.samples()
+            inner = index[curved.inner]
+            points.append(at)
+            normals.append(outward)
+            first.append(np.full(len(at), inner))
+            second.append(np.full(len(at), b if inner == a else a))
+    if not points:
+        empty = np.zeros((0, 3))
+        none = np.zeros(0, dtype=np.int64)
+        return ContactPoints(empty, empty, none, none, empty, empty)
+    n = np.vstack(normals)
+    n = n / np.linalg.norm(n, axis=1, keepdims=True)
+    u, v = _tangents(n, np.asarray(direction, dtype=np.float64), assembly.tolerance(tol))
+    return ContactPoints(
+        np.vstack(points),
+        n,
+        np.concatenate(first).astype(np.int64),
+        np.concatenate(second).astype(np.int64),
+        u,
+        v,
+    )
+
+
+def _tangents(
+    normals: NDArray[np.float64], down: NDArray[np.float64], tol: Tolerance
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per normal, ``u`` along gravity's component in the contact plane (a coordinate
+    axis across the normal when gravity is along it) and ``v = n x u``."""
+    u = down - (normals @ down)[:, None] * normals
+    flat = np.linalg.norm(u, axis=1) <= tol.angle
+    if flat.any():
+        # gravity along the normal: any tangent will do; the axis least along the normal
+        axis = np.eye(3)[np.argmin(np.abs(normals[flat]), axis=1)]
+        u[flat] = axis - np.sum(axis * normals[flat], axis=1)[:, None] * normals[flat]
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    return u, np.cross(normals, u)
+
+
+@dataclass(frozen=True, eq=False)
+class EquilibriumModel:
+    """The equilibrium equations of every part of an assembly, assembled once.
+
+    Column ``p * CONE_SIDES + s`` is generator ``s`` of force point ``p``; its force on
+    the pushed part is ``normal_part + mu * tangent_part`` (the two sparse matrices,
+    6 rows per part: force, then moment about ``origin`` divided by ``scale``, each row
+    divided by the part's weight), and the opposite on the pushing part. ``load`` holds
+    the scaled weights. A state (a subset of the parts, some of them fixed) keeps the
+    rows of its free parts and the columns of the points between its parts.
+    """
+
+    names: tuple[str, ...]
+    normal_part: sp.csr_matrix
+    tangent_part: sp.csr_matrix
+    load: NDArray[np.float64]
+    point_parts: NDArray[np.int64]
+    heights: NDArray[np.float64]
+    fixed: tuple[str, ...]
+    friction: float
+    threshold: float
+    _index: dict[str, int] = field(default_factory=dict, repr=False)
+
+    def __post_init__(self) -> None:
+        self._index.update({name: i for i, name in enumerate(self.names)})
+
+    def mask(self, names: Iterable[str] | None) -> NDArray[np.bool_]:
+        """``names`` (default: all parts) as a boolean vector over :attr:`names`."""
+        out = np.zeros(len(self.names), dtype=bool)
+        if names is None:
+            out[:] = True
+        else:
+            out[[self._index[n] for n in names]] = True
+        return out
+
+    def residuals(
+        self,
+        present: NDArray[np.bool_],
+        fixed: NDArray[np.bool_],
+        friction: float | None = None,
+    ) -> NDArray[np.float64]:
+        """Per part, the largest scaled residual of its six equations at the optimum of
+        the slack program (0 for fixed and absent parts). A state that stands is told by
+        the equations alone first: that program is smaller, and its answer is all zeros."""
+        mu = self.friction if friction is None else friction
+        free = present & ~fixed
+        out = np.zeros(len(self.names))
+        if not free.any():
+            return out
+        rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
+        points = present[self.point_parts].all(axis=1)
+        columns = (CONE_SIDES * np.flatnonzero(points)[:, None] + np.arange(CONE_SIDES)).ravel()
+        if not len(columns):
+            # nothing touches: every free part keeps its whole weight as residual
+            out[free] = np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
+            return out
+        matrix = self.normal_part[rows][:, columns] + mu * self.tangent_part[rows][:, columns]
+        options = {"primal_feasibility_tolerance": LP_FEASIBILITY}
+        found = linprog(
+            np.zeros(len(columns)),
+            A_eq=matrix.tocsc(),
+            b_eq=-self.load[rows],
+            bounds=(0, None),
+            method="highs",
+            options=options,
+        )
+        if found.status == 0:
+            return out
+        size = len(rows)
+        eye = sp.identity(size, format="csr")
+        system = sp.hstack([matrix, eye, -eye], format="csc")
+        cost = np.r_[np.zeros(len(columns)), np.ones(2 * size)]
+        result = linprog(
+            cost,
+            A_eq=system,
+            b_eq=-self.load[rows],
+            bounds=(0, None),
+            method="highs",
+            options=options,
+        )
+        if result.status != 0:
+            raise NumericError(f"equilibrium program failed: {result.message}")
+        slack = result.x[len(columns) :]
+        residual = np.abs(slack[:size] - slack[size:]).reshape(-1, 6).max(axis=1)
+        out[free] = residual
+        return out
+
+    def falling(
+        self, present: NDArray[np.bool_], fixed: NDArray[np.bool_], friction: float | None = None
+    ) -> NDArray[np.bool_]:
+        """The parts of ``present`` that cannot be in equilibrium with ``fixed`` immobile."""
+        return self.residuals(present, fixed, friction) > self.threshold
+
+    def check(self, parts: Iterable[str] | None = None, held: Iterable[str] = ()) -> Equilibrium:
+        """Whether ``parts`` (default: all) stand, with the model's fixed parts among them
+        and ``held`` immobile."""
+        present = self.mask(parts)
+        fixed = present & (self.mask(self.fixed) | self.mask(held))
+        residual = self.residuals(present, fixed)
+        free = np.flatnonzero(present & ~fixed)
+        return Equilibrium(
+            parts=tuple(self.names[i] for i in np.flatnonzero(present)),
+            fixed=tuple(self.names[i] for i in np.flatnonzero(fixed)),
+            would_fall=tuple(self.names[i] for i in free if residual[i] > self.threshold),
+            residuals=tuple(float(residual[i]) for i in free),
+        )
+
+    def friction_needed(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> float | None:
+        """The least friction coefficient, within ``friction / 2**FRICTION_STEPS`` (the
+        upper end of the bisection: one with which the state is shown to stand), with
+        which ``present`` stands; ``None`` when ``friction`` itself does not suffice."""
+        if self.falling(present, fixed).any():
+            return None
+        if not self.falling(present, fixed, 0.0).any():
+            return 0.0
+        low, high = 0.0, self.friction
+        for _ in range(FRICTION_STEPS):
+            middle = (low + high) / 2
+            if self.falling(present, fixed, middle).any():
+                low = middle
+            else:
+                high = middle
+        return high
+
+
+def equilibrium_model(
+    assembly: Assembly,
+    direction: ArrayLike = DOWN,
+    friction: float = FRICTION,
+    fixed: Sequence[str] | None = None,
+    densities: Mapping[str, float] | None = None,
+    tol: Tolerance | None = None,
+) -> EquilibriumModel:
+    """The equilibrium equations of ``assembly`` under gravity along ``direction``
+    (module docstring), assembled with numpy into sparse matrices. ``fixed`` defaults to
+    :func:`lowest_parts`; ``densities`` (default 1) scale each part's weight."""
+    tol = assembly.tolerance(tol)
+    down = gravity_direction(direction)
+    names = tuple(assembly.names)
+    for name in (*(fixed or ()), *(densities or {})):
+        assembly.part(name)
+    if not math.isfinite(friction) or friction < 0:
+        raise InputError(
+            f"expected a friction coefficient >= 0, got {friction}", where="--friction"
+        )
+    density = np.array([(densities or {}).get(n, 1.0) for n in names], dtype=np.float64)
+    weight = density * np.array([assembly.parts[n].volume for n in names])
+    centres = np.array([assembly.parts[n].mesh.center_mass for n in names], dtype=np.float64)
+    origin = assembly.bounds.mean(axis=0)
+    scale = assembly.scale
+    found = contact_points(assembly, down, tol)
+
+    angles = 2 * np.pi * np.arange(CONE_SIDES) / CONE_SIDES
+    # per point and generator: the force's normal and tangential parts (P x S x 3)
+    normal_force = np.repeat(found.normals[:, None, :], CONE_SIDES, axis=1)
+    tangent_force = (
+        np.cos(angles)[None, :, None] * found.u[:, None, :]
+        + np.sin(angles)[None, :, None] * found.v[:, None, :]
+    )
+    arm = (found.points - origin) / scale
+    ends = np.stack([found.second, found.first], axis=1)
+    signs = np.array([1.0, -1.0])
+    total_columns = len(found.points) * CONE_SIDES
+    columns = np.arange(total_columns).reshape(-1, CONE_SIDES)
+
+    def matrix(force: NDArray[np.float64]) -> sp.csr_matrix:
+        moment = np.cross(arm[:, None, :], force)
+        wrench = np.concatenate([force, moment], axis=2)  # P x S x 6
+        # P x 2 (pushed, pushing) x S x 6, each row divided by its part's weight
+        data = signs[None, :, None, None] * wrench[:, None] / weight[ends][:, :, None, None]
+        rows = 6 * ends[:, :, None, None] + np.arange(6)[None, None, None, :]
+        cols = np.broadcast_to(columns[:, None, :, None], data.shape)
+        return sp.csr_matrix(
+            (data.ravel(), (np.broadcast_to(rows, data.shape).ravel(), cols.ravel())),
+            shape=(6 * len(names), total_columns),
+        )
+
+    load = np.concatenate(
+        [np.tile(down, (len(names), 1)), np.cross((centres - origin) / scale, down)], axis=1
+    )
+    return EquilibriumModel(
+        names=names,
+        normal_part=matrix(normal_force),
+        tangent_part=matrix(tangent_force),
+        load=load.ravel(),
+        point_parts=ends,
+        heights=centres @ down,
+        fixed=tuple(fixed) if fixed is not None else lowest_parts(assembly, down, tol),
+        friction=float(friction),
+        threshold=max(tol.rel_length, LP_FEASIBILITY),
+    )
+
+
+def equilibrium(
+    assembly: Assembly,
+    direction: ArrayLike = DOWN,
+    friction: float = FRICTION,
+    fixed: Sequence[str] | None = None,
+    held: Iterable[str] = (),
+    densities: Mapping[str, float] | None = None,
+    tol: Tolerance | None = None,
+) -> Equilibrium:
+    """Whether every part of ``assembly`` stands under gravity along ``direction``, with
+    ``fixed`` (default: :func:`lowest_parts`) and ``held`` parts immobile."""
+    model = equilibrium_model(assembly, direction, friction, fixed, densities, tol)
+    return model.check(held=held)
+
+
+@dataclass(frozen=True)
+class StepStability:
+    """A disassembly step under gravity: ``held`` are the parts held during it (one grip
+    on the moved parts, the grip of a subassembly being taken apart in the air, and the
+    parts held so that the rest stands), ``would_fall`` the parts that would fall without
+    the holds beyond the grip(s), ``stands`` whether every state stands with the holds
+    (within the ``holds`` allowed), ``friction_needed`` the least friction coefficient
+    with which they stand (``None`` when ``friction`` does not suffice)."""
+
+    held: tuple[str, ...]
+    would_fall: tuple[str, ...]
+    stands: bool
+    friction_needed: float | None
+    friction: float
+
+    @property
+    def margin(self) -> float | None:
+        """``friction - friction_needed``: how much friction may be lost before the states
+        of the step no longer stand (``None`` when they do not)."""
+        return None if self.friction_needed is None else self.friction - self.friction_needed
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON keys added to a step: ``held``, ``would_fall``, ``stands``,
+        ``friction_needed``, ``stability_margin``."""
+        return {
+            "held": list(self.held),
+            "would_fall": list(self.would_fall),
+            "stands": self.stands,
+            "friction_needed": self.friction_needed,
+            "stability_margin": self.margin,
+        }
+
+    def cells(self) -> list[str]:
+        """Table cells: held, would fall, friction needed."""
+        needed = "more than μ" if self.friction_needed is None else f"{self.friction_needed:.3f}"
+        return [", ".join(self.held), ", ".join(self.would_fall) or "-", needed]
+
+
+@dataclass(frozen=True)
+class GravityReport:
+    """A plan's stability: its ``settings``, the ``fixed`` parts, whether the ``whole``
+    assembly stands, the least friction it needs, and ``stable``: every state of the plan
+    stands with the holds listed."""
+
+    settings: Gravity
+    fixed: tuple[str, ...]
+    whole: Equilibrium
+    friction_needed: float | None
+    stable: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: the settings, ``fixed``, ``stable``, ``stands`` and ``would_fall``
+        (of the whole assembly) and its ``friction_needed``."""
+        return {
+            **self.settings.to_dict(),
+            "fixed": list(self.fixed),
+            "stable": self.stable,
+            "stands": self.whole.stands,
+            "would_fall": list(self.whole.would_fall),
+            "friction_needed": self.friction_needed,
+        }
+
+    def summary(self) -> str:
+        """One phrase for a table title."""
+        holds = f"{self.settings.holds} hold{'s' if self.settings.holds > 1 else ''}"
+        verdict = "every state stands" if self.stable else "some states fall"
+        return f"gravity, μ = {self.settings.friction:g}, {holds}: {verdict}"
+
+
+@dataclass(frozen=True)
+class _Assessment:
+    held: NDArray[np.bool_]
+    falls: NDArray[np.bool_]
+    stands: bool
+    states: tuple[tuple[NDArray[np.bool_], NDArray[np.bool_]], ...]
+
+
+class StateJudge:
+    """Stability of the planner's candidate steps (sets of parts as bit masks).
+
+    A step moves ``moved`` out of ``members``. The set on the ground (it holds the
+    planner's base, ``ground_base``) keeps the model's fixed parts immobile; a
+    subassembly taken away earlier is held by its grip (its base), which costs a hold.
+    The moved parts are gripped at their base (one hold) and must stand on it when they
+    are several; what remains must stand. Parts that would fall are held greedily,
+    highest first, while holds remain (``holds`` in all). ``vector`` turns a mask into a
+    boolean vector over the model's parts; ``base`` names a set's base.
+    """
+
+    def __init__(
+        self,
+        model: EquilibriumModel,
+        holds: int,
+        vector: Callable[[int], NDArray[np.bool_]],
+        base: Callable[[int], int],
+        ground_base: int,
+    ) -> None:
+        self.model = model
+        self.holds = holds
+        self.vector = vector
+        self.base = base
+        self.ground_base = ground_base
+        self.fixed = model.mask(model.fixed)
+        self._falling: dict[tuple[bytes, bytes], NDArray[np.bool_]] = {}
+        self._assessed: dict[tuple[int, int], _Assessment] = {}
+
+    def falling(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """:meth:`EquilibriumModel.falling`, once per state."""
+        key = (present.tobytes(), fixed.tobytes())
+        if key not in self._falling:
+            self._falling[key] = self.model.falling(present, fixed)
+        return self._falling[key]
+
+    def _hold(
+        self, present: NDArray[np.bool_], fixed: NDArray[np.bool_], budget: int
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_], bool]:
+        falls = self.falling(present, fixed)
+        held = np.zeros_like(present)
+        now = falls
+        while now.any() and int(held.sum()) < budget:
+            top = min(np.flatnonzero(now), key=lambda i: (self.model.heights[i], i))
+            held[top] = True
+            now = self.falling(present, fixed | held)
+        return held, falls, not now.any()
+
+    def _one(self, index: int) -> NDArray[np.bool_]:
+        out = np.zeros(len(self.model.names), dtype=bool)
+        out[index] = True
+        return out
+
+    def assess(self, members: int, moved: int) -> _Assessment:
+        """The holds, falling parts and verdict of moving ``moved`` out of ``members``."""
+        key = (members, moved)
+        if key in self._assessed:
+            return self._assessed[key]
+        inside, taken = self.vector(members), self.vector(moved)
+        rest = inside & ~taken
+        grounded = bool(members >> self.ground_base & 1)
+        ground = self.fixed if grounded else self._one(self.base(members))
+        grip = self._one(self.base(moved))
+        base_held = rest & ground if not grounded else np.zeros_like(rest)
+        budget = self.holds - 1 - int(base_held.sum())
+        held_rest, falls_rest, rest_ok = self._hold(rest, rest & ground, budget)
+        held_moved, falls_moved = np.zeros_like(rest), np.zeros_like(rest)
+        moved_ok = True
+        if int(taken.sum()) > 1:
+            held_moved, falls_moved, moved_ok = self._hold(
+                taken, grip, budget - int(held_rest.sum())
+            )
+        held = grip | base_held | held_rest | held_moved
+        found = _Assessment(
+            held=held,
+            falls=falls_rest | falls_moved,
+            stands=rest_ok and moved_ok and int(held.sum()) <= self.holds,
+            states=((rest, (rest & ground) | held_rest), (taken, grip | held_moved)),
+        )
+        self._assessed[key] = found
+        return found
+
+    def _ordered(self, sets: list[int]) -> list[int]:
+        """Fewest parts first, then the highest (a set's highest centre), then index."""
+
+        def key(mask: int) -> tuple[int, float, int]:
+            inside = self.vector(mask)
+            return (int(inside.sum()), float(self.model.heights[inside].min()), mask)
+
+        return sorted(sets, key=key)
+
+    def stable(self, members: int, k: int, sets: list[int]) -> list[int]:
+        """The first set (:meth:`_ordered`) whose removal stands with the holds allowed,
+        alone; none if there is none (``k``, the direction, does not matter)."""
+        for mask in self._ordered(sets):
+            if self.assess(members, mask).stands:
+                return [mask]
+        return []
+
+    def fewest_falling(self, members: int, k: int, sets: list[int]) -> list[int]:
+        """The set whose removal leaves the fewest parts falling (a step that does not
+        stand, reported as such)."""
+        return [min(self._ordered(sets), key=lambda m: int(self.assess(members, m).falls.sum()))]
+
+    def judge(self, members: int, moved: int) -> StepStability:
+        """The step's stability, with the least friction its states need."""
+        found = self.assess(members, moved)
+        names = self.model.names
+        needed: list[float | None] = [
+            self.model.friction_needed(present, fixed)
+            for present, fixed in found.states
+            if (present & ~fixed).any()
+        ]
+        return StepStability(
+            held=tuple(names[i] for i in np.flatnonzero(found.held)),
+            would_fall=tuple(names[i] for i in np.flatnonzero(found.falls)),
+            stands=found.stands,
+            friction_needed=None if None in needed else max(needed, default=0.0),  # type: ignore[type-var]
+            friction=self.model.friction,
+        )

@@ -1,0 +1,245 @@
+"""Tests of static equilibrium under gravity and of planning with it, on blocks whose
+answers are computed by hand (a block on a slope, an overhanging stack, a corbelled
+arch, a leaning pair) and on the bundled COMPAS arch and ASAP beam. Every plan is checked
+again state by state from its JSON."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.errors import InputError, UnknownNameError
+from assemblykit.io.assembly import load_assembly
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning.sequence import plan
+from assemblykit.planning.stability import (
+    FRICTION_STEPS,
+    Gravity,
+    equilibrium,
+    equilibrium_model,
+    gravity_direction,
+    lowest_parts,
+)
+from datasets import dataset
+
+MU = 0.5
+RESOLUTION = MU / 2**FRICTION_STEPS
+
+
+def box(extents: tuple[float, ...], low: tuple[float, ...]) -> trimesh.Trimesh:
+    """An axis-aligned box with its lowest corner at ``low``."""
+    mesh = trimesh.creation.box(extents=extents)
+    mesh.apply_translation(np.asarray(low) + np.asarray(extents) / 2)
+    return mesh
+
+
+def block_on_slope(degrees: float) -> Assembly:
+    """A unit cube resting on the top face of a slab tilted by ``degrees`` about y."""
+    turn = trimesh.transformations.rotation_matrix(math.radians(degrees), [0, 1, 0])
+    slab = trimesh.creation.box(extents=(4.0, 4.0, 1.0))
+    slab.apply_transform(turn)
+    cube = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+    cube.apply_transform(turn)
+    cube.apply_translation(turn[:3, :3] @ [0.0, 0.0, 1.0])
+    return Assembly([Part("slope", slab), Part("block", cube)])
+
+
+def overhanging_stack(overhang: float) -> Assembly:
+    """Three unit cubes stacked; the top one shifted by ``overhang`` along x."""
+    return Assembly(
+        [
+            Part("bottom", box((1, 1, 1), (0, 0, 0))),
+            Part("middle", box((1, 1, 1), (0, 0, 1))),
+            Part("top", box((1, 1, 1), (overhang, 0, 2))),
+        ]
+    )
+
+
+def corbels(keystone: bool) -> Assembly:
+    """A ground slab, two unit pillars (x in [-2, -1] and [1, 2]) and on each a corbel
+    reaching inwards past its pillar: with a keystone (x in [-0.2, 0.2]) between them
+    the corbels are 1.4 long (centre 0.1 beyond the pillar's edge), without it they are
+    1.8 long and lean on each other at x = 0."""
+    inner, outer = (0.2, 1.6) if keystone else (0.0, 1.8)
+    parts = [
+        Part("ground", box((6, 1, 1), (-3, 0, -1))),
+        Part("pillar_l", box((1, 1, 1), (-2, 0, 0))),
+        Part("pillar_r", box((1, 1, 1), (1, 0, 0))),
+        Part("corbel_l", box((outer - inner, 1, 1), (-outer, 0, 1))),
+        Part("corbel_r", box((outer - inner, 1, 1), (inner, 0, 1))),
+    ]
+    if keystone:
+        parts.append(Part("keystone", box((0.4, 1, 1), (-0.2, 0, 1))))
+    return Assembly(parts)
+
+
+def assert_every_state_stands(assembly: Assembly, data: dict, friction: float = MU) -> None:
+    """Re-run the equilibrium program on every state of a plan's JSON: the whole
+    assembly, and at each step what remains with the parts the step holds."""
+    model = equilibrium_model(assembly, friction=friction)
+    assert model.check().stands
+    for step in data["steps"]:
+        rest = set(step["rest"])
+        held = set(step["held"]) & rest
+        assert model.check(rest, held).stands, step
+        assert len(step["held"]) <= data["gravity"]["holds"]
+
+
+@pytest.mark.parametrize("degrees", [25.0, 30.0])
+def test_a_block_on_a_slope_stands_iff_the_slope_is_within_the_friction_angle(degrees):
+    # tan 25 deg = 0.466 <= 0.5 < tan 30 deg = 0.577 (atan 0.5 = 26.57 deg)
+    assembly = block_on_slope(degrees)
+    found = equilibrium(assembly, friction=MU)
+    assert found.fixed == ("slope",)
+    assert found.stands is (math.tan(math.radians(degrees)) <= MU)
+    assert found.would_fall == (() if found.stands else ("block",))
+
+
+def test_the_friction_a_block_on_a_slope_needs_is_the_slopes_tangent():
+    model = equilibrium_model(block_on_slope(25.0), friction=MU)
+    present = model.mask(None)
+    needed = model.friction_needed(present, model.mask(["slope"]))
+    assert needed is not None
+    assert math.tan(math.radians(25.0)) <= needed <= math.tan(math.radians(25.0)) + RESOLUTION
+
+
+@pytest.mark.parametrize(("overhang", "stands"), [(0.4, True), (0.6, False)])
+def test_an_overhanging_top_stands_iff_its_centre_is_over_its_support(overhang, stands):
+    # the top's centre is at x = overhang + 0.5; the middle block spans x in [0, 1]
+    found = equilibrium(overhanging_stack(overhang))
+    assert found.fixed == ("bottom",)
+    assert found.stands is stands
+    assert found.would_fall == (() if stands else ("top",))
+
+
+def test_a_part_touching_nothing_falls():
+    assembly = Assembly(
+        [Part("ground", box((2, 2, 1), (0, 0, 0))), Part("floating", box((1, 1, 1), (0, 0, 3)))]
+    )
+    found = equilibrium(assembly)
+    assert found.would_fall == ("floating",) and found.residuals == (1.0,)
+
+
+def test_a_held_part_does_not_fall():
+    assert equilibrium(overhanging_stack(0.6), held=["top"]).stands
+
+
+def test_the_corbelled_arch_stands_only_when_complete():
+    assembly = corbels(keystone=True)
+    model = equilibrium_model(assembly, friction=MU)
+    assert model.fixed == ("ground",)
+    assert model.check().stands
+    assert set(model.check(set(assembly.names) - {"keystone"}).would_fall) == {
+        "corbel_l",
+        "corbel_r",
+    }
+    assert {"keystone", "corbel_r"} <= set(
+        model.check(set(assembly.names) - {"corbel_l"}).would_fall
+    )
+    # by hand: the corbels' overturning moment 1.4 x 0.1 + 0.2 x 0.8 = 0.3 needs a thrust
+    # N >= 0.3 from the keystone; the keystone's half weight 0.2 <= mu N and the pillar's
+    # friction N <= mu 1.6 give the least mu at N^2 = 0.32: mu = 1 / (2 sqrt 2) = 0.354
+    present = model.mask(None)
+    needed = model.friction_needed(present, model.mask(["ground"]))
+    assert needed is not None
+    assert 1 / (2 * math.sqrt(2)) <= needed <= 1 / (2 * math.sqrt(2)) + RESOLUTION
+
+
+def test_the_arch_plan_needs_three_holds():
+    assembly = corbels(keystone=True)
+    falling = plan(assembly, gravity=Gravity(holds=1)).to_dict()
+    assert falling["gravity"]["stable"] is False
+    assert falling["gravity"]["stands"] is True
+    assert not falling["steps"][0]["stands"] and falling["steps"][0]["would_fall"]
+
+    data = plan(assembly, gravity=Gravity(holds=3)).to_dict()
+    assert data["feasible"] and data["gravity"]["stable"]
+    assert [step["parts"] for step in data["steps"][:3]] == [
+        ["keystone"],
+        ["corbel_l"],
+        ["corbel_r"],
+    ]
+    assert [sorted(step["held"]) for step in data["steps"][:3]] == [
+        ["corbel_l", "corbel_r", "keystone"],
+        ["corbel_l", "corbel_r"],
+        ["corbel_r"],
+    ]
+    assert data["steps"][0]["would_fall"] == ["corbel_l", "corbel_r"]
+    assert "ground" not in {name for step in data["steps"] for name in step["parts"]}
+    assert_every_state_stands(assembly, data)
+    # assembled in reverse: the keystone last, inserted downwards, both corbels held
+    last = data["assembly_steps"][-1]
+    assert last["parts"] == ["keystone"]
+    assert last["direction"] == [0.0, 0.0, -1.0]
+    assert sorted(last["held"]) == ["corbel_l", "corbel_r", "keystone"]
+
+
+def test_a_leaning_pair_needs_one_hold():
+    assembly = corbels(keystone=False)
+    # by hand: overturning moment 1.8 x 0.1 = 0.18 = N x 1 at most, N <= mu 1.8: mu >= 0.1
+    model = equilibrium_model(assembly, friction=MU)
+    needed = model.friction_needed(model.mask(None), model.mask(["ground"]))
+    assert needed is not None and 0.1 <= needed <= 0.1 + RESOLUTION
+    data = plan(assembly, gravity=Gravity(holds=2)).to_dict()
+    first = data["steps"][0]
+    assert len(first["held"]) == 2 and set(first["held"]) == {"corbel_l", "corbel_r"}
+    assert first["would_fall"] == [n for n in ("corbel_l", "corbel_r") if n not in first["parts"]]
+    assert all(len(step["held"]) == 1 for step in data["steps"][1:])
+    assert data["gravity"]["stable"]
+    assert_every_state_stands(assembly, data)
+
+
+def test_without_gravity_the_plan_is_unchanged_and_one_at_a_time_splits_steps():
+    assembly = corbels(keystone=True)
+    free = plan(assembly).to_dict()
+    assert free["gravity"] is None
+    assert all("held" not in step for step in free["steps"])
+    one = plan(assembly, one_at_a_time=True).to_dict()
+    assert all(len(step["parts"]) == 1 for step in one["steps"])
+    assert sorted(n for step in one["steps"] for n in step["parts"]) == sorted(
+        n for step in free["steps"] for n in step["parts"]
+    )
+    assert len(free["steps"]) < len(one["steps"]) == len(assembly.names) - 1
+
+
+def test_gravity_directions_and_lowest_parts():
+    assert gravity_direction("-z").tolist() == [0.0, 0.0, -1.0]
+    assert gravity_direction("+y").tolist() == [0.0, 1.0, 0.0]
+    assert gravity_direction("0, 0, -2").tolist() == [0.0, 0.0, -1.0]
+    with pytest.raises(InputError, match="--gravity"):
+        gravity_direction("up")
+    assembly = overhanging_stack(0.4)
+    tol = assembly.tolerance()
+    assert lowest_parts(assembly, [0, 0, -1], tol) == ("bottom",)
+    assert lowest_parts(assembly, [0, 0, 1], tol) == ("top",)
+    with pytest.raises(UnknownNameError):
+        equilibrium(assembly, fixed=["nothing"])
+
+
+def test_the_compas_arch_is_planned_with_its_holds_listed():
+    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    result = plan(assembly, gravity=Gravity(holds=3), max_and_or_parts=0)
+    data = result.to_dict()
+    assert data["feasible"] and data["gravity"]["stable"]
+    assert data["gravity"]["fixed"] == ["0", "29"]
+    # the crown goes first, and every step but the last few holds the parts that would fall
+    assert data["steps"][0]["parts"] == ["15"]
+    assert all(set(step["would_fall"]) or len(step["held"]) == 1 for step in data["steps"])
+    assert_every_state_stands(assembly, data)
+
+
+@pytest.mark.slow
+def test_the_asap_beam_comes_apart_beams_first_without_holds():
+    assembly = load_assembly(dataset("asap_beam_assembly"))
+    data = plan(assembly, gravity=Gravity(), max_and_or_parts=0).to_dict()
+    assert [set(step["parts"]) for step in data["steps"]][:2] in ([{"0"}, {"1"}], [{"1"}, {"0"}])
+    assert {n for step in data["steps"][2:] for n in step["parts"]} == {"2", "3"}
+    assert all(step["held"] == step["parts"] for step in data["steps"])
+    assert data["gravity"]["stable"]
+    assert_every_state_stands(assembly, data)
+    assert [step["parts"] for step in data["assembly_steps"]] == [
+        step["parts"] for step in reversed(data["steps"])
+    ]
