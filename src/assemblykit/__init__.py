@@ -1,7 +1,44 @@
 """assemblykit: geometric reasoning about mechanical assemblies.
 
 The public API (DESIGN.md §5.4) is imported lazily so that ``import assemblykit`` stays
-cheap and optional extras are only needed by the functions that use them.
+cheap and optional extras are only needed by the functions that use them; ``dir()``
+lists it. Results print as one line and show as tables in notebooks; results indexed by
+name behave as mappings.
+
+A task: where every body is in every situation (RAPT network reduction).
+
+>>> from pathlib import Path
+>>> import assemblykit
+>>> examples = Path(assemblykit.__file__).parent / "examples"
+>>> task = assemblykit.load_task(examples / "tasks" / "peg_in_block.rapt")
+>>> task
+Task(3 bodies, 2 situations, mm, peg_in_block.rapt)
+>>> solution = task.solve()
+>>> solution
+Solution(underconstrained, 6 body instances, 0 conflicts)
+>>> "peg@s1" in solution, list(solution)[:3]
+(True, ['table@s1', 'block@s1', 'peg@s1'])
+
+An assembly: how each part can move, and a disassembly plan.
+
+>>> hinge = assemblykit.load_assembly(examples / "motion" / "hinge" / "hinge.yaml")
+>>> hinge
+Assembly(2 parts, mm, hinge.yaml)
+>>> "door" in hinge
+True
+>>> motions = assemblykit.motion(hinge)
+>>> motions["door"]
+Motion(door, revolute, 1 dof)
+>>> sorted(motions)
+['door', 'frame']
+>>> gearbox = assemblykit.load_assembly(examples / "gearbox_demo" / "gearbox.yaml")
+>>> plan = assemblykit.plan(gearbox)
+>>> plan
+Plan(feasible, 5 steps, 14 parts)
+>>> plan.steps[0]
+Step(cover, pin_1, pin_2, pin_3 and 1 more along +Z)
+>>> plan.order[0]  # assembly order: the plan reversed
+('housing',)
 """
 
 from __future__ import annotations
@@ -22,6 +59,9 @@ _PUBLIC = {
     "load_problem": "assemblykit.io.problem",
     "mate": "assemblykit.mating.search",
     "Tolerance": "assemblykit.tolerance",
+    "write_report": "assemblykit.viz.viewer",
+    "write_plan": "assemblykit.io.exports",
+    "write_gltf": "assemblykit.io.exports",
 }
 
 __all__ = ["AssemblyKitError", "__version__", *_PUBLIC]
@@ -32,3 +72,8 @@ def __getattr__(name: str) -> Any:
     if module is None:
         raise AttributeError(f"module 'assemblykit' has no attribute {name!r}")
     return getattr(importlib.import_module(module), name)
+
+
+def __dir__() -> list[str]:
+    """The module's names with the lazily imported public API."""
+    return sorted({*globals(), *__all__})

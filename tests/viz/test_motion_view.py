@@ -25,3 +25,29 @@ def test_the_png_draws_the_revolute_axis_in_black(tmp_path: Path) -> None:
     empty = write_motion_png(assembly, type(report)({}), tmp_path / "bare.png", dpi=60)
     bare = np.all(imread(empty)[..., :3] < 0.15, axis=-1).sum()
     assert dark > bare
+
+
+GEARS = Path(assemblykit.__file__).parent / "examples" / "motion" / "gearbox" / "gearbox.yaml"
+
+
+def test_the_motion_table_says_each_motion_in_words_with_gear_ratios() -> None:
+    from assemblykit.motion.articulation import articulation
+    from assemblykit.viz.motion_view import motion_table
+
+    assembly = load_assembly(GEARS)
+    table = motion_table(articulation(assembly), assembly.tolerance(), "mm")
+    assert table.headers == ("part", "motion", "axis", "through (mm)", "lifts off", "speed ratio")
+    rows = {row[0]: row for row in table.rows}
+    assert rows["cover"] == ("cover", "fixed (0 dof), 2 positions", "-", "-", "+Z", "-")
+    # pitch radii 10, 20, 5, 25 on axes at x = 0, 30, 55, 85: w2 = -(10/20) w1,
+    # w3 = (10/5) w1, w4 = -(10/25) w1
+    assert rows["gear_2"] == (
+        "gear_2",
+        "revolute (1 dof)",
+        "+Z",
+        "(30, 0, 0)",
+        "+Z",
+        "-0.5 x gear_1",
+    )
+    assert rows["gear_3"][5] == "2 x gear_1" and rows["gear_4"][5] == "-0.4 x gear_1"
+    assert rows["gear_1"][5] == "1 x gear_1"

@@ -1,13 +1,27 @@
-"""Tests of the HTML report: figure structure, exploded frames, tables, offline page."""
+"""Tests of the HTML report: the figure, the per-step data of the page's script, the
+tables in words, the size of large reports and the CDN option."""
 
 from __future__ import annotations
 
+import base64
+import json
+import re
+
 import numpy as np
+import pytest
 import trimesh
 
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.sequence import Interlock, Plan, Step
-from assemblykit.viz.viewer import EXPLODE_FRACTION, figure, report_html, write_report
+from assemblykit.viz.viewer import (
+    ARROW_FRACTION,
+    PALETTE,
+    ReportTable,
+    figure,
+    report_html,
+    view_box,
+    write_report,
+)
 
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -26,46 +40,102 @@ def lifted(assembly: Assembly) -> Plan:
     return Plan(tuple(assembly.names), (step,), (), None, 4)
 
 
-def test_figure_has_a_mesh_per_part_and_a_frame_per_step():
+def page_data(page: str) -> dict:
+    """The JSON the page's script walks through."""
+    return json.loads(re.search(r"const P = (\{.*?\});\n", page).group(1))
+
+
+def test_one_trace_holds_every_part_and_one_the_arrow():
     assembly = two_boxes()
     fig = figure(assembly, lifted(assembly))
     assert [t.type for t in fig.data] == ["mesh3d", "mesh3d"]
-    assert [t.name for t in fig.data] == ["base", "lid<1>"]
-    assert len(fig.data[0].i) == 12  # a box has 12 triangles
-    assert [f.name for f in fig.frames] == ["0", "1"]
-    slider = fig.layout.sliders[0]
-    assert [s.label for s in slider.steps] == ["assembled", "1"]
-    assert list(slider.steps[1].args[0]) == ["1"]
-    assert slider.steps[1].method == "animate"
-    # step 1 lifts the lid by the explode distance; the base stays
-    shift = EXPLODE_FRACTION * assembly.scale
-    lid_z = np.asarray(fig.frames[1].data[1].z)
-    assert np.allclose(lid_z.min(), 1.0 + shift, atol=1e-5)
-    assert np.allclose(np.asarray(fig.frames[1].data[0].z).max(), 1.0)
-    # the camera box holds the lifted lid
-    assert fig.layout.scene.zaxis.range[1] >= 2.0 + shift - 1e-5
+    parts, arrow = fig.data
+    assert len(parts.i) == 24 and len(parts.x) == 16  # two boxes: 12 triangles, 8 corners
+    assert list(parts.intensity) == [0] * 12 + [1] * 12  # colour slot per face
+    assert parts.intensitymode == "cell"
+    assert arrow.visible is False and fig.frames == ()
+    assert fig.layout.showlegend is False
 
 
-def test_report_is_self_contained_and_lists_steps_and_blocking(tmp_path):
+def test_the_camera_box_is_fitted_to_the_assembled_state():
+    assembly = two_boxes()  # 2 x 2 x 2 around (0, 0, 1)
+    lo, hi = view_box(assembly)
+    # 1.5 x the half-extents (1, 1, 1) around the centre
+    assert np.allclose(lo, [-1.5, -1.5, -0.5]) and np.allclose(hi, [1.5, 1.5, 2.5])
+    scene = figure(assembly, lifted(assembly)).layout.scene
+    assert list(scene.zaxis.range) == pytest.approx([-0.5, 2.5])
+
+
+def test_the_script_moves_the_step_parts_inside_the_view_with_an_arrow():
     assembly = two_boxes()
     page = report_html(assembly, lifted(assembly), title="boxes")
-    assert page.startswith("<!DOCTYPE html>")
-    assert "<script src=" not in page  # plotly.js is embedded, no CDN
-    assert len(page) > 3_000_000
-    assert "<td>lid&lt;1&gt;</td>" in page  # names are escaped
-    assert "<td>(0.000, 0.000, 1.000)</td>" in page
-    # the lid held the base in place along +z: listed as held in place
-    assert "<td>base</td></tr>" in page
-    path = write_report(assembly, lifted(assembly), tmp_path / "sub" / "r.html")
-    assert path.read_text(encoding="utf-8") == report_html(assembly, lifted(assembly))
+    data = page_data(page)
+    assert data["names"] == ["base", "lid<1>"]
+    assert data["stepOf"] == [0, 1] and data["directions"] == [[0.0, 0.0, 1.0]]
+    vertices = np.frombuffer(base64.b64decode(data["vertices"]), dtype=np.float32)
+    assert vertices.reshape(-1, 3)[8:, 2].min() == 1.0  # the lid's corners follow the base's
+    # the view ends at z = 2.5: the lid (top at 2) and its arrow (0.12 x the diagonal
+    # sqrt(12) = 0.4157) leave 0.0843 of room, less than the smallest move, 3% of the
+    # diagonal: 0.1039
+    arrow = ARROW_FRACTION * assembly.scale
+    assert arrow == pytest.approx(0.41569, abs=1e-5)
+    assert data["travel"][1] == pytest.approx(0.103923, abs=1e-6)
+    tip = np.asarray(data["arrows"][0])  # rows x, y, z of the arrow's vertices
+    assert tip[2].min() == pytest.approx(2.103923, abs=1e-4)
+    assert tip[2].max() == pytest.approx(2.103923 + 0.41569, abs=1e-4)
+    assert (
+        data["captions"][1] == "Step 1 of 1: lid<1> moves along +Z (translation) away from 1 part."
+    )
+    assert data["labels"] == ["assembled", "step 1 of 1"]
 
 
-def test_infeasible_report_lists_the_interlocked_parts():
+def test_the_page_says_it_in_words_and_folds_long_lists(tmp_path):
+    names = [f"b{i}" for i in range(12)]
+    blocks = [
+        trimesh.creation.box(extents=(1, 1, 1)).apply_translation((i, 0, 0)) for i in range(12)
+    ]
+    assembly = Assembly([Part(n, m) for n, m in zip(names, blocks, strict=True)])
+    step = Step(tuple(names[:1]), np.array([0.0, -1.0, 1e-17]), tuple(names[1:]), ())
+    plan = Plan(tuple(names), (step,), (), None, 3)
+    page = report_html(assembly, plan)
+    assert "<td>-Y</td>" in page  # the direction as an axis, the tiny component dropped
+    assert "<details><summary>11 parts</summary>b1, b2," in page  # away from: a count
+    assert "<script src=" not in page and len(page) > 3_000_000  # plotly.js embedded
+    assert page.count('class="swatch"') == 12  # the part list, grouped by step
+    assert "<summary>12 parts, by step</summary>" in page
+    small = write_report(assembly, plan, tmp_path / "r.html", plotlyjs="cdn")
+    text = small.read_text(encoding="utf-8")
+    assert 'src="https://cdn.plot.ly/plotly-' in text and small.stat().st_size < 200_000
+
+
+def test_extra_tables_and_interlocks_are_tables_without_paths():
     assembly = two_boxes()
     lock = Interlock(("base", "lid<1>"), translation_locked=True, rigid_may_free=False)
     plan = Plan(tuple(assembly.names), (), (lock,), None, 1)
-    page = report_html(assembly, plan, extra={"Motion": {"lid": "fixed"}})
+    motion = ReportTable("Motion of each part", ("part", "motion"), (("lid<1>", "fixed"),))
+    page = report_html(assembly, plan, extra=(motion,))
     assert "infeasible: interlocked parts base, lid&lt;1&gt;" in page
-    assert "<h2>Interlocked</h2>" in page
     assert "<td>base, lid&lt;1&gt;</td><td>yes</td><td>no</td>" in page
-    assert "&quot;lid&quot;: &quot;fixed&quot;" in page
+    assert "<h2>Motion of each part</h2>" in page
+    assert "<tr><td>lid&lt;1&gt;</td><td>fixed</td></tr>" in page
+    assert "<pre>" not in page
+
+
+def test_a_report_of_hundreds_of_parts_carries_the_geometry_once():
+    blocks = [
+        Part(
+            f"p{i}", trimesh.creation.box(extents=(1, 1, 1)).apply_translation((i % 20, i // 20, 0))
+        )
+        for i in range(400)
+    ]
+    assembly = Assembly(blocks)
+    steps = tuple(
+        Step((f"p{i}",), UP, tuple(f"p{j}" for j in range(i + 1, 400)), ()) for i in range(399)
+    )
+    page = report_html(assembly, Plan(tuple(assembly.names), steps, (), None, 1))
+    plotly_js = 4_000_000
+    assert len(page) - plotly_js < 3_000_000  # not 400 steps x 400 traces
+    assert len(set(page_data(page)["arrows"][0][0])) > 1
+    assert max(int(s) for s in re.findall(r'"slot":\[([0-9,]+)\]', page)[0].split(",")) < len(
+        PALETTE
+    )

@@ -35,6 +35,16 @@ class DirectionalBlockingGraph:
         g.add_edges_from(self.arcs)
         return g
 
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary(
+            "DirectionalBlockingGraph",
+            fmt.direction(self.direction),
+            fmt.count(len(self.parts), "part"),
+            fmt.count(len(self.arcs), "arc"),
+        )
+
     def blocks(self, blocker: str, moving: str) -> bool:
         """Whether ``blocker`` blocks ``moving`` along the direction."""
         return (moving, blocker) in self.arcs

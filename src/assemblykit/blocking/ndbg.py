@@ -480,6 +480,29 @@ class NonDirectionalBlockingGraph:
                     terms.append(BlockingTerm(moving, blocker, normals))
         return terms
 
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        counts = self.arrangement.counts
+        return fmt.summary(
+            "NonDirectionalBlockingGraph",
+            self.motion,
+            fmt.count(len(self.parts), "part"),
+            fmt.count(self.contacts, "contact"),
+            fmt.count(sum(counts.values()), "region"),
+        )
+
+    def _repr_html_(self) -> str:
+        """The removable subassemblies and a direction for each (notebooks)."""
+        from assemblykit import formatting as fmt
+
+        rows = [
+            (", ".join(sorted(r.parts)), fmt.direction(r.directions[0], self.tol))
+            for r in self.removable()
+            if r.directions
+        ]
+        return fmt.html_summary(repr(self), ("removable", "e.g. along"), rows)
+
     def to_dict(self) -> dict[str, Any]:
         """JSON of DESIGN.md §5.3: ``parts``, ``contacts``, ``regions`` counts and
         ``removable`` sets with their unit directions."""

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from assemblykit.errors import NumericError
+from assemblykit.formatting import zero_threshold
 from assemblykit.tolerance import Tolerance, current
 
 SIGNIFICANT_DIGITS = 12
@@ -35,11 +36,10 @@ def json_number(x: float, tol: Tolerance | None = None) -> float | str:
     and NaN values become the strings ``"inf"``, ``"-inf"`` and ``"nan"`` because JSON
     has no literal for them and dropping them would hide a failure.
     """
-    tol = current() if tol is None else tol
     value = float(x)
     if not math.isfinite(value):
         return repr(value)
-    if abs(value) <= min(tol.length, tol.angle):
+    if abs(value) <= zero_threshold(tol):
         return 0.0
     return float(f"{value:.{SIGNIFICANT_DIGITS}g}")
 

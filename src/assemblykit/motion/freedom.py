@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -213,6 +213,11 @@ class Motion(GroupMotion):
         """The report key: the part name, or ``a+b`` for a subassembly."""
         return subassembly_key(self.parts)
 
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary("Motion", self.key, self.kind, f"{self.dof} dof")
+
     @property
     def separates(self) -> bool:
         """Whether the bilateral motion carries the set arbitrarily far away: its group
@@ -361,6 +366,31 @@ class MotionReport:
 
     def __getitem__(self, key: str) -> Motion:
         return self.motions[key]
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.motions
+
+    def __iter__(self) -> Iterator[str]:
+        """The part (and subassembly) names, as a mapping iterates."""
+        return iter(self.motions)
+
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        moving = sum(1 for m in self.motions.values() if m.dof > 0)
+        return fmt.summary(
+            "MotionReport",
+            fmt.count(len(self.motions), "moving set"),
+            f"{moving} with freedom",
+            fmt.file_name(self.source),
+        )
+
+    def _repr_html_(self) -> str:
+        """The motions as a table (notebooks)."""
+        from assemblykit import formatting as fmt
+
+        rows = [(k, m.kind, str(m.dof), ", ".join(m.touching)) for k, m in self.motions.items()]
+        return fmt.html_summary(repr(self), ("part", "motion", "dof", "touching"), rows)
 
     def to_dict(self) -> dict[str, Any]:
         """``parts`` keyed by part name (subassemblies by ``a+b``), DESIGN.md §5.3."""

@@ -1,4 +1,4 @@
-"""The self-contained HTML view of a motion report (seed 003; DESIGN.md §6).
+"""The self-contained HTML view of a motion report (Liu 1997; DESIGN.md §6).
 
 Every part is drawn as a ``mesh3d`` trace with its bilateral motion on top: the axis of
 a revolute, cylindrical or helical motion as a line with a turning arc, the direction
@@ -17,11 +17,14 @@ import numpy as np
 import plotly.graph_objects as go
 from numpy.typing import NDArray
 
+from assemblykit import formatting as fmt
 from assemblykit.algebra import se3
 from assemblykit.io.outputs import atomic_output
 from assemblykit.model.assembly import Assembly
+from assemblykit.motion.articulation import Articulation
 from assemblykit.motion.freedom import Motion, MotionReport
-from assemblykit.viz.viewer import part_colors
+from assemblykit.tolerance import Tolerance
+from assemblykit.viz.viewer import ReportTable, part_colors
 
 GLYPH_FRACTION = 0.12
 """Size of arcs and arrows, as a fraction of the assembly's bounding-box diagonal."""
@@ -145,6 +148,55 @@ def motion_figure(assembly: Assembly, report: MotionReport) -> go.Figure:
         margin={"l": 0, "r": 0, "t": 40, "b": 0},
     )
     return figure
+
+
+def _lift_off(motion: Motion, tol: Tolerance) -> str:
+    """The push-only reading in words: the directions it lifts off along, if any."""
+    reading = motion.unilateral
+    if reading.lift_off:
+        return ", ".join(fmt.direction(ray, tol) for ray in reading.lift_off)
+    if reading.can_lift_off:
+        return "by turning"
+    return "held" if not reading.free else "keeps every contact"
+
+
+def motion_table(result: Articulation, tol: Tolerance, units: str | None = None) -> ReportTable:
+    """The motion of each part in words (Liu 1997): its motion and degrees of freedom,
+    the direction and a point of its axis, the directions it lifts off along and, for a
+    gear, its speed relative to the first gear of its train (Liu, §4)."""
+    ratios = {
+        gear: f"{fmt.number(ratio, tol)} x {train.gears[0]}"
+        for train in result.trains
+        for gear, ratio in train.ratios.items()
+        if ratio is not None
+    }
+    rows = []
+    for key, moved in result.report.motions.items():
+        data = moved.to_dict()
+        kind = f"{data['motion']} ({fmt.count(int(data['dof']), 'dof', 'dof')})"
+        if data.get("components", 1) > 1:
+            kind += f", {data['components']} positions"
+        axis = data.get("axis") or {}
+        line = data.get("direction") or axis.get("direction") or data.get("normal")
+        point = axis.get("point", data.get("center"))
+        rows.append(
+            (
+                key,
+                kind,
+                "-" if line is None else fmt.direction(line, tol),
+                "-" if point is None else fmt.vector(point, tol),
+                _lift_off(moved, tol),
+                ratios.get(key, "-"),
+            )
+        )
+    return ReportTable(
+        "Motion of each part",
+        ("part", "motion", "axis", fmt.header("through", units), "lifts off", "speed ratio"),
+        tuple(rows),
+        "How each part can still move while the others stay in place: its bilateral motion "
+        "(keeping every contact), the directions along which it can lift off its contacts, "
+        "and for meshing gears the speed relative to the first gear of the train.",
+    )
 
 
 def write_motion_html(assembly: Assembly, report: MotionReport, path: str | Path) -> Path:

@@ -1,0 +1,90 @@
+"""The Python API for people: ``dir(assemblykit)``, one-line reprs without arrays, tables
+in notebooks, results indexed by name that behave as mappings, and the Examples in the
+public docstrings (run here with doctest)."""
+
+from __future__ import annotations
+
+import doctest
+import importlib
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import assemblykit
+from assemblykit.blocking.dbg import DirectionalBlockingGraph
+from assemblykit.planning.sequence import Plan, Step
+
+EXAMPLES = Path(assemblykit.__file__).parent / "examples"
+DOCUMENTED = (
+    "assemblykit",
+    "assemblykit.formatting",
+    "assemblykit.io.exports",
+    "assemblykit.viz.explode",
+    "assemblykit.viz.plots",
+)
+
+
+@pytest.mark.parametrize("name", DOCUMENTED)
+def test_the_examples_in_the_docstrings_hold(name: str):
+    module = importlib.import_module(name)
+    result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0 and result.failed == 0
+
+
+def test_dir_lists_the_public_api_and_every_name_resolves():
+    listed = dir(assemblykit)
+    for name in ("load_task", "load_assembly", "motion", "blocking_graph", "plan", "mate"):
+        assert name in listed and name in assemblykit.__all__
+    for name in assemblykit.__all__:
+        assert getattr(assemblykit, name) is not None
+    with pytest.raises(AttributeError, match="no attribute 'nosuch'"):
+        assemblykit.nosuch  # noqa: B018
+
+
+def test_reprs_are_one_short_line_without_arrays_or_paths():
+    task = assemblykit.load_task(EXAMPLES / "tasks" / "peg_in_block.rapt")
+    solution = task.solve()
+    hinge = assemblykit.load_assembly(EXAMPLES / "motion" / "hinge" / "hinge.yaml")
+    ndbg = assemblykit.blocking_graph(hinge)
+    shown = [repr(x) for x in (task, solution, solution["peg@s1"], hinge, ndbg)]
+    assert shown[2] == "BodyInstanceResult(peg@s1, cylindrical, 2 dof)"
+    assert shown[3] == "Assembly(2 parts, mm, hinge.yaml)"
+    # the hinge's sphere arrangement: 6 vertices, 12 edges, 8 faces; one contact
+    assert shown[4] == "NonDirectionalBlockingGraph(infinitesimal, 2 parts, 1 contact, 26 regions)"
+    for text in shown:
+        assert "\n" not in text and len(text) < 120
+        assert "array" not in text and str(EXAMPLES) not in text
+
+
+def test_blocking_graph_and_plan_reprs_say_it_in_words():
+    dbg = DirectionalBlockingGraph(("a", "b"), np.array([0.0, -1.0, 0.0]), frozenset({("a", "b")}))
+    assert repr(dbg) == "DirectionalBlockingGraph(-Y, 2 parts, 1 arc)"
+    step = Step(("lid",), np.array([0.0, 0.0, 1.0]), ("base",), ())
+    plan = Plan(("base", "lid"), (step,), (), None, 1)
+    assert repr(plan) == "Plan(feasible, 1 step, 2 parts)"
+    assert repr(step) == "Step(lid along +Z)"
+    assert plan._repr_html_() == (
+        "<p>Plan(feasible, 1 step, 2 parts)</p><table><tr><th>step</th><th>move</th>"
+        "<th>direction</th><th>motion</th><th>away from</th></tr><tr><td>1</td><td>lid</td>"
+        "<td>+Z</td><td>translation</td><td>1 part</td></tr></table>"
+    )
+
+
+def test_notebook_tables_and_mappings_by_name():
+    task = assemblykit.load_task(EXAMPLES / "tasks" / "peg_in_block.rapt")
+    solution = task.solve()
+    assert list(solution) == list(solution.bodies) and "nosuch@s1" not in solution
+    cells = re.findall(r"<td>(.*?)</td>", solution._repr_html_())
+    assert cells[:4] == ["table@s1", "0", "fixed", "(0, 0, 0)"]
+    assert re.findall(r"<td>(.*?)</td>", task._repr_html_())[:3] == [
+        "table",
+        "yes",
+        "top, wall_x, wall_y",
+    ]
+    hinge = assemblykit.load_assembly(EXAMPLES / "motion" / "hinge" / "hinge.yaml")
+    assert "<th>volume (mm³)</th>" in hinge._repr_html_()
+    report = assemblykit.motion(hinge)
+    assert list(report) == ["frame", "door"] and "door" in report and "lid" not in report
+    assert "<td>door</td><td>revolute</td><td>1</td>" in report._repr_html_()

@@ -1,0 +1,261 @@
+"""The HTML report in a real browser: headless Chromium with the network off opens the
+file, draws the assembled model large, highlights the parts of the shown step with an
+arrow along its direction, and plays the steps.
+
+Driven through Chromium's DevTools protocol (``--remote-debugging-port``) with the
+``websocket-client`` package; skipped when Chromium or that package is missing.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import itertools
+import json
+import shutil
+import socket
+import subprocess
+import time
+import urllib.request
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from assemblykit.io.assembly import load_assembly
+from assemblykit.model.assembly import Assembly
+from assemblykit.planning.sequence import Plan, Step
+from assemblykit.viz.viewer import PALETTE, write_report
+from datasets import dataset
+
+pytestmark = pytest.mark.browser
+
+websocket = pytest.importorskip("websocket", reason="websocket-client is not installed")
+Image = pytest.importorskip("PIL.Image", reason="Pillow is not installed")
+CHROMIUM = next(
+    (shutil.which(b) for b in ("chromium", "chromium-browser", "google-chrome") if shutil.which(b)),
+    None,
+)
+if CHROMIUM is None:
+    pytest.skip("Chromium is not installed", allow_module_level=True)
+
+ROOT = Path(__file__).resolve().parents[2]
+DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--window-size=1100,1000",
+]
+DEADLINE = 30.0
+UP = np.array([0.0, 0.0, 1.0])
+LIFTED = ("cover", "pin_1", "pin_2", "pin_3", "pin_4")
+
+
+class DevTools:
+    """A minimal DevTools-protocol client over one page's websocket."""
+
+    def __init__(self, url: str) -> None:
+        self.socket = websocket.create_connection(url, timeout=DEADLINE)
+        self.ids = itertools.count(1)
+
+    def send(self, method: str, **params: Any) -> dict[str, Any]:
+        number = next(self.ids)
+        self.socket.send(json.dumps({"id": number, "method": method, "params": params}))
+        while True:
+            message = json.loads(self.socket.recv())
+            if message.get("id") == number:
+                assert "error" not in message, message
+                return message.get("result", {})
+
+    def evaluate(self, expression: str) -> Any:
+        result = self.send("Runtime.evaluate", expression=expression, returnByValue=True)
+        return result["result"].get("value")
+
+    def wait_for(self, expression: str) -> Any:
+        end = time.monotonic() + DEADLINE
+        while time.monotonic() < end:
+            value = self.evaluate(expression)
+            if value:
+                return value
+            time.sleep(0.1)
+        raise AssertionError(f"timed out waiting for {expression}")
+
+    def open(self, page: Path) -> dict[str, float]:
+        """Load ``page``, wait until plotly has drawn it; the scene canvas's rectangle."""
+        self.send("Page.enable")
+        self.send("Page.navigate", url=page.as_uri())
+        self.wait_for(
+            "typeof Plotly !== 'undefined' && !!document.querySelector('#assembly-view canvas')"
+            " && document.getElementById('assembly-view').dataset.step === '0'"
+        )
+        time.sleep(0.5)  # let WebGL finish the first frame
+        return self.evaluate(
+            "(() => { const r = document.querySelector('#assembly-view canvas')"
+            ".getBoundingClientRect(); return {x: r.x, y: r.y, width: r.width,"
+            " height: r.height}; })()"
+        )
+
+    def screenshot(self, clip: dict[str, float]) -> np.ndarray:
+        data = self.send("Page.captureScreenshot", format="png", clip={**clip, "scale": 1})
+        image = Image.open(io.BytesIO(base64.b64decode(data["data"]))).convert("RGB")
+        return np.asarray(image, dtype=np.int16)
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory: pytest.TempPathFactory) -> Iterator[DevTools]:
+    profile = tmp_path_factory.mktemp("profile")
+    port = free_port()
+    process = subprocess.Popen(
+        [
+            CHROMIUM,
+            *FLAGS,
+            f"--remote-debugging-port={port}",
+            f"--user-data-dir={profile}",
+            "about:blank",
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        end = time.monotonic() + DEADLINE
+        pages: list[dict[str, Any]] = []
+        while not pages:
+            if time.monotonic() > end:
+                raise AssertionError("Chromium did not open its DevTools port")
+            try:
+                with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list") as reply:
+                    pages = [t for t in json.load(reply) if t["type"] == "page"]
+            except OSError:
+                time.sleep(0.1)
+        tools = DevTools(pages[0]["webSocketDebuggerUrl"])
+        tools.send("Network.enable")
+        tools.send(
+            "Network.emulateNetworkConditions",
+            offline=True,
+            latency=0,
+            downloadThroughput=-1,
+            uploadThroughput=-1,
+        )
+        yield tools
+        tools.socket.close()
+    finally:
+        process.terminate()
+        process.wait(timeout=10)
+
+
+def painted_box(image: np.ndarray) -> tuple[float, float]:
+    """Width and height of the drawn pixels' bounding box, as fractions of the image."""
+    painted = np.any(np.abs(image - image[2, 2]) > 30, axis=2)
+    rows, cols = np.nonzero(painted)
+    assert len(rows), "nothing drawn"
+    return (
+        (cols.max() - cols.min() + 1) / image.shape[1],
+        (rows.max() - rows.min() + 1) / image.shape[0],
+    )
+
+
+def layered(assembly: Assembly, layers: int) -> Plan:
+    """A plan lifting the parts in ``layers`` groups from the top down (for display)."""
+    names = sorted(assembly.names, key=lambda n: -assembly.parts[n].mesh.bounds[1][2])
+    groups = [tuple(g) for g in np.array_split(np.array(names, dtype=object), layers)]
+    steps = tuple(
+        Step(group, UP, tuple(n for later in groups[k + 1 :] for n in later), ())
+        for k, group in enumerate(groups[:-1])
+    )
+    return Plan(tuple(assembly.names), steps, (), None, 1)
+
+
+@pytest.fixture
+def gearbox_report(tmp_path: Path) -> Path:
+    assembly = load_assembly(DEMO)
+    steps = (
+        Step(LIFTED, UP, ("base", "housing"), (("housing", "cover"),)),
+        Step(("plug",), np.array([1.0, 0.0, 0.0]), ("base", "housing"), ()),
+    )
+    plan = Plan(tuple(assembly.names), steps, (), None, 2)
+    return write_report(assembly, plan, tmp_path / "report.html")
+
+
+def test_the_gearbox_fills_the_view_step_one_is_highlighted_and_play_walks_on(
+    browser: DevTools, gearbox_report: Path
+):
+    scene = browser.open(gearbox_report)
+    assert scene["width"] > 300 and scene["height"] > 300
+    before = browser.screenshot(scene)
+    width, height = painted_box(before)
+    assert width > 1 / 3 and height > 1 / 3  # the assembled state fills the view
+
+    browser.evaluate(
+        "(() => { const s = document.getElementById('step-slider'); s.value = 1;"
+        " s.dispatchEvent(new Event('input')); })()"
+    )
+    shown = browser.wait_for(
+        "(() => { const gd = document.getElementById('assembly-view');"
+        " if (gd.dataset.step !== '1') return null;"
+        " return {intensity: Array.from(gd.data[0].intensity), arrow: gd.data[1].visible,"
+        " x: Array.from(gd.data[1].x), y: Array.from(gd.data[1].y),"
+        " z: Array.from(gd.data[1].z),"
+        " caption: document.getElementById('caption').textContent,"
+        " current: Array.from(document.querySelectorAll('tr.current'), r => r.dataset.step)};"
+        " })()"
+    )
+    assembly = load_assembly(DEMO)
+    faces = np.cumsum([0] + [len(p.mesh.faces) for p in assembly])
+    slots = np.asarray(shown["intensity"])
+    for index, name in enumerate(assembly.names):
+        own = slots[faces[index] : faces[index + 1]]
+        if name in LIFTED:  # in its own colour
+            assert np.all(own == index % len(PALETTE)), name
+        else:  # dimmed
+            assert np.all(own == index % len(PALETTE) + len(PALETTE)), name
+    assert shown["arrow"] is True
+    arrow = np.column_stack([shown["x"], shown["y"], shown["z"]])
+    spread = arrow.max(axis=0) - arrow.min(axis=0)
+    # an arrow along z, 0.12 x the diagonal of the 120 x 80 x 60 box long, 1/3 as wide
+    assert spread[2] == pytest.approx(0.12 * np.sqrt(120**2 + 80**2 + 60**2), abs=1e-3)
+    assert spread[2] > 2.5 * max(spread[0], spread[1])
+    cover_top = assembly.parts["cover"].mesh.bounds[1][2]
+    assert arrow[:, 2].min() > cover_top  # above the lifted cover
+    assert shown["caption"].startswith("Step 1 of 2: cover, pin_1, pin_2, pin_3 and 1 more")
+    assert "+Z" in shown["caption"]
+    assert shown["current"] == ["1"]
+    time.sleep(0.5)
+    changed = np.any(np.abs(browser.screenshot(scene) - before) > 30, axis=2).mean()
+    assert changed > 0.01
+
+    browser.evaluate("document.getElementById('play').click()")
+    assert browser.wait_for("document.getElementById('assembly-view').dataset.step === '2'")
+    assert browser.evaluate("document.getElementById('caption').textContent").startswith(
+        "Step 2 of 2: plug moves along +X"
+    )
+
+
+def test_the_dome_report_is_quick_small_and_large_on_screen(browser: DevTools, tmp_path: Path):
+    assembly = load_assembly(dataset("compas_assembly/dome_assembly.json"))
+    plan = layered(assembly, 40)
+    start = time.perf_counter()
+    page = write_report(assembly, plan, tmp_path / "dome.html")
+    seconds = time.perf_counter() - start
+    assert seconds < 5.0
+    assert page.stat().st_size < 25_000_000
+    scene = browser.open(page)
+    width, height = painted_box(browser.screenshot(scene))
+    assert width > 1 / 3 and height > 1 / 3
+    legend = browser.evaluate("document.querySelectorAll('#assembly-view .legend').length")
+    assert legend == 0
+    # long lists are folded: 39 steps of a 527-part dome fit in a few screens
+    assert browser.evaluate("document.body.scrollHeight") < 6000
