@@ -121,3 +121,78 @@ def test_plan_reports_the_hands_a_planar_interlock_needs(capsys):
     assert json.loads(out)["hands"]["needed"] is None
     code, _, err = run(capsys, "plan", str(PLANAR / "three_hands.yaml"), "--max-hands", "1")
     assert code == 2 and "--max-hands" in err
+
+
+def _leaning_pair(folder: Path) -> Path:
+    """A manifest of a ground slab, two pillars and two corbels leaning on each other
+    (each alone would tip over its pillar's edge)."""
+    import trimesh
+
+    boxes = {
+        "ground": ((6, 1, 1), (-3, 0, -1)),
+        "pillar_l": ((1, 1, 1), (-2, 0, 0)),
+        "pillar_r": ((1, 1, 1), (1, 0, 0)),
+        "corbel_l": ((1.8, 1, 1), (-1.8, 0, 1)),
+        "corbel_r": ((1.8, 1, 1), (0, 0, 1)),
+    }
+    entries = []
+    for name, (extents, low) in boxes.items():
+        mesh = trimesh.creation.box(extents=extents)
+        mesh.apply_translation([lo + e / 2 for lo, e in zip(low, extents, strict=True)])
+        mesh.export(folder / f"{name}.obj")
+        entries.append(f"  - {{name: {name}, mesh: {name}.obj}}")
+    manifest = folder / "pair.yaml"
+    manifest.write_text("parts:\n" + "\n".join(entries) + "\n")
+    return manifest
+
+
+def test_plan_under_gravity_lists_holds_and_the_assembly_order(capsys, tmp_path):
+    manifest = _leaning_pair(tmp_path)
+    html = tmp_path / "pair.html"
+    code, out, err = run(
+        capsys, "plan", str(manifest), "--json", "--gravity", "--holds", "2", "--html", str(html)
+    )
+    assert code == 0, err
+    page = html.read_text()
+    assert "<h2>Assembly order</h2>" in page and "<th>stands</th>" in page
+    data = json.loads(out)
+    assert data["gravity"]["direction"] == [0.0, 0.0, -1.0]
+    assert data["gravity"]["fixed"] == ["ground"] and data["gravity"]["stable"] is True
+    first = data["steps"][0]
+    assert {"parts", "direction", "motion", "held", "would_fall", "stability_margin"} <= set(first)
+    assert set(first["held"]) == {"corbel_l", "corbel_r"}
+    assert all(len(step["parts"]) == 1 for step in data["steps"])
+    last = data["assembly_steps"][-1]
+    assert last["parts"] == first["parts"] and set(last["held"]) == set(first["held"])
+    assert last["direction"] == [-x + 0.0 for x in first["direction"]]
+
+    code, out, _ = run(capsys, "plan", str(manifest), "--gravity", "0,0,-1", "--friction", "0.05")
+    assert code == 0
+    assert "Assembly order" in out and "some states fall" in out
+    code, out, _ = run(capsys, "plan", str(manifest), "--json", "--gravity=+x")
+    assert json.loads(out)["gravity"]["direction"] == [1.0, 0.0, 0.0]
+    # a direction starting with a minus is a value, not an option
+    for given in (["--gravity", "-y"], ["--gravity=-y"], ["--gravity", "0,-1,0"]):
+        code, out, err = run(capsys, "plan", str(manifest), "--json", *given)
+        assert code == 0, err
+        assert json.loads(out)["gravity"]["direction"] == [0.0, -1.0, 0.0]
+
+
+@pytest.mark.parametrize(
+    ("option", "named"),
+    [
+        (["--gravity=up"], "--gravity"),
+        (["--gravity", "--fixed", "nothing"], "nothing"),
+        (["--gravity", "--friction", "-1"], "--friction"),
+    ],
+)
+def test_bad_gravity_options_are_one_line_and_exit_2(capsys, tmp_path, option, named):
+    manifest = _leaning_pair(tmp_path)
+    code, out, err = run(capsys, "plan", str(manifest), *option)
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and named in err and "Traceback" not in err
+
+
+def test_no_holds_at_all_is_bad_input(capsys, tmp_path):
+    code, _, err = run(capsys, "plan", str(_leaning_pair(tmp_path)), "--gravity", "--holds", "0")
+    assert code == 2 and "--holds" in err

@@ -1,17 +1,21 @@
 """The ``assemblykit`` command (DESIGN.md §5.3).
 
 Every command takes ``INPUT``, ``--json`` (the documented JSON on stdout), ``--tolerance``
-(relative length tolerance) and ``--debug`` (tracebacks); the commands that load an
+(relative length tolerance; ``solve`` and ``motion`` also take ``--angle-tolerance``, which
+otherwise follows it) and ``--debug`` (tracebacks); the commands that load an
 assembly take ``--as-written`` (keep rounded mesh-folder poses unsettled). Exit codes: 0
 for every answer (including *inconsistent* or *infeasible*), 2 for bad input (one line on
-stderr naming the file and the fault), 1 for an internal error.
+stderr naming the file and the fault), 1 for an internal error, 130 after Ctrl-C (one
+line, "assemblykit: interrupted").
 """
 
 from __future__ import annotations
 
 import functools
 import json
+import re
 import sys
+import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, NoReturn, Protocol
 
@@ -20,19 +24,40 @@ import click
 from assemblykit import __version__
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
 from assemblykit.io.outputs import HTML_SUFFIXES, PNG_SUFFIXES, checked_output
-from assemblykit.tolerance import MAX_REL_LENGTH, MIN_REL_LENGTH, Tolerance
+from assemblykit.tolerance import MAX_ANGLE, MAX_REL_LENGTH, MIN_ANGLE, MIN_REL_LENGTH, Tolerance
 
 if TYPE_CHECKING:
     from rich.console import Console
 
     from assemblykit.model.assembly import Assembly
+    from assemblykit.planning.stability import Gravity
 
 # Output captured by a program (a pipe, a file, a test) is laid out at this width whatever
 # the terminal says, so that what machines read never depends on COLUMNS.
 PLAIN_WIDTH = 120
 
+INTERRUPTED = 130
+"""Exit code after Ctrl-C (SIGINT): 128 + the signal's number, as shells report it."""
+
+
+class Interrupted(BaseException):
+    """Ctrl-C during a command. A :class:`BaseException` like :class:`KeyboardInterrupt`,
+    so that no ``except Exception`` stops it; click turns only the latter into its own
+    message."""
+
+
+class _Commands(click.Group):
+    """The command group, passing an interruption on as :class:`Interrupted`."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            raise Interrupted from None
+
 
 @click.group(
+    cls=_Commands,
     name="assemblykit",
     context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100},
     no_args_is_help=True,
@@ -63,6 +88,12 @@ class _OptionRange(click.FloatRange):
         option = param.opts[0] if param is not None and param.opts else None
         raise InputError(message, where=option)
 
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        number = super().convert(value, param, ctx)
+        if number != number:  # NaN passes every range comparison
+            self.fail(f"{value!r} is not a number", param, ctx)
+        return number
+
 
 json_option = click.option(
     "--json", "as_json", is_flag=True, help="Print the result as JSON on stdout."
@@ -71,7 +102,14 @@ tolerance_option = click.option(
     "--tolerance",
     type=_OptionRange(MIN_REL_LENGTH, MAX_REL_LENGTH),
     default=None,
-    help="Relative length tolerance (fraction of the model's bounding-box diagonal).",
+    help="Relative length tolerance (fraction of the model's bounding-box diagonal);"
+    " the angle tolerance follows it unless --angle-tolerance is given.",
+)
+angle_tolerance_option = click.option(
+    "--angle-tolerance",
+    type=_OptionRange(MIN_ANGLE, MAX_ANGLE),
+    default=None,
+    help="Angle tolerance in radians (default: the --tolerance value, else 1e-9).",
 )
 debug_option = click.option("--debug", is_flag=True, help="Show tracebacks on errors.")
 as_written_option = click.option(
@@ -91,23 +129,27 @@ class Result(Protocol):
     def render(self) -> Any: ...
 
 
-def tolerance_from(option: float | None) -> Tolerance:
-    """The tolerance policy with the command line's ``--tolerance`` applied."""
-    return Tolerance() if option is None else Tolerance(rel_length=option)
+def tolerance_from(option: float | None, angle: float | None = None) -> Tolerance:
+    """The tolerance policy with the command line's ``--tolerance`` and
+    ``--angle-tolerance`` applied (the angle follows ``--tolerance`` unless given)."""
+    return Tolerance.relative(option, angle)
 
 
 def loaded_assembly(path: str, tol: Tolerance, as_written: bool) -> Assembly:
     """The assembly at ``path`` with the command line's tolerance, settled unless
-    ``--as-written``."""
+    ``--as-written``; what the loader skipped is said on stderr."""
     from assemblykit.io.assembly import load_assembly
 
-    return load_assembly(path, tol, settle=not as_written)
+    loaded = load_assembly(path, tol, settle=not as_written)
+    for item in loaded.skipped:
+        note(f"{path}: skipped {item.item}: {item.reason}")
+    return loaded
 
 
 def assembly_or_polygons(path: str, tol: Tolerance, as_written: bool) -> Any:
     """A YAML file of 2D polygons (``parts: {name: [[x, y], ...]}``) as a polygon
     assembly, anything else as :func:`loaded_assembly`."""
-    from assemblykit.blocking.polygons import is_polygon_file, load_polygons
+    from assemblykit.io.polygons import is_polygon_file, load_polygons
 
     if is_polygon_file(path):
         return load_polygons(path)
@@ -134,13 +176,41 @@ def _fail(message: str, code: int) -> None:
     raise SystemExit(code)
 
 
+DIRECTION_OPTIONS = ("--gravity",)
+"""Options whose optional value is a direction, which may start with a minus (``-z``)."""
+_DIRECTION = re.compile(r"^[+-]?[xyzXYZ]$|^[+-]?[\d.eE+-]+(,[+-]?[\d.eE+-]+){2}$")
+
+
+def _direction_values(args: list[str]) -> list[str]:
+    """``args`` with a direction given to a :data:`DIRECTION_OPTIONS` option (``--gravity
+    -z``, ``--gravity=-z``) protected by a leading space: click takes a word starting
+    with a minus after an option with an optional value for the next option."""
+    result: list[str] = []
+    for k, arg in enumerate(args):
+        name, equals, value = arg.partition("=")
+        if equals and name in DIRECTION_OPTIONS and _DIRECTION.match(value):
+            result.append(f"{name}= {value}")
+        elif k > 0 and args[k - 1] in DIRECTION_OPTIONS and _DIRECTION.match(arg):
+            result.append(f" {arg}")
+        else:
+            result.append(arg)
+    return result
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the console script: maps errors to one line and an exit code
-    (usage errors print the usage and exit 2, like bad input)."""
-    args = sys.argv[1:] if argv is None else argv
+    (usage errors print the usage and exit 2, like bad input; Ctrl-C prints
+    "assemblykit: interrupted" and exits ``INTERRUPTED``). Without ``--debug``,
+    RuntimeWarnings are not shown."""
+    args = _direction_values(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in args
     try:
-        app.main(args=args, prog_name="assemblykit", standalone_mode=False)
+        with warnings.catch_warnings():
+            if not debug:
+                # numpy and trimesh report floating-point edge cases (0/0 on a degenerate
+                # facet, ...) that the algorithms handle; to a user they are noise
+                warnings.simplefilter("ignore", RuntimeWarning)
+            app.main(args=args, prog_name="assemblykit", standalone_mode=False)
     except click.exceptions.Exit as done:
         raise SystemExit(done.exit_code) from None
     except click.UsageError as usage:
@@ -150,8 +220,8 @@ def main(argv: list[str] | None = None) -> None:
         if debug:
             raise
         _fail(bad.format_message(), 2)
-    except (click.exceptions.Abort, KeyboardInterrupt):
-        _fail("interrupted", 1)
+    except (Interrupted, click.exceptions.Abort, KeyboardInterrupt):
+        _fail("interrupted", INTERRUPTED)
     except (InputError, MissingExtraError) as bad:
         if debug:
             raise
@@ -178,12 +248,19 @@ def command(fn: Callable[..., None]) -> click.Command:
 @click.argument("task")
 @json_option
 @tolerance_option
+@angle_tolerance_option
 @click.option("--explain", is_flag=True, help="Also print the reduction steps (the trace).")
 @debug_option
 def solve_cmd(
-    task: str, as_json: bool, tolerance: float | None, explain: bool, debug: bool
+    task: str,
+    as_json: bool,
+    tolerance: float | None,
+    angle_tolerance: float | None,
+    explain: bool,
+    debug: bool,
 ) -> None:
-    """Pose of every body in every situation of a task (RAPT network reduction, seed 000).
+    """Pose of every body in every situation of a task (RAPT network reduction,
+    Corner, Ambler & Popplestone 1983).
 
     TASK: task file, .yaml, .yml, .json or .rapt.
     """
@@ -191,7 +268,7 @@ def solve_cmd(
     from assemblykit.tolerance import using
 
     # The engine scales the policy to the model's size; only the relative part comes from here.
-    with using(tolerance_from(tolerance)):
+    with using(tolerance_from(tolerance, angle_tolerance)):
         emit(load_task(task).solve(explain=explain), as_json)
 
 
@@ -220,10 +297,63 @@ def _updater(bar: Any) -> Callable[[str, int, int], None]:
     return update
 
 
+def _plan_input(path: str, tol: Tolerance, as_written: bool, problem: int, solution: int) -> Any:
+    """What ``plan`` reads: a BurrTools puzzle placed as ``solution`` of ``problem``, or
+    :func:`assembly_or_polygons`."""
+    if path.lower().endswith(".xmpuzzle"):
+        from assemblykit.io.burrtools import load_burrtools
+
+        return load_burrtools(path, tol, problem, solution)
+    return assembly_or_polygons(path, tol, as_written)
+
+
+def _multi_move_plan(
+    loaded: Any, path: str, max_states: int | None, progress: Callable[[str, int, int], None]
+) -> Result:
+    """The multi-move plan of a loaded voxel puzzle, compared with its stored level."""
+    from assemblykit.io.burrtools import VoxelAssembly
+    from assemblykit.planning.multimove import MAX_STATES, plan_voxels
+
+    if not isinstance(loaded, VoxelAssembly):
+        raise InputError(
+            "--moves multi plans voxel puzzles: give a BurrTools .xmpuzzle", source=path
+        )
+    puzzle = loaded.puzzle
+    return plan_voxels(
+        puzzle.names,
+        [p.voxels for p in puzzle.pieces],
+        [p.group for p in puzzle.pieces],
+        max_states=MAX_STATES if max_states is None else max_states,
+        reference_level=puzzle.level,
+        progress=progress,
+    )
+
+
+def _gravity(
+    direction: str | None, friction: float, holds: int, fixed: tuple[str, ...]
+) -> Gravity | None:
+    """The settings of ``plan --gravity`` (``None`` without it)."""
+    if direction is None:
+        return None
+    from assemblykit.planning.stability import Gravity, gravity_direction
+
+    down = gravity_direction(direction)
+    return Gravity((float(down[0]), float(down[1]), float(down[2])), friction, holds, fixed or None)
+
+
 @command
 @assembly_argument
 @click.option("--html", default=None, help="Write a self-contained HTML report here.")
 @click.option("--png", default=None, help="Write a static exploded view (PNG) here.")
+@click.option("--out", default=None, help="Write the step table here (.json or .csv).")
+@click.option("--gltf", default=None, help="Write the exploded view as glTF here (.glb or .gltf).")
+@click.option(
+    "--plotly",
+    type=click.Choice(["inline", "cdn"]),
+    default="inline",
+    show_default=True,
+    help="--html: embed plotly.js (opens offline) or link it from its CDN (a small file).",
+)
 @click.option(
     "--max-hands",
     type=click.IntRange(min=2),
@@ -231,6 +361,60 @@ def _updater(bar: Any) -> Callable[[str, int, int], None]:
     show_default=True,
     help="For parts no two-handed move separates: try up to this many hands.",
 )
+@click.option(
+    "--moves",
+    type=click.Choice(["monotone", "multi", "rigid"]),
+    default="monotone",
+    show_default=True,
+    help="monotone: one translation per separation (NDBG); multi: sequences of lattice "
+    "moves for voxel puzzles (.xmpuzzle); rigid: monotone, then turns (screw motions) "
+    "for what translations leave stuck.",
+)
+@click.option(
+    "--max-states",
+    type=click.IntRange(min=1),
+    default=None,
+    help="--moves multi: states per separation before the search is cut [default: 250000].",
+)
+@click.option(
+    "--problem", type=click.IntRange(min=0), default=0, help=".xmpuzzle: the problem (from 0)."
+)
+@click.option(
+    "--solution",
+    type=click.IntRange(min=0),
+    default=0,
+    help=".xmpuzzle: the stored solution giving the assembled position (from 0).",
+)
+@click.option(
+    "--gravity",
+    is_flag=False,
+    flag_value="-z",
+    default=None,
+    metavar="[DIR]",
+    help="Plan under gravity along DIR (-z when bare; +y, x, or a vector such as 0,-1,0): "
+    "every state must stand (static equilibrium with friction).",
+)
+@click.option(
+    "--friction",
+    type=_OptionRange(min=0.0),
+    default=0.5,
+    show_default=True,
+    help="--gravity: Coulomb friction coefficient of every contact.",
+)
+@click.option(
+    "--holds",
+    type=click.IntRange(min=1),
+    default=1,
+    show_default=True,
+    help="--gravity: parts that may be held per step, the moved one included.",
+)
+@click.option(
+    "--fixed",
+    multiple=True,
+    help="--gravity: a part that never moves (ground, fixture); repeatable "
+    "[default: the parts touching the lowest plane].",
+)
+@click.option("--one-at-a-time", is_flag=True, help="Move one free set (a part) per step.")
 @json_option
 @tolerance_option
 @as_written_option
@@ -239,41 +423,96 @@ def plan_cmd(
     assembly: str,
     html: str | None,
     png: str | None,
+    out: str | None,
+    gltf: str | None,
+    plotly: str,
     max_hands: int,
+    moves: str,
+    max_states: int | None,
+    problem: int,
+    solution: int,
+    gravity: str | None,
+    friction: float,
+    holds: int,
+    fixed: tuple[str, ...],
+    one_at_a_time: bool,
     as_json: bool,
     tolerance: float | None,
     as_written: bool,
     debug: bool,
 ) -> None:
-    """Disassembly (and assembly) sequence by extended translations (seed 004).
+    """Disassembly (and assembly) sequence by extended translations (Wilson & Latombe
+    1992), or by sequences of lattice moves for interlocking voxel puzzles (--moves
+    multi).
 
     ASSEMBLY: mesh folder, .yaml manifest, .step, COMPAS .json, or a YAML file of 2D
-    polygons 'parts: {name: [[x, y], ...]}' (planned in the plane).
+    polygons 'parts: {name: [[x, y], ...]}' (planned in the plane), or a BurrTools
+    .xmpuzzle (placed as its stored --solution of --problem).
     """
     from assemblykit.planning.sequence import plan
+
+    if moves != "monotone" and (html is not None or png is not None):
+        raise InputError(f"--html and --png draw translation plans: not with --moves {moves}")
+    if moves != "monotone" and (gravity is not None or one_at_a_time):
+        raise InputError(f"--gravity and --one-at-a-time plan translations, not --moves {moves}")
 
     if html is not None:
         checked_output(html, "--html", HTML_SUFFIXES)
     if png is not None:
         checked_output(png, "--png", PNG_SUFFIXES)
+    if moves != "monotone" and (out is not None or gltf is not None):
+        raise InputError(f"--out and --gltf export translation plans: not with --moves {moves}")
+    from assemblykit.io.exports import GLTF_SUFFIXES, PLAN_SUFFIXES
+
+    if out is not None:
+        checked_output(out, "--out", PLAN_SUFFIXES)
+    if gltf is not None:
+        checked_output(gltf, "--gltf", GLTF_SUFFIXES)
     tol = tolerance_from(tolerance)
     with _progress_bar() as bar:
         update = _updater(bar)
-        loaded = assembly_or_polygons(assembly, tol, as_written)
+        loaded = _plan_input(assembly, tol, as_written, problem, solution)
+        if getattr(loaded, "dimension", 3) == 2 and gltf is not None:
+            raise InputError("--gltf draws meshes: not for a 2D polygon assembly")
         if getattr(loaded, "dimension", 3) == 2 and (html is not None or png is not None):
             raise InputError("--html and --png draw meshes: not for a 2D polygon assembly")
-        result = plan(loaded, tol=tol, progress=update, max_hands=max_hands)
+        if moves == "multi":
+            result = _multi_move_plan(loaded, assembly, max_states, update)
+        elif moves == "rigid":
+            from assemblykit.planning.screw import plan_with_screws
+
+            if getattr(loaded, "dimension", 3) == 2:
+                raise InputError("--moves rigid turns 3D parts: not for a 2D polygon assembly")
+            result = plan_with_screws(loaded, tol)
+        else:
+            result = plan(
+                loaded,
+                tol=tol,
+                progress=update,
+                max_hands=max_hands,
+                gravity=_gravity(gravity, friction, holds, fixed),
+                one_at_a_time=one_at_a_time,
+            )
         if html is not None:
             from assemblykit.viz.viewer import write_report
 
             update("writing the report", 0, 1)
-            write_report(loaded, result, html)
+            write_report(loaded, result, html, plotlyjs=plotly)  # type: ignore[arg-type]
         if png is not None:
             from assemblykit.viz.plots import exploded_view_png
 
             update("drawing the exploded view", 0, 1)
             exploded_view_png(loaded, result, png)
-    for written in (html, png):
+        if out is not None:
+            from assemblykit.io.exports import write_plan
+
+            write_plan(result, out, getattr(loaded, "tolerance", lambda: tol)())
+        if gltf is not None:
+            from assemblykit.io.exports import write_gltf
+
+            update("writing the glTF scene", 0, 1)
+            write_gltf(loaded, result, gltf, loaded.tolerance())
+    for written in (html, png, out, gltf):
         if written is not None:
             note(f"wrote {written}")
     emit(result, as_json)
@@ -359,6 +598,7 @@ def batch_cmd(
             scheduler=scheduler,
             rel_tolerance=tolerance,
             progress=lambda done, total: bar.update(task, completed=done, total=total),
+            notice=note,
         )
     emit(summary, as_json)
     if summary.missing:
@@ -405,6 +645,7 @@ def _task_motion(path: str, tol: Tolerance, as_json: bool) -> None:
 @click.option("--html", default=None, help="Also write a self-contained HTML view to FILE.")
 @json_option
 @tolerance_option
+@angle_tolerance_option
 @as_written_option
 @debug_option
 def motion_cmd(
@@ -413,10 +654,11 @@ def motion_cmd(
     html: str | None,
     as_json: bool,
     tolerance: float | None,
+    angle_tolerance: float | None,
     as_written: bool,
     debug: bool,
 ) -> None:
-    """Motion of each part and subassembly relative to the rest, gear trains (seed 003);
+    """Motion of each part and subassembly relative to the rest, gear trains (Liu 1997);
     on a task, of each body in each situation from the relations it takes part in.
 
     ASSEMBLY: mesh folder, .yaml manifest, .step or COMPAS .json, or a task (.yaml/.json
@@ -426,7 +668,7 @@ def motion_cmd(
 
     if html is not None:
         checked_output(html, "--html", HTML_SUFFIXES)
-    tol = tolerance_from(tolerance)
+    tol = tolerance_from(tolerance, angle_tolerance)
     if _is_task_file(assembly):
         if subassembly or html is not None:
             raise InputError("--subassembly and --html apply to assemblies, not tasks")
@@ -544,7 +786,7 @@ def blocking_cmd(
 @tolerance_option
 @debug_option
 def mate_cmd(problem: str, as_json: bool, tolerance: float | None, debug: bool) -> None:
-    """Mating inference (seed 002): which compound features mate to satisfy the goals.
+    """Mating inference (Liu & Popplestone 1990): which compound features mate to satisfy the goals.
 
     PROBLEM: mating problem, .yaml, .yml or .json.
     """
