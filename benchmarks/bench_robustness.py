@@ -2,7 +2,7 @@
 
 Every vertex of the bundled mesh assemblies is moved by seeded uniform noise of
 amplitude ``level`` x the model's size per axis: 1e-8 with the default tolerance, 1e-6
-with ``--tolerance 5e-6`` (five times the noise, docs/contacts.md). Printed per
+with ``--tolerance 5e-6`` (five times the noise, docs/geometry.md). Printed per
 assembly: flat coplanar groups (planar faces), contact pairs and planar patches, whether
 the motion kinds are those of the exact meshes, and the ``plan`` time (median of three,
 contacts included) next to the exact meshes' time.

@@ -4,7 +4,7 @@ Every vertex of a bundled assembly is moved by seeded uniform noise of amplitude
 ``level`` x the model's size along each axis. At 1e-8 (a hundredth of the default mesh
 tolerance) the default policy must give the same contact pairs, motion kinds and plan as
 the exact meshes; at 1e-6 (the default tolerance itself) the same answers come with a
-tolerance five times the noise (``--tolerance 5e-6``, docs/contacts.md). Scaling the
+tolerance five times the noise (``--tolerance 5e-6``, docs/geometry.md). Scaling the
 whole model by 1e-3 or 1e3 changes no answer (every threshold is relative to its size).
 The hand-known answers: the hinge's door turns about its pin (revolute), the gearbox's
 cover is fixed and its gears turn, the stacked blocks slide on each other (planar).

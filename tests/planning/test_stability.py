@@ -225,8 +225,9 @@ def test_the_compas_arch_is_planned_with_its_holds_listed():
     data = result.to_dict()
     assert data["feasible"] and data["gravity"]["stable"]
     assert data["gravity"]["fixed"] == ["0", "29"]
-    # the crown goes first, and every step but the last few holds the parts that would fall
-    assert data["steps"][0]["parts"] == ["15"]
+    # a crown block goes first (14 and 15 are mirror images: which one is a float tie),
+    # and every step but the last few holds the parts that would fall
+    assert data["steps"][0]["parts"] in (["14"], ["15"])
     assert all(set(step["would_fall"]) or len(step["held"]) == 1 for step in data["steps"])
     assert_every_state_stands(assembly, data)
 
