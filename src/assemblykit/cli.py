@@ -250,6 +250,13 @@ def command(fn: Callable[..., None]) -> click.Command:
 @tolerance_option
 @angle_tolerance_option
 @click.option("--explain", is_flag=True, help="Also print the reduction steps (the trace).")
+@click.option(
+    "--max-branches",
+    type=click.IntRange(min=1, max=100_000),
+    default=None,
+    help="Most finite alternatives (discrete poses, assembly modes) followed to the end "
+    "(default 64).",
+)
 @debug_option
 def solve_cmd(
     task: str,
@@ -257,6 +264,7 @@ def solve_cmd(
     tolerance: float | None,
     angle_tolerance: float | None,
     explain: bool,
+    max_branches: int | None,
     debug: bool,
 ) -> None:
     """Pose of every body in every situation of a task (RAPT network reduction,
@@ -269,7 +277,7 @@ def solve_cmd(
 
     # The engine scales the policy to the model's size; only the relative part comes from here.
     with using(tolerance_from(tolerance, angle_tolerance)):
-        emit(load_task(task).solve(explain=explain), as_json)
+        emit(load_task(task).solve(explain=explain, max_branches=max_branches), as_json)
 
 
 def _progress_bar() -> Any:
@@ -640,7 +648,8 @@ def _task_motion(path: str, tol: Tolerance, as_json: bool) -> None:
 @click.option(
     "--subassembly",
     multiple=True,
-    help="Comma-separated parts that move together (e.g. a,b); repeat for several.",
+    help="Comma-separated parts that move together (e.g. a,b), or the name of a "
+    "subassembly of a STEP file; repeat for several.",
 )
 @click.option("--html", default=None, help="Also write a self-contained HTML view to FILE.")
 @json_option
@@ -675,7 +684,10 @@ def motion_cmd(
         _task_motion(assembly, tol, as_json)
         return
     loaded = loaded_assembly(assembly, tol, as_written)
-    sets = [[n.strip() for n in spec.split(",") if n.strip()] for spec in subassembly]
+    sets = [
+        loaded.groups.get(spec.strip()) or [n.strip() for n in spec.split(",") if n.strip()]
+        for spec in subassembly
+    ]
     if any(not names for names in sets):
         raise InputError("--subassembly needs comma-separated part names", source=assembly)
     result = articulation(loaded, sets, tol)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from importlib.resources import files
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from assemblykit.algebra import se3
 from assemblykit.features.primitives import Ball, Hole, Plane, Point, Prism, Shaft, Socket, Thread
 from assemblykit.inference import solve_numeric_only
 from assemblykit.inference.reduction import model_scale
+from assemblykit.io.spec import load_task
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Action, Situation, Task
@@ -874,3 +876,30 @@ def test_model_scale_counts_radii_and_sizes():
         10 * math.sqrt(3)
     )
     assert model_scale(Task("mm", {"flat": flat}, situation)) == 1.0  # no extent at all
+
+
+def test_a_search_cut_at_its_limit_says_so_and_counts_what_it_found(tmp_path):
+    """The W14 square peg with 100-sided prisms has exactly 100 poses, the written one
+    turned about the axis by 2πk/100; the default search follows 64 of them and says so."""
+    square = files("assemblykit") / "examples" / "tasks" / "w14_square_peg.yaml"
+    path = tmp_path / "hundred.yaml"
+    path.write_text(square.read_text().replace("sides: 4", "sides: 100"), encoding="utf-8")
+    task = load_task(path)
+
+    cut = task.solve()
+    assert cut.status == "ambiguous"
+    assert cut.cut is not None and (cut.cut.followed, cut.cut.not_followed) == (64, 36)
+    assert cut.to_dict()["truncated"]["not_followed"] == 36
+    assert cut["peg@s1"].solutions == 64
+
+    whole = task.solve(max_branches=100)
+    assert whole.cut is None and "truncated" not in whole.to_dict()
+    peg = whole["peg@s1"]
+    assert peg.solutions == 100
+    turns = sorted(
+        round(math.atan2(p[1, 0], p[0, 0]) / (2 * math.pi / 100)) % 100
+        for p in (peg.pose, *peg.alternatives)
+    )
+    assert turns == list(range(100))
+    for p in (peg.pose, *peg.alternatives):
+        assert np.allclose(p[:3, 3], 0, atol=1e-12) and np.allclose(p[2, :3], [0, 0, 1])

@@ -72,6 +72,7 @@ from assemblykit.inference.numeric import (
 )
 from assemblykit.inference.solution import (
     BodyInstanceResult,
+    BranchCut,
     Conflict,
     Solution,
     TraceStep,
@@ -604,23 +605,27 @@ def _motion(value: Any) -> tuple[str, Mapping[str, Any]]:
     return _kind_name(value), invariants
 
 
-def explore(reducer: Reducer, max_branches: int) -> list[Reducer]:
+def explore(reducer: Reducer, max_branches: int) -> tuple[list[Reducer], int]:
     """Run the reduction, branching depth first on finite alternatives (rule 3).
 
-    At most ``max_branches`` leaves are explored; past that, only the first alternative
-    of a choice is followed.
+    At most ``max_branches`` leaves are explored: a choice with more alternatives than
+    there is room for follows only as many as fit (at least one). Returns the leaves and
+    the number of alternatives not followed, so that a cut search says so in its answer.
     """
     reducer.run()
     leaves: list[Reducer] = []
     stack = [reducer]
+    skipped = 0
     while stack:
         state = stack.pop()
         choice = None if state.conflicts else state.branch_choice()
         if choice is None:
             leaves.append(state)
             continue
-        if len(leaves) + len(stack) + len(choice) > max_branches:
-            choice = choice[:1]
+        room = max(1, max_branches - len(leaves) - len(stack))
+        if len(choice) > room:
+            skipped += len(choice) - room
+            choice = choice[:room]
         children = []
         for alternative in choice:
             child = state.copy()
@@ -628,7 +633,7 @@ def explore(reducer: Reducer, max_branches: int) -> list[Reducer]:
             child.run()
             children.append(child)
         stack.extend(reversed(children))
-    return leaves
+    return leaves, skipped
 
 
 def _components_of(network: Network, reducer: Reducer) -> list[set[Node]]:
@@ -1164,8 +1169,16 @@ def _collector_paused() -> Iterator[None]:
             gc.enable()
 
 
+MAX_BRANCHES = 64
+"""Default number of branches (finite alternatives, assembly modes) followed to the end;
+an answer whose search was cut says how many alternatives it did not follow."""
+
+
 def solve_network(
-    network: Network, tol: Tolerance | None = None, explain: bool = False, max_branches: int = 64
+    network: Network,
+    tol: Tolerance | None = None,
+    explain: bool = False,
+    max_branches: int = MAX_BRANCHES,
 ) -> Solution:
     """Reduce a network (rules 1-4), then report every instance (rule 5)."""
     tol = tol or current()
@@ -1173,14 +1186,15 @@ def solve_network(
     cache: dict[Hashable, tuple[Any, list[GroupEvent], int]] = {}
     for group in _parallel_groups(network.links):
         root.add_parallel(group, cache)
-    leaves = explore(root, max_branches)
+    leaves, skipped = explore(root, max_branches)
     reports = [_leaf_report(network, leaf, tol) for leaf in leaves]
     bodies, conflicts = _combine(network, reports, tol)
     trace = tuple(dict.fromkeys(step for leaf in leaves for step in leaf.trace))
     free = tuple(
         TraceStep("free", key, b.dof, b.dof, b.freedom) for key, b in bodies.items() if b.freedom
     )
-    return Solution(bodies, tuple(conflicts), trace + free, explain)
+    cut = BranchCut(len(leaves), skipped, max_branches) if skipped else None
+    return Solution(bodies, tuple(conflicts), trace + free, explain, cut)
 
 
 _EXTENTS = ("radius", "size", "major_radius", "minor_radius")
@@ -1204,11 +1218,21 @@ def model_scale(task: Any) -> float:
     return diagonal if diagonal > 0 else 1.0
 
 
-def solve_task(task: Any, tol: Tolerance | None = None, explain: bool = False) -> Solution:
-    """RAPT inference on a task: poses of every body in every situation (seed 000 §III)."""
+def solve_task(
+    task: Any,
+    tol: Tolerance | None = None,
+    explain: bool = False,
+    max_branches: int | None = None,
+) -> Solution:
+    """RAPT inference on a task: poses of every body in every situation (seed 000 §III).
+
+    ``max_branches`` (default :data:`MAX_BRANCHES`) bounds the finite alternatives
+    followed (rule 3); a cut search is reported in :attr:`Solution.cut`."""
     tol = tol or current().with_scale(model_scale(task))
     with using(tol), _collector_paused():
-        return solve_network(build_network(task.validate()), tol, explain)
+        return solve_network(
+            build_network(task.validate()), tol, explain, max_branches or MAX_BRANCHES
+        )
 
 
 def solve_numeric_only(task: Any, tol: Tolerance | None = None, starts: int = 8) -> Solution:

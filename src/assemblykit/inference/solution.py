@@ -197,12 +197,46 @@ class TraceStep:
         }
 
 
-def status_of(bodies: Mapping[str, BodyInstanceResult], conflicts: tuple[Conflict, ...]) -> str:
+@dataclass(frozen=True)
+class BranchCut:
+    """A search over finite alternatives (rule 3) that stopped at its limit: ``followed``
+    branches were followed to the end, ``not_followed`` alternatives were not, so the
+    solution counts are lower bounds."""
+
+    followed: int
+    not_followed: int
+    limit: int
+
+    @property
+    def message(self) -> str:
+        return (
+            f"only {self.followed} branches were followed (limit {self.limit}); "
+            f"{self.not_followed} alternatives were not: solution counts are lower bounds "
+            "(raise --max-branches to follow more)"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "followed": self.followed,
+            "not_followed": self.not_followed,
+            "limit": self.limit,
+            "message": self.message,
+        }
+
+
+def status_of(
+    bodies: Mapping[str, BodyInstanceResult],
+    conflicts: tuple[Conflict, ...],
+    cut: BranchCut | None = None,
+) -> str:
     """Inconsistent if anything conflicts; ambiguous if some instance has finitely many
-    poses; underconstrained if some instance keeps freedom (dof > 0 or a lattice)."""
+    poses (or alternatives were left unexplored); underconstrained if some instance keeps
+    freedom (dof > 0 or a lattice)."""
     if conflicts:
         return "inconsistent"
-    if any(b.solutions is not None and b.solutions > 1 and b.dof == 0 for b in bodies.values()):
+    if cut is not None or any(
+        b.solutions is not None and b.solutions > 1 and b.dof == 0 for b in bodies.values()
+    ):
         return "ambiguous"
     if any(b.dof > 0 or b.solutions is None for b in bodies.values()):
         return "underconstrained"
@@ -211,17 +245,19 @@ def status_of(bodies: Mapping[str, BodyInstanceResult], conflicts: tuple[Conflic
 
 @dataclass(frozen=True)
 class Solution:
-    """Poses of every body instance, the conflicts found and (on request) the trace."""
+    """Poses of every body instance, the conflicts found, (on request) the trace, and
+    ``cut`` when the search over finite alternatives stopped at its limit."""
 
     bodies: Mapping[str, BodyInstanceResult]
     conflicts: tuple[Conflict, ...] = ()
     trace: tuple[TraceStep, ...] = ()
     explain: bool = False
+    cut: BranchCut | None = None
 
     @property
     def status(self) -> str:
         """``solved``, ``ambiguous``, ``underconstrained`` or ``inconsistent``."""
-        return status_of(self.bodies, self.conflicts)
+        return status_of(self.bodies, self.conflicts, self.cut)
 
     def __getitem__(self, key: str) -> BodyInstanceResult:
         return self.bodies[key]
@@ -272,6 +308,8 @@ class Solution:
         }
         if self.conflicts:
             out["suggested_tolerance"] = self.suggested_tolerance
+        if self.cut is not None:
+            out["truncated"] = self.cut.to_dict()
         if self.explain:
             out["trace"] = [step.to_dict() for step in self.trace]
         return out
@@ -296,6 +334,8 @@ class Solution:
                 invariants,
             )
         parts: list[Any] = [table]
+        if self.cut is not None:
+            parts.append(Text(self.cut.message))
         parts.extend(Text(b.freedom) for b in self.bodies.values() if b.freedom)
         for c in self.conflicts:
             parts.append(Text(f"conflict ({c.kind} {c.value:.6g}): {', '.join(c.relations)}"))

@@ -187,11 +187,15 @@ class Task:
                 self._check_action(action, where)
         return self
 
-    def solve(self, tol: Tolerance | None = None, explain: bool = False) -> Solution:
-        """Poses of every body in every situation by network reduction (seed 000 §III)."""
+    def solve(
+        self, tol: Tolerance | None = None, explain: bool = False, max_branches: int | None = None
+    ) -> Solution:
+        """Poses of every body in every situation by network reduction (seed 000 §III);
+        at most ``max_branches`` finite alternatives are followed (default
+        ``inference.reduction.MAX_BRANCHES``; ``Solution.cut`` says when more were left)."""
         from assemblykit.inference import solve_task
 
-        return solve_task(self, tol=tol, explain=explain)
+        return solve_task(self, tol=tol, explain=explain, max_branches=max_branches)
 
     def _body(self, name: str, where: str) -> Body:
         """The body called ``name``; :class:`UnknownNameError` naming ``where`` if none."""
