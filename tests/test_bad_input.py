@@ -276,6 +276,21 @@ CASES: list[Case] = [
         "b.final_state",
     ),
     Case(
+        "contacts null part name",
+        on_assembly("contacts", text=manifest().replace("name: b", "name: null")),
+        "parts[1].name",
+    ),
+    Case(
+        "plan overflowing translation",
+        on_assembly("plan", text=manifest("{translation: [0, -1.0e+308, 1]}")),
+        "parts[1].pose.translation",
+    ),
+    Case(
+        "motion overflowing final_state",
+        on_folder('{"b": {"final_state": [0, 0, 1e300, 0, 0, 0]}}'),
+        "b.final_state",
+    ),
+    Case(
         "motion inf final_state",
         on_folder('{"b": {"final_state": [0, 0, Infinity, 0, 0, 0]}}'),
         "b.final_state",

@@ -267,7 +267,8 @@ def _final_states(config: Path) -> dict[str, list[float]]:
         state = entry["final_state"]
         if not (isinstance(state, list) and len(state) == 6 and _numbers(state)):
             raise SchemaError(
-                "final_state must be 6 finite numbers [x, y, z, rx, ry, rz]",
+                "final_state must be 6 finite numbers [x, y, z, rx, ry, rz] of size at most "
+                f"{MAX_MESH_COORDINATE:g}",
                 source=source,
                 where=f"{name}.final_state",
             )
@@ -276,9 +277,15 @@ def _final_states(config: Path) -> dict[str, list[float]]:
 
 
 def _numbers(values: Sequence[Any]) -> bool:
-    """Whether every value is a finite number (NaN or infinity would place a part nowhere)."""
+    """Whether every value is a finite number of magnitude at most ``MAX_MESH_COORDINATE``
+    (NaN or infinity would place a part nowhere; a larger translation would move its mesh
+    beyond the coordinates a mesh may have)."""
     return all(
-        isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in values
+        isinstance(v, int | float)
+        and not isinstance(v, bool)
+        and math.isfinite(v)
+        and abs(v) <= MAX_MESH_COORDINATE
+        for v in values
     )
 
 
@@ -299,7 +306,9 @@ def pose_from_spec(
             value = spec.get(key, [0.0, 0.0, 0.0])
             if not (isinstance(value, list) and len(value) == 3 and _numbers(value)):
                 raise SchemaError(
-                    "expected 3 finite numbers", source=source, where=f"{where}.{key}"
+                    f"expected 3 finite numbers of size at most {MAX_MESH_COORDINATE:g}",
+                    source=source,
+                    where=f"{where}.{key}",
                 )
         rotation = Rotation.from_euler("xyz", spec.get("rotation_xyz_deg", [0, 0, 0]), degrees=True)
         pose[:3, :3] = rotation.as_matrix()
@@ -311,7 +320,11 @@ def pose_from_spec(
             "expected a 4x4 matrix or {translation, rotation_xyz_deg}", source=source, where=where
         )
     if not all(_numbers(r) for r in rows):
-        raise SchemaError("matrix entries must be finite numbers", source=source, where=where)
+        raise SchemaError(
+            f"matrix entries must be finite numbers of size at most {MAX_MESH_COORDINATE:g}",
+            source=source,
+            where=where,
+        )
     pose = np.array(rows, dtype=np.float64)
     rotation = pose[:3, :3]
     rigid = np.allclose(rotation.T @ rotation, np.eye(3), atol=tol.mesh_angle, rtol=0)
@@ -336,7 +349,14 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         where = f"parts[{i}]"
         if not isinstance(entry, dict) or not isinstance(entry.get("mesh"), str):
             raise SchemaError("expected {name, mesh, pose}", source=source, where=where)
-        name = str(entry.get("name", Path(entry["mesh"]).stem))
+        name = entry.get("name", Path(entry["mesh"]).stem)
+        if isinstance(name, bool) or not isinstance(name, str | int) or not str(name).strip():
+            raise SchemaError(
+                f"a part name must be a non-empty text or a number, got {name!r}",
+                source=source,
+                where=f"{where}.name",
+            )
+        name = str(name)
         if any(p.name == name for p in parts):
             raise SchemaError(f"duplicate part name {name!r}", source=source, where=where)
         pose = pose_from_spec(entry.get("pose"), source=source, where=f"{where}.pose", tol=tol)
