@@ -11,7 +11,18 @@ Then a task file of 1,000 stacked bodies (YAML, DESIGN.md §5.1) read and solved
 process: load time (YAML parsing, by yaml-rs, and validation),
 solve time and their sum.
 
-Run: python benchmarks/bench_rapt.py [--quick] [--one-start]
+Then a chain of 40 bodies, each seated on the one below, against CadQuery's assembly
+solver on the same chain (41 unit boxes, each ``Plane``-constrained onto the one below
+and ``Axis``-aligned with it), both with load included: for us reading the task file
+and solving; for CadQuery building the assembly (its boxes and constraints) and solving.
+Both are timed in a warm process (the best of repeats, as timeit advises on a shared
+machine) and cold (a fresh interpreter,
+imports included). CadQuery runs in this interpreter when it imports here, else in the
+interpreter named by ``--cadquery-python PATH`` (or ``$CADQUERY_PYTHON``); without
+either only our figure is printed.
+
+Run: python benchmarks/bench_rapt.py [--quick] [--one-start] [--chain-only]
+[--cadquery-python PATH]
 
 ``--quick`` stops at N = 1,000. The numeric-only path runs with the residue solver's
 default settings (its deterministic multi-start; several minutes at N = 100 on a busy
@@ -21,7 +32,10 @@ a lower bound of its cost.
 
 from __future__ import annotations
 
+import importlib.util
+import os
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -181,6 +195,109 @@ def load_and_solve(n: int, repeats: int = 5) -> None:
     )
 
 
+CHAIN = 40
+
+_OURS_COLD = """
+import sys, time
+start = time.perf_counter()
+from assemblykit.io.spec import load_task
+solution = load_task(sys.argv[1]).solve()
+assert solution.status == "solved", solution.status
+print(time.perf_counter() - start)
+"""
+
+_CADQUERY = """
+import sys, time
+start = time.perf_counter()
+import cadquery as cq
+imported = time.perf_counter()
+n, repeats = int(sys.argv[1]), int(sys.argv[2])
+
+
+def chain():
+    assy = cq.Assembly()
+    assy.add(cq.Workplane().box(1, 1, 1), name="b0")
+    for i in range(1, n + 1):
+        # written away from the answer, as our chain's bodies are
+        away = cq.Location((0.3 * i, 0.2, 2.0 * i))
+        assy.add(cq.Workplane().box(1, 1, 1), name=f"b{i}", loc=away)
+    assy.constrain("b0", "Fixed")
+    for i in range(1, n + 1):
+        assy.constrain(f"b{i - 1}@faces@>Z", f"b{i}@faces@<Z", "Plane")
+        assy.constrain(f"b{i - 1}@faces@>X", f"b{i}@faces@>X", "Axis", param=0)
+    assy.solve()
+    return assy
+
+
+top = chain().children[-1].loc.toTuple()[0]
+cold = time.perf_counter() - start
+assert abs(top[2] - n) < 1e-6 and abs(top[0]) < 1e-6, top
+warm = []
+for _ in range(repeats):
+    begin = time.perf_counter()
+    chain()
+    warm.append(time.perf_counter() - begin)
+print(cold, min(warm), imported - start)
+"""
+
+
+def _cadquery_python() -> str | None:
+    """The interpreter that runs CadQuery: this one when it imports cadquery, else the
+    one named on the command line or in ``$CADQUERY_PYTHON``."""
+    if "--cadquery-python" in sys.argv:
+        return sys.argv[sys.argv.index("--cadquery-python") + 1]
+    if importlib.util.find_spec("cadquery") is not None:
+        return sys.executable
+    return os.environ.get("CADQUERY_PYTHON")
+
+
+def chain_against_cadquery(n: int = CHAIN, repeats: int = 20) -> None:
+    """Load + solve a chain of ``n`` bodies, ours against CadQuery's assembly solver."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / f"chain{n}.yaml"
+        path.write_text(yaml.safe_dump(stack_file(n), sort_keys=False))
+        runs = []
+        for _ in range(repeats + 1):  # the first run also imports what solving needs
+            start = time.perf_counter()
+            solution = load_task(path).solve()
+            runs.append(time.perf_counter() - start)
+            assert solution.status == "solved", solution.status
+        ours = min(runs[1:])
+        cold = float(
+            subprocess.run(
+                [sys.executable, "-c", _OURS_COLD, str(path)],
+                capture_output=True,
+                text=True,
+                check=True,
+            ).stdout
+        )
+    print(
+        f"chain of {n} bodies, load + solve: ours {ours * 1e3:.2f} ms warm (best of {repeats}),"
+        f" {cold:.3f} s cold (imports included)"
+    )
+    python = _cadquery_python()
+    if python is None:
+        print("CadQuery not installed: give --cadquery-python PATH to compare")
+        return
+    run = subprocess.run(
+        [python, "-c", _CADQUERY, str(n), str(max(3, repeats // 4))],
+        capture_output=True,
+        text=True,
+    )
+    if run.returncode != 0:
+        print(f"CadQuery failed: {run.stderr.strip().splitlines()[-1:]}")
+        return
+    cq_cold, cq_warm, cq_import = (float(v) for v in run.stdout.split()[-3:])
+    best = f"best of {max(3, repeats // 4)}"
+    print(
+        f"chain of {n} bodies, CadQuery build + solve: {cq_warm * 1e3:.1f} ms warm ({best}),"
+        f" {cq_cold:.3f} s cold (import {cq_import:.3f} s)"
+    )
+    print(
+        f"chain of {n} bodies: ours {cq_warm / ours:.0f}x faster warm, {cq_cold / cold:.1f}x cold"
+    )
+
+
 def timed(fn: Callable[[], object], repeats: int) -> float:
     """Median wall time of ``repeats`` calls (garbage collection left on, as in use)."""
     return statistics.median(timeit.repeat(fn, "gc.enable()", number=1, repeat=repeats))
@@ -188,6 +305,9 @@ def timed(fn: Callable[[], object], repeats: int) -> float:
 
 def main() -> None:
     quick = "--quick" in sys.argv
+    chain_against_cadquery()
+    if "--chain-only" in sys.argv:
+        return
     load_and_solve(1000)
     sizes = (10, 100, 1000) if quick else (10, 100, 1000, 10000)
     print(f"{'shape':8} {'N':>7} {'median s':>10} {'bodies/s':>10}")

@@ -11,7 +11,7 @@ import pytest
 
 import assemblykit
 from assemblykit.algebra import se3
-from assemblykit.features.primitives import Ball, Hole, Plane, Point, Shaft
+from assemblykit.features.primitives import Axis, Ball, Hole, Plane, Point, Shaft
 from assemblykit.inference import solve_numeric_only
 from assemblykit.io.spec import load_task
 from assemblykit.model.body import Body
@@ -71,7 +71,8 @@ def test_point_in_one_plane_keeps_five_dof_and_the_pose_as_written():
     np.testing.assert_allclose(v["invariants"]["point"], [0.5, 0, 0], atol=EXACT)
     assert v["freedom"] == (
         "v@s1 can slide its point (0.5, 0, 0) in the plane normal to (1, 0, 0)"
-        " and turn about it: 5 dof"
+        " and turn about it: 5 dof; two more point_on_plane on the same point (making a"
+        " spherical joint) and relations on the body's orientation would remove it"
     )
 
 
@@ -93,10 +94,13 @@ def test_point_in_three_planes_is_a_spherical_joint_about_the_corner():
     np.testing.assert_allclose(v["invariants"]["center"], [0.5, 1, 1.5], atol=EXACT)
     # the representative is the pose as written moved onto the corner: identity rotation
     np.testing.assert_allclose(v["pose"], shift(0.5, 1.0, 1.5), atol=EXACT)
-    assert v["freedom"] == "v@s1 can turn about (0.5, 1, 1.5): 3 dof"
+    assert v["freedom"] == (
+        "v@s1 can turn about (0.5, 1, 1.5): 3 dof; a fits or coaxial through (0.5, 1, 1.5)"
+        " (leaving a turn about that axis) and a stop off that axis would remove it"
+    )
     assert "mechanism" not in v  # a Hervé family needs no other name
-    assert ("free", "v@s1", 3, 3) in [
-        (s["rule"], s["link"], s["dof_before"], s["dof_after"]) for s in out["trace"]
+    assert ("free", "v@s1", 3, 3, v["freedom"]) in [
+        (s["rule"], s["link"], s["dof_before"], s["dof_after"], s["detail"]) for s in out["trace"]
     ]
     assert "residue" not in [step["rule"] for step in out["trace"]]
 
@@ -216,7 +220,10 @@ def test_box_on_table_with_corner_on_the_line_of_two_walls_turns_about_it():
     np.testing.assert_allclose(b["invariants"]["point"], [5, 0, 0], atol=EXACT)
     assert unoriented(b["invariants"]["direction"], Z)
     np.testing.assert_allclose(b["pose"], shift(4, -1), atol=EXACT)
-    assert b["freedom"] == "box@s1 can turn about the axis through (5, 0, 0) along (0, 0, 1): 1 dof"
+    assert b["freedom"] == (
+        "box@s1 can turn about the axis through (5, 0, 0) along (0, 0, 1): 1 dof;"
+        " a stop against the turn (an against or point_on_plane off that axis) would remove it"
+    )
 
 
 def test_box_on_table_with_corner_in_three_planes_is_the_same_revolute():
@@ -377,5 +384,26 @@ def test_an_instance_merged_into_another_says_its_own_name():
         ),
     )
     bodies = task.solve().to_dict()["bodies"]
-    assert bodies["v@s2"]["freedom"] == "v@s2 can turn about (0.5, 1, 1.5): 3 dof"
+    assert bodies["v@s2"]["freedom"].startswith("v@s2 can turn about (0.5, 1, 1.5): 3 dof;")
     np.testing.assert_allclose(bodies["v@s2"]["pose"], shift(0.5, 1, 1.5), atol=EXACT)
+
+
+def test_edge_on_face_is_a_line_in_the_plane():
+    """An edge (a line feature) lying on a face: ``distance`` 0 between the line and the
+    plane. The edge through (0, 0, 2) along (0, 1, 1)/√2 turns by the smallest rotation
+    onto z = const, -45° about x through (0, 0, 2), then drops by 2 onto the table:
+    R = Rx(-π/4), so R·(0, 0, 2) = (0, √2, √2) and t = (0, 0, 0) - R·(0, 0, 2) = (0, -√2, -√2)."""
+    edge = Body("slab", {"edge": Axis((0, 0, 2), (0, 1 / SQRT2, 1 / SQRT2))})
+    on_face = rel("distance", "slab.edge", "world.table", distance=0.0)
+    b = solve([WORLD, edge], on_face)["bodies"]["slab@s1"]
+    assert (b["dof"], b["motion"], b["mechanism"]) == (4, "mechanism", "line-on-plane")
+    expected = se3.rot_x(-np.pi / 4)
+    expected[:3, 3] = [0, -SQRT2, -SQRT2]
+    np.testing.assert_allclose(b["pose"], expected, atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["direction"], Y, atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["point"], [0, 0, 0], atol=EXACT)
+    # the relation written out at the pose: the edge's point on z = 0, its direction flat
+    pose = np.asarray(b["pose"])
+    assert se3.apply(pose, (0, 0, 2))[2] == pytest.approx(0.0, abs=EXACT)
+    assert (pose[:3, :3] @ (0, 1 / SQRT2, 1 / SQRT2))[2] == pytest.approx(0.0, abs=EXACT)
+    assert solve_numeric_only(make_task([WORLD, edge], on_face))["slab@s1"].dof == 4

@@ -1,4 +1,6 @@
-"""Closed-form loop solvers (ALGEBRA.md §5.2 rule 4): circle against a point orbit."""
+"""Loops and coupled joints (ALGEBRA.md §5.2 rule 4): closed-form circle-orbit solvers,
+closures of up to four bodies with every assembly mode, gears, racks and screws. Each
+branch found is checked against its relations written out by hand in the test."""
 
 from __future__ import annotations
 
@@ -9,7 +11,8 @@ import pytest
 from tests.inference.test_reduction import Z, body, rel, rz, shift, solve
 
 from assemblykit.algebra import Coset, SymmetryGroup, se3
-from assemblykit.features.primitives import Ball, Hole, Plane, Shaft, Socket
+from assemblykit.errors import FeatureError, SchemaError
+from assemblykit.features.primitives import Axis, Ball, Hole, Plane, Shaft, Socket, Thread
 from assemblykit.inference.loops import (
     Circle,
     circle_line,
@@ -18,6 +21,7 @@ from assemblykit.inference.loops import (
     circle_sphere,
     point_loop,
 )
+from assemblykit.model.relations import Relation, relation_residual
 from assemblykit.tolerance import Tolerance
 
 TOL = Tolerance(10.0)
@@ -226,3 +230,295 @@ def test_slider_crank_out_of_reach_is_inconsistent():
     assert out["status"] == "inconsistent"
     assert out["conflicts"][0]["kind"] == "loop"
     assert "circle-line" in out["conflicts"][0]["message"]
+
+
+# ------------------------------------------------- closures of four bodies, coupled joints
+
+
+def revolute_about(pose, point, direction) -> bool:
+    """Whether ``pose`` is a rotation about the line through ``point`` along ``direction``:
+    it keeps the point and the direction (written out, independent of the algebra)."""
+    pose = np.asarray(pose)
+    point, direction = np.asarray(point, float), np.asarray(direction, float)
+    return bool(
+        np.allclose(pose[:3, :3] @ point + pose[:3, 3], point, atol=1e-9)
+        and np.allclose(pose[:3, :3] @ direction, direction, atol=1e-9)
+    )
+
+
+def modes(out, key: str) -> list[np.ndarray]:
+    b = out["bodies"][key]
+    return [np.asarray(p) for p in (b["pose"], *b["alternatives"])]
+
+
+def rx(angle: float) -> np.ndarray:
+    return se3.rot_x(angle)
+
+
+def ry(angle: float) -> np.ndarray:
+    return se3.rot_y(angle)
+
+
+# A spherical four-bar: every joint axis passes through the origin O. The ground holds the
+# crank about z and the rocker about x; the crank holds the coupler about y; the coupler
+# and the rocker turn about each other about a = (1, 1, 1)/√3 (a pin fitted in a bore,
+# with a ball in a socket at O to keep each joint from sliding). A stop holds the crank.
+UNIT_A = tuple(np.full(3, 1 / math.sqrt(3)))
+X_AXIS, Y_AXIS = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)
+
+
+def spherical_four_bar():
+    ground = body(
+        "ground",
+        fixed=True,
+        h1=Hole((0, 0, 0), Z, 0.5),
+        s1=Socket((0, 0, 0), 0.5),
+        h4=Hole((0, 0, 0), X_AXIS, 0.5),
+        s4=Socket((0, 0, 0), 0.5),
+        stop=Plane((0, 1, 0), (0, -1, 0)),
+    )
+    crank = body(
+        "crank",
+        p1=Shaft((0, 0, 0), Z, 0.5),
+        b1=Ball((0, 0, 0), 0.5),
+        h2=Hole((0, 0, 0), Y_AXIS, 0.5),
+        s2=Socket((0, 0, 0), 0.5),
+        side=Plane((0, 1, 0), (0, 1, 0)),
+    )
+    coupler = body(
+        "coupler",
+        p2=Shaft((0, 0, 0), Y_AXIS, 0.5),
+        b2=Ball((0, 0, 0), 0.5),
+        h3=Hole((0, 0, 0), UNIT_A, 0.5),
+        s3=Socket((0, 0, 0), 0.5),
+    )
+    rocker = body(
+        "rocker",
+        p4=Shaft((0, 0, 0), X_AXIS, 0.5),
+        b4=Ball((0, 0, 0), 0.5),
+        p3=Shaft((0, 0, 0), UNIT_A, 0.5),
+        b3=Ball((0, 0, 0), 0.5),
+    )
+    joints = [
+        rel("fits", "crank.p1", "ground.h1"),
+        rel("fits", "crank.b1", "ground.s1"),
+        rel("fits", "coupler.p2", "crank.h2"),
+        rel("fits", "coupler.b2", "crank.s2"),
+        rel("fits", "rocker.p3", "coupler.h3"),
+        rel("fits", "rocker.b3", "coupler.s3"),
+        rel("fits", "rocker.p4", "ground.h4"),
+        rel("fits", "rocker.b4", "ground.s4"),
+        rel("against", "crank.side", "ground.stop"),
+    ]
+    return solve([ground, crank, coupler, rocker], *joints, explain=True)
+
+
+def test_spherical_four_bar_has_two_assembly_modes():
+    """The coupler turns about y by φ and the rocker about x by ψ; they close when both
+    carry a to the same u: u·y = a·y = 1/√3 and u·x = 1/√3, so u = (1, 1, ±1)/√3. The
+    mode u = a is the pose as written (φ = ψ = 0); u = (1, 1, -1)/√3 needs Ry(φ) to take
+    (x, z) = (1, 1) to (1, -1): φ = π/2, and Rx(ψ) to take (y, z) = (1, 1) to (1, -1):
+    ψ = -π/2."""
+    out = spherical_four_bar()
+    assert out["status"] == "ambiguous"
+    assert "residue" not in rules(out)
+    assert np.allclose(out["bodies"]["crank@s1"]["pose"], np.eye(4), atol=1e-12)
+    coupler, rocker = modes(out, "coupler@s1"), modes(out, "rocker@s1")
+    assert len(coupler) == len(rocker) == 2
+    for found, expected in ((coupler, ry(math.pi / 2)), (rocker, rx(-math.pi / 2))):
+        assert any(np.allclose(p, np.eye(4), atol=1e-9) for p in found)
+        assert any(np.allclose(p, expected, atol=1e-9) for p in found)
+    # every branch, by its own residuals: the coupler turns about the crank's y axis, the
+    # rocker about the ground's x axis, and both put the joint axis a on one line
+    a = np.asarray(UNIT_A)
+    for c, r in zip(coupler, rocker, strict=True):
+        assert revolute_about(c, (0, 0, 0), Y_AXIS) and revolute_about(r, (0, 0, 0), X_AXIS)
+        np.testing.assert_allclose(c[:3, :3] @ a, r[:3, :3] @ a, atol=1e-9)
+
+
+# An RRPR (inverted slider-crank): the crank, stopped, carries the pin B = (0, 3); the
+# rocker turns about D = (4, 0) and carries a slot along its x axis through D; the slider
+# turns on B and slides in the slot. Written, the slider's bore sits at D.
+B, D = np.array([0.0, 3.0, 0.0]), np.array([4.0, 0.0, 0.0])
+
+
+def rrpr():
+    r = 0.5
+    ground = body(
+        "ground",
+        fixed=True,
+        top=Plane((0, 0, 0), Z),
+        ha=Hole((0, 0, 0), Z, r),
+        hd=Hole(tuple(D), Z, r),
+        stop=Plane((1, 0, 0), (-1, 0, 0)),
+    )
+    crank = body(
+        "crank",
+        bottom=Plane((0, 0, 0), (0, 0, -1)),
+        pa=Shaft((0, 0, 0), Z, r),
+        top=Plane((0, 0, 1), Z),
+        pb=Shaft(tuple(B), Z, r),
+        side=Plane((1, 0, 0), (1, 0, 0)),
+    )
+    rocker = body(
+        "rocker",
+        bottom=Plane(tuple(D), (0, 0, -1)),
+        pd=Shaft(tuple(D), Z, r),
+        top=Plane((4, 0, 1), Z),
+        rail=Plane(tuple(D), (0, 1, 0)),
+    )
+    slider = body(
+        "slider",
+        bottom=Plane((4, 0, 1), (0, 0, -1)),
+        hb=Hole(tuple(D), Z, r),
+        side=Plane(tuple(D), (0, -1, 0)),
+    )
+    joints = [
+        rel("fits", "crank.pa", "ground.ha"),
+        rel("against", "crank.bottom", "ground.top"),
+        rel("against", "crank.side", "ground.stop"),
+        rel("fits", "rocker.pd", "ground.hd"),
+        rel("against", "rocker.bottom", "ground.top"),
+        rel("fits", "slider.hb", "crank.pb"),
+        rel("against", "slider.bottom", "crank.top"),
+        rel("against", "slider.bottom", "rocker.top"),
+        rel("against", "slider.side", "rocker.rail"),
+    ]
+    return solve([ground, crank, rocker, slider], *joints, explain=True)
+
+
+def test_rrpr_has_two_modes_with_the_slot_through_the_pin():
+    """The slot is a line through D that must pass through B: along ±(B - D) = ±(-4, 3),
+    so the rocker turns to ψ = atan2(3, -4) or atan2(-3, 4). The slider turns with the
+    rocker and its bore moves from D to B: pose Tr(B - D)·Rz(ψ about D), a slide of
+    s = ±5 along the slot."""
+    out = rrpr()
+    assert out["status"] == "ambiguous"
+    rocker, slider = modes(out, "rocker@s1"), modes(out, "slider@s1")
+    assert len(rocker) == len(slider) == 2
+    for psi in (math.atan2(3, -4), math.atan2(-3, 4)):
+        assert any(np.allclose(p, rz(psi, tuple(D)), atol=1e-9) for p in rocker)
+        expected = shift(*(B - D)) @ rz(psi, tuple(D))
+        assert any(np.allclose(p, expected, atol=1e-9) for p in slider)
+    for r, s in zip(rocker, slider, strict=True):
+        assert revolute_about(r, D, Z)  # R: the rocker about D
+        np.testing.assert_allclose(se3.apply(s, D), B, atol=1e-9)  # R: the slider on B
+        relative = se3.inverse(r) @ s  # P: no turn, a shift along the slot's x only
+        np.testing.assert_allclose(relative[:3, :3], np.eye(3), atol=1e-9)
+        np.testing.assert_allclose(relative[1:3, 3], 0.0, atol=1e-9)
+        assert abs(relative[0, 3]) == pytest.approx(5.0, abs=1e-9)
+
+
+# A rack and pinion: the pinion (pitch radius 2) turns about z on the carrier, the rack
+# slides along x on it. A stop face at 30° about z holds the pinion.
+def rack_and_pinion(held: bool):
+    a = math.pi / 6
+    towards = np.array([-math.sin(a), math.cos(a), 0.0])
+    carrier = body(
+        "carrier",
+        fixed=True,
+        top=Plane((0, 0, 0), Z),
+        bore=Hole((0, 0, 0), Z, 1.0),
+        bed=Plane((0, -2, 0), (0, 1, 0)),
+        stop=Plane(tuple(towards), tuple(-towards)),
+    )
+    pinion = body(
+        "pinion",
+        bottom=Plane((0, 0, 0), (0, 0, -1)),
+        axle=Shaft((0, 0, 0), Z, 1.0),
+        flat=Plane((0, 1, 0), (0, 1, 0)),
+    )
+    rack = body(
+        "rack",
+        bottom=Plane((0, -2, 0), (0, 0, -1)),
+        back=Plane((0, -2, 0), (0, -1, 0)),
+        line=Axis((0, -2, 0), X_AXIS),
+    )
+    joints = [
+        rel("fits", "pinion.axle", "carrier.bore"),
+        rel("against", "pinion.bottom", "carrier.top"),
+        rel("against", "rack.bottom", "carrier.top"),
+        rel("against", "rack.back", "carrier.bed"),
+        rel("rack", "pinion.axle", "rack.line", radius=2.0),
+    ]
+    if held:
+        joints.append(rel("against", "pinion.flat", "carrier.stop"))
+    return solve([carrier, pinion, rack], *joints)
+
+
+def test_rack_and_pinion_moves_together_then_is_held():
+    free = rack_and_pinion(held=False)["bodies"]
+    assert (free["pinion@s1"]["dof"], free["pinion@s1"]["motion"]) == (1, "revolute")
+    assert (free["rack@s1"]["dof"], free["rack@s1"]["motion"]) == (1, "prismatic")
+    out = rack_and_pinion(held=True)
+    assert out["status"] == "solved"
+    # the pinion's flat normal (0, 1, 0) turned onto the stop's -normal: θ = π/6; the pitch
+    # circle rolls along the rack: s = 2·π/6 = π/3 along x
+    pinion = np.asarray(out["bodies"]["pinion@s1"]["pose"])
+    rack = np.asarray(out["bodies"]["rack@s1"]["pose"])
+    np.testing.assert_allclose(pinion, rz(math.pi / 6), atol=1e-9)
+    np.testing.assert_allclose(rack, shift(math.pi / 3), atol=1e-9)
+    # the relation written out: the rack's shift along x is the radius times the turn
+    theta = math.atan2(pinion[1, 0], pinion[0, 0])
+    assert rack[0, 3] - 2.0 * theta == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_rack_takes_only_line_features_and_needs_its_radius():
+    with pytest.raises(FeatureError):
+        relation_residual("rack", Plane((0, 0, 0), Z), Axis((0, 0, 0), Z), {"radius": 1.0})
+    with pytest.raises(SchemaError, match="radius"):
+        Relation.parse(["rack", "a.x", "b.y"])
+
+
+# A lead screw (right hand, lead 2) turns on a revolute in a frame; the nut slides along z
+# against two faces of the frame; the threads couple them. A stop turns the screw by 90°.
+def lead_screw(held: bool):
+    a = math.pi / 2
+    towards = np.array([-math.sin(a), math.cos(a), 0.0])
+    frame = body(
+        "frame",
+        fixed=True,
+        seat=Plane((0, 0, 0), Z),
+        bore=Hole((0, 0, 0), Z, 1.0),
+        guide=Plane((0, 3, 0), (0, -1, 0)),
+        side=Plane((-3, 0, 0), (1, 0, 0)),
+        stop=Plane(tuple(towards), tuple(-towards)),
+    )
+    screw = body(
+        "screw",
+        collar=Plane((0, 0, 0), (0, 0, -1)),
+        journal=Shaft((0, 0, 0), Z, 1.0),
+        thread=Thread((0, 0, 0), Z, 1.0, 2.0),
+        flat=Plane((0, 1, 0), (0, 1, 0)),
+    )
+    nut = body(
+        "nut",
+        thread=Thread((0, 0, 0), Z, 1.0, 2.0, male=False),
+        back=Plane((0, 3, 0), (0, 1, 0)),
+        left=Plane((-3, 0, 0), (-1, 0, 0)),
+    )
+    joints = [
+        rel("fits", "screw.journal", "frame.bore"),
+        rel("against", "screw.collar", "frame.seat"),
+        rel("against", "nut.back", "frame.guide"),
+        rel("against", "nut.left", "frame.side"),
+        rel("fits", "nut.thread", "screw.thread"),
+    ]
+    if held:
+        joints.append(rel("against", "screw.flat", "frame.stop"))
+    return solve([frame, screw, nut], *joints, explain=True)
+
+
+def test_lead_screw_drives_the_nut_by_its_lead():
+    free = lead_screw(held=False)["bodies"]
+    assert (free["screw@s1"]["dof"], free["screw@s1"]["motion"]) == (1, "revolute")
+    assert (free["nut@s1"]["dof"], free["nut@s1"]["motion"]) == (1, "prismatic")
+    out = lead_screw(held=True)
+    screw, nut = out["bodies"]["screw@s1"], out["bodies"]["nut@s1"]
+    np.testing.assert_allclose(screw["pose"], rz(math.pi / 2), atol=1e-12)
+    # relative to the screw the nut turns by -90°, so a right-hand thread of lead 2 moves it
+    # by 2·(-1/4) = -0.5; one turn more or less of the nut is the same contact: a lattice of
+    # poses 2 apart along z (the pose itself says nothing of how many turns were made)
+    assert (nut["dof"], nut["solutions"]) == (0, "infinite")
+    np.testing.assert_allclose(nut["pose"], shift(0, 0, -0.5), atol=1e-12)
+    assert "residue" not in rules(out)

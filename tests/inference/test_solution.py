@@ -14,6 +14,7 @@ from assemblykit.inference.solution import (
     Solution,
     TraceStep,
     freedom_words,
+    remedy_words,
     status_of,
 )
 
@@ -150,8 +151,46 @@ def test_freedom_is_said_in_words_and_only_when_there_is_some():
         ),
         ("prismatic", 1, {"direction": [0, -0.0, 1]}, "can slide along (0, 0, 1): 1 dof"),
         ("fixed", 0, {}, ""),
-        ("mechanism", 2, {}, ""),
+        (
+            "mechanism",
+            2,
+            {},
+            "keeps 2 dof that no joint names (a closed loop or a relation no coset holds)",
+        ),
     ],
 )
 def test_freedom_words(motion, dof, invariants, expected):
     assert freedom_words(motion, dof, invariants) == expected
+
+
+@pytest.mark.parametrize(
+    ("motion", "mechanism", "invariants", "expected"),
+    [
+        (
+            "spherical",
+            "",
+            {"center": [0.5, 1, 1.5]},
+            "a fits or coaxial through (0.5, 1, 1.5) (leaving a turn about that axis) and a"
+            " stop off that axis would remove it",
+        ),
+        (
+            "prismatic",
+            "",
+            {"direction": [0, 0, 1]},
+            "a stop across (0, 0, 1) (an against or point_on_plane on a face not parallel to"
+            " it) would remove it",
+        ),
+        (
+            "mechanism",
+            "planar-point-on-line",
+            {"direction": [0, 1, 0], "normal": [0, 0, 1], "point": [4, 1, 0]},
+            "a point_on_plane on the same point across (0, 1, 0) (making a revolute about"
+            " (0, 0, 1)) and a stop off that axis would remove it",
+        ),
+        ("mechanism", "", {}, "a stop on it or on a body it moves with would remove one dof"),
+    ],
+)
+def test_remedy_words_name_the_relations_that_remove_the_freedom(
+    motion, mechanism, invariants, expected
+):
+    assert remedy_words(motion, mechanism, invariants) == expected

@@ -92,6 +92,7 @@ def test_every_kind_is_registered():
         "point_on_line",
         "distance",
         "gear",
+        "rack",
         "mirror",
     }
     assert all(spec.arity == 2 for spec in RELATIONS.values())

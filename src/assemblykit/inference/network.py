@@ -8,7 +8,7 @@ situation. Fixed bodies are the world: all their instances are the one node
 * a spatial relation ``[kind, first, second]`` within a situation links the second
   body's instance to the first's with ``relation_coset`` (the set of
   ``inv(L_second) @ L_first``); relations that are not cosets (point_on_plane, distance,
-  gear, mirror, ...) become general constraints (residual functions);
+  gear, rack, mirror, ...) become general constraints (residual functions);
 * an action between consecutive situations links the body's two instances
   (seed 000 §III B: "f ** p2 = rel(v) ** f ** p1"): ``move b along f by s`` is the fixed
   transform F·Tr(0,0,s)·F⁻¹, ``along f`` without ``by`` the prismatic coset F·T(z)·F⁻¹,
@@ -35,7 +35,12 @@ import numpy as np
 
 from assemblykit.algebra import Coset, EmptySet, Mismatch, SymmetryGroup, se3
 from assemblykit.errors import SchemaError
-from assemblykit.inference.numeric import Constraint, gear_residual, mirror_residual
+from assemblykit.inference.numeric import (
+    Constraint,
+    gear_residual,
+    mirror_residual,
+    rack_residual,
+)
 from assemblykit.model.relations import (
     AXIAL,
     COUPLED,
@@ -235,7 +240,7 @@ def _carrier(situation: Situation, pair: tuple[str, str], node: Callable[[str], 
 def _coupled_constraint(
     task: Task, situation: Situation, relation: Relation, node: Callable[[str], Node], label: str
 ) -> Constraint:
-    """A gear or mirror relation as a general constraint (see :mod:`numeric`)."""
+    """A gear, rack or mirror relation as a general constraint (see :mod:`numeric`)."""
     where = relation.where or label
     first, second = (task.feature(r, where) for r in relation.refs)
     frames = (np.asarray(first.frame(), dtype=float), np.asarray(second.frame(), dtype=float))
@@ -244,6 +249,9 @@ def _coupled_constraint(
     if relation.kind == "gear":
         ratio = float(relation.options["ratio"])
         residual = gear_residual(*frames, ratio, current().arm)
+        return Constraint((*bodies, carrier), residual, (label,))
+    if relation.kind == "rack":
+        residual = rack_residual(*frames, float(relation.options["radius"]))
         return Constraint((*bodies, carrier), residual, (label,))
     direction = frames[0][:3, 2]
     if first.type_name != "plane":

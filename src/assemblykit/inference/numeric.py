@@ -14,7 +14,8 @@ instances (ALGEBRA.md §2.5, "numeric fallback"):
 
 It also defines the two coupled relations that are not relations between two features
 in the coset sense (seed 000 §III G, "the jaws of a gripper ... equal and opposite";
-seed 003 Fig. 9, gear pairs): :func:`gear_residual` and :func:`mirror_residual`.
+seed 003 Fig. 9, gear pairs): :func:`gear_residual`, :func:`rack_residual` and
+:func:`mirror_residual`.
 """
 
 from __future__ import annotations
@@ -316,6 +317,31 @@ def gear_residual(
         theta1 = rotation_about(to_carrier @ poses[0][:3, :3], axis1)
         theta2 = rotation_about(to_carrier @ poses[1][:3, :3], axis2)
         return np.array([wrap_angle(theta2 - ratio * theta1) * scale])
+
+    return residual
+
+
+def rack_residual(pinion_frame: np.ndarray, rack_frame: np.ndarray, radius: float) -> Residual:
+    """The coupled relation ``rack``: a pinion turning about its axis drives a rack along
+    its line (seed 003 Fig. 9, a gear pair whose second gear has an infinite radius).
+
+    Semantics as :func:`gear_residual`: both bodies move relative to the carrier (the
+    body both are related to; the pinion's revolute and the rack's slide are separate
+    relations), and in the reference pose every body frame coincides with the
+    carrier's. With θ the pinion's turn about its axis (+z of ``pinion_frame``, the
+    principal angle in (-π, π] as for ``gear``) and ``s`` the rack's displacement along
+    its line (+z of ``rack_frame``), the relation holds when ``s = radius·θ``: the pitch
+    circle rolls on the rack's pitch line without slipping. The residual is that length
+    difference. It takes the world poses ``(L_pinion, L_rack, L_carrier)``.
+    """
+    axis, direction = pinion_frame[:3, 2], rack_frame[:3, 2]
+    origin = np.append(rack_frame[:3, 3], 1.0)
+
+    def residual(poses: Sequence[np.ndarray]) -> np.ndarray:
+        to_carrier = np.linalg.inv(poses[2])
+        theta = rotation_about(to_carrier[:3, :3] @ poses[0][:3, :3], axis)
+        shift = float(direction @ ((to_carrier @ poses[1] @ origin)[:3] - origin[:3]))
+        return np.array([shift - radius * theta])
 
     return residual
 

@@ -78,6 +78,7 @@ from assemblykit.inference.solution import (
     TraceStep,
     freedom_words,
     point_text,
+    remedy_words,
 )
 from assemblykit.tolerance import Tolerance, current, using
 
@@ -1099,9 +1100,13 @@ def _leaf_report(
 
 
 def _said(key: str, instance: _Instance) -> str:
-    """The sentence saying what of ``key`` is free (empty when nothing is, or unnamed)."""
+    """The sentence saying what of ``key`` is free and which relations would remove it
+    (empty when nothing is free)."""
     text = instance.freedom or freedom_words(instance.motion, instance.dof, instance.invariants)
-    return f"{key} {text}" if text else ""
+    if not text:
+        return ""
+    remedy = remedy_words(instance.motion, instance.mechanism, instance.invariants)
+    return f"{key} {text}; {remedy}"
 
 
 def _same_pose(a: np.ndarray, b: np.ndarray, tol: Tolerance) -> bool:

@@ -112,7 +112,8 @@ def point_text(point: Any) -> str:
 
 def freedom_words(motion: str, dof: int, invariants: Mapping[str, Any]) -> str:
     """What remains free, in words, after the instance's name: ``"can turn about (0.5, 1,
-    1.5): 3 dof"``; empty for a fixed instance and for a mechanism nothing names."""
+    1.5): 3 dof"``; empty for a fixed instance. A ``mechanism`` that the reduction does
+    not name (a closed loop, a coupled joint, a relation that is no coset) says its dof."""
     inv = {k: point_text(v) for k, v in invariants.items() if k != "pitch"}
     phrases = {
         "revolute": "turn about the axis through {point} along {direction}",
@@ -127,13 +128,59 @@ def freedom_words(motion: str, dof: int, invariants: Mapping[str, Any]) -> str:
         "free": "move freely",
     }
     phrase = phrases.get(motion)
-    if dof == 0 or phrase is None:
+    if dof == 0:
         return ""
+    if phrase is None:
+        return f"keeps {dof} dof that no joint names (a closed loop or a relation no coset holds)"
     try:
         text = phrase.format(**inv)
     except KeyError:
         return f"moves as a {motion} joint: {dof} dof"
     return f"can {text}: {dof} dof"
+
+
+_REMEDIES = {
+    "revolute": "a stop against the turn (an against or point_on_plane off that axis)",
+    "prismatic": "a stop across {direction} (an against or point_on_plane on a face not"
+    " parallel to it)",
+    "helical": "a stop off that axis (the slide follows the turn)",
+    "cylindrical": "an against on a face normal to the axis (the slide) and a stop off it"
+    " (the turn)",
+    "planar": "three stops in the plane (against or point_on_plane on faces across it, one"
+    " off the line of the other two)",
+    "spherical": "a fits or coaxial through {center} (leaving a turn about that axis) and a"
+    " stop off that axis",
+    "translation2": "two stops across the plane's directions (against or point_on_plane)",
+    "translation3": "three against relations on faces of independent normals",
+    "schoenflies": "an against on a face normal to {direction} and three stops in its plane",
+    "pseudo-planar": "an against on a face normal to the axis and two stops in its plane",
+    "free": "a fixed relation (or three against relations on faces of independent normals)",
+    "point-in-plane": "two more point_on_plane on the same point (making a spherical joint)"
+    " and relations on the body's orientation",
+    "point-on-line": "a point_on_plane on the same point across the line (making a spherical"
+    " joint) and relations on the body's orientation",
+    "planar-point-on-line": "a point_on_plane on the same point across {direction} (making"
+    " a revolute about {normal}) and a stop off that axis",
+    "line-on-plane": "a second point of the body on the plane (the turn about the line) and"
+    " stops in the plane (the slides and the turn about {normal})",
+}
+
+
+def remedy_words(motion: str, mechanism: str, invariants: Mapping[str, Any]) -> str:
+    """Which relations would remove the freedom of a ``motion`` (or of a named
+    ``mechanism``), in words: ``"a fits or coaxial through (0.5, 1, 1.5) (leaving a turn
+    about that axis) and a stop off that axis would remove it"``. A mechanism without a
+    name (a closed loop, a coupled joint, a relation that is no coset, solved
+    numerically) loses at most one dof to each stop on it or on a body it moves with."""
+    inv = {k: point_text(v) for k, v in invariants.items() if k != "pitch"}
+    phrase = _REMEDIES.get(mechanism or motion, "")
+    try:
+        phrase = phrase.format(**inv)
+    except KeyError:
+        phrase = ""
+    if not phrase:
+        return "a stop on it or on a body it moves with would remove one dof"
+    return f"{phrase} would remove it"
 
 
 @dataclass(frozen=True)

@@ -142,13 +142,16 @@ RELATIONS: Mapping[str, RelationSpec] = MappingProxyType(
             RelationSpec(
                 "gear", 2, _pairs(AXIAL, AXIAL), frozenset({"ratio"}), frozenset({"ratio"})
             ),
+            RelationSpec(
+                "rack", 2, _pairs(AXIAL, AXIAL), frozenset({"radius"}), frozenset({"radius"})
+            ),
             RelationSpec("mirror", 2, _pairs({"plane", "point"}, {"plane", "point"})),
         )
     }
 )
 """Every relation kind (DESIGN §5.1 and the extended vocabulary)."""
 
-COUPLED = frozenset({"gear", "mirror"})
+COUPLED = frozenset({"gear", "rack", "mirror"})
 """Relations that couple motions through a third body; their semantics belong to the
 network (``assemblykit.inference``), not to a pair of features."""
 
@@ -453,7 +456,7 @@ def relation_residual(
     and a plane: a cylinder of radius d lying on the plane, ALGEBRA.md §3), planes
     parallel with n₁·(p₂ − p₁) = d (two planes). Here d
     is a normal or axis, c a feature's point (centre, apex), p a plane point. Coupled
-    kinds (``gear``, ``mirror``) raise :class:`FeatureError`: they are defined on the
+    kinds (``gear``, ``rack``, ``mirror``) raise :class:`FeatureError`: they are defined on the
     network (``assemblykit.inference.numeric``).
     """
     tol = tol or current()

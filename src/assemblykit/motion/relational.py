@@ -19,7 +19,7 @@ pose is unchanged); a relation of a moved body holds only where it is stated aga
 The poses L are the representative poses of RAPT inference (``Task.solve``); a placed
 group depends only on the second body's pose. Relations that are not cosets (``angle``,
 ``perpendicular``, ``distance``, ``point_on_plane``, ``point_on_line``, and the coupled
-``gear``, ``mirror``) constrain no subgroup; they, and relations whose features cannot
+``gear``, ``rack``, ``mirror``) constrain no subgroup; they, and relations whose features cannot
 meet (an :class:`~assemblykit.algebra.EmptySet`, e.g. unequal radii), are reported as
 ``ignored`` with the reason.
 """
