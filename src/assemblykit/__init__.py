@@ -39,6 +39,37 @@ Plan(feasible, 5 steps, 14 parts)
 Step(cover, pin_1, pin_2, pin_3 and 1 more along +Z)
 >>> plan.order[0]  # assembly order: the plan reversed
 ('housing',)
+
+Which parts block which along a direction (Wilson & Latombe 1992, §3):
+
+>>> blocking = assemblykit.blocking_graph(hinge)
+>>> blocking
+NonDirectionalBlockingGraph(infinitesimal, 2 parts, 1 contact, 26 regions)
+>>> blocking.dbg([0, 0, 1])
+DirectionalBlockingGraph(+Z, 2 parts, 1 arc)
+
+Where a peg can sit in a bore (Liu & Popplestone 1990): one configuration, the peg
+free to slide and turn along the bore's axis.
+
+>>> problem = assemblykit.load_problem(examples / "mating" / "shaft_fit.yaml")
+>>> found = assemblykit.mate(problem)
+>>> len(found.configurations), found.configurations[0].motions["peg"].kind
+(1, 'cylindrical')
+
+The algebra: symmetry groups and their cosets (Liu & Popplestone 1994). A pin in a hole
+(cylindrical) whose head rests on a plane (planar) can only turn about its axis.
+
+>>> import numpy as np
+>>> from assemblykit.algebra import Coset, SymmetryGroup
+>>> in_hole = Coset(SymmetryGroup.cylindrical((0, 0, 0), (0, 0, 1)), np.eye(4))
+>>> on_plane = Coset(SymmetryGroup.planar((0, 0, 1)), np.eye(4))
+>>> both = in_hole.intersect(on_plane)
+>>> both.group
+SymmetryGroup<revolute about line through (0, 0, 0) along (0, 0, 1)>
+>>> lifted = np.eye(4)
+>>> lifted[2, 3] = 5.0
+>>> in_hole.contains(lifted), on_plane.contains(lifted), both.dof
+(True, False, 1)
 """
 
 from __future__ import annotations

@@ -1,7 +1,12 @@
 """STEP round trip built with OCP: a plate with a through hole and a shaft in it, a ball
-in a socket; exact radii and axes, and the curved contacts between them."""
+in a socket; exact radii and axes, and the curved contacts between them. Part names and
+subassemblies from the product structure (the bundled gearbox, a file written by OCP's
+XCAF writer)."""
 
 from __future__ import annotations
+
+import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,6 +14,7 @@ import pytest
 from assemblykit.errors import GeometryError
 from assemblykit.features.primitives import Ball, Hole, Shaft, Socket
 from assemblykit.io.assembly import load_assembly
+from assemblykit.io.step import LINEAR_DEFLECTION, declared_solids, numbered
 
 pytest.importorskip("OCP")
 
@@ -159,3 +165,126 @@ def test_a_damaged_step_still_gives_json_that_parses_and_says_what_was_skipped(d
 def test_an_intact_step_skips_nothing(step_file):
     asm = load_assembly(step_file)
     assert asm.skipped == () and asm.warnings == ()
+
+
+GEARBOX = (
+    Path(__file__).resolve().parents[2] / "src" / "assemblykit" / "examples" / "motion" / "gearbox"
+)
+
+
+def test_the_gearbox_parts_are_named_after_its_products():
+    asm = load_assembly(GEARBOX / "gearbox.step")
+    assert asm.names == ["housing", "cover", "gear_1", "gear_2", "gear_3", "gear_4"]
+    assert asm.groups == {} and asm.skipped == ()
+    # each name is on the right solid: the same part as the mesh of that name (up to
+    # the deflection of the tessellation of the curved faces)
+    meshes = load_assembly(GEARBOX / "gearbox.yaml")
+    for name in asm.names:
+        bounds = meshes[name].mesh.bounds
+        deflection = LINEAR_DEFLECTION * np.linalg.norm(bounds[1] - bounds[0])
+        np.testing.assert_allclose(asm[name].mesh.bounds, bounds, atol=deflection)
+        assert asm[name].volume == pytest.approx(meshes[name].volume, rel=1e-2)
+
+
+def _box(x: float, y: float, z: float):
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+
+    return BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), x, y, z).Shape()
+
+
+def _at(x: float, y: float, z: float):
+    from OCP.gp import gp_Trsf, gp_Vec
+    from OCP.TopLoc import TopLoc_Location
+
+    move = gp_Trsf()
+    move.SetTranslation(gp_Vec(x, y, z))
+    return TopLoc_Location(move)
+
+
+@pytest.fixture(scope="module")
+def structured_step(tmp_path_factory):
+    """A product structure written by OCP's XCAF writer: the product ``bench`` uses a
+    ``housing`` plate (40 x 20 x 5), a ``pin`` (2 x 2 x 3) twice, and the subassembly
+    ``gear_train`` placed on the plate, which uses a ``gear`` (8 x 8 x 4) twice, the two
+    side by side and touching."""
+    from OCP.STEPCAFControl import STEPCAFControl_Writer
+    from OCP.STEPControl import STEPControl_AsIs
+    from OCP.TCollection import TCollection_ExtendedString
+    from OCP.TDataStd import TDataStd_Name
+    from OCP.TDocStd import TDocStd_Document
+    from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+    document = TDocStd_Document(TCollection_ExtendedString("MDTV-XCAF"))
+    tool = XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
+
+    def product(name, label):
+        TDataStd_Name.Set_s(label, TCollection_ExtendedString(name))
+        return label
+
+    bench = product("bench", tool.NewShape())
+    housing = product("housing", tool.AddShape(_box(40, 20, 5), False))
+    pin = product("pin", tool.AddShape(_box(2, 2, 3), False))
+    train = product("gear_train", tool.NewShape())
+    gear = product("gear", tool.AddShape(_box(8, 8, 4), False))
+    tool.AddComponent(train, gear, _at(2, 2, 0))
+    tool.AddComponent(train, gear, _at(10, 2, 0))
+    tool.AddComponent(bench, housing, _at(0, 0, 0))
+    tool.AddComponent(bench, pin, _at(30, 5, 5))
+    tool.AddComponent(bench, pin, _at(30, 12, 5))
+    tool.AddComponent(bench, train, _at(0, 0, 5))
+    tool.UpdateAssemblies()
+    writer = STEPCAFControl_Writer()
+    writer.SetNameMode(True)
+    writer.Transfer(document, STEPControl_AsIs)
+    path = tmp_path_factory.mktemp("structure") / "bench.step"
+    writer.Write(str(path))
+    return path
+
+
+def test_instances_of_one_product_are_numbered_and_placed(structured_step):
+    text = structured_step.read_text()
+    assert text.count("NEXT_ASSEMBLY_USAGE_OCCURRENCE") == 6
+    asm = load_assembly(structured_step)
+    assert asm.names == ["housing", "pin_1", "pin_2", "gear_1", "gear_2"]
+    expected = {
+        "housing": [[0, 0, 0], [40, 20, 5]],
+        "pin_1": [[30, 5, 5], [32, 7, 8]],
+        "pin_2": [[30, 12, 5], [32, 14, 8]],
+        "gear_1": [[2, 2, 5], [10, 10, 9]],  # the train's place plus the gear's
+        "gear_2": [[10, 2, 5], [18, 10, 9]],
+    }
+    for name, bounds in expected.items():
+        np.testing.assert_allclose(asm[name].mesh.bounds, bounds, atol=1e-9)
+    # three solids are declared (one per product); none is reported missing
+    assert len(declared_solids(text)) == 3 and asm.skipped == ()
+
+
+def test_a_subassembly_is_a_group_that_motion_takes(structured_step, capsys):
+    from assemblykit.cli import main
+    from assemblykit.motion.freedom import motion
+
+    asm = load_assembly(structured_step)
+    assert asm.groups == {"gear_train": ("gear_1", "gear_2")}
+    assert asm.subset(["housing", "gear_2"]).groups == {"gear_train": ("gear_2",)}
+    # each gear rests on the plate and against the other gear: it can only slide along
+    # y; together they only rest on the plate: they slide in its plane and turn about z
+    report = motion(asm, asm.groups.values())
+    assert (report["gear_1"].kind, report["gear_1"].dof) == ("prismatic", 1)
+    assert (report["gear_1+gear_2"].kind, report["gear_1+gear_2"].dof) == ("planar", 3)
+    main(["motion", str(structured_step), "--subassembly", "gear_train", "--json"])
+    parts = json.loads(capsys.readouterr().out)["parts"]
+    assert (parts["gear_1+gear_2"]["motion"], parts["gear_1+gear_2"]["dof"]) == ("planar", 3)
+    assert parts["gear_1"]["direction"] == pytest.approx([0.0, 1.0, 0.0], abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("bases", "names"),
+    [
+        (["housing", "gear", "gear"], ["housing", "gear_1", "gear_2"]),
+        (["pin", "pin_1", "pin"], ["pin_2", "pin_1", "pin_3"]),
+        (["a", "b"], ["a", "b"]),
+    ],
+)
+def test_numbered_names_are_unique(bases, names):
+    assert numbered(bases) == names

@@ -1,11 +1,22 @@
 """Assemblies from STEP files (DESIGN.md §5.2; extra ``cad``: OCP from
 ``cadquery-ocp-novtk``, imported only when a STEP file is read).
 
-Each solid is one part, named ``solid<i>`` (1-based, file order). Its faces keep their
-exact surface (plane, cylinder, cone, sphere, torus, with axes and radii) for feature
-recognition (seed 003 §2), and are tessellated into the part's mesh; the triangles of
-each face are recorded so contacts can tell which surface they lie on. Faces of other
-surface types are only tessellated. OCP reads STEP lengths in millimetres.
+Each solid is one part, named from the file's product structure (ISO 10303-44: each
+``PRODUCT`` is placed by ``NEXT_ASSEMBLY_USAGE_OCCURRENCE`` entities in the product that
+uses it), read through OCP's XCAF document: a solid is named after the product it makes
+up, and the instances of a product used several times are numbered in file order
+(``pin_1``, ``pin_2``, ...). A solid without a product name of its own (a product of
+several solids, an unnamed one, or one with the placeholder name Open CASCADE's writer
+gives unnamed shapes) is ``solid<i>``, ``i`` its 1-based place among all
+solids. The products that are assemblies below the whole (subassemblies) become the
+assembly's ``groups``, named and numbered the same way, each listing the parts it holds
+(``motion --subassembly NAME`` takes one).
+
+Each part's faces keep their exact surface (plane, cylinder, cone, sphere, torus, with
+axes and radii) for feature recognition (Liu 1997, §2), and are
+tessellated into the part's mesh; the triangles of each face are recorded so contacts
+can tell which surface they lie on. Faces of other surface types are only tessellated.
+OCP reads STEP lengths in millimetres.
 
 Tessellation: linear deflection ``LINEAR_DEFLECTION`` x the solid's bounding-box
 diagonal and angular deflection ``ANGULAR_DEFLECTION`` (below the smooth-edge angle of
@@ -29,7 +40,9 @@ import os
 import re
 import sys
 import tempfile
-from collections.abc import Iterator
+from collections import Counter
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -55,6 +68,8 @@ _DECLARED = re.compile(
     r"#(\d+)\s*=\s*(" + "|".join(SOLID_ENTITIES) + r")\s*\(\s*'((?:[^']|'')*)'", re.IGNORECASE
 )
 _ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
+_PLACEHOLDER = re.compile(r"Open CASCADE STEP translator [\d.]+ [\d.]+")
+"""The product name Open CASCADE's STEP writer gives a shape that has none."""
 
 
 _OCP_NAMES = {
@@ -64,12 +79,18 @@ _OCP_NAMES = {
     "BRepBndLib": ("BRepBndLib",),
     "BRepMesh": ("BRepMesh_IncrementalMesh",),
     "GeomAbs": ("GeomAbs_SurfaceType",),
+    "collections": ("Sequence_TDF_Label",),
     "IFSelect": ("IFSelect_ReturnStatus",),
-    "STEPControl": ("STEPControl_Reader",),
+    "STEPCAFControl": ("STEPCAFControl_Reader",),
+    "TCollection": ("TCollection_ExtendedString",),
+    "TDataStd": ("TDataStd_Name",),
+    "TDF": ("TDF_Label",),
+    "TDocStd": ("TDocStd_Document",),
     "TopAbs": ("TopAbs_Orientation", "TopAbs_ShapeEnum"),
     "TopExp": ("TopExp_Explorer",),
     "TopLoc": ("TopLoc_Location",),
     "TopoDS": ("TopoDS",),
+    "XCAFDoc": ("XCAFDoc_DocumentTool",),
 }
 
 
@@ -303,33 +324,130 @@ def _skipped_solids(
     return skipped
 
 
+@dataclass(frozen=True)
+class _Solid:
+    """One solid of the product structure, placed: the name of the product it makes up
+    (empty when that product has several solids or no name) and the subassemblies
+    around it (indices into the list of groups)."""
+
+    product: str
+    shape: Any
+    groups: tuple[int, ...]
+
+
+def numbered(bases: Sequence[str]) -> list[str]:
+    """Unique names for ``bases`` in order: a base used once is kept, one used ``n``
+    times becomes ``base_1`` ... ``base_n`` (skipping names already taken)."""
+    totals = Counter(bases)
+    taken = {base for base in bases if totals[base] == 1}
+    seen: Counter[str] = Counter()
+    names = []
+    for base in bases:
+        name = base
+        while totals[base] > 1 and (name == base or name in taken):
+            seen[base] += 1
+            name = f"{base}_{seen[base]}"
+        taken.add(name)
+        names.append(name)
+    return names
+
+
+def _label_name(ocp: Any, label: Any) -> str:
+    """The name the STEP reader gave an XCAF label (the product's name), or ``""`` when
+    it has none or only the writer's placeholder."""
+    attribute = ocp.TDataStd_Name()
+    if not label.FindAttribute(ocp.TDataStd_Name.GetID_s(), attribute):
+        return ""
+    name = str(attribute.Get().ToExtString()).strip()
+    return "" if _PLACEHOLDER.fullmatch(name) else name
+
+
+def _labels(ocp: Any, fill: Any) -> list[Any]:
+    """The labels an XCAF query writes into a label sequence, as a list."""
+    sequence = ocp.Sequence_TDF_Label()
+    fill(sequence)
+    return [sequence.Value(i) for i in range(1, sequence.Length() + 1)]
+
+
+def _product_solids(
+    ocp: Any,
+    tool: Any,
+    label: Any,
+    location: Any,
+    within: tuple[int, ...],
+    groups: list[str],
+) -> Iterator[_Solid]:
+    """The solids of the product at ``label`` placed by ``location``, depth first in
+    file order; each subassembly met below it appends its name to ``groups``."""
+    if tool.IsAssembly_s(label):
+        for component in _labels(ocp, lambda seq: tool.GetComponents_s(label, seq, False)):
+            referred = ocp.TDF_Label()
+            tool.GetReferredShape_s(component, referred)
+            placed = location.Multiplied(tool.GetLocation_s(component))
+            inner = within
+            if tool.IsAssembly_s(referred):
+                groups.append(_label_name(ocp, referred) or "subassembly")
+                inner = (*within, len(groups) - 1)
+            yield from _product_solids(ocp, tool, referred, placed, inner, groups)
+        return
+    shape = tool.GetShape_s(label).Moved(location)
+    explorer = ocp.TopExp_Explorer(shape, ocp.TopAbs_ShapeEnum.TopAbs_SOLID)
+    solids = []
+    while explorer.More():
+        solids.append(ocp.TopoDS.Solid(explorer.Current()))
+        explorer.Next()
+    product = _label_name(ocp, label) if len(solids) == 1 else ""
+    yield from (_Solid(product, solid, within) for solid in solids)
+
+
+def _structure(ocp: Any, document: Any) -> tuple[list[_Solid], list[str]]:
+    """Every solid of the document's product structure and the subassembly names. The
+    free products are the roots; when there are several, those that are assemblies are
+    subassemblies too."""
+    tool = ocp.XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
+    roots = _labels(ocp, tool.GetFreeShapes)
+    groups: list[str] = []
+    solids: list[_Solid] = []
+    for root in roots:
+        within: tuple[int, ...] = ()
+        if len(roots) > 1 and tool.IsAssembly_s(root):
+            groups.append(_label_name(ocp, root) or "subassembly")
+            within = (len(groups) - 1,)
+        solids += _product_solids(ocp, tool, root, ocp.TopLoc_Location(), within, groups)
+    return solids, groups
+
+
 def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
-    """An assembly with one part per solid of the STEP file at ``path`` (module
-    docstring): the solids it could not read are in its ``skipped`` items, and what the
-    reader printed in its ``warnings``."""
+    """An assembly with one part per solid of the STEP file at ``path``, named from its
+    product structure, its subassemblies as ``groups`` (module docstring): the solids it
+    could not read are in its ``skipped`` items, and what the reader printed in its
+    ``warnings``."""
     ocp = _ocp()
     source = str(Path(path))
     if not Path(path).is_file():
         raise GeometryError("STEP file not found", source=source)
     declared = declared_solids(Path(path).read_bytes().decode("latin-1"))
-    reader = ocp.STEPControl_Reader()
+    reader = ocp.STEPCAFControl_Reader()
+    reader.SetNameMode(True)
+    document = ocp.TDocStd_Document(ocp.TCollection_ExtendedString("MDTV-XCAF"))
     with _captured_stdout() as warnings:
         status = reader.ReadFile(source)
         if status == ocp.IFSelect_ReturnStatus.IFSelect_RetDone:
-            reader.TransferRoots()
+            reader.Transfer(document)
     if status != ocp.IFSelect_ReturnStatus.IFSelect_RetDone:
         said = f": {'; '.join(warnings)}" if warnings else ""
         raise GeometryError(f"cannot read STEP file{said}", source=source)
-    shape = reader.OneShape()
-    explorer = ocp.TopExp_Explorer(shape, ocp.TopAbs_ShapeEnum.TopAbs_SOLID)
-    parts = []
-    while explorer.More():
-        solid = ocp.TopoDS.Solid(explorer.Current())
-        parts.append(_solid_part(ocp, solid, f"solid{len(parts) + 1}", source))
-        explorer.Next()
-    if not parts:
+    solids, group_names = _structure(ocp, document)
+    if not solids:
         said = f": {'; '.join(warnings)}" if warnings else ""
         raise GeometryError(f"no solids in STEP file{said}", source=source)
+    names = numbered([s.product or f"solid{i}" for i, s in enumerate(solids, start=1)])
+    parts = [_solid_part(ocp, s.shape, n, source) for s, n in zip(solids, names, strict=True)]
+    groups = {
+        name: tuple(n for s, n in zip(solids, names, strict=True) if index in s.groups)
+        for index, name in enumerate(numbered(group_names))
+    }
+    distinct = len({hash(s.shape.Located(ocp.TopLoc_Location())) for s in solids})
     return Assembly(
         parts,
         units="mm",
@@ -337,6 +455,7 @@ def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         source=source,
         exact=True,
         policy=tol,
-        skipped=_skipped_solids(declared, reader.Model(), len(parts)),
+        skipped=_skipped_solids(declared, reader.Reader().Model(), distinct),
         warnings=warnings,
+        groups=groups,
     )

@@ -3,8 +3,9 @@
 A :class:`Part` is a triangle mesh already placed in the world, the pose that placed it,
 and, for CAD input, the exact surfaces of its faces. An :class:`Assembly` is an ordered
 set of parts with their units and the file they came from; it computes (and caches) the
-contacts between its parts (seeds 003 and 004 start from "the specification of the
-contact surfaces between parts") and the surface features recognised on each part.
+contacts between its parts (Liu 1997 and Wilson & Latombe 1992 start from "the
+specification of the contact surfaces between parts") and the surface features
+recognised on each part.
 
 The geometry is computed by :mod:`assemblykit.geometry` (same layer); those modules are
 imported inside the methods because they themselves take an :class:`Assembly`.
@@ -75,7 +76,8 @@ class Assembly:
     ``precision`` is the input's own precision measured by the loader
     (:mod:`assemblykit.geometry.precision`); lengths are never compared more finely.
     ``skipped`` lists what the loader could not read (:class:`Skipped`) and ``warnings``
-    what the reader reported while reading.
+    what the reader reported while reading. ``groups`` names sets of parts the input
+    keeps together (a STEP file's subassemblies), each listing its parts in order.
     """
 
     def __init__(
@@ -91,9 +93,15 @@ class Assembly:
         precision: Precision | None = None,
         skipped: Iterable[Skipped] = (),
         warnings: Iterable[str] = (),
+        groups: Mapping[str, Iterable[str]] | None = None,
     ) -> None:
         items = parts.values() if isinstance(parts, Mapping) else parts
         self.parts: dict[str, Part] = {p.name: p for p in items}
+        self.groups: dict[str, tuple[str, ...]] = {
+            group: kept
+            for group, names in (groups or {}).items()
+            if (kept := tuple(n for n in names if n in self.parts))
+        }
         self.units = units
         self.units_source = units_source
         self.source = source
@@ -247,6 +255,7 @@ class Assembly:
             precision=self.precision,
             skipped=self.skipped,
             warnings=self.warnings,
+            groups=self.groups,
         )
 
     def subset(self, names: Iterable[str]) -> Assembly:
