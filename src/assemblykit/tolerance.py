@@ -153,7 +153,7 @@ class Tolerance:
         return replace(self, rel_length=self.mesh_rel_length, angle=self.mesh_angle)
 
 
-LENGTH_MISMATCHES = frozenset({"distance", "radius", "size", "residual"})
+LENGTH_MISMATCHES = frozenset({"distance", "radius", "size", "residual", "loop"})
 """Mismatch kinds measured in model units (numeric residuals weigh angles as lengths)."""
 
 

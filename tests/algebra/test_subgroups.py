@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assemblykit.algebra import Kind, SymmetryGroup, se3
+from assemblykit.algebra import Kind, Locus, SymmetryGroup, se3
 from assemblykit.algebra.subgroups import _connected_meet, classify_algebra, psd_solve
 from assemblykit.errors import GroupError
 from assemblykit.tolerance import Tolerance
@@ -436,3 +436,25 @@ def test_psd_solve_is_regular_whatever_the_tolerance(rel):
     tolerance must not make it a minimum-norm least-squares answer."""
     x = psd_solve((3.0, 0.0, 0.0, 3.0, 0.0, 1.0), (15.0, 15.0, -10.0), Tolerance.relative(rel))
     assert x == pytest.approx((5.0, 5.0, -10.0), abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("kind", "radius", "expected"),
+    [
+        ("point", 0.0, math.sqrt(29)),
+        ("circle", 1.0, math.hypot(2, 4)),
+        ("cylinder", 2.0, 3.0),
+        ("line", 0.0, 5.0),
+        ("plane", 0.0, 2.0),
+        ("sphere", 1.0, math.sqrt(29) - 1),
+    ],
+)
+def test_locus_distance_of_a_point_by_hand(kind, radius, expected):
+    """(3, 4, 2) from loci about the z axis through the origin: 4 out and 2 up."""
+    locus = Locus(kind, point=np.zeros(3), direction=np.array([0.0, 0.0, 1.0]), radius=radius)
+    assert locus.distance(np.array([3.0, 4.0, 2.0]))[0] == pytest.approx(expected, abs=1e-12)
+
+
+def test_a_helix_has_no_closed_form_distance():
+    with pytest.raises(GroupError):
+        Locus("helix", point=np.zeros(3), direction=np.array([0.0, 0.0, 1.0])).distance(np.zeros(3))

@@ -10,11 +10,12 @@ import numpy as np
 import pytest
 from tests.inference.test_reduction import Z, body, rel, rz, shift, solve
 
-from assemblykit.algebra import Coset, SymmetryGroup, se3
+from assemblykit.algebra import Coset, Locus, SymmetryGroup, se3
 from assemblykit.errors import FeatureError, SchemaError
 from assemblykit.features.primitives import Axis, Ball, Hole, Plane, Shaft, Socket, Thread
 from assemblykit.inference.loops import (
     Circle,
+    circle_gap,
     circle_line,
     circle_meets,
     circle_plane,
@@ -230,6 +231,8 @@ def test_slider_crank_out_of_reach_is_inconsistent():
     assert out["status"] == "inconsistent"
     assert out["conflicts"][0]["kind"] == "loop"
     assert "circle-line" in out["conflicts"][0]["message"]
+    # the pin's circle of radius 5 about the origin misses the line y = 9 by 4
+    assert out["conflicts"][0]["value"] == pytest.approx(4.0, abs=1e-9)
 
 
 # ------------------------------------------------- closures of four bodies, coupled joints
@@ -522,3 +525,30 @@ def test_lead_screw_drives_the_nut_by_its_lead():
     assert (nut["dof"], nut["solutions"]) == (0, "infinite")
     np.testing.assert_allclose(nut["pose"], shift(0, 0, -0.5), atol=1e-12)
     assert "residue" not in rules(out)
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("kind", ["point", "line", "plane", "sphere", "circle", "cylinder"])
+def test_circle_gap_is_the_least_distance_found_by_brute_force(kind, seed):
+    """A random circle against a random locus: the refined gap equals the least distance
+    over a million points of the circle, or is 0 where the circle crosses the locus."""
+    rng = np.random.default_rng(seed)
+    circle = Circle(rng.normal(size=3), se3.unit(rng.normal(size=3)), float(rng.uniform(0.5, 2)))
+    locus = Locus(
+        kind,
+        point=rng.normal(size=3) * 2,
+        direction=se3.unit(rng.normal(size=3)),
+        radius=float(rng.uniform(0.5, 2)),
+    )
+    frame = se3.frame(np.zeros(3), circle.normal)
+    phi = np.linspace(0, 2 * math.pi, 1_000_000, endpoint=False)
+    points = circle.center + circle.radius * (
+        np.outer(np.cos(phi), frame[:3, 0]) + np.outer(np.sin(phi), frame[:3, 1])
+    )
+    brute = float(locus.distance(points).min())
+    gap = circle_gap(circle, locus)
+    assert 0 <= gap <= brute + 1e-12
+    if brute > 1e-4:  # a miss: the minimum is smooth, and the samples find it to 1e-11
+        assert gap == pytest.approx(brute, abs=1e-10)
+    else:  # a crossing: the samples straddle it, 2π/1e6 of the radius apart at most
+        assert gap <= 1e-9

@@ -618,6 +618,9 @@ def test_revolute_loop_that_cannot_close_is_inconsistent():
     out = solve([*bodies[:3], short], *relations)
     assert out["status"] == "inconsistent"
     assert out["conflicts"][0]["kind"] == "loop"
+    # C sweeps the circle of radius 5 about B = (0, 0) and the circle of radius 0.5 about
+    # D = (6, 0): they miss by 6 - 5 - 0.5
+    assert out["conflicts"][0]["value"] == pytest.approx(0.5, abs=1e-9)
     assert "fits coupler.pc rocker.hc @s1" in out["conflicts"][0]["relations"]
 
 

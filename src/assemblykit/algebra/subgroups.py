@@ -429,6 +429,33 @@ class Locus:
             return abs(along) <= tol.length and abs(rho - self.radius) <= tol.length
         return self._helix_contains(d, along, radial, rho, tol)
 
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """The distances of ``points`` (n x 3) from the locus, for the kinds a closed
+        curve or surface has: point, circle, line, cylinder, plane, sphere, space.
+
+        A circle's nearest point to ``p`` lies on the ray from the centre towards ``p``'s
+        projection into its plane, at distance ``√(along² + (ρ − r)²)``."""
+        q = np.atleast_2d(np.asarray(points, dtype=np.float64))
+        if self.kind == "space":
+            return np.zeros(len(q))
+        if self.kind in ("helix", "union") or self.point is None:
+            raise GroupError(f"no distance to a {self.kind} locus")
+        d = q - self.point
+        if self.kind == "point":
+            return np.linalg.norm(d, axis=1)
+        if self.kind == "sphere":
+            return np.abs(np.linalg.norm(d, axis=1) - self.radius)
+        assert self.direction is not None
+        along = d @ self.direction
+        rho = np.linalg.norm(d - along[:, None] * self.direction, axis=1)
+        if self.kind == "plane":
+            return np.abs(along)
+        if self.kind == "line":
+            return rho
+        if self.kind == "cylinder":
+            return np.abs(rho - self.radius)
+        return np.hypot(along, rho - self.radius)
+
     def _helix_contains(
         self, d: np.ndarray, along: float, radial: np.ndarray, rho: float, tol: Tolerance
     ) -> bool:

@@ -33,10 +33,44 @@ class Circle:
 @dataclass(frozen=True)
 class LoopPoses:
     """The answer of a point-orbit loop solver: the pattern solved (``"circle-sphere"``,
-    ``"circle-plane"``, ``"circle-line"``, ...) and the poses of the first link (0, 1, 2)."""
+    ``"circle-plane"``, ``"circle-line"``, ...), the poses of the first link (0, 1, 2)
+    and, when there is none, the ``gap``: how far the loop is from closing."""
 
     pattern: str
     poses: tuple[np.ndarray, ...]
+    gap: float = 0.0
+
+
+GAP_SAMPLES = 720
+"""Points of a circle sampled before the nearest one is refined (:func:`circle_gap`); a
+distance along a circle has at most a few local minima, each far wider than 1/720 turn."""
+
+
+def circle_gap(circle: Circle, locus: Locus) -> float:
+    """The least distance between a circle and a locus (point, circle, line, cylinder,
+    plane, sphere): how far a loop whose joint point sweeps ``circle`` is from closing on
+    ``locus``. The circle is sampled, then the best sample refined by golden sections
+    within its neighbours (the distance is smooth and unimodal there)."""
+    c, r = circle.center, circle.radius
+    axes = se3.frame(np.zeros(3), circle.normal)
+    e1, e2 = axes[:3, 0], axes[:3, 1]
+
+    def at(phi: np.ndarray) -> np.ndarray:
+        return c + r * (np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2)
+
+    step = 2 * math.pi / GAP_SAMPLES
+    phis = np.arange(GAP_SAMPLES) * step
+    best = float(phis[int(np.argmin(locus.distance(at(phis))))])
+    low, high = best - step, best + step
+    ratio = (math.sqrt(5) - 1) / 2
+    for _ in range(60):  # (0.618)^60 of a 1/360 turn: below float64's resolution
+        a, b = high - ratio * (high - low), low + ratio * (high - low)
+        da, db = locus.distance(at(np.array([a, b])))
+        if da < db:
+            high = b
+        else:
+            low = a
+    return float(locus.distance(at(np.array([(low + high) / 2])))[0])
 
 
 def foot(point: np.ndarray, origin: np.ndarray, direction: np.ndarray) -> np.ndarray:
@@ -204,12 +238,14 @@ def point_loop(first: Any, second: Any, closing: Any, tol: Tolerance) -> LoopPos
             continue
         q_k = se3.apply(se3.inverse(second.rep), q_j)
         locus = closing.group.orbit(se3.apply(closing.rep, q_k), tol)
-        meets = circle_meets(Circle(center, u1, radius), locus, tol)
+        circle = Circle(center, u1, radius)
+        meets = circle_meets(circle, locus, tol)
         if meets is None:
             continue
         poses = tuple(
             rotation_about(p1, u1, signed_angle(q0 - center, p - center, u1)) @ first.rep
             for p in meets
         )
-        return LoopPoses(f"circle-{locus.kind}", poses)
+        gap = 0.0 if poses else circle_gap(circle, locus)
+        return LoopPoses(f"circle-{locus.kind}", poses, gap)
     return None

@@ -42,11 +42,12 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from assemblykit.algebra import Coset, EmptySet, SymmetryGroup, se3
+from assemblykit.algebra import Coset, EmptySet, Locus, SymmetryGroup, se3
 from assemblykit.inference.loops import (
     Circle,
     LoopPoses,
     circle_circle,
+    circle_gap,
     foot,
     point_loop,
     rotation_about,
@@ -380,14 +381,14 @@ class Reducer:
                     self._replace(closing, a, result, labels, "chain")
                     return True
             elif n == 3:
-                points = revolute_loop(
+                closed = revolute_loop(
                     self.edges[frozenset((path[0], path[1]))].oriented(path[0]),
                     self.edges[frozenset((path[1], path[2]))].oriented(path[1]),
                     direct,
                     self.tol,
                 )
-                if points is not None:
-                    return self._apply_loop(closing, path, points, labels)
+                if closed is not None:
+                    return self._apply_loop(closing, path, *closed, labels)
                 for way in (path, path[::-1]):  # the revolute may come first either way
                     solved = point_loop(
                         self.edges[frozenset((way[0], way[1]))].oriented(way[0]),
@@ -426,17 +427,21 @@ class Reducer:
         closing: _Edge,
         path: list[Node],
         points: list[tuple[np.ndarray, np.ndarray]],
+        gap: float,
         labels: tuple[str, ...],
     ) -> bool:
-        """Record the closed-form loop answer: no point is a conflict, one or two points
-        become a branch over the assembly modes (each sets both links to a point)."""
+        """Record the closed-form loop answer: no point is a conflict (of size ``gap``, the
+        distance between the joint circles), one or two points become a branch over the
+        assembly modes (each sets both links to a point)."""
         if not points:
             self.conflicts.append(
-                Conflict(
+                Conflict.measured(
                     tuple(dict.fromkeys(closing.labels + labels)),
                     "loop",
-                    0.0,
-                    "the two revolute joints cannot close the loop (the joint circles miss)",
+                    gap,
+                    "the two revolute joints cannot close the loop (the joint circles miss"
+                    f" by {gap:.6g})",
+                    self.tol,
                 )
             )
             return True
@@ -464,12 +469,13 @@ class Reducer:
         names = tuple(dict.fromkeys(closing.labels + labels))
         if not solved.poses:
             self.conflicts.append(
-                Conflict(
+                Conflict.measured(
                     names,
                     "loop",
-                    0.0,
+                    solved.gap,
                     f"the loop cannot close ({solved.pattern}: the joint point's circle"
-                    " misses its orbit under the closing link)",
+                    f" misses its orbit under the closing link by {solved.gap:.6g})",
+                    self.tol,
                 )
             )
             return True
@@ -540,15 +546,16 @@ def _axis(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
 
 def revolute_loop(
     first: Any, second: Any, closing: Any, tol: Tolerance
-) -> list[tuple[np.ndarray, np.ndarray]] | None:
+) -> tuple[list[tuple[np.ndarray, np.ndarray]], float] | None:
     """Closed-form R·R ∩ R (ALGEBRA.md §5.2 rule 4: "the orbit of a point under two
     revolutes gives circle-circle intersections").
 
     ``first`` (i→j), ``second`` (j→k) and ``closing`` (i→k) are revolute cosets with
     parallel axes. The joint point q on the j→k axis traces a circle under ``first``
     (in i's frame) and, carried by k, a circle under ``closing``; each common point fixes
-    both angles. Returns the pairs ``(X_ij, X_ik)`` (0, 1 or 2), or None when the pattern
-    does not apply (not three revolutes, non-parallel axes, or a continuum).
+    both angles. Returns the pairs ``(X_ij, X_ik)`` (0, 1 or 2) with, when there is none
+    because the circles miss, the distance between them; None when the pattern does not
+    apply (not three revolutes, non-parallel axes, or a continuum).
     """
     axes = [_axis(v) for v in (first, second, closing)]
     if any(a is None for a in axes):
@@ -570,6 +577,9 @@ def revolute_loop(
     )
     if meets is None:
         return None
+    if not meets:
+        far = Locus("circle", point=c3, direction=u3, radius=float(np.linalg.norm(q1 - c3)))
+        return [], circle_gap(Circle(c1, u1, float(np.linalg.norm(q0 - c1))), far)
     answers = []
     for point in meets:
         a1 = signed_angle(q0 - c1, point - c1, u1)
@@ -578,7 +588,7 @@ def revolute_loop(
         x_ik = rotation_about(p3, u3, a3) @ x_close
         if second.contains(se3.inverse(x_ij) @ x_ik):
             answers.append((x_ij, x_ik))
-    return answers
+    return answers, 0.0
 
 
 @dataclass(frozen=True)
