@@ -11,14 +11,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assemblykit.algebra import se3
+from assemblykit.algebra import Coset, SymmetryGroup, se3
 from assemblykit.features.primitives import Ball, Hole, Plane, Point, Prism, Shaft, Socket, Thread
 from assemblykit.inference import solve_numeric_only
-from assemblykit.inference.reduction import model_scale
+from assemblykit.inference.reduction import model_scale, revolute_loop
 from assemblykit.io.spec import load_task
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Action, Situation, Task
+from assemblykit.tolerance import Tolerance
 
 
 def body(name: str, fixed: bool = False, **features) -> Body:
@@ -906,3 +907,24 @@ def test_a_search_cut_at_its_limit_says_so_and_counts_what_it_found(tmp_path):
     assert turns == list(range(100))
     for p in (peg.pose, *peg.alternatives):
         assert np.allclose(p[:3, 3], 0, atol=1e-12) and np.allclose(p[2, :3], [0, 0, 1])
+
+
+def test_revolute_loop_carries_the_joint_point_by_the_closing_link():
+    """R·R ∩ R with representatives that do not close (as before any solving): the joint
+    point p2 = (1, 0, 0) of j is (1, -2, 0) in k (second rep Tr(0, 2, 0)); it sweeps the
+    unit circle about the origin under the first link and the circle of radius √8 about
+    (3, 0, 0) under the closing one, which meet at x = 1/3, y = ±√8/3."""
+    z = (0.0, 0.0, 1.0)
+    first = Coset(SymmetryGroup.revolute((0, 0, 0), z), se3.rot_z(math.pi / 2))
+    second = Coset(SymmetryGroup.revolute((1, 0, 0), z), se3.translation((0, 2, 0)))
+    closing = Coset(SymmetryGroup.revolute((3, 0, 0), z), np.eye(4))
+    closed = revolute_loop(first, second, closing, Tolerance())
+    assert closed is not None
+    pairs, gap = closed
+    assert gap == 0.0 and len(pairs) == 2
+    met = sorted(tuple(np.round(se3.apply(x_ij, np.array([1.0, 0, 0])), 12)) for x_ij, _ in pairs)
+    y = round(math.sqrt(8) / 3, 12)
+    assert met == [(round(1 / 3, 12), -y, 0.0), (round(1 / 3, 12), y, 0.0)]
+    for x_ij, x_ik in pairs:  # the loop closes: X_ij · X_jk = X_ik with X_jk in the second
+        assert first.contains(x_ij) and closing.contains(x_ik)
+        assert second.contains(se3.inverse(x_ij) @ x_ik)

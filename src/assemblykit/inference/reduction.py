@@ -563,8 +563,9 @@ def revolute_loop(
     (p1, u1), (p2, _), (p3, u3) = axes  # the joint axis point p2 is in j's frame
     x_first, x_close = first.rep, closing.rep
     q_world = x_first @ np.append(p2, 1.0)  # joint point at the first's representative
-    q_in_k = se3.inverse(x_close) @ x_first @ se3.inverse(second.rep)
-    q_in_k = (q_in_k @ np.append(p2, 1.0))[:3]
+    # the joint point in k's frame is fixed by every pose of the second link (its axis
+    # passes through it); the closing link carries it into i's frame
+    q_in_k = (se3.inverse(second.rep) @ np.append(p2, 1.0))[:3]
     q0 = q_world[:3]
     q1 = (x_close @ np.append(q_in_k, 1.0))[:3]
     c1, c3 = foot(q0, p1, u1), foot(q1, p3, u3)
