@@ -9,12 +9,13 @@ holds ``compas_assembly/dome_assembly.json``.
 
 Puzzles: multi-move plans (``plan --moves multi``) of BurrTools' example puzzles, with the
 level each stored and the ``time`` BurrTools recorded for the problem, and all 314 solid
-six-piece burrs (skipped unless ``burrtools/`` is found like the other data).
+six-piece burrs (bundled under ``tests/data/burrtools``). ``--puzzles`` runs only these.
 """
 
 from __future__ import annotations
 
 import statistics
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -77,9 +78,17 @@ def multi_move(path: Path, solution: int = 0) -> tuple[float, MultiMovePlan]:
     return time.perf_counter() - start, result
 
 
+def burrtools_time(seconds: float | None) -> str:
+    """BurrTools' recorded time for a problem (whole seconds), or that it stores none."""
+    return "not stored" if seconds is None else f"{seconds:g} s"
+
+
 def puzzles() -> None:
     """Multi-move plans of the BurrTools puzzles, then of all 314 six-piece burrs."""
-    print("puzzles (--moves multi, one run each)")
+    print(
+        "puzzles (--moves multi, one run each; BurrTools time: what the file records for "
+        "solving the whole problem, assemblies and disassemblies)"
+    )
     for name in PUZZLES:
         path = dataset(f"burrtools/{name}.xmpuzzle")
         if path is None:
@@ -87,30 +96,37 @@ def puzzles() -> None:
             continue
         seconds, result = multi_move(path)
         stored = load_puzzle(path)
+        same = "same" if result.level == stored.level else "DIFFERENT"
         print(
-            f"{name:<28} {len(result.parts):>5} parts {seconds:>8.3f} s  level {result.level}"
-            f"  (stored {stored.level}, BurrTools time {stored.time} s)  {result.states} states"
+            f"{name:<28} {len(result.parts):>5} parts {seconds:>8.3f} s  "
+            f"(BurrTools time {burrtools_time(stored.time)})  "
+            f"first separation: {result.first_moves} moves, level {result.level} "
+            f"({same} as stored {stored.level})  {result.states} states"
         )
     path = dataset("burrtools/SolidSixPieceBurrs.xmpuzzle")
     if path is None:
         print("six-piece burrs              skipped (not found)")
         return
-    total, solved, multi = 0.0, 0, 0
+    total, solved, multi, same = 0.0, 0, 0, 0
     count = solution_count(path)
     for solution in range(count):
         seconds, result = multi_move(path, solution)
         total += seconds
         solved += result.feasible
         multi += result.root is not None and max(result.root.levels()) > 1
+        same += result.level == result.reference_level
     print(
         f"six-piece burrs: {solved} of {count} taken apart, {multi} need several moves for "
-        f"a separation, {total:.2f} s in all ({total / count * 1000:.1f} ms each; "
-        f"BurrTools time {load_puzzle(path).time} s)"
+        f"a separation, {same} at the stored level, {total:.2f} s in all "
+        f"({total / count * 1000:.1f} ms each; BurrTools time "
+        f"{burrtools_time(load_puzzle(path).time)} to find and take apart all of them)"
     )
 
 
 def main() -> None:
     puzzles()
+    if "--puzzles" in sys.argv:
+        return
     print("planning (median wall time; loading excluded, contacts and blocking included)")
     demo = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
     cases = [("gearbox demo", demo, REPEATS)]

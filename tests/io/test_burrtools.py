@@ -205,6 +205,33 @@ def test_stored_solutions_fill_the_result_and_their_separations_replay(name):
     replay_stored(puzzle, root, dict(zip(root.pieces, root.states[0], strict=True)))
 
 
+@pytest.mark.parametrize(
+    ("info", "level"),
+    [
+        ("2 0 0", "1"),
+        ("2 3 2 2 2 0 0 0 0 0 0", "1.2.1.1.1"),
+        ("5 0 10 0 0 | 0 0 1 0 0", "4.9"),
+        ("", None),
+        ("2 0", None),
+        ("2 0 0 0", None),
+        ("2 -1 0", None),
+    ],
+)
+def test_separation_info_gives_the_level(tmp_path, info, level):
+    cube = ("1 1 1", "#", "Cube")
+    text = puzzle_xml([cube, ("2 1 1", "##", "Result")], [2], "0 0 0 0 1 0 0 0").replace(
+        "</assembly>", f"</assembly><separationInfo>{info}</separationInfo>"
+    )
+    path = tmp_path / "info.xmpuzzle"
+    path.write_text(text)
+    if level is None:
+        with pytest.raises(SchemaError, match="separation tree") as raised:
+            load_puzzle(path)
+        assert "separationInfo" in str(raised.value)
+    else:
+        assert load_puzzle(path).level == level
+
+
 def test_every_six_piece_burr_fills_the_knot():
     path = dataset("burrtools/SolidSixPieceBurrs.xmpuzzle")
     assert solution_count(path) == 314
@@ -213,3 +240,6 @@ def test_every_six_piece_burr_fills_the_knot():
         union = [c for p in puzzle.pieces for c in cells(p.voxels)]
         assert len(puzzle.pieces) == 6 and len(union) == len(set(union))
         assert set(union) == cells(puzzle.filled)
+    # each solution stores only the shape of BurrTools' separation tree (separationInfo)
+    levels = [load_puzzle(path, solution=s).level for s in range(314)]
+    assert levels == ["1.1.1.1.1"] * 257 + ["1.2.1.1.1"] * 57

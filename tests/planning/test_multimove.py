@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import itertools
 import json
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -11,8 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from assemblykit.cli import main
-from assemblykit.io.burrtools import load_puzzle
-from assemblykit.planning.multimove import MultiMovePlan, Separation, plan_voxels
+from assemblykit.io.burrtools import load_puzzle, solution_count
+from assemblykit.planning.multimove import Move, MultiMovePlan, Separation, plan_voxels
 from datasets import dataset
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -33,17 +35,26 @@ def cage_and_key(channel: list[tuple[int, int, int]]) -> tuple[list[str], list[n
 def replay(plan: MultiMovePlan, voxels: dict[str, np.ndarray]) -> None:
     """Apply every move of ``plan`` to the cells one unit at a time and assert that no
     two parts of the subassembly being taken apart ever share a cell, that the last move
-    of each separation leaves the rest behind for good, and that every part ends alone
-    or in a kept group."""
-    cells = {name: {tuple(c) for c in v.tolist()} for name, v in voxels.items()}
+    of each separation takes the moved parts wholly beyond the rest along its direction
+    (from there on nothing can meet them), and that every part ends alone or in a kept
+    group."""
     ends: list[tuple[str, ...]] = []
-
-    def shifted(name: str, offset: np.ndarray) -> set[tuple[int, ...]]:
-        return {(x + offset[0], y + offset[1], z + offset[2]) for x, y, z in cells[name]}
 
     def disjoint(parts: tuple[str, ...], offsets: dict[str, np.ndarray]) -> bool:
         placed = np.concatenate([voxels[name] + offsets[name] for name in parts])
         return len(np.unique(placed, axis=0)) == len(placed)
+
+    def reach(
+        parts: list[str], offsets: dict[str, np.ndarray], direction: np.ndarray
+    ) -> np.ndarray:
+        """How far along ``direction`` the cells of ``parts`` lie (one value per cell)."""
+        return np.concatenate([(voxels[n] + offsets[n]) @ direction for n in parts])
+
+    def clear(move: Move, rest: list[str], offsets: dict[str, np.ndarray]) -> bool:
+        """Whether the cells moved by ``move`` all lie beyond those of ``rest``."""
+        direction = np.array(move.direction)
+        ahead = reach(list(move.parts), offsets, direction).min()
+        return bool(ahead > reach(rest, offsets, direction).max())
 
     def walk(node: Separation | None, offsets: dict[str, np.ndarray]) -> None:
         if node is None:
@@ -56,22 +67,21 @@ def replay(plan: MultiMovePlan, voxels: dict[str, np.ndarray]) -> None:
         for move in node.moves:
             direction = np.array(move.direction)
             assert set(move.parts) < set(node.parts) and abs(direction).sum() == 1
-            span = max(np.ptp(np.array(sorted(cells[n])), axis=0).max() for n in node.parts)
-            steps = move.distance if move.distance is not None else int(span) + 60
-            for _ in range(steps):
+            rest = [n for n in node.parts if n not in move.parts]
+            # to infinity: until the moved cells all lie beyond the others, which takes
+            # at most the depth of the whole subassembly along the move
+            depth = int(np.ptp(reach(list(node.parts), offsets, direction))) + 1
+            steps = depth if move.distance is None else move.distance
+            moved = 0
+            while moved < steps and not (move.distance is None and clear(move, rest, offsets)):
                 for name in move.parts:
                     offsets[name] = offsets[name] + direction
+                moved += 1
                 assert disjoint(node.parts, offsets)
             if move.distance is None:
-                rest = set(node.parts) - set(move.parts)
-                gone = set().union(*(shifted(n, offsets[n]) for n in move.parts))
-                stay = set().union(*(shifted(n, offsets[n]) for n in rest))
-                axis = int(np.flatnonzero(direction)[0])
-                sign = int(direction[axis])
-                # the moved parts now lie wholly beyond the rest along the move
-                assert min(sign * c[axis] for c in gone) > max(sign * c[axis] for c in stay)
+                assert clear(move, rest, offsets), "the last move does not get clear of the rest"
                 for name in move.parts:
-                    offsets[name] = offsets[name] - steps * direction
+                    offsets[name] = offsets[name] - moved * direction
         assert set(node.removed_parts) == set(node.moves[-1].parts) or set(node.parts) - set(
             node.removed_parts
         ) == set(node.moves[-1].parts)
@@ -183,6 +193,31 @@ def test_plan_command_moves_multi(capsys):
     assert code == 2 and ".xmpuzzle" in err
 
 
+def test_plan_command_on_burrtools_files_compares_with_the_stored_level(capsys):
+    pelikan = str(dataset("burrtools/PelikanBurr.xmpuzzle"))
+    code, out, err = run(capsys, "plan", pelikan, "--moves", "multi", "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["feasible"] and data["first_moves"] == 98
+    assert data["level"] == data["reference_level"] == "98.1.2.1.4.2"
+    tree = data["separations"]
+    assert len(tree["moves"]) == 98 and tree["moves"][-1]["distance"] is None
+    assert all(m["distance"] >= 1 for m in tree["moves"][:-1])
+    assert len(data["steps"]) == 98 + 1 + 2 + 1 + 4 + 2
+    code, out, _ = run(capsys, "plan", pelikan, "--moves", "multi")
+    assert code == 0 and "first separation: 98 moves (stored level 98.1.2.1.4.2)" in out
+    burrs = str(dataset("burrtools/SolidSixPieceBurrs.xmpuzzle"))
+    argv = ("plan", burrs, "--moves", "multi", "--problem", "0", "--solution", "257", "--json")
+    code, out, err = run(capsys, *argv)
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["level"] == data["reference_level"] == "1.2.1.1.1"
+    second = data["separations"]["left"] or data["separations"]["removed"]
+    assert [m["distance"] for m in second["moves"]] == [1, None]
+    code, _, err = run(capsys, "plan", burrs, "--moves", "multi", "--problem", "1")
+    assert code == 2 and "no problem 1 (the file has 1)" in err
+
+
 @pytest.mark.parametrize(
     ("name", "level"),
     [
@@ -206,13 +241,64 @@ def test_puzzles_come_apart_in_as_many_moves_as_burrtools_says(name, level):
     replay(result, {p.name: p.voxels for p in puzzle.pieces})
 
 
-# solutions 257..313 are the 57 burrs whose second separation needs two moves
-@pytest.mark.parametrize(
-    ("solution", "level"),
-    [(0, "1.1.1.1.1"), (257, "1.2.1.1.1"), (285, "1.2.1.1.1"), (313, "1.2.1.1.1")],
-)
-def test_six_piece_burrs_with_and_without_a_monotone_plan(solution, level):
-    puzzle = load_puzzle(dataset("burrtools/SolidSixPieceBurrs.xmpuzzle"), solution=solution)
-    result = plan_voxels(puzzle.names, [p.voxels for p in puzzle.pieces])
-    assert result.feasible and result.level == level
-    replay(result, {p.name: p.voxels for p in puzzle.pieces})
+def line_spans(cells: np.ndarray, axis: int) -> dict[tuple[int, ...], tuple[int, int]]:
+    """The lowest and highest coordinate along ``axis`` of the cells on each line
+    parallel to it (keyed by the other two coordinates)."""
+    spans: dict[tuple[int, ...], tuple[int, int]] = {}
+    for cell in cells.tolist():
+        key = tuple(cell[:axis] + cell[axis + 1 :])
+        low, high = spans.get(key, (cell[axis], cell[axis]))
+        spans[key] = (min(low, cell[axis]), max(high, cell[axis]))
+    return spans
+
+
+def has_monotone_plan(voxels: list[np.ndarray]) -> bool:
+    """Whether the pieces come apart by single translations to infinity along the axes,
+    one subassembly at a time (a monotone two-handed plan), by exhausting the splits:
+    a set leaves along +axis iff on every line no cell left behind lies ahead of its
+    rearmost cell there."""
+    spans = [[line_spans(v, axis) for axis in range(3)] for v in voxels]
+
+    def leaves(moving: tuple[int, ...], staying: tuple[int, ...], axis: int, sign: int) -> bool:
+        rear: dict[tuple[int, ...], int] = {}
+        for k in moving:
+            for key, (low, high) in spans[k][axis].items():
+                back = low if sign > 0 else -high  # sign x coordinate of the rearmost cell
+                rear[key] = min(rear.get(key, back), back)
+        for k in staying:
+            for key, (low, high) in spans[k][axis].items():
+                if key in rear and (high if sign > 0 else -low) > rear[key]:
+                    return False
+        return True
+
+    @cache
+    def apart(members: tuple[int, ...]) -> bool:
+        return len(members) == 1 or any(
+            apart(moving)
+            and apart(staying)
+            and any(leaves(moving, staying, a, s) for a in range(3) for s in (1, -1))
+            for size in range(1, len(members))
+            for moving in itertools.combinations(members, size)
+            for staying in [tuple(m for m in members if m not in moving)]
+        )
+
+    return apart(tuple(range(len(voxels))))
+
+
+def test_every_six_piece_burr_comes_apart_at_the_level_burrtools_stores():
+    path = dataset("burrtools/SolidSixPieceBurrs.xmpuzzle")
+    assert solution_count(path) == 314
+    no_monotone_plan, several_moves = [], []
+    for solution in range(314):
+        puzzle = load_puzzle(path, solution=solution)
+        voxels = [p.voxels for p in puzzle.pieces]
+        result = plan_voxels(puzzle.names, voxels)
+        assert result.feasible and result.level == puzzle.level, solution
+        replay(result, {p.name: p.voxels for p in puzzle.pieces})
+        if not has_monotone_plan(voxels):
+            no_monotone_plan.append(solution)
+        if max(result.root.levels()) > 1:
+            several_moves.append(solution)
+    # the 57 burrs without a monotone plan are exactly those whose plan (and BurrTools'
+    # stored one, level 1.2.1.1.1) needs two moves for a separation: solutions 257..313
+    assert no_monotone_plan == several_moves == list(range(257, 314))

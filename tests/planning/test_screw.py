@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import json
 import math
 
 import manifold3d
@@ -10,9 +11,9 @@ import numpy as np
 import pytest
 import trimesh
 from rich.console import Console
+from scipy.spatial.transform import Rotation
 
-from assemblykit.algebra import se3
-from assemblykit.geometry.interference import interference_threshold, solid
+from assemblykit.cli import main
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.screw import plan_with_screws, screw_removal
 
@@ -40,11 +41,21 @@ def cube(lo, hi) -> manifold3d.Manifold:
     return manifold3d.Manifold.cube(np.subtract(hi, lo)).translate(lo)
 
 
-def hooked() -> Assembly:
+def base_solid() -> manifold3d.Manifold:
+    """The base built straight from its boxes (not through the assembly's meshes)."""
     base = cube(*BASE[0])
     for lo, hi in BASE[1:]:
         base = base + cube(lo, hi)
-    return Assembly([Part("base", mesh_of(base)), Part("hook", mesh_of(cube(*HOOK)))])
+    return base
+
+
+def turned(points: np.ndarray, point: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
+    """``points`` turned by ``angle`` about the line through ``point`` along ``axis``."""
+    return Rotation.from_rotvec(angle * axis).apply(points - point) + point
+
+
+def hooked() -> Assembly:
+    return Assembly([Part("base", mesh_of(base_solid())), Part("hook", mesh_of(cube(*HOOK)))])
 
 
 def swept_volume(hull_points: np.ndarray, base: manifold3d.Manifold) -> float:
@@ -66,22 +77,35 @@ def test_the_hook_turns_fifty_degrees_about_its_top_left_edge_then_lifts_out():
     assert data["motion"] == "screw" and data["angle_deg"] == pytest.approx(50.0)
 
 
+CORNERS = np.array(list(itertools.product(*zip(*HOOK, strict=True))), dtype=float)
+# overlaps below this are floating-point noise: the real ones near the answer are
+# hundredths (the exit a degree early) or tenths (a degree the wrong way)
+NOISE = 1e-9
+
+
+def turn_is_clear(point: np.ndarray, axis: np.ndarray, angle: float, leave: np.ndarray) -> bool:
+    """Whether the hook turned by ``angle`` about the line (``point``, ``axis``) and then
+    sent along ``leave`` never cuts into the base. The hull of two poses a tenth of a
+    degree apart holds the sweep between them, but for arcs bulging past the chords by
+    r (1 - cos 0.05 deg), under 2e-6 here; the hull of the last pose and its copy far
+    along ``leave`` holds the exit's sweep."""
+    base = base_solid()
+    poses = [turned(CORNERS, point, axis, a) for a in np.linspace(0.0, angle, 501)]
+    pairs = [*itertools.pairwise(poses), (poses[-1], poses[-1] + 100 * leave)]
+    return all(swept_volume(np.vstack(pair), base) <= NOISE for pair in pairs)
+
+
 def test_an_independent_sweep_confirms_the_turn_and_that_no_translation_frees_the_hook():
-    assembly = hooked()
-    turn = screw_removal(assembly, ["hook"])
-    base = solid(assembly["base"].mesh)
-    limit = interference_threshold(assembly["base"].mesh, assembly["hook"].mesh)
-    corners = np.asarray(assembly["hook"].mesh.vertices)
-    # the hull of two poses a tenth of a degree apart holds the sweep between them, but
-    # for arcs bulging past the chords by r (1 - cos 0.05 deg), under 2e-6 here
-    fractions = np.linspace(0.0, 1.0, 501)
-    poses = [se3.apply(turn.pose(f), corners) for f in fractions]
-    for before, after in itertools.pairwise(poses):
-        assert swept_volume(np.vstack([before, after]), base) <= limit
-    assert swept_volume(np.vstack([poses[-1], poses[-1] + [0, 0, 100]]), base) <= limit
+    turn = screw_removal(hooked(), ["hook"])
+    assert turn_is_clear(turn.point, turn.axis, turn.angle, turn.exit)
+    # a degree short of the turn the lip still holds the hook; turning the other way
+    # digs into the floor
+    assert not turn_is_clear(turn.point, turn.axis, turn.angle - math.radians(1), turn.exit)
+    assert not turn_is_clear(turn.point, -turn.axis, turn.angle, turn.exit)
     # from the assembled pose every straight way out is blocked
+    base = base_solid()
     for direction in np.vstack([np.eye(3), -np.eye(3)]):
-        assert swept_volume(np.vstack([corners, corners + 100 * direction]), base) > limit
+        assert swept_volume(np.vstack([CORNERS, CORNERS + 100 * direction]), base) > 1e-3
 
 
 def test_plan_with_turns_takes_the_hook_out_where_translations_stop():
@@ -92,10 +116,29 @@ def test_plan_with_turns_takes_the_hook_out_where_translations_stop():
     data = result.to_dict()
     assert data["feasible"] and data["stuck"] == []
     assert [s["motion"] for s in data["steps"]] == ["screw"]
-    assert data["steps"][0]["axis"]["direction"] == pytest.approx([0, -1, 0])
+    step = data["steps"][0]
+    assert step["axis"]["direction"] == pytest.approx([0, -1, 0])
+    # the step as printed, checked by the independent sweep
+    axis = {name: np.array(value) for name, value in step["axis"].items()}
+    assert turn_is_clear(axis["point"], axis["direction"], step["angle"], np.array(step["exit"]))
     console = Console(record=True, width=200)
     console.print(result.render())
     assert "turn 50.0 deg" in console.export_text()
+
+
+def test_plan_command_moves_rigid_prints_the_turn(tmp_path, capsys):
+    for part in hooked():
+        part.mesh.export(tmp_path / f"{part.name}.stl")
+    try:
+        main(["plan", str(tmp_path), "--moves", "rigid", "--json"])
+    except SystemExit as done:
+        assert not done.code
+    data = json.loads(capsys.readouterr().out)
+    assert data["feasible"] and data["moves"] == "rigid"
+    [step] = data["steps"]
+    assert step["motion"] == "screw" and step["parts"] == ["hook"]
+    axis = {name: np.array(value) for name, value in step["axis"].items()}
+    assert turn_is_clear(axis["point"], axis["direction"], step["angle"], np.array(step["exit"]))
 
 
 def test_a_sealed_hook_has_no_turn_out():

@@ -19,6 +19,10 @@ A ``<separation>`` tree is BurrTools' own disassembly: the pieces of a subassemb
 positions of each piece after every move (a coordinate beyond :data:`REMOVED_BEYOND` means
 "gone to infinity"), and the subassemblies ``removed`` and ``left`` by the separation.
 Its *level* is the number of moves of each separation, in that order (``4.9.3``).
+Files that keep only the shape of that tree store a ``<separationInfo>`` instead: the
+tree in pre-order, one number per node, ``moves + 1`` for a separation (followed by its
+two halves) and ``0`` for a half that is not separated further; its level lists the
+nonzero numbers less one (``2 3 2 2 2 0 0 0 0 0 0`` is ``1.2.1.1.1``).
 """
 
 from __future__ import annotations
@@ -110,7 +114,9 @@ class StoredSeparation:
 class VoxelPuzzle:
     """A BurrTools puzzle as assembled by one stored solution: its ``pieces``, the
     result shape's ``filled`` and ``variable`` cells, BurrTools' own ``separation`` tree
-    (when stored) and the solver ``time`` the file records for the problem (seconds)."""
+    (when stored), the solver ``time`` the file records for the problem (seconds) and
+    the move counts of a ``<separationInfo>`` (``separation_levels``, when stored
+    instead of the tree)."""
 
     source: str
     pieces: tuple[VoxelPiece, ...]
@@ -118,6 +124,7 @@ class VoxelPuzzle:
     variable: NDArray[np.int64]
     separation: StoredSeparation | None
     time: float | None
+    separation_levels: tuple[int, ...] | None = None
 
     @property
     def names(self) -> list[str]:
@@ -126,10 +133,15 @@ class VoxelPuzzle:
 
     @property
     def level(self) -> str | None:
-        """BurrTools' level of the stored separation (``4.9.3``), or None."""
-        if self.separation is None:
+        """BurrTools' level of the stored separation tree or, without one, of the
+        stored ``<separationInfo>`` (``4.9.3``); None when the file stores neither."""
+        if self.separation is not None:
+            levels = self.separation.levels()
+        elif self.separation_levels is not None:
+            levels = self.separation_levels
+        else:
             return None
-        return ".".join(str(n) for n in self.separation.levels())
+        return ".".join(str(n) for n in levels)
 
 
 def _parse(path: Path) -> ElementTree.Element:
@@ -219,6 +231,22 @@ def _separation(element: ElementTree.Element, source: str, where: str) -> Stored
             raise SchemaError(f"unknown separation type {kind!r}", source=source, where=where)
     shaped = np.array(states, dtype=np.int64).reshape(len(states), len(pieces), 3)
     return StoredSeparation(pieces, shaped, removed, left)
+
+
+def _separation_levels(text: str | None, source: str, where: str) -> tuple[int, ...]:
+    """The move counts of a ``<separationInfo>`` pre-order tree (module docstring);
+    rotation counts that newer files append after ``|`` are not read."""
+    values = _integers((text or "").split("|")[0], source, where)
+    open_ends = 1
+    for position, value in enumerate(values):
+        if value < 0 or open_ends == 0:
+            raise SchemaError(
+                f"bad separation tree at value {position}: {value}", source=source, where=where
+            )
+        open_ends += 1 if value else -1
+    if open_ends:
+        raise SchemaError("the separation tree is incomplete", source=source, where=where)
+    return tuple(value - 1 for value in values if value)
 
 
 def _placed(
@@ -345,6 +373,12 @@ def load_puzzle(path: str | Path, problem: int = 0, solution: int = 0) -> VoxelP
         )
     tree = stored.find("separation")
     separation = None if tree is None else _separation(tree, source, f"{where} separation")
+    info = stored.find("separationInfo")
+    levels = (
+        None
+        if info is None
+        else _separation_levels(info.text, source, f"{where} solution {solution} separationInfo")
+    )
     seconds = chosen.get("time")
     return VoxelPuzzle(
         source,
@@ -353,6 +387,7 @@ def load_puzzle(path: str | Path, problem: int = 0, solution: int = 0) -> VoxelP
         result["+"],
         separation,
         None if seconds is None else float(_integer(seconds, source, where)),
+        levels,
     )
 
 
