@@ -23,6 +23,8 @@ DOCUMENTED = (
     "assemblykit.io.exports",
     "assemblykit.viz.explode",
     "assemblykit.viz.plots",
+    "assemblykit.viz.task_view",
+    "assemblykit.viz.mating_view",
 )
 
 
@@ -88,3 +90,31 @@ def test_notebook_tables_and_mappings_by_name():
     report = assemblykit.motion(hinge)
     assert list(report) == ["frame", "door"] and "door" in report and "lid" not in report
     assert "<td>door</td><td>revolute</td><td>1</td>" in report._repr_html_()
+
+
+def test_coset_and_mating_reprs_say_it_in_words():
+    from assemblykit.algebra import Coset, SymmetryGroup, se3
+
+    revolute = SymmetryGroup.revolute(np.zeros(3), np.array([0.0, 0.0, 1.0]))
+    assert repr(Coset(revolute, se3.translation([0.0, 0.0, 5.0]))) == (
+        "Coset(revolute, 1 dof, axis through (0, 0, 0) along +Z)"
+    )
+    assert repr(Coset(SymmetryGroup.identity(), se3.translation([1.0, 2.0, 1e-17]))) == (
+        "Coset(fixed, 0 dof, at (1, 2, 0))"
+    )
+    helical = SymmetryGroup.helical(np.array([1.0, 0.0, 0.0]), np.array([0.0, -1.0, 0.0]), 0.5)
+    assert repr(Coset(helical, np.eye(4))) == (
+        "Coset(helical, 1 dof, axis through (1, 0, 0) along -Y, pitch 0.5)"
+    )
+    square = assemblykit.features.Prism(point=(0, 0, 0), axis=(0, 0, 1), sides=4, size=1)
+    assert (
+        repr(Coset(square.group(), np.eye(4))) == "Coset(prismatic, 1 dof, along +Z, 4 components)"
+    )
+    mating = EXAMPLES / "mating"
+    problem = assemblykit.load_problem(mating / "example1.yaml")
+    assert repr(problem) == "MatingProblem(4 bodies, 3 goals, mm, example1.yaml)"
+    assert repr(assemblykit.mate(problem)) == "MatingResult(solved, 8 configurations, 2 found)"
+    arms = assemblykit.mate(assemblykit.load_problem(mating / "two_arms.yaml"))
+    assert repr(arms) == "MatingResult(no solution, goal 1 emptied by the arc consistency law)"
+    for shown in (repr(problem), repr(arms)):
+        assert "array" not in shown and str(EXAMPLES) not in shown

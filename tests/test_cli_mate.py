@@ -76,3 +76,22 @@ def test_example3_position_up_to_the_peg_symmetry(
         [0.0, 0.0, 1.0, 0.0],
         [0.0, 0.0, 0.0, 1.0],
     ]
+
+
+def test_png_draws_the_two_layer_graph(
+    mating_examples: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "graph.png"
+    code, out, err = _run(capsys, str(mating_examples / "example1.yaml"), "--png", str(png))
+    assert code == 0 and "8 configurations" in out
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert err.strip() == f"wrote {png}"
+
+
+@pytest.mark.parametrize("name", ["missing/graph.png", "graph.svg", ""])
+def test_a_bad_png_path_exits_2_before_reading_the_problem(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, _, err = _run(capsys, str(tmp_path / "nosuch.yaml"), "--png", str(tmp_path / name))
+    assert code == 2 and "--png" in err and len(err.strip().splitlines()) == 1
+    assert not list(tmp_path.iterdir())

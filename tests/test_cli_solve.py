@@ -362,3 +362,26 @@ def test_a_bad_tolerance_exits_2_naming_the_option(command, option, value, capsy
     assert captured.out == ""
     (line,) = captured.err.splitlines()
     assert line.startswith(f"assemblykit: {option}: ")
+
+
+@needs_engine
+def test_png_draws_the_solution_and_names_the_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+):
+    png = tmp_path / "peg.png"
+    assert run(["solve", str(EXAMPLES / "peg_in_block.yaml"), "--json", "--png", str(png)]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["status"] == "underconstrained"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert err.strip() == f"wrote {png}"
+
+
+@pytest.mark.parametrize("name", ["missing/peg.png", "peg.gif"])
+def test_a_bad_png_path_exits_2_before_reading_the_task(
+    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+):
+    # the task does not exist either: the output is checked first
+    assert run(["solve", str(tmp_path / "nosuch.yaml"), "--png", str(tmp_path / name)]) == 2
+    err = capsys.readouterr().err
+    assert "--png" in err and len(err.strip().splitlines()) == 1
+    assert not list(tmp_path.rglob("*.png")) and not list(tmp_path.rglob("*.gif"))

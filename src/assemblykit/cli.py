@@ -257,6 +257,7 @@ def command(fn: Callable[..., None]) -> click.Command:
     help="Most finite alternatives (discrete poses, assembly modes) followed to the end "
     "(default 64).",
 )
+@click.option("--png", default=None, help="Also write a PNG of the bodies and their freedom here.")
 @debug_option
 def solve_cmd(
     task: str,
@@ -265,6 +266,7 @@ def solve_cmd(
     angle_tolerance: float | None,
     explain: bool,
     max_branches: int | None,
+    png: str | None,
     debug: bool,
 ) -> None:
     """Pose of every body in every situation of a task (RAPT network reduction,
@@ -275,9 +277,17 @@ def solve_cmd(
     from assemblykit.io.spec import load_task
     from assemblykit.tolerance import using
 
+    if png is not None:
+        checked_output(png, "--png", PNG_SUFFIXES)
     # The engine scales the policy to the model's size; only the relative part comes from here.
     with using(tolerance_from(tolerance, angle_tolerance)):
-        emit(load_task(task).solve(explain=explain, max_branches=max_branches), as_json)
+        loaded = load_task(task)
+        result = loaded.solve(explain=explain, max_branches=max_branches)
+        if png is not None:
+            from assemblykit.viz.task_view import write_task_png
+
+            note(f"wrote {write_task_png(loaded, result, png)}")
+        emit(result, as_json)
 
 
 def _progress_bar() -> Any:
@@ -794,10 +804,13 @@ def blocking_cmd(
 
 @command
 @click.argument("problem")
+@click.option("--png", default=None, help="Also write a PNG of the two-layer graph here.")
 @json_option
 @tolerance_option
 @debug_option
-def mate_cmd(problem: str, as_json: bool, tolerance: float | None, debug: bool) -> None:
+def mate_cmd(
+    problem: str, png: str | None, as_json: bool, tolerance: float | None, debug: bool
+) -> None:
     """Mating inference (Liu & Popplestone 1990): which compound features mate to satisfy the goals.
 
     PROBLEM: mating problem, .yaml, .yml or .json.
@@ -805,4 +818,12 @@ def mate_cmd(problem: str, as_json: bool, tolerance: float | None, debug: bool) 
     from assemblykit.io.problem import load_problem
     from assemblykit.mating.search import mate
 
-    emit(mate(load_problem(problem, tolerance_from(tolerance))), as_json)
+    if png is not None:
+        checked_output(png, "--png", PNG_SUFFIXES)
+    loaded = load_problem(problem, tolerance_from(tolerance))
+    result = mate(loaded)
+    if png is not None:
+        from assemblykit.viz.mating_view import write_mating_png
+
+        note(f"wrote {write_mating_png(loaded, result, png)}")
+    emit(result, as_json)

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from assemblykit import formatting as fmt
 from assemblykit.algebra import se3
 from assemblykit.algebra.caching import cached
 from assemblykit.algebra.lattices import IntegerPoints, commensurate, integer_points
@@ -181,6 +182,32 @@ class Coset:
     def describe(self) -> str:
         """One line: the group and the representative's translation."""
         return f"{self.group.describe()} . x0 (x0 translation {self.rep[:3, 3].round(9).tolist()})"
+
+    def __repr__(self) -> str:
+        """One line in words, e.g. ``Coset(revolute, 1 dof, axis through (0, 0, 0) along
+        +Z)``: the kind, the dof, the invariants that place it (those of a fixed coset:
+        the representative's translation) and its discrete components."""
+        inv = self.group.invariants
+        if "axis" in inv:
+            where = f"axis through {fmt.vector(inv['point'])} along {fmt.direction(inv['axis'])}"
+        elif "point" in inv:
+            where = f"about {fmt.vector(inv['point'])}"
+        elif "direction" in inv:
+            where = f"along {fmt.direction(inv['direction'])}"
+        elif "normal" in inv:
+            where = f"normal {fmt.direction(inv['normal'])}"
+        elif self.kind is Kind.FIXED:
+            where = f"at {fmt.vector(self.rep[:3, 3])}"
+        else:
+            where = ""
+        pitch = f"pitch {fmt.number(inv['pitch'])}" if "pitch" in inv else ""
+        if self.group.lattice:
+            parts = "a lattice of components"
+        else:
+            parts = fmt.count(len(self.group.reps), "component") if len(self.group.reps) > 1 else ""
+        return fmt.summary(
+            "Coset", self.kind.value, fmt.count(self.dof, "dof", "dof"), where, pitch, parts
+        )
 
     # ------------------------------------------------------------------ set operations
 

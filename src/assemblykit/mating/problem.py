@@ -64,6 +64,17 @@ class MatingProblem:
     source: str | None = None
     tolerance: Tolerance = field(default_factory=current)
 
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary(
+            "MatingProblem",
+            fmt.count(len(self.bodies), "body", "bodies"),
+            fmt.count(len(self.goals), "goal"),
+            self.units,
+            fmt.file_name(self.source),
+        )
+
 
 def mating_body(
     name: str,

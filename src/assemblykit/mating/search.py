@@ -35,6 +35,7 @@ import numpy as np
 from rich.console import Group
 from rich.text import Text
 
+from assemblykit import formatting as fmt
 from assemblykit.algebra import Coset, EmptySet, Kind, SymmetryGroup
 from assemblykit.errors import MissingExtraError
 from assemblykit.geometry.interference import interferes as interfering_solids
@@ -154,8 +155,9 @@ class Emptied:
 class MatingResult:
     """The answer of :func:`mate`: the configurations (representatives), the ``count``
     including equivalent copies, the domain sizes after each law, the goal whose domain
-    emptied (if any), how many assignments step three rejected, and how many candidate
-    pairs path consistency deleted."""
+    emptied (if any), how many assignments step three rejected, how many candidate
+    pairs path consistency deleted, and the domains themselves after each law
+    (``stages``, one per entry of :data:`LAWS`)."""
 
     configurations: tuple[Configuration, ...]
     statistics: Mapping[int, tuple[int, ...]]
@@ -164,11 +166,27 @@ class MatingResult:
     rejected: int
     pairs_removed: int = 0
     rejections: tuple[Rejection, ...] = ()
+    stages: tuple[Domains, ...] = ()
 
     @property
     def count(self) -> int:
         """Configurations including symmetric (orbit) copies."""
         return sum(c.copies for c in self.configurations)
+
+    def __repr__(self) -> str:
+        """``MatingResult(solved, 8 configurations, 2 found)``, or why there is none."""
+        if self.configurations:
+            facts = [
+                "solved",
+                fmt.count(self.count, "configuration"),
+                f"{len(self.configurations)} found",
+            ]
+        elif self.emptied is not None:
+            goal, law = self.emptied.goal, self.emptied.law
+            facts = ["no solution", f"goal {goal} emptied by the {law} law"]
+        else:
+            facts = ["no solution", f"{fmt.count(self.rejected, 'assignment')} rejected"]
+        return fmt.summary("MatingResult", *facts)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -236,7 +254,7 @@ def mate(problem: MatingProblem) -> MatingResult:
     emptied = _emptied(stages, problem, clashes)
     domains = stages[-1]
     if emptied is not None:
-        return MatingResult((), statistics, emptied, 0, 0, path.pairs_removed)
+        return MatingResult((), statistics, emptied, 0, 0, path.pairs_removed, stages=tuple(stages))
     assignments = solve_csp(domains)
     placements = [
         place(problem, tuple(assignment[g.number] for g in problem.goals))
@@ -252,6 +270,7 @@ def mate(problem: MatingProblem) -> MatingResult:
         rejected,
         path.pairs_removed,
         tuple(r for p in placements for r in p.rejections),
+        tuple(stages),
     )
 
 

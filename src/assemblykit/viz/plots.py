@@ -27,12 +27,13 @@ if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
 
 
-def _save_png(figure: Figure, path: str | Path, dpi: int) -> Path:
-    """Write ``figure`` as a PNG cropped to its content, close it and return the path."""
+def save_png(figure: Figure, path: str | Path, dpi: int, *, crop: bool = True) -> Path:
+    """Write ``figure`` as a PNG (cropped to its content unless ``crop`` is false, when
+    it keeps the figure's size times ``dpi``), close it and return the path."""
     path = Path(path)
     try:
         with atomic_output(path) as temporary:
-            figure.savefig(temporary, dpi=dpi, bbox_inches="tight")
+            figure.savefig(temporary, dpi=dpi, bbox_inches="tight" if crop else None)
     finally:
         plt.close(figure)
     return path
@@ -66,7 +67,7 @@ def plot_contacts(
     axes.set_box_aspect((1, 1, 1))
     axes.set_title(f"{len(assembly)} parts, {len(contacts)} contacts")
     axes.set_axis_off()
-    return _save_png(figure, path, dpi)
+    return save_png(figure, path, dpi)
 
 
 if TYPE_CHECKING:
@@ -313,4 +314,4 @@ def plot_ndbg(
     )
     axes.set_title(f"DBG of region {chosen}: d = {fmt.direction(dbg.direction, ndbg.tol, 3)}")
     axes.set_axis_off()
-    return _save_png(figure, path, dpi)
+    return save_png(figure, path, dpi)
