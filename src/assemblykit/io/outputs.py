@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -55,6 +56,16 @@ def checked_output(path: str | Path, option: str, suffixes: Sequence[str] = ()) 
     return target
 
 
+def _mode_of(target: Path) -> int:
+    """The permission bits ``target`` has, or a new file would get."""
+    try:
+        return stat.S_IMODE(target.stat().st_mode)
+    except FileNotFoundError:
+        mask = os.umask(0)
+        os.umask(mask)
+        return 0o666 & ~mask
+
+
 @contextlib.contextmanager
 def atomic_output(path: str | Path) -> Iterator[Path]:
     """A temporary path beside ``path`` (same suffix, so writers that choose the format
@@ -72,6 +83,9 @@ def atomic_output(path: str | Path) -> Iterator[Path]:
     temporary = Path(name)
     try:
         yield temporary
+        # mkstemp makes the file private; the output gets the mode of the file it
+        # replaces, or that of any new file (0666 less the umask)
+        os.chmod(temporary, _mode_of(target))
         os.replace(temporary, target)
     except OSError as error:
         raise InputError(f"cannot write: {error.strerror}", source=str(path)) from None
