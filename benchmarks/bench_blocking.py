@@ -1,4 +1,5 @@
-"""Benchmark of the blocking graphs (seed 004): run ``python benchmarks/bench_blocking.py``.
+"""Benchmark of the blocking graphs (Wilson & Latombe 1992): run ``python
+benchmarks/bench_blocking.py``.
 
 Prints
 * Γ_t for synthetic assemblies of n = 50 parts with c = 50, 100, 200, 400 distinct
@@ -71,7 +72,7 @@ def timed(fn, *args, repeats: int = REPEATS):
 
 
 def per_region(table: ConstraintTable, directions: np.ndarray) -> list[np.ndarray]:
-    """Each region's DBG recomputed on its own (seed 004: inner products with every
+    """Each region's DBG recomputed on its own (Wilson & Latombe 1992: inner products with every
     contact normal, then the arcs), one direction at a time."""
     return [table.direct_arcs(d[None, :], TOL) for d in directions]
 

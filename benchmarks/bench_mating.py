@@ -1,4 +1,4 @@
-"""Mating inference on a generated problem: 50 goals with domains of 10 (seed 002).
+"""Mating inference on a generated problem: 50 goals with domains of 10 (Liu & Popplestone 1990).
 
 A base carries 50 seats, seat j a plane with a hole of radius r_j = 1 + 0.05 j and a key
 hole of radius 0.5 beside it. Peg i carries ten compound features, one for each radius
@@ -7,7 +7,7 @@ use seats i .. i+9: the last goal has one candidate and the mandatory request la
 propagates back to a single configuration. Prints load and solve times (median of 3,
 wall clock and this process's CPU time, since the machine may be shared), the domain
 sizes after each law and the candidate pairs path consistency deleted. Then the
-interference checks over remaining freedoms (seed 002 step three) on the bundled
+interference checks over remaining freedoms (Liu & Popplestone 1990 step three) on the bundled
 ``two_arms.yaml`` and ``shaft_fit.yaml``: the time spent judging pairs of bodies over their
 joint parameter ranges, and the whole solve.
 """

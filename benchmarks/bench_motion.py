@@ -1,4 +1,4 @@
-"""Benchmark: the motion of every part of a 500-part assembly (seed 003).
+"""Benchmark: the motion of every part of a 500-part assembly (Liu 1997).
 
 Run ``python benchmarks/bench_motion.py``. The assembly is a floor slab carrying a wall
 of 2 x 1 x 1 blocks, 5 courses of 10 rows of 10, in running bond (every other course
@@ -9,7 +9,7 @@ parts per second, and how many parts got each motion kind. The requirement is at
 5 s for all 500 parts.
 
 It then times the compound-feature group of single parts touching many planes (the
-slow case of the permutation method, seed 003 Props 3.2.6-5.0.9): a block boxed in on
+slow case of the permutation method, Liu 1997 Props 3.2.6-5.0.9): a block boxed in on
 all six sides (24 components), and the same with two or three stepped faces more.
 """
 

@@ -2,7 +2,7 @@
 
 Prints, per shape and N, the median solve time; the growth ratio t(10,000)/t(1,000);
 and at N = 100 the ratio of the numeric-only path (the whole network handed to the
-residue solver, the "equation solving" system of seed 000 §III G) to reduction.
+residue solver, the "equation solving" system of Corner et al. 1983 §III G) to reduction.
 
 Shapes: ``stack`` (equal cubes, so reduction reuses the intersections of repeated
 geometry), ``stack~`` (every cube a different size: no reuse), ``tree`` and ``grid``.

@@ -31,7 +31,7 @@ EXAMPLES = Path(assemblykit.__file__).parent / "examples"
 CASES = (
     ("gearbox demo", EXAMPLES / "gearbox_demo" / "gearbox.yaml"),
     ("hinge", EXAMPLES / "motion" / "hinge" / "hinge.yaml"),
-    ("gearbox (seed 003)", EXAMPLES / "motion" / "gearbox" / "gearbox.yaml"),
+    ("gearbox (Liu 1997)", EXAMPLES / "motion" / "gearbox" / "gearbox.yaml"),
     ("interlock", EXAMPLES / "motion" / "interlock" / "interlock.yaml"),
     ("compas stack", dataset("compas_assembly/stack_assembly.json")),
     ("compas arch", dataset("compas_assembly/arch_assembly.json")),

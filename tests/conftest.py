@@ -19,5 +19,6 @@ settings.load_profile("repeatable")
 
 @pytest.fixture(scope="session")
 def mating_examples() -> Path:
-    """The folder of bundled mating problems (seed 002 Examples 1-2, no-solution case)."""
+    """The folder of bundled mating problems (Liu & Popplestone 1990 Examples 1-2, no-solution
+    case)."""
     return Path(__file__).resolve().parents[1] / "src" / "assemblykit" / "examples" / "mating"

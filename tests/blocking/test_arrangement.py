@@ -1,4 +1,4 @@
-"""Partitions of S¹ and arrangements of great circles on S² (seed 004)."""
+"""Partitions of S¹ and arrangements of great circles on S² (Wilson & Latombe 1992)."""
 
 from __future__ import annotations
 

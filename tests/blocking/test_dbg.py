@@ -1,4 +1,5 @@
-"""DirectionalBlockingGraph: components and locally free subassemblies (seed 004, Fig. 1)."""
+"""DirectionalBlockingGraph: components and locally free subassemblies (Wilson & Latombe 1992, Fig.
+1)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Γ_e: blocking for extended translations (seed 004, "Extended translations")."""
+"""Γ_e: blocking for extended translations (Wilson & Latombe 1992, "Extended translations")."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Γ_t: NDBG for infinitesimal translations, crossing rule against direct DBGs (seed 004)."""
+"""Γ_t: NDBG for infinitesimal translations, crossing rule against direct DBGs (Wilson & Latombe
+1992)."""
 
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ def crossing_equals_direct(g) -> None:
 
 
 def boundary_property(g) -> None:
-    """An arc present in a region is present in every region it bounds (seed 004)."""
+    """An arc present in a region is present in every region it bounds (Wilson & Latombe 1992)."""
     arr = g.arrangement
     for low, high in zip(arr.links_low, arr.links_high, strict=True):
         assert g.region_dbg(low).arcs <= g.region_dbg(high).arcs

@@ -1,4 +1,4 @@
-"""Tests of extended translations of polygons, Γ_e in the plane (seed 004, 2D case),
+"""Tests of extended translations of polygons, Γ_e in the plane (Wilson & Latombe 1992, 2D case),
 on hand-drawn parts whose blocked arcs are derived from their vertices."""
 
 from __future__ import annotations

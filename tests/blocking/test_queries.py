@@ -1,4 +1,4 @@
-"""Questions answered by the NDBG (seed 004, introduction and conclusion)."""
+"""Questions answered by the NDBG (Wilson & Latombe 1992, introduction and conclusion)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Γ_g: infinitesimal rigid motions, from the S⁵ arrangement and by linear programming
-(seed 004, Fig. 5)."""
+(Wilson & Latombe 1992, Fig. 5)."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ def point(normal, at) -> PlanarPatch:
 
 
 def fig5_points() -> ContactAssembly:
-    """Seed 004, Fig. 5 with point contacts: a block wedged in the x-z plane (floor at
+    """Wilson & Latombe 1992, Fig. 5 with point contacts: a block wedged in the x-z plane (floor at
     x = 0.5, ceiling at x = 0.9, left wall at z = 0.9, right wall at z = 0.1) and held in
     y by a wall on each side at different x. Every translation is blocked; turning about
     y through (0.7, 0.5) with a little turn about z breaks all six contacts."""

@@ -1,4 +1,4 @@
-"""Cells of central hyperplane arrangements in twist space R⁶ (seed 004, S⁵)."""
+"""Cells of central hyperplane arrangements in twist space R⁶ (Wilson & Latombe 1992, S⁵)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Pairwise relationships (seed 003 Def. 3.1.2) and compound-feature groups (§4.1)."""
+"""Pairwise relationships (Liu 1997 Def. 3.1.2) and compound-feature groups (§4.1)."""
 
 from __future__ import annotations
 
@@ -40,23 +40,23 @@ D, ONE, TWO, COMP = (
 @pytest.mark.parametrize(
     ("f1", "f2", "expected"),
     [
-        # Seed 003 Fig. 1: adjacent faces of a cube are swapped by a half-turn.
+        # Liu 1997 Fig. 1: adjacent faces of a cube are swapped by a half-turn.
         (Plane((0, 0, 0), (1, 0, 0)), Plane((0, 0, 0), (0, 1, 0)), TWO),
-        # Seed 003: parallel planes, normals the same way -> 1-congruent ...
+        # Liu 1997: parallel planes, normals the same way -> 1-congruent ...
         (Plane((0, 0, 0), (0, 0, 1)), Plane((0, 0, 3), (0, 0, 1)), ONE),
         # ... normals opposite (a slot, or a slab) -> 2-congruent.
         (Plane((0, 0, 0), (0, 0, 1)), Plane((0, 0, 10), (0, 0, -1)), TWO),
         (Plane((0, 0, 0), (0, 0, 1)), Plane((0, 0, 10), (0, 0, 1)), ONE),
-        # Seed 003 Fig. 5: parallel cylinders of equal radius, same side.
+        # Liu 1997 Fig. 5: parallel cylinders of equal radius, same side.
         (Shaft((0, 0, 0), (0, 0, 1), 2), Shaft((5, 0, 0), (0, 0, 1), 2), TWO),
         (Shaft((0, 0, 0), (0, 0, 1), 2), Shaft((5, 0, 0), (0, 1, 0), 2), TWO),
-        # Seed 003 Fig. 2(b) / Fig. 6: a hole and a shaft of one radius are complementary.
+        # Liu 1997 Fig. 2(b) / Fig. 6: a hole and a shaft of one radius are complementary.
         (Hole((0, 0, 0), (0, 0, 1), 2), Shaft((5, 0, 0), (0, 0, 1), 2), COMP),
         (Ball((0, 0, 0), 1), Socket((3, 0, 0), 1), COMP),
         (Shaft((0, 0, 0), (0, 0, 1), 2), Shaft((0, 0, 0), (0, 0, 1), 3), D),
         (Shaft((0, 0, 0), (0, 0, 1), 2), Plane((0, 0, 0), (0, 0, 1)), D),
         (Ball((0, 0, 0), 1), Ball((3, 0, 0), 1), TWO),
-        # Seed 003 Fig. 4: coaxial cones, apexes apart along the axis -> 1-congruent.
+        # Liu 1997 Fig. 4: coaxial cones, apexes apart along the axis -> 1-congruent.
         (Cone((0, 0, 0), (0, 0, 1), 0.3), Cone((0, 0, 2), (0, 0, 1), 0.3), ONE),
         (Cone((0, 0, 0), (0, 0, 1), 0.3), Cone((0, 0, 2), (0, 0, -1), 0.3), TWO),
         (Cone((0, 0, 0), (0, 0, 1), 0.3), Cone((4, 0, 0), (0, 0, 1), 0.3), TWO),
@@ -90,7 +90,7 @@ def test_prisms_differ_by_sides():
 
 
 def test_complementary_features_share_their_group():
-    """Seed 003 Prop. 3.1.5: with S1 = S2 the groups are equal."""
+    """Liu 1997 Prop. 3.1.5: with S1 = S2 the groups are equal."""
     shaft, hole = Shaft((1, 2, 3), (0, 1, 0), 2), Hole((1, 2, 3), (0, 1, 0), 2)
     assert shaft.group().equals(hole.group())
     ball, socket = Ball((1, 2, 3), 4), Socket((1, 2, 3), 4)
@@ -98,7 +98,7 @@ def test_complementary_features_share_their_group():
 
 
 def test_adjacent_cube_faces_prismatic_along_the_edge_with_the_swap():
-    """Seed 003 §2, Fig. 1: faces x = 1 and y = 1 of the unit cube, edge at (1, 1, z)."""
+    """Liu 1997 §2, Fig. 1: faces x = 1 and y = 1 of the unit cube, edge at (1, 1, z)."""
     group = compound_group([Plane((1, 0, 0), (1, 0, 0)), Plane((0, 1, 0), (0, 1, 0))])
     assert (str(group.kind), group.dof, group.n_components) == ("prismatic", 1, 2)
     assert np.allclose(abs(group.axis @ (0, 0, 1)), 1.0)
@@ -145,7 +145,7 @@ def test_four_pins_on_a_square():
 
 
 def test_gearbox_gear_hub_is_revolute():
-    """Seed 003 §4, Fig. 9: L_i = a_i SO(2) a_i⁻¹ from a bore and its shoulder faces; the
+    """Liu 1997 §4, Fig. 9: L_i = a_i SO(2) a_i⁻¹ from a bore and its shoulder faces; the
     gear's two faces are 2-congruent, so with an undirected bore it may also sit flipped."""
     hub = [
         Hole((0, 0, 0), (0, 0, 1), 3, directed=False),

@@ -1,4 +1,5 @@
-"""Configuration obstacles of translating convex pieces (seed 004, extended translations)."""
+"""Configuration obstacles of translating convex pieces (Wilson & Latombe 1992, extended
+translations)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Exact extended blocking on triangle meshes by projection (seed 004, "Extended
+"""Exact extended blocking on triangle meshes by projection (Wilson & Latombe 1992, "Extended
 translations"), checked by hand and against swept volumes built with manifold3d."""
 
 from __future__ import annotations

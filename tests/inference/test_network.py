@@ -1,4 +1,4 @@
-"""The relational network of body instances (seed 000 §III A-B)."""
+"""The relational network of body instances (Corner et al. 1983 §III A-B)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""The residue solver on hand-built constraint systems (seed 000 §III G, ALGEBRA.md §2.5)."""
+"""The residue solver on hand-built constraint systems (Corner et al. 1983 §III G, ALGEBRA.md
+§2.5)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Network reduction on tasks built from the model (seed 000 §III, ALGEBRA.md §5.2, §6)."""
+"""Network reduction on tasks built from the model (Corner et al. 1983 §III, ALGEBRA.md §5.2,
+§6)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""Step three and the answer: seed 002 Examples 1-2, emptied domains, loci, sweeping."""
+"""Step three and the answer: Liu & Popplestone 1990 Examples 1-2, emptied domains, loci,
+sweeping."""
 
 from __future__ import annotations
 

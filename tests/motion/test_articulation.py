@@ -1,4 +1,4 @@
-"""Articulated assemblies: joints and the coupled gear train of seed 003 Figs. 7-9."""
+"""Articulated assemblies: joints and the coupled gear train of Liu 1997 Figs. 7-9."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Motion of parts and subassemblies (seed 003 eq. (2)) on the bundled motion examples."""
+"""Motion of parts and subassemblies (Liu 1997 eq. (2)) on the bundled motion examples."""
 
 from __future__ import annotations
 
@@ -52,7 +52,7 @@ def test_drawer_slides_along_its_runners(reports: dict[str, MotionReport]) -> No
     tray = reports["drawer"]["tray"].to_dict()
     assert (tray["motion"], tray["dof"]) == ("prismatic", 1)
     np.testing.assert_allclose(tray["direction"], [1.0, 0.0, 0.0], atol=1e-9)
-    # the two walls are swapped by the half-turn about a vertical line (seed 003 Prop 3.2.8)
+    # the two walls are swapped by the half-turn about a vertical line (Liu 1997 Prop 3.2.8)
     assert tray["components"] == 2
     np.testing.assert_allclose(tray["unilateral"]["lift_off"], [[0.0, 0.0, 1.0]], atol=1e-9)
     sliding = np.array(tray["unilateral"]["sliding"])
@@ -100,7 +100,7 @@ def test_interlock_parts_are_all_fixed_alone(reports: dict[str, MotionReport]) -
     assert not report["bar_a"].unilateral.free and not report["bar_b"].unilateral.free
     np.testing.assert_allclose(report["lid"].unilateral.lift_off, [[0.0, 0.0, 1.0]], atol=1e-9)
     np.testing.assert_allclose(report["base"].unilateral.lift_off, [[0.0, 0.0, -1.0]], atol=1e-9)
-    # no continuous motion, but two equivalent positions (seed 003 eq. (2), a finite
+    # no continuous motion, but two equivalent positions (Liu 1997 eq. (2), a finite
     # group): bar_a's seven contact planes (normals +-x, +-y, -z and two +z) are mapped
     # onto themselves by the half-turn about the vertical line x = 1.5, y = 2
     group = report["bar_a"].group
@@ -233,7 +233,7 @@ def test_a_rod_in_a_half_round_groove_slides_along_it_and_lifts_off_upwards() ->
     from curved_parts import rod_in_groove
 
     rod = part_motion(rod_in_groove(through=True), "rod")
-    # the fit of seed 003 keeps the shaft: turning about and sliding along y
+    # the fit of Liu 1997 keeps the shaft: turning about and sliding along y
     assert rod.kind == "cylindrical"
     reading = rod.unilateral
     # the groove pushes only along its half circle of normals -x, -z, +x: the free

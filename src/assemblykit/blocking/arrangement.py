@@ -1,4 +1,4 @@
-"""Partitions of the direction sphere into regular regions (seed 004, "Non-Directional
+"""Partitions of the direction sphere into regular regions (Wilson & Latombe 1992, "Non-Directional
 Blocking Graph" and "Computation of Blocking Graph").
 
 Every blocking constraint "``n . d > 0``" has its boundary on the great circle
@@ -14,7 +14,7 @@ Every blocking constraint "``n . d > 0``" has its boundary on the great circle
 A region is described by a representative unit direction and, for the crossing rule,
 by its *links*: ``(low, high, circle, sign)`` says that region ``low`` lies in the
 boundary of region ``high`` and that ``high`` is on side ``sign`` of ``circle`` where
-``low`` is on it (seed 004, crossing rule).
+``low`` is on it (Wilson & Latombe 1992, crossing rule).
 
 Robustness (DESIGN.md §6): normals parallel within the angle tolerance are first snapped
 to one circle; three circles whose determinant is within rounding error of zero are
@@ -121,7 +121,7 @@ def _links(rows: list[tuple[int, int, int, int]]) -> tuple[NDArray[np.int64], ..
 
 
 def circle_partition(normals: NDArray[np.float64], tol: Tolerance | None = None) -> Arrangement:
-    """The partition of S¹ (seed 004, 2D case) by the diameters perpendicular to the
+    """The partition of S¹ (Wilson & Latombe 1992, 2D case) by the diameters perpendicular to the
     given in-plane circle normals (distinct, z = 0): points and open arcs, in angular
     order, each arc linked to its two endpoints. O(c log c)."""
     normals = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
@@ -254,8 +254,8 @@ def _vertices(
 
 
 def sphere_arrangement(normals: NDArray[np.float64]) -> Arrangement:
-    """The arrangement of great circles on S² (seed 004, 3D case) for distinct (snapped)
-    circle normals: vertices, edges and faces with their boundary links. O(c² log c)."""
+    """The arrangement of great circles on S² (Wilson & Latombe 1992, 3D case) for distinct
+    (snapped) circle normals: vertices, edges and faces with their boundary links. O(c² log c)."""
     normals = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     c = len(normals)
     if c == 0:

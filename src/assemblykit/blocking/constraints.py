@@ -3,7 +3,7 @@
 A :class:`BlockingTerm` says "``blocker`` blocks ``moving`` along every d with
 ``n . d > 0`` for all its normals ``n``" (an open polyhedral cone of directions; no
 normals means every direction). A part blocks another along d iff one of their terms
-holds at d. Every kind of motion of seed 004 reduces to such terms:
+holds at d. Every kind of motion of Wilson & Latombe 1992 reduces to such terms:
 
 * infinitesimal translations (Γ_t): one term per planar contact patch, ``n`` the normal
   from ``moving`` into ``blocker`` ("the open half-sphere contains the direction of the
@@ -65,7 +65,7 @@ def curved_normals(patch: CurvedPatch, moving_is_inner: bool) -> NDArray[np.floa
 
 
 def infinitesimal_terms(contacts: Iterable[Contact]) -> list[BlockingTerm]:
-    """The Γ_t terms of the contacts, both ways (seed 004, 2D and 3D cases)."""
+    """The Γ_t terms of the contacts, both ways (Wilson & Latombe 1992, 2D and 3D cases)."""
     terms: list[BlockingTerm] = []
     for contact in contacts:
         for patch in contact.planar:

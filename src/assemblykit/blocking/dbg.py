@@ -1,4 +1,4 @@
-"""The directional blocking graph G(d, A) (seed 004, "Directional Blocking Graph").
+"""The directional blocking graph G(d, A) (Wilson & Latombe 1992, "Directional Blocking Graph").
 
 Nodes are the parts; an arc ``i -> j`` means that part ``j`` blocks the motion of part
 ``i`` along the direction ``d``. A subassembly ``S`` is locally free along ``d`` iff no
@@ -60,7 +60,8 @@ class DirectionalBlockingGraph:
         return nx.condensation(self.graph)
 
     def is_free(self, subassembly: frozenset[str] | set[str]) -> bool:
-        """Whether ``subassembly`` is locally free: no arc from it to the rest (seed 004)."""
+        """Whether ``subassembly`` is locally free: no arc from it to the rest (Wilson & Latombe
+        1992)."""
         inside = set(subassembly)
         return not any(i in inside and j not in inside for i, j in self.arcs)
 
@@ -93,7 +94,7 @@ class DirectionalBlockingGraph:
 @dataclass(frozen=True, eq=False)
 class Region:
     """A regular region of an NDBG: a unit ``direction`` inside it, its ``dimension``
-    (0 vertex/point, 1 edge/arc, 2 face) and its ``dbg`` (seed 004, G(R, A))."""
+    (0 vertex/point, 1 edge/arc, 2 face) and its ``dbg`` (Wilson & Latombe 1992, G(R, A))."""
 
     direction: NDArray[np.float64]
     dimension: int

@@ -1,4 +1,4 @@
-"""Blocking for extended translations, Γ_e (seed 004, "Extended translations").
+"""Blocking for extended translations, Γ_e (Wilson & Latombe 1992, "Extended translations").
 
 Part ``j`` blocks part ``i`` along ``d`` iff ``i`` swept along ``d`` to infinity meets
 the interior of ``j``. Two exact tests decide it, both here and nowhere else:

@@ -1,4 +1,5 @@
-"""The exact free set of an extended translation (seed 004 §5, "Extended translations").
+"""The exact free set of an extended translation (Wilson & Latombe 1992 §5, "Extended
+translations").
 
 Part ``j`` blocks part ``i`` along ``d`` iff the ray ``{t d, t > 0}`` enters the grown
 obstacle ``P_j ⊕ (−P_i)``; the directions blocked by ``j`` are the projection of that
@@ -193,7 +194,7 @@ def overlay_faces(sets: Sequence[ChartSet], tol: Tolerance, limit: int = 20_000)
 def blocked_by(
     assembly: Any, moving: Iterable[str], blocker: str, tol: Tolerance
 ) -> ChartSet | None:
-    """The directions along which ``blocker`` blocks some part of ``moving`` (seed 004
+    """The directions along which ``blocker`` blocks some part of ``moving`` (Wilson & Latombe 1992
     §5), or ``None`` when there are more triangle pairs than :data:`TRIANGLE_PAIRS`."""
     from assemblykit.blocking.extended import obstacles
 
@@ -268,7 +269,7 @@ def exact_free_directions(
     limit: int = 8,
 ) -> ExactFree:
     """Up to ``limit`` directions, one per face of the free set of ``moving`` among the
-    parts ``among`` (default: all), each checked exactly (seed 004 §5)."""
+    parts ``among`` (default: all), each checked exactly (Wilson & Latombe 1992 §5)."""
     from assemblykit.blocking.extended import extended_free
 
     movers = sorted(set(moving))

@@ -1,4 +1,4 @@
-"""The non-directional blocking graph (seed 004): regular regions of directions, each
+"""The non-directional blocking graph (Wilson & Latombe 1992): regular regions of directions, each
 with its DBG, computed by the crossing rule.
 
 The blocking terms (:mod:`assemblykit.blocking.constraints`) are snapped onto great
@@ -10,7 +10,7 @@ counts is full. The DBG of the root region is computed directly; every other reg
 is reached by a breadth-first walk over the boundary links of the arrangement and
 obtained by the crossing rule: entering a higher-dimensional region adds the terms
 that become positive on the crossed circles, leaving it for its boundary retracts them
-(seed 004, "Computation of Blocking Graph", 2D crossing rule and its 3D adaptation).
+(Wilson & Latombe 1992, "Computation of Blocking Graph", 2D crossing rule and its 3D adaptation).
 A whole breadth-first layer is updated at once with array operations.
 """
 
@@ -199,7 +199,7 @@ def crossing_rule(arrangement: Arrangement, table: ConstraintTable) -> NDArray[n
 
 @dataclass(frozen=True, eq=False)
 class NonDirectionalBlockingGraph:
-    """Γ_t or Γ_e of an assembly (seed 004): the regular regions of the directions and
+    """Γ_t or Γ_e of an assembly (Wilson & Latombe 1992): the regular regions of the directions and
     the DBG of each (``packed``: bit-packed blocking slots per region). ``exact``, when
     given, computes G(d, A) over the given parts for any direction instead of the
     table (Γ_e of non-convex parts, :func:`assemblykit.blocking.extended.sampled_ndbg`)."""
@@ -300,7 +300,7 @@ class NonDirectionalBlockingGraph:
 
     def without_parts(self, names: Iterable[str]) -> NonDirectionalBlockingGraph:
         """The NDBG of the assembly without some parts, updated instead of recomputed
-        (seed 004, "Incremental modification"): the arrangement is kept (its regions
+        (Wilson & Latombe 1992, "Incremental modification"): the arrangement is kept (its regions
         stay regular), and every slot touching a removed part is cleared in all regions
         at once (a bitwise AND) and becomes a *pad*: a self-arc ``m -> m`` of a
         neighbouring kept mover that can never block. Slots stay grouped by moving part;
@@ -349,7 +349,7 @@ class NonDirectionalBlockingGraph:
     def with_terms(
         self, new_parts: Sequence[str], terms: Sequence[BlockingTerm], contacts: int
     ) -> NonDirectionalBlockingGraph:
-        """The NDBG with parts added whose terms are given (seed 004, "Incremental
+        """The NDBG with parts added whose terms are given (Wilson & Latombe 1992, "Incremental
         modification"). When their normals lie on circles already in the arrangement,
         only the new slots are evaluated, on the circles they use, at every region's
         direction; otherwise the NDBG is rebuilt. Slots stay sorted by moving part."""

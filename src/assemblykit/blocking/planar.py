@@ -1,4 +1,4 @@
-"""Extended translations of polygons, Γ_e in the plane (seed 004, "Extended
+"""Extended translations of polygons, Γ_e in the plane (Wilson & Latombe 1992, "Extended
 translations", 2D case).
 
 Part ``j`` blocks part ``i`` along ``d`` (a direction of the circle S¹) iff the area
@@ -7,7 +7,7 @@ Each polygon is cut into convex pieces (a constrained triangulation whose triang
 merged while their union stays convex). For a convex piece ``p`` of ``i`` and ``q`` of
 ``j`` the sweep of ``p`` meets the interior of ``q`` iff the ray from the origin along
 ``d`` enters the interior of the grown obstacle ``M = q ⊕ (−p)`` (the convex hull of the
-vertex differences; seed 004 with [Lozano-Pérez, 1983]). So the blocked directions of a
+vertex differences; Wilson & Latombe 1992 with [Lozano-Pérez, 1983]). So the blocked directions of a
 pair of pieces are read off ``M`` seen from the origin, exactly, from the vertices:
 
 * origin outside ``M``: the open arc between the two extreme directions of the vertices

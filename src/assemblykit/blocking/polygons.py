@@ -1,4 +1,4 @@
-"""Planar assemblies of polygonal parts (seed 004, "2D case").
+"""Planar assemblies of polygonal parts (Wilson & Latombe 1992, "2D case").
 
 Parts are simple polygons in the plane z = 0, in assembled position: read from a small
 YAML file (``parts: {name: [[x, y], ...]}``, by :mod:`assemblykit.io.polygons`) or cut

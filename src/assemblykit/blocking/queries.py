@@ -1,4 +1,4 @@
-"""Questions the NDBG answers (seed 004, introduction and conclusion).
+"""Questions the NDBG answers (Wilson & Latombe 1992, introduction and conclusion).
 
 * which parts and subassemblies can be removed directly, and along which directions
   (Γ_e gives a sufficient condition, Γ_t and Γ_g necessary ones);
@@ -174,7 +174,7 @@ def removable_parts(
 
 @dataclass(frozen=True, eq=False)
 class Prerequisite:
-    """The parts to take out before ``part`` (seed 004, introduction): ``parts`` leave
+    """The parts to take out before ``part`` (Wilson & Latombe 1992, introduction): ``parts`` leave
     first (in some order, one at a time, each by an extended translation), then
     ``part`` leaves along ``direction``. ``minimal`` is true when no smaller set
     works along any direction; false when a smaller set of direct blockers exists that
@@ -188,8 +188,8 @@ class Prerequisite:
 
 def removal_before(assembly: AssemblyLike, part: str, tol: Tolerance | None = None) -> Prerequisite:
     """The fewest parts to remove before ``part`` can leave by an extended translation,
-    over all directions (seed 004 §5): the directions are one per face of the overlay of
-    the sets each other part blocks (over a face, the parts blocking ``part`` are
+    over all directions (Wilson & Latombe 1992 §5): the directions are one per face of the overlay
+    of the sets each other part blocks (over a face, the parts blocking ``part`` are
     constant), so every set of direct blockers is seen; the sets are tried smallest
     first, and the first whose parts can be taken out one at a time (each along a face
     of its exact free set) is the answer."""

@@ -1,4 +1,4 @@
-"""Blocking for infinitesimal rigid motions, Γ_g (seed 004, "Infinitesimal rigid
+"""Blocking for infinitesimal rigid motions, Γ_g (Wilson & Latombe 1992, "Infinitesimal rigid
 motions").
 
 A twist ``(omega; v)`` (DESIGN.md §4: ``v`` is the velocity of the point at the origin)
@@ -6,7 +6,7 @@ moves a point ``p`` of a part with velocity ``v + omega x p``. At a contact poin
 with normal ``n`` pointing from the moving part into the other, the twist is allowed
 iff ``n . (v + omega x p) <= 0``, i.e. ``w . (omega; v) <= 0`` with the wrench
 ``w = (p x n; n)``. For planar patches the points are the vertices of the patch's
-convex hull (seed 004, "for each vertex v of the convex hull of the contacting area");
+convex hull (Wilson & Latombe 1992, "for each vertex v of the convex hull of the contacting area");
 for curved patches the normals generating the patch's normal cone at both ends of its
 axial extent (:meth:`~assemblykit.geometry.contacts.CurvedPatch.samples`; exact for
 cylinders and spheres, whose constraints are linear in the normal).
@@ -261,7 +261,7 @@ class RigidBlockingGraph:
 
     def removable(self, max_size: int | None = None) -> list[Removal]:
         """Subassemblies that some rigid twist frees (a necessary condition for
-        removal, seed 004): those free in a cell's DBG (up to ``max_size`` parts), with
+        removal, Wilson & Latombe 1992): those free in a cell's DBG (up to ``max_size`` parts), with
         the cells' twists, which break all their contacts; then the connected ones (up
         to ``max_size``, default ``RIGID_MAX_SIZE`` parts) not found so, whose freedom
         needs sliding or lies beyond the arrangement's limit, each with its LP witness."""

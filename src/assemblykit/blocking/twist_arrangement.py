@@ -1,5 +1,5 @@
 """The arrangement of central hyperplanes in twist space R⁶: its full-dimensional cells
-(the 5-dimensional regular regions of S⁵ of seed 004, "Infinitesimal rigid motions").
+(the 5-dimensional regular regions of S⁵ of Wilson & Latombe 1992, "Infinitesimal rigid motions").
 
 Each contact point gives a hyperplane ``a . xi = 0`` through the origin; the cells are
 the sign vectors ``sign(A xi)`` with no zero that some twist ``xi`` realises. They are

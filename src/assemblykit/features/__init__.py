@@ -1,5 +1,5 @@
 """Oriented primitive features, their pairwise relationships and compound features
-(seed 003 §2-§3, ALGEBRA.md §4)."""
+(Liu 1997 §2-§3, ALGEBRA.md §4)."""
 
 from assemblykit.features.compound import (
     CompoundFeature,

@@ -1,6 +1,6 @@
 """Pairwise relationships of oriented features and compound-feature symmetry groups.
 
-Seed 003 §3: a compound feature is a set of oriented primitive features (Def. 3.0.1);
+Liu 1997 §3: a compound feature is a set of oriented primitive features (Def. 3.0.1);
 its symmetry group is the intersection of the primitive groups (Props 3.2.6, 3.2.7)
 enlarged by the isometries that swap congruent features (Props 3.2.8, 5.0.9). It is
 computed here by the permutation method of ALGEBRA.md §4.1, which covers all of them:
@@ -38,7 +38,7 @@ from assemblykit.tolerance import Tolerance, current
 
 
 class Relationship(Enum):
-    """The four relationships of a pair of oriented primitive features (seed 003 Def. 3.1.2)."""
+    """The four relationships of a pair of oriented primitive features (Liu 1997 Def. 3.1.2)."""
 
     DISTINCT = "distinct"
     ONE_CONGRUENT = "1-congruent"
@@ -111,12 +111,12 @@ def feature_transporter(source: Feature, target: Feature) -> Coset:
 
 
 def _swap_exists(f1: Feature, f2: Feature, tol: Tolerance) -> bool:
-    """Whether some proper motion maps f1 onto f2 *and* f2 onto f1 (seed 003 Def. 3.1.2).
+    """Whether some proper motion maps f1 onto f2 *and* f2 onto f1 (Liu 1997 Def. 3.1.2).
 
     Closed forms (each a half-turn, derived from the invariants of ALGEBRA.md §2.4):
 
     * two oriented planes: always, except parallel planes with equal normals and a
-      non-zero offset (seed 003's 1-congruent example); the half-turn is about the
+      non-zero offset (Liu's (1997) 1-congruent example); the half-turn is about the
       bisector of the normals through the planes' common line (or mid-plane);
     * two points, two lines (directed or not), two spheres, two cylinders: always; the
       half-turn is about the bisector of the directions through the midpoint of the
@@ -148,7 +148,7 @@ def _swap_exists(f1: Feature, f2: Feature, tol: Tolerance) -> bool:
 
 
 def relationship(f1: Feature, f2: Feature, tol: Tolerance | None = None) -> Relationship:
-    """The relationship of two oriented primitive features (seed 003 Def. 3.1.2).
+    """The relationship of two oriented primitive features (Liu 1997 Def. 3.1.2).
 
     Reading of the definition used here:
 
@@ -160,7 +160,7 @@ def relationship(f1: Feature, f2: Feature, tol: Tolerance | None = None) -> Rela
       (see :func:`_swap_exists`), else **1-congruent**.
 
     Planes: any two oriented planes are complementary *and* 1- or 2-congruent at once
-    (seed 003 Cor. 3.1.4 and the remark after it). Since complementarity carries no
+    (Liu 1997 Cor. 3.1.4 and the remark after it). Since complementarity carries no
     information for planes, their congruence is returned. Datum points, axes and frames
     have no material side and are never complementary. Props 3.1.3 (exhaustiveness) and
     3.1.5 (complementary features have conjugate groups aG₁a⁻¹ = G₂) hold by construction.
@@ -262,7 +262,7 @@ def _transporters(
 
 
 def compound_group(features: Sequence[Feature], tol: Tolerance | None = None) -> SymmetryGroup:
-    """The symmetry group of a compound feature (seed 003 Props 3.2.6-3.2.8, 5.0.9).
+    """The symmetry group of a compound feature (Liu 1997 Props 3.2.6-3.2.8, 5.0.9).
 
     ALGEBRA.md §4.1: the union of the non-empty transporters over class-preserving
     permutations. The identity permutation gives G₁ ∩ ... ∩ Gₙ (Props 3.2.6, 3.2.7),
@@ -303,7 +303,7 @@ def compound_group(features: Sequence[Feature], tol: Tolerance | None = None) ->
 
 @dataclass(frozen=True, eq=False)
 class CompoundFeature:
-    """A named set of oriented primitive features of one body (seed 003 Def. 3.0.1)."""
+    """A named set of oriented primitive features of one body (Liu 1997 Def. 3.0.1)."""
 
     name: str
     features: tuple[Feature, ...]

@@ -1,6 +1,6 @@
-"""Oriented primitive features and their symmetry groups (seed 003 §2, ALGEBRA.md §4).
+"""Oriented primitive features and their symmetry groups (Liu 1997 §2, ALGEBRA.md §4).
 
-A feature is an oriented surface of a body (seed 003 Def. 2.1.2: the surface plus its
+A feature is an oriented surface of a body (Liu 1997 Def. 2.1.2: the surface plus its
 outward normals), or an auxiliary datum (point, axis, frame). Every feature has
 
 * a **frame** F in its body (DESIGN §4): origin on the feature, +z along the outward
@@ -132,7 +132,7 @@ def _about_axis(frame: Matrix, angle: float) -> Matrix:
 
 
 class Feature(ABC):
-    """An oriented primitive feature (seed 003 Def. 2.1.2) of a body."""
+    """An oriented primitive feature (Liu 1997 Def. 2.1.2) of a body."""
 
     type_name: ClassVar[str]
     name: str | None
@@ -225,7 +225,7 @@ class _Line(_Axial):
 class Plane(Feature):
     """A planar face through ``point`` with outward unit ``normal``: Sym = G(z), 3 dof.
 
-    The flip is excluded: it would invert the normal (seed 003 §2, ALGEBRA.md §4)."""
+    The flip is excluded: it would invert the normal (Liu 1997 §2, ALGEBRA.md §4)."""
 
     point: Vector
     normal: Vector

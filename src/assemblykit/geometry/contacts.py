@@ -2,8 +2,8 @@
 
 A :class:`Contact` joins two parts ``a`` and ``b`` that touch. It holds the planar
 patches where their faces coincide with opposite normals, and the curved patches where
-cylinders, cones or spheres coincide. Seeds 003 and 004 start from exactly this: "the
-specification of the contact surfaces between parts".
+cylinders, cones or spheres coincide. Liu 1997 and Wilson & Latombe 1992 start from exactly this:
+"the specification of the contact surfaces between parts".
 
 The functions below find them (:func:`find_contacts`): a broad phase over the parts'
 bounding boxes (an R-tree, boxes inflated by the length tolerance) keeps only pairs
@@ -18,7 +18,7 @@ revolution both parts cover, as the normals there (:mod:`assemblykit.geometry.cu
 
 Convention: every normal stored here is the outward normal of part ``a``'s surface, so
 it points from ``a`` into ``b``. Translating ``a`` infinitesimally along ``d`` pushes
-into ``b`` across a planar patch iff ``d . normal > 0`` (seed 004, DBG arcs).
+into ``b`` across a planar patch iff ``d . normal > 0`` (Wilson & Latombe 1992, DBG arcs).
 """
 
 from __future__ import annotations
@@ -99,8 +99,8 @@ class CurvedPatch:
 
     def normal_cone(self) -> NDArray[np.float64]:
         """Unit outward normals of the inner part generating the cone of the patch's
-        normals (seed 004, "Infinitesimal translations": the inner part is blocked along
-        ``d`` iff ``n . d > 0`` for one of them): ``normals``, or for the whole surface
+        normals (Wilson & Latombe 1992, "Infinitesimal translations": the inner part is blocked
+        along ``d`` iff ``n . d > 0`` for one of them): ``normals``, or for the whole surface
         the four directions ``±e1, ±e2`` across a cylinder's axis, the six signed axes
         for a sphere, ``CONE_AZIMUTHS`` normals around a cone."""
         if self.normals is not None:
@@ -458,10 +458,10 @@ def curved_contact(
 ) -> CurvedPatch | None:
     """The curved contact of two surfaces of parts ``names``, or ``None``: equal coaxial
     cylinders or cones, or equal concentric spheres, one convex and one concave, whose
-    axial extents overlap by more than the length tolerance (seed 003 §2: a shaft fits
+    axial extents overlap by more than the length tolerance (Liu 1997 §2: a shaft fits
     a hole, a ball a socket) and that share more than a line. ``triangles``: each
     surface's triangles (t x 3 x 3, world), which tell the part of the surface of
-    revolution both cover (:mod:`assemblykit.geometry.curved`; seed 004 builds the
+    revolution both cover (:mod:`assemblykit.geometry.curved`; Wilson & Latombe 1992 builds the
     blocking constraints from the normals of that part only)."""
     if first.kind != second.kind or first.convex == second.convex:
         return None

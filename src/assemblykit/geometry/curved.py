@@ -1,7 +1,7 @@
 """Where a curved contact really touches: the normals of its patch.
 
-Seed 004 ("Infinitesimal translations") builds the blocking constraints of a contact
-from the normals of its *contact surface*, and seed 003 §2 reads a shaft in a hole or a
+Wilson & Latombe 1992 ("Infinitesimal translations") builds the blocking constraints of a contact
+from the normals of its *contact surface*, and Liu 1997 §2 reads a shaft in a hole or a
 ball in a socket as a fit of the whole surfaces. A rod lying in a half-round groove, or a
 ball in a cup shallower than a hemisphere, touches only part of the surface of
 revolution, and the directions it can leave along depend on that part alone: the rod is

@@ -1,4 +1,4 @@
-"""Configuration obstacles of translating parts (seed 004, "Extended translations").
+"""Configuration obstacles of translating parts (Wilson & Latombe 1992, "Extended translations").
 
 Part ``j`` blocks the extended translation of part ``i`` along ``d`` iff the volume that
 ``i`` sweeps meets the interior of ``j``, i.e. iff the ray ``{t d, t > 0}`` enters the
@@ -138,7 +138,7 @@ def triangle_cones(
     ``{d : n . d > 0 for its twelve rows}`` (rows of zeros hold always-true padding with
     normal ``0``: callers treat a zero row as no constraint). A facet of a pointed cone
     through the origin is spanned by two generators, so the supporting planes spanned by
-    pairs of generators give its H-representation (seed 004 §5, the Minkowski
+    pairs of generators give its H-representation (Wilson & Latombe 1992 §5, the Minkowski
     difference's projection). With outward triangle normals (a mesh bounding a volume)
     two more rows keep only a front face of the moving part (``n_m . d > 0``) meeting a
     back face of the obstacle (``n_o . d < 0``): the first contact of a blocked sweep is

@@ -1,5 +1,5 @@
 """Which meshes a translating mesh runs into: exact extended blocking on triangle meshes
-(seed 004, "Extended translations").
+(Wilson & Latombe 1992, "Extended translations").
 
 Part ``j`` blocks the extended translation of part ``i`` along ``d`` iff the volume
 ``i`` sweeps to infinity meets the interior of ``j``. On a line parallel to ``d`` the

@@ -1,4 +1,4 @@
-"""Surface features of a part: planar faces, cylinders, cones and spheres (seed 003 §2,
+"""Surface features of a part: planar faces, cylinders, cones and spheres (Liu 1997 §2,
 oriented primitive features), recognised on triangle meshes or read exactly from CAD.
 
 Method on meshes (all thresholds from the tolerance policy):
@@ -98,7 +98,7 @@ class Surface:
     extent: tuple[float, float] = (0.0, 0.0)
 
     def feature(self) -> Any:
-        """The :mod:`assemblykit.features` primitive of this surface (seed 003 §2)."""
+        """The :mod:`assemblykit.features` primitive of this surface (Liu 1997 §2)."""
         from assemblykit.features.primitives import (
             Ball,
             Cone,

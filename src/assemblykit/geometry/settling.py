@@ -2,8 +2,8 @@
 
 Parts designed to touch share thin layers once their poses are rounded (ASAP's
 ``final_state`` is written to 4 decimals) or their faces generated slightly off (COMPAS
-vaults). Seed 002 asks that mated parts do not occupy the same space; this module finds
-how far they must move apart for that.
+vaults). Liu & Popplestone 1990 asks that mated parts do not occupy the same space; this module
+finds how far they must move apart for that.
 
 The shared volume ``V`` of solids ``A`` and ``B``, as a function of a translation ``t``
 of ``A``, has the gradient ``∂V/∂t = ∫_{∂A ∩ B} n_A dS``: only the part of ``A``'s

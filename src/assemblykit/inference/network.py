@@ -1,4 +1,4 @@
-"""The relational network of a RAPT task (seed 000 §III, ALGEBRA.md §5.2).
+"""The relational network of a RAPT task (Corner et al. 1983 §III, ALGEBRA.md §5.2).
 
 Nodes are **body instances** ``(body, situation)``: the pose of one body in one
 situation. Fixed bodies are the world: all their instances are the one node
@@ -10,7 +10,7 @@ situation. Fixed bodies are the world: all their instances are the one node
   ``inv(L_second) @ L_first``); relations that are not cosets (point_on_plane, distance,
   gear, rack, mirror, ...) become general constraints (residual functions);
 * an action between consecutive situations links the body's two instances
-  (seed 000 §III B: "f ** p2 = rel(v) ** f ** p1"): ``move b along f by s`` is the fixed
+  (Corner et al. 1983 §III B: "f ** p2 = rel(v) ** f ** p1"): ``move b along f by s`` is the fixed
   transform F·Tr(0,0,s)·F⁻¹, ``along f`` without ``by`` the prismatic coset F·T(z)·F⁻¹,
   ``turn b about f by θ`` the fixed F·Rz(θ)·F⁻¹, without ``by`` the revolute coset
   F·R(z)·F⁻¹; a free ``move b`` adds no link;
@@ -180,7 +180,7 @@ def _axis_residual(
 
 
 def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | None:
-    """The link ``prev → next`` of one action (seed 000 §III B), or None for a free move.
+    """The link ``prev → next`` of one action (Corner et al. 1983 §III B), or None for a free move.
 
     The feature's frame has +z along its axis or normal (DESIGN.md §4), so moving along it
     by ``s`` is F·Tr(0,0,s)·F⁻¹ and turning about it by θ is F·Rz(θ)·F⁻¹ in body coordinates.
@@ -483,7 +483,8 @@ def _relation_part(
 
 
 def build_network(task: Task) -> Network:
-    """The relational network of a (validated) task: body instances and links (seed 000 §III)."""
+    """The relational network of a (validated) task: body instances and links (Corner et al. 1983
+    §III)."""
     fixed = frozenset(name for name, body in task.bodies.items() if body.fixed)
     situations = tuple(s.name for s in task.situations)
     instances = tuple((b, s) for s in situations for b in task.bodies if b not in fixed)

@@ -1,6 +1,7 @@
-"""The residue solver: what network reduction leaves, solved numerically (seed 000 §III G).
+"""The residue solver: what network reduction leaves, solved numerically (Corner et al. 1983 §III
+G).
 
-Seed 000 hands "the residue" of the cycle finder to "a more powerful inference system".
+Corner et al. 1983 hands "the residue" of the cycle finder to "a more powerful inference system".
 Here that system is a least-squares solve over the world poses of the remaining body
 instances (ALGEBRA.md §2.5, "numeric fallback"):
 
@@ -13,8 +14,8 @@ instances (ALGEBRA.md §2.5, "numeric fallback"):
 * the solver never claims emptiness: it reports "no solution found" with the best residual.
 
 It also defines the two coupled relations that are not relations between two features
-in the coset sense (seed 000 §III G, "the jaws of a gripper ... equal and opposite";
-seed 003 Fig. 9, gear pairs): :func:`gear_residual`, :func:`rack_residual` and
+in the coset sense (Corner et al. 1983 §III G, "the jaws of a gripper ... equal and opposite";
+Liu 1997 Fig. 9, gear pairs): :func:`gear_residual`, :func:`rack_residual` and
 :func:`mirror_residual`.
 """
 
@@ -299,7 +300,7 @@ def gear_residual(
 ) -> Residual:
     """The coupled relation ``gear``: two bodies turning about their axes in a fixed ratio.
 
-    Semantics (seed 003 Fig. 9: gears on a common carrier): each body turns about its
+    Semantics (Liu 1997 Fig. 9: gears on a common carrier): each body turns about its
     feature's axis (+z of ``first_frame`` / ``second_frame``) relative to the carrier (the
     body both gears are related to; their revolute joints are separate relations). In the
     reference pose every body frame coincides with the carrier's frame, so the axes in
@@ -323,7 +324,7 @@ def gear_residual(
 
 def rack_residual(pinion_frame: np.ndarray, rack_frame: np.ndarray, radius: float) -> Residual:
     """The coupled relation ``rack``: a pinion turning about its axis drives a rack along
-    its line (seed 003 Fig. 9, a gear pair whose second gear has an infinite radius).
+    its line (Liu 1997 Fig. 9, a gear pair whose second gear has an infinite radius).
 
     Semantics as :func:`gear_residual`: both bodies move relative to the carrier (the
     body both are related to; the pinion's revolute and the rack's slide are separate
@@ -351,7 +352,7 @@ def mirror_residual(
 ) -> Residual:
     """The coupled relation ``mirror``: two bodies moving equal and opposite along a direction.
 
-    Semantics (seed 000 §III G: gripper jaws "constrained to move in equal and opposite
+    Semantics (Corner et al. 1983 §III G: gripper jaws "constrained to move in equal and opposite
     directions by the same amount"): the jaws move relative to a carrier (the palm, the
     body both jaws are related to). In the reference pose every body frame coincides with
     the carrier's frame, so the features' origins ``o1``, ``o2`` (in their bodies) are

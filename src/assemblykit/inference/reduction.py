@@ -1,4 +1,4 @@
-"""Reduction of the relational network to a fixpoint (seed 000 §III C-F, ALGEBRA.md §5.2).
+"""Reduction of the relational network to a fixpoint (Corner et al. 1983 §III C-F, ALGEBRA.md §5.2).
 
 The rules, in the seed's order:
 
@@ -83,7 +83,7 @@ from assemblykit.inference.solution import (
 )
 from assemblykit.tolerance import Tolerance, current, using
 
-CYCLE_LENGTH = 4  # seed 000 §III F: "we restrict the size of the cycles ... to four"
+CYCLE_LENGTH = 4  # Corner et al. 1983 §III F: "we restrict the size of the cycles ... to four"
 
 _EYE = np.eye(4)
 _EYE.flags.writeable = False  # shared by every find() of a representative
@@ -1018,7 +1018,7 @@ def _numeric_component(
     starts: int = 8,
     candidates: Mapping[Node, Any] | None = None,
 ) -> tuple[dict[Node, _Instance], list[Conflict]]:
-    """The residue of one component, solved numerically (seed 000 §III G).
+    """The residue of one component, solved numerically (Corner et al. 1983 §III G).
 
     An instance's feasible set lies inside its direct link from the world and inside the
     product along its tree path (``candidates``); when one of those is a coset of the
@@ -1240,7 +1240,7 @@ def solve_task(
     explain: bool = False,
     max_branches: int | None = None,
 ) -> Solution:
-    """RAPT inference on a task: poses of every body in every situation (seed 000 §III).
+    """RAPT inference on a task: poses of every body in every situation (Corner et al. 1983 §III).
 
     ``max_branches`` (default :data:`MAX_BRANCHES`) bounds the finite alternatives
     followed (rule 3); a cut search is reported in :attr:`Solution.cut`."""
@@ -1253,7 +1253,7 @@ def solve_task(
 
 def solve_numeric_only(task: Any, tol: Tolerance | None = None, starts: int = 8) -> Solution:
     """The whole network solved by the residue solver alone, without reduction (the
-    "equation solving" system seed 000 §III G compares against; used for benchmarks)."""
+    "equation solving" system Corner et al. 1983 §III G compares against; used for benchmarks)."""
     tol = tol or current().with_scale(model_scale(task))
     with using(tol):
         network = build_network(task.validate())

@@ -1,4 +1,4 @@
-"""Files of planar assemblies (seed 004, "2D case"): ``parts: {name: [[x, y], ...]}``
+"""Files of planar assemblies (Wilson & Latombe 1992, "2D case"): ``parts: {name: [[x, y], ...]}``
 in YAML, each part a simple polygon in assembled position, read into a
 :class:`~assemblykit.blocking.polygons.PolygonAssembly`.
 

@@ -1,4 +1,4 @@
-"""The mating problem file (seed 002, "Input"), read into a validated
+"""The mating problem file (Liu & Popplestone 1990, "Input"), read into a validated
 :class:`~assemblykit.mating.problem.MatingProblem`.
 
 File layout (YAML or JSON, validated with pydantic; features use the task-file YAML of

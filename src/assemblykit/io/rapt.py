@@ -1,4 +1,4 @@
-"""The ``.rapt`` task language (seed 000 §II), read with lark and written back.
+"""The ``.rapt`` task language (Corner et al. 1983 §II), read with lark and written back.
 
 The text maps 1:1 onto the YAML/JSON task file (DESIGN.md §5.1): one statement per line,
 ``body ... end`` and ``situation ... end`` blocks, relations written in the seed's

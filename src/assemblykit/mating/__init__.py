@@ -1,1 +1,2 @@
-"""Mating inference (seed 002): problems, the two-layer graph, the laws and the search."""
+"""Mating inference (Liu & Popplestone 1990): problems, the two-layer graph, the laws and the
+search."""

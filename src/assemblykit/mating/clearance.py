@@ -1,5 +1,5 @@
-"""Interference of bodies that keep a freedom, over their whole parameter ranges (seed 002
-step three, "the no-pairwise-interference constraint", and its Discussion: "sweep the
+"""Interference of bodies that keep a freedom, over their whole parameter ranges (Liu & Popplestone
+1990 step three, "the no-pairwise-interference constraint", and its Discussion: "sweep the
 body concerned under the symmetry group of its constantly contacting features, then
 intersect this swept volume with the rest of the assembly").
 

@@ -1,19 +1,20 @@
-"""Step one of the assembly constraint satisfaction process (seed 002): the two-layer
+"""Step one of the assembly constraint satisfaction process (Liu & Popplestone 1990): the two-layer
 constraint graph and node consistency.
 
 * The **top layer** has the bodies as nodes and the goals as arcs (the dual of the
   constraint graph); here each goal is a node joined to its two bodies.
 * The **bottom layer** has the compound features as nodes and the candidate mating
   pairs as arcs, each labelled with its symmetry constraint (the common group) and the
-  relative position of the two bodies (seed 002 eqs (1)-(3)).
+  relative position of the two bodies (Liu & Popplestone 1990 eqs (1)-(3)).
 * A candidate pair is two compound features of the goal's bodies that are complementary
-  (seed 003 Prop. 3.1.5): their primitives pair up one to one (plane against plane,
+  (Liu 1997 Prop. 3.1.5): their primitives pair up one to one (plane against plane,
   shaft in hole, ball in socket, ...), the intersection of the pairs' relation cosets is
   not empty, and its group is the group of the second compound (conjugate groups).
 * **Node consistency**: when the relative position is determined (identity; a common
   group equal to one body's symmetry group, which determines it up to that symmetry; or
   a finite common group: one candidate per position), the two meshes are checked for
-  interference (seed 002: the *intersect* predicate of PADL2; here manifold3d volumes).
+  interference (Liu & Popplestone 1990: the *intersect* predicate of PADL2; here manifold3d
+  volumes).
 """
 
 from __future__ import annotations
@@ -46,8 +47,8 @@ from assemblykit.mating.problem import Goal, MatingBody, MatingProblem
 from assemblykit.model.relations import relation_coset
 from assemblykit.tolerance import Tolerance
 
-#: Rarity of primitive feature types (seed 002 step one: threads, gears and cylinders are
-#: matched first because surfaces with given parameters are rare). Higher is rarer.
+#: Rarity of primitive feature types (Liu & Popplestone 1990 step one: threads, gears and cylinders
+#: are matched first because surfaces with given parameters are rare). Higher is rarer.
 RARITY: Mapping[type[Feature], int] = {
     Thread: 4,
     Prism: 3,
@@ -64,8 +65,8 @@ RARITY: Mapping[type[Feature], int] = {
 class Candidate:
     """A candidate mating pair of a goal: compound ``first`` of the goal's first body with
     compound ``second`` of its second body, the primitive ``pairing`` (feature names), the
-    relative position ``coset`` (X = L_second⁻¹·L_first, seed 002 eq. (3)), the number of
-    equivalent ``copies`` it stands for (equivalent feature law), the non-sharable
+    relative position ``coset`` (X = L_second⁻¹·L_first, Liu & Popplestone 1990 eq. (3)), the
+    number of equivalent ``copies`` it stands for (equivalent feature law), the non-sharable
     features it ``uses`` as (body, feature), and its ``priority`` (rarity)."""
 
     goal: Goal
@@ -87,7 +88,7 @@ class Candidate:
         return replace(self, copies=copies)
 
     def describe(self) -> str:
-        """Seed 002's form ``[fit [b1 comp1] [b4 comp13]]``."""
+        """Liu & Popplestone's (1990) form ``[fit [b1 comp1] [b4 comp13]]``."""
         g = self.goal
         return f"[{g.relation} [{g.first} {self.first}] [{g.second} {self.second}]]"
 
@@ -98,7 +99,7 @@ Domains = dict[int, tuple[Candidate, ...]]
 
 def matable(a: Feature, b: Feature, tol: Tolerance) -> str | None:
     """The relation by which primitive ``a`` mates with ``b``: ``against`` for two planes,
-    ``fits`` for complementary features (seed 003 Def. 3.1.2), else ``None``."""
+    ``fits`` for complementary features (Liu 1997 Def. 3.1.2), else ``None``."""
     if isinstance(a, Plane) and isinstance(b, Plane):
         return "against"
     return "fits" if relationship(a, b, tol) is Relationship.COMPLEMENTARY else None
@@ -129,7 +130,7 @@ def pair_coset(
     tol: Tolerance,
 ) -> Coset | EmptySet:
     """The relative position allowed by all the paired primitives at once: the
-    intersection of their relation cosets (seed 002 eq. (3), ALGEBRA.md §2.5)."""
+    intersection of their relation cosets (Liu & Popplestone 1990 eq. (3), ALGEBRA.md §2.5)."""
     result: Coset | EmptySet | None = None
     for i, j, kind in pairing:
         step = relation_coset(kind, first[i], second[j], tol=tol)
@@ -143,7 +144,7 @@ def pair_coset(
 def up_to_symmetry(coset: Coset, first: MatingBody, second: MatingBody, tol: Tolerance) -> bool:
     """Whether the common group equals the symmetry group of one of the bodies, so that
     every member of the coset places that body onto the same point set: the relative
-    position is determined up to the body's own symmetry (seed 002 step one, Example
+    position is determined up to the body's own symmetry (Liu & Popplestone 1990 step one, Example
     Three). X = h·x₀ with h ∈ H in ``second``'s frame, so H must equal sym(second), or
     x₀⁻¹·H·x₀ (the same motions seen in ``first``'s frame) must equal sym(first)."""
     group = coset.group
@@ -167,8 +168,8 @@ def positions(coset: Coset, first: MatingBody, second: MatingBody, tol: Toleranc
 def goal_candidates(
     problem: MatingProblem, goal: Goal, groups: dict[tuple[str, str], SymmetryGroup]
 ) -> list[Candidate]:
-    """All candidate mating pairs of ``goal`` (seed 002 step one; seed 003 Prop. 3.1.5);
-    ``groups`` caches compound groups by (body, compound)."""
+    """All candidate mating pairs of ``goal`` (Liu & Popplestone 1990 step one; Liu 1997 Prop.
+    3.1.5); ``groups`` caches compound groups by (body, compound)."""
     tol = problem.tolerance
     a, b = problem.bodies[goal.first], problem.bodies[goal.second]
     found: list[Candidate] = []
@@ -217,7 +218,7 @@ def interfering(
 
 
 def node_consistent(problem: MatingProblem, candidate: Candidate) -> bool:
-    """Node consistency (seed 002 step one): a candidate whose relative position is
+    """Node consistency (Liu & Popplestone 1990 step one): a candidate whose relative position is
     determined, alone or up to a body's symmetry, is kept only if the two bodies do not
     interfere at its representative position."""
     g = candidate.goal
@@ -230,7 +231,7 @@ def node_consistent(problem: MatingProblem, candidate: Candidate) -> bool:
 
 @dataclass(frozen=True, eq=False)
 class ConstraintGraph:
-    """The two-layer graph (seed 002 step one): ``top`` (bodies and goals, networkx
+    """The two-layer graph (Liu & Popplestone 1990 step one): ``top`` (bodies and goals, networkx
     ``Graph``), ``bottom`` (compound features joined by candidate pairs, ``MultiGraph``),
     and the ``initial`` and node-consistent ``domains`` of the goals."""
 
@@ -242,7 +243,7 @@ class ConstraintGraph:
 
 def build_graph(problem: MatingProblem) -> ConstraintGraph:
     """Set up the two-layer graph with the candidate pairs of every goal and apply node
-    consistency (seed 002 step one)."""
+    consistency (Liu & Popplestone 1990 step one)."""
     top = nx.Graph()
     bottom = nx.MultiGraph()
     for body in problem.bodies.values():

@@ -1,4 +1,4 @@
-"""Step two of the assembly constraint satisfaction process (seed 002): the laws that
+"""Step two of the assembly constraint satisfaction process (Liu & Popplestone 1990): the laws that
 shrink the goals' domains.
 
 * **Mandatory request law**: a goal with one candidate left claims its non-sharable
@@ -6,14 +6,14 @@ shrink the goals' domains.
 * **Equivalent feature law**: compound features of a body in the same orbit of the
   body's symmetry group are equivalent; one representative is kept and the others are
   counted as copies. It is applied only to bodies in a single goal: for a body in
-  several goals, dismissing orbit members would end the process (seed 002 Example 2).
+  several goals, dismissing orbit members would end the process (Liu & Popplestone 1990 Example 2).
 * **Arc consistency** (Mackworth 1985; Mohr & Henderson 1986, AC-3): two candidates of
   different goals are compatible unless they use a common non-sharable feature or, for
   goals sharing a body, the two other bodies interfere in every position the candidates
-  allow (seed 002 Example one: "intersection is found by arc consistency checking",
+  allow (Liu & Popplestone 1990 Example one: "intersection is found by arc consistency checking",
   Figure 2; judged over both freedoms by :mod:`assemblykit.mating.clearance`); a
   candidate without a compatible one in some other goal is deleted.
-* **Path consistency** (Mohr & Henderson 1986; seed 002 step two, "arc/path
+* **Path consistency** (Mohr & Henderson 1986; Liu & Popplestone 1990 step two, "arc/path
   consistency"): the allowed pairs of candidates of two goals start as the compatible
   ones; a pair is deleted when some third goal sharing a body with both has no candidate
   allowed with each of the two; a candidate left in no allowed pair with some
@@ -37,12 +37,12 @@ from assemblykit.tolerance import Tolerance
 
 def compatible(a: Candidate, b: Candidate) -> bool:
     """Whether two candidates of different goals can hold together: no non-sharable
-    feature is used by both (seed 002 footnote 3)."""
+    feature is used by both (Liu & Popplestone 1990 footnote 3)."""
     return not (a.uses & b.uses)
 
 
 def mandatory_request(domains: Domains) -> Domains:
-    """The mandatory request law (seed 002 step two), propagated until quiescent."""
+    """The mandatory request law (Liu & Popplestone 1990 step two), propagated until quiescent."""
     current = dict(domains)
     queue = deque(g for g, d in current.items() if len(d) == 1)
     settled: set[int] = set()
@@ -72,7 +72,7 @@ def _congruent(a: object, b: object, tol: Tolerance) -> bool:
 
 def compound_orbits(body: MatingBody, tol: Tolerance) -> dict[str, str]:
     """The representative (first in file order) of each compound feature's orbit under
-    the body's symmetry group (seed 002 equivalent feature law): ``c ~ c'`` when some
+    the body's symmetry group (Liu & Popplestone 1990 equivalent feature law): ``c ~ c'`` when some
     discrete element g of the group maps every primitive of ``c`` onto one of ``c'``."""
     names = list(body.compounds)
     reps: dict[str, str] = {}
@@ -100,8 +100,8 @@ def compound_orbits(body: MatingBody, tol: Tolerance) -> dict[str, str]:
 
 
 def equivalent_features(problem: MatingProblem, domains: Domains) -> Domains:
-    """The equivalent feature law (seed 002 step two): for each body in exactly one goal,
-    keep the candidates of one compound feature per orbit and count the others as copies.
+    """The equivalent feature law (Liu & Popplestone 1990 step two): for each body in exactly one
+    goal, keep the candidates of one compound feature per orbit and count the others as copies.
     """
     tol = problem.tolerance
     involvement: dict[str, int] = {}
@@ -140,7 +140,7 @@ def _representatives(
 
 @dataclass(eq=False)
 class Clashes:
-    """Interference between candidates of two goals sharing a body (seed 002 Example
+    """Interference between candidates of two goals sharing a body (Liu & Popplestone 1990 Example
     one, Figure 2): with the shared body as the frame, each candidate places the goal's
     other body on its relative coset; the candidates clash when those two bodies
     interfere in every pair of positions (a certified verdict, never a sample). Verdicts

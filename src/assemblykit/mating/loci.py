@@ -1,4 +1,4 @@
-"""Global positions of bodies joined by non-rigid relations (seed 002 step three,
+"""Global positions of bodies joined by non-rigid relations (Liu & Popplestone 1990 step three,
 Figs 4-5, and its Discussion).
 
 * **Representative-point loci**: a goal whose two bodies each keep a revolute world
@@ -13,7 +13,7 @@ Figs 4-5, and its Discussion).
   parameters of both bodies and of the relation, X(t) = h(s)·x₀, from a deterministic
   grid of starts (scipy ``least_squares``). Only solutions are reported: finding none
   proves nothing, so the caller keeps the unresolved cosets instead of claiming the
-  loop cannot close (seed 002 Discussion: geometric methods are incomplete).
+  loop cannot close (Liu & Popplestone 1990 Discussion: geometric methods are incomplete).
 """
 
 from __future__ import annotations
@@ -116,9 +116,9 @@ def turn_to(coset: Coset, start: np.ndarray, target: np.ndarray) -> np.ndarray:
 def loci_branches(
     world: Mapping[str, Coset], second: str, first: str, relative: Coset, tol: Tolerance
 ) -> list[World] | None:
-    """Representative-point loci (seed 002 Figs 4-5) for a goal X = L_second⁻¹·L_first ∈
-    ``relative`` whose two bodies each have a revolute world coset and whose relation is
-    revolute or spherical: the relation's fixed point p is carried by both bodies, and
+    """Representative-point loci (Liu & Popplestone 1990 Figs 4-5) for a goal X =
+    L_second⁻¹·L_first ∈ ``relative`` whose two bodies each have a revolute world coset and whose
+    relation is revolute or spherical: the relation's fixed point p is carried by both bodies, and
     its two orbits meet in the possible positions of p; each fixes ``second``'s turn.
     ``None`` when the case is not of this form or the loci have no closed form."""
     wu, wv = world[second], world[first]

@@ -1,4 +1,5 @@
-"""Step three of the assembly constraint satisfaction process (seed 002) and the answer.
+"""Step three of the assembly constraint satisfaction process (Liu & Popplestone 1990) and the
+answer.
 
 ``mate(problem)`` sets up the two-layer graph (step one), applies the laws (step two:
 mandatory request, equivalent features, arc and path consistency), enumerates every
@@ -9,7 +10,7 @@ the bodies globally and checks the spatial constraint:
 * **global positions**: one body is fixed and the relative cosets are chained around the
   goal graph; a body reached twice gets the intersection of the two world cosets (seed
   002 eq. (3)); a body rigidly attached to a moving body moves with it; a loop that
-  chaining leaves open is closed by the representative-point loci of seed 002 Figs 4-5
+  chaining leaves open is closed by the representative-point loci of Liu & Popplestone 1990 Figs 4-5
   or, without a closed form, numerically (:mod:`assemblykit.mating.loci`), each
   solution a configuration;
 * **interference** between every two placed bodies over their joint parameter ranges
@@ -17,7 +18,7 @@ the bodies globally and checks the spatial constraint:
   rejects the configuration with the reason; otherwise a joint free pose is found by
   exact checks (the representative when it is free, else the nearest free pose along
   the freedom) and reported;
-* **sweeping** (seed 002 Discussion): a body left with a one-parameter group is swept
+* **sweeping** (Liu & Popplestone 1990 Discussion): a body left with a one-parameter group is swept
   with the others at their chosen poses, sampled finely, the collision-free intervals
   refined by bisection and reported as its range of motion.
 """
@@ -206,7 +207,7 @@ class MatingResult:
         }
 
     def render(self) -> Group:
-        """Seed 002's Or/And form, then the pruning statistics."""
+        """Liu & Popplestone's (1990) Or/And form, then the pruning statistics."""
         lines = [Text(self.or_and())]
         if self.emptied is not None:
             lines.append(
@@ -230,7 +231,8 @@ class MatingResult:
         return Group(*lines)
 
     def or_and(self) -> str:
-        """``** [Or [And [fit [b1 comp1] [b4 comp13]] ...] ...]`` (seed 002 Examples)."""
+        """``** [Or [And [fit [b1 comp1] [b4 comp13]] ...] ...]`` (Liu & Popplestone 1990
+        Examples)."""
         if not self.configurations:
             return "** [Or]"
         ands = [
@@ -241,7 +243,8 @@ class MatingResult:
 
 
 def mate(problem: MatingProblem) -> MatingResult:
-    """All assembly configurations satisfying the goals (seed 002, steps one to three)."""
+    """All assembly configurations satisfying the goals (Liu & Popplestone 1990, steps one to
+    three)."""
     graph = build_graph(problem)
     stages: list[Domains] = [graph.initial, graph.domains]
     stages.append(mandatory_request(stages[-1]))
@@ -386,7 +389,7 @@ class Placement:
 
 
 def place(problem: MatingProblem, pairs: tuple[Candidate, ...]) -> Placement:
-    """The configurations of one assignment (seed 002 step three): global positions by
+    """The configurations of one assignment (Liu & Popplestone 1990 step three): global positions by
     coset chaining and representative-point loci, then the no-pairwise-interference
     constraint over the bodies' remaining freedoms (:mod:`assemblykit.mating.clearance`)."""
     tol = problem.tolerance
@@ -440,7 +443,7 @@ def _root(pairs: Sequence[Candidate], names: Sequence[str]) -> str:
 def _positions(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> list[World]:
     """Every consistent set of world cosets reachable from ``world``: chain and intersect
     until quiescent, then branch on a loop that is not closed yet: representative-point
-    loci (seed 002 Figs 4-5), else the numeric closure. A closed form with no meeting
+    loci (Liu & Popplestone 1990 Figs 4-5), else the numeric closure. A closed form with no meeting
     point rejects the assignment; the numeric path never does (module docstring of
     :mod:`assemblykit.mating.loci`)."""
     settled = _propagate(dict(world), pairs, tol)
@@ -518,12 +521,12 @@ def _propagate(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> Worl
 def _spatial(
     problem: MatingProblem, pairs: tuple[Candidate, ...], world: World
 ) -> Configuration | Rejection:
-    """The no-pairwise-interference constraint (seed 002 step three) on one set of world
-    cosets: every two bodies are judged over their joint parameter ranges (fixed ones at
+    """The no-pairwise-interference constraint (Liu & Popplestone 1990 step three) on one set of
+    world cosets: every two bodies are judged over their joint parameter ranges (fixed ones at
     their pose, moving ones over their whole freedom, :func:`judge_pair`); a pair proved
     to interfere everywhere rejects the configuration; otherwise a joint free pose is
     searched for the pairs not proved clear, and each moving body's range of motion is
-    swept with the others at their chosen poses (seed 002 Discussion)."""
+    swept with the others at their chosen poses (Liu & Popplestone 1990 Discussion)."""
     tol = problem.tolerance
     units = _units(pairs, world, tol)
     movers: dict[str, Mover] = {}
@@ -668,8 +671,8 @@ def _ranges(
 ) -> dict[str, Motion]:
     """The range of motion of a one-parameter unit with every other body at its chosen
     pose: the whole turn or travel when no pair of it is open (its sweeps clear them,
-    certified); else sampled and refined by bisection (seed 002 Discussion). Units with
-    more freedom report their kind only; their pose was checked."""
+    certified); else sampled and refined by bisection (Liu & Popplestone 1990 Discussion). Units
+    with more freedom report their kind only; their pose was checked."""
     kind = lead.coset.kind
     if lead.dof != 1:
         return {name: Motion(kind.value, "none", ()) for name in unit}

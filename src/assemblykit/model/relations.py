@@ -6,7 +6,7 @@ feature's body (ALGEBRA.md §5.1: the second feature's body is body 1, the "from
 So ``[against, block.bottom, table.top]`` is the set of block poses in the table frame.
 
 Lower-pair relations are right cosets H₁·x₀ with x₀ = F₁·σ·F₂⁻¹ and H₁ the common
-symmetry group placed on body 1's feature (ALGEBRA.md §3, §5.1; seed 002 eq. (1), seed
+symmetry group placed on body 1's feature (ALGEBRA.md §3, §5.1; Liu & Popplestone 1990 eq. (1), seed
 003 eq. (2)). The other relations (perpendicular, angle, point_on_plane, point_on_line,
 distance) are not cosets; they, and all the others, have a residual vector for the
 numeric residue solver (ALGEBRA.md §2.5, numeric fallback).

@@ -1,9 +1,10 @@
-"""A RAPT task: bodies with features, and situations of relations and actions (seed 000 §II).
+"""A RAPT task: bodies with features, and situations of relations and actions (Corner et al. 1983
+§II).
 
 A task lists the bodies (each with named features, some fixed: the world), then a sequence
 of *situations*. In each situation spatial relations (``against``, ``fits``, ...) hold
 between features of bodies; *actions* say how bodies moved from the previous situation
-(seed 000 §II: ``move / body``, ``move / body parallel shaft of body``, optionally by a
+(Corner et al. 1983 §II: ``move / body``, ``move / body parallel shaft of body``, optionally by a
 given amount). A body that no action moves keeps its pose into the next situation
 (DESIGN.md §5.1). This module holds the validated model; the file formats live in
 ``assemblykit.io.spec`` (YAML/JSON) and ``assemblykit.io.rapt`` (text).
@@ -30,13 +31,13 @@ ACTION_KINDS: tuple[ActionKind, ...] = ("move", "turn")
 
 @dataclass(frozen=True)
 class Action:
-    """How ``body`` moved from the previous situation into this one (seed 000 §II).
+    """How ``body`` moved from the previous situation into this one (Corner et al. 1983 §II).
 
     ``move`` alone leaves the new pose free; ``move`` ``along`` a feature keeps the body
     on a translation along that feature's axis (or normal), by exactly ``by`` model units
     when given; ``turn`` ``about`` a feature rotates it about the feature's axis, by
     ``by`` radians when given. The feature belongs to the moved body and is taken at its
-    pose before the action (seed 000 §III B: ``f ** p1 = rel(v) ** f ** p2``).
+    pose before the action (Corner et al. 1983 §III B: ``f ** p1 = rel(v) ** f ** p2``).
     """
 
     kind: ActionKind
@@ -190,7 +191,7 @@ class Task:
     def solve(
         self, tol: Tolerance | None = None, explain: bool = False, max_branches: int | None = None
     ) -> Solution:
-        """Poses of every body in every situation by network reduction (seed 000 §III);
+        """Poses of every body in every situation by network reduction (Corner et al. 1983 §III);
         at most ``max_branches`` finite alternatives are followed (default
         ``inference.reduction.MAX_BRANCHES``; ``Solution.cut`` says when more were left)."""
         from assemblykit.inference import solve_task

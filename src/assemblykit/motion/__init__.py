@@ -1,4 +1,4 @@
-"""Motion analysis (seed 003): the motion group of every part and subassembly
+"""Motion analysis (Liu 1997): the motion group of every part and subassembly
 (:mod:`~assemblykit.motion.freedom`), its push-only reading
 (:mod:`~assemblykit.motion.unilateral`), separable subassemblies
 (:mod:`~assemblykit.motion.separation`), gear trains

@@ -1,6 +1,6 @@
-"""Articulated assemblies: joints and coupled gear trains (seed 003 §4, Figs. 7-9).
+"""Articulated assemblies: joints and coupled gear trains (Liu 1997 §4, Figs. 7-9).
 
-Seed 003 represents the gearbox by the motion group of each gear relative to the
+Liu 1997 represents the gearbox by the motion group of each gear relative to the
 housing, Lᵢ = aᵢ SO(2) aᵢ⁻¹ (a revolute about the gear's shaft, from a cylinder and a
 plane), and the gear pairs by products Lᵢⱼ = Lᵢ Lⱼ "where the relative gear pitch ratio
 is also embedded". Here every part whose motion (:func:`assemblykit.motion.motion`) is
@@ -154,7 +154,7 @@ def gear_trains(meshes: Iterable[GearMesh], tol: Tolerance) -> list[GearTrain]:
 
 @dataclass(frozen=True, eq=False)
 class Articulation:
-    """The motions of an assembly with its gear trains coupled (seed 003 Fig. 9)."""
+    """The motions of an assembly with its gear trains coupled (Liu 1997 Fig. 9)."""
 
     report: MotionReport
     trains: tuple[GearTrain, ...]

@@ -1,18 +1,18 @@
-"""Motion of a part or subassembly relative to the rest of an assembly (seed 003).
+"""Motion of a part or subassembly relative to the rest of an assembly (Liu 1997).
 
-Seed 003 eq. (2): under surface contacts the relative position of a moving set S is
+Liu 1997 eq. (2): under surface contacts the relative position of a moving set S is
 ``l₁⁻¹l₂ ∈ f₁ G f₂⁻¹`` where G is the symmetry group of the *compound feature* formed by
 all the oriented surfaces of S that touch the rest. G tells the motion: the identity
 (fixed), a finite group (finitely many equivalent positions) or a continuous group of
 dimension n (n degrees of freedom), with its invariants (axis, direction, point).
 
 Every contact patch between S and the rest becomes one oriented primitive feature of
-the moving side (seed 003 Def. 2.1.2: the surface with S's outward normals): a planar
+the moving side (Liu 1997 Def. 2.1.2: the surface with S's outward normals): a planar
 patch a :class:`Plane` with the patch normal pointing out of S, a cylindrical patch a
 :class:`Shaft` (S inside) or :class:`Hole`, a spherical one a :class:`Ball` or
 :class:`Socket`, a conical one a :class:`Cone`. Repeated surfaces (coplanar patches,
 one cylinder split in several patches) are one feature. The group is
-:func:`assemblykit.features.compound_group` (seed 003 Props 3.2.6-3.2.8, 5.0.9).
+:func:`assemblykit.features.compound_group` (Liu 1997 Props 3.2.6-3.2.8, 5.0.9).
 
 Next to this *bilateral* reading (contacts are fits), every motion carries the
 *unilateral* reading of :mod:`assemblykit.motion.unilateral` (faces only push): whether
@@ -113,7 +113,7 @@ def boundary_contacts(contacts: Iterable[Contact], moving: frozenset[str]) -> li
 def moving_features(
     contacts: Iterable[Contact], moving: frozenset[str], tol: Tolerance
 ) -> tuple[tuple[Feature, ...], ContactSamples]:
-    """The compound feature of ``moving`` (its oriented contact surfaces, seed 003
+    """The compound feature of ``moving`` (its oriented contact surfaces, Liu 1997
     Def. 3.0.1) and the sampled contact points with normals out of ``moving``; contacts
     inside ``moving`` or inside the rest are skipped."""
     features: list[Feature] = []
@@ -269,7 +269,7 @@ class MotionSolver:
     moving the features by g maps G to g G g⁻¹), so a compound feature that is a
     translate of one already solved (keys of :func:`_feature_key` seen from the lower
     corner of the moving set's bounding box) gets that group conjugated by the
-    translation, instead of a new permutation search (seed 003 Props 3.2.6-5.0.9).
+    translation, instead of a new permutation search (Liu 1997 Props 3.2.6-5.0.9).
     """
 
     def __init__(self, assembly: Assembly, tol: Tolerance | None = None) -> None:
@@ -283,7 +283,7 @@ class MotionSolver:
             self._by_part.setdefault(contact.b, []).append(contact)
 
     def group(self, features: Sequence[Feature], anchor: Vector) -> SymmetryGroup:
-        """The symmetry group of the compound feature (seed 003 Props 3.2.6-3.2.8, 5.0.9)."""
+        """The symmetry group of the compound feature (Liu 1997 Props 3.2.6-3.2.8, 5.0.9)."""
         key = tuple(sorted(_feature_key(f, anchor, self.tol) for f in features))
         if key not in self._groups:
             self._groups[key] = (compound_group(features, self.tol), anchor)
@@ -293,7 +293,7 @@ class MotionSolver:
 
     def connected_group(self, features: Sequence[Feature]) -> SymmetryGroup:
         """The identity component of the compound feature's group: the swaps of
-        2-congruent features only add discrete components (seed 003 Props 3.2.8,
+        2-congruent features only add discrete components (Liu 1997 Props 3.2.8,
         5.0.9), so it is the identity component of G₁ ∩ ... ∩ Gₙ (Prop 3.2.6)."""
         groups = [f.group().connected_part for f in features]
         return functools.reduce(lambda g, h: g.intersect(h, tol=self.tol), groups)
@@ -424,7 +424,7 @@ def motion(
     tol: Tolerance | None = None,
 ) -> MotionReport:
     """The motion of every part, and of each given subassembly, relative to the rest
-    (seed 003 eq. (2)): one compound-feature symmetry group per moving set."""
+    (Liu 1997 eq. (2)): one compound-feature symmetry group per moving set."""
     solver = MotionSolver(assembly, tol)
     sets: list[Sequence[str]] = [(name,) for name in assembly.names]
     sets.extend(subassemblies or ())

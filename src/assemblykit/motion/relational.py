@@ -1,6 +1,6 @@
-"""Motion of each body of a task relative to the rest, from the task's relations (seed 003).
+"""Motion of each body of a task relative to the rest, from the task's relations (Liu 1997).
 
-Seed 003 takes the compound feature of a moving part from its contacts; a task names them
+Liu 1997 takes the compound feature of a moving part from its contacts; a task names them
 instead: in a situation, the relations a body takes part in pair its features with
 features of other bodies. Each coset relation ``[kind, first, second]`` allows the
 relative poses X = L_second⁻¹·L_first ∈ H·x₀ with H on the second feature's body
@@ -8,7 +8,7 @@ relative poses X = L_second⁻¹·L_first ∈ H·x₀ with H on the second featu
 other body in place, a motion g of the body (L ↦ g·L) keeps the relation iff
 g ∈ L_second·H·L_second⁻¹, whichever side the body is on; so the body's motion group
 relative to the rest (fixed bodies are the world) is the intersection of these placed
-groups over its relations (seed 003 eq. (2), Prop 3.2.6). Every relation names which
+groups over its relations (Liu 1997 eq. (2), Prop 3.2.6). Every relation names which
 feature meets which, so the swaps of 2-congruent features (Props 3.2.8, 5.0.9) are not
 motions here: they would pair a feature with the wrong partner.
 

@@ -1,10 +1,10 @@
 """Separable subassemblies: the smallest moving sets whose motion group separates them.
 
-Seed 003 §4 (the non-linearizable assembly of its Fig. 10): every single part has the
+Liu 1997 §4 (the non-linearizable assembly of its Fig. 10): every single part has the
 identity group, yet a two-part subassembly S₁ ∪ S₂ has a T₁ group, "a one dimensional
 translation which can separate the assembly". The search grows connected subsets of the
 contact graph (networkx) one neighbour at a time, size 1, 2, ..., and stops at the first
-size where some subset's compound-feature group (seed 003 eq. (2)) contains a motion
+size where some subset's compound-feature group (Liu 1997 eq. (2)) contains a motion
 that carries it away (:attr:`Motion.separates`). A set and its complement separate
 along the same motion, so of two complementary sets of equal size only the one holding
 the assembly's first part is reported.

@@ -1,6 +1,6 @@
 """The unilateral reading of contacts: which twists a part may make when faces only push.
 
-Seed 003 reads every contact as a fit: the surfaces stay coincident and the motions are
+Liu 1997 reads every contact as a fit: the surfaces stay coincident and the motions are
 the symmetry group of the compound feature. A real face contact only pushes, so a part
 may also move *away* from an obstacle. To first order, a twist ξ = (ω; v) of the moving
 part (DESIGN.md §4: ``v`` is the velocity of the point at the origin) is allowed at a
