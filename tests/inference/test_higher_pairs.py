@@ -221,7 +221,7 @@ def test_box_on_table_with_corner_on_the_line_of_two_walls_turns_about_it():
     assert unoriented(b["invariants"]["direction"], Z)
     np.testing.assert_allclose(b["pose"], shift(4, -1), atol=EXACT)
     assert b["freedom"] == (
-        "box@s1 can turn about the axis through (5, 0, 0) along (0, 0, 1): 1 dof;"
+        "box@s1 can turn about the axis through (5, 0, 0) along +Z: 1 dof;"
         " a stop against the turn (an against or point_on_plane off that axis) would remove it"
     )
 

@@ -147,9 +147,9 @@ def test_freedom_is_said_in_words_and_only_when_there_is_some():
             "revolute",
             1,
             {"point": [5, 0, 0], "direction": [0, 0, 1]},
-            "can turn about the axis through (5, 0, 0) along (0, 0, 1): 1 dof",
+            "can turn about the axis through (5, 0, 0) along +Z: 1 dof",
         ),
-        ("prismatic", 1, {"direction": [0, -0.0, 1]}, "can slide along (0, 0, 1): 1 dof"),
+        ("prismatic", 1, {"direction": [0, -0.0, 1]}, "can slide along +Z: 1 dof"),
         ("fixed", 0, {}, ""),
         (
             "mechanism",
@@ -177,15 +177,15 @@ def test_freedom_words(motion, dof, invariants, expected):
             "prismatic",
             "",
             {"direction": [0, 0, 1]},
-            "a stop across (0, 0, 1) (an against or point_on_plane on a face not parallel to"
+            "a stop across +Z (an against or point_on_plane on a face not parallel to"
             " it) would remove it",
         ),
         (
             "mechanism",
             "planar-point-on-line",
             {"direction": [0, 1, 0], "normal": [0, 0, 1], "point": [4, 1, 0]},
-            "a point_on_plane on the same point across (0, 1, 0) (making a revolute about"
-            " (0, 0, 1)) and a stop off that axis would remove it",
+            "a point_on_plane on the same point across +Y (making a revolute about"
+            " +Z) and a stop off that axis would remove it",
         ),
         ("mechanism", "", {}, "a stop on it or on a body it moves with would remove one dof"),
     ],

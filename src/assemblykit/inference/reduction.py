@@ -36,7 +36,7 @@ import math
 from collections import deque
 from collections.abc import Hashable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import networkx as nx
@@ -1246,9 +1246,10 @@ def solve_task(
     followed (rule 3); a cut search is reported in :attr:`Solution.cut`."""
     tol = tol or current().with_scale(model_scale(task))
     with using(tol), _collector_paused():
-        return solve_network(
+        solution = solve_network(
             build_network(task.validate()), tol, explain, max_branches or MAX_BRANCHES
         )
+    return replace(solution, units=task.units)
 
 
 def solve_numeric_only(task: Any, tol: Tolerance | None = None, starts: int = 8) -> Solution:

@@ -106,15 +106,17 @@ class BodyInstanceResult:
 
 
 def point_text(point: Any) -> str:
-    """``(0.5, 1, 1.5)``: a point or direction as people write it."""
-    return "(" + ", ".join(f"{float(v):.6g}" for v in np.asarray(point, dtype=float) + 0.0) + ")"
+    """``(0.5, 1, 1.5)``: a point or direction as people write it (tiny values as 0)."""
+    from assemblykit import formatting as fmt
+
+    return fmt.vector(np.asarray(point, dtype=np.float64))
 
 
 def freedom_words(motion: str, dof: int, invariants: Mapping[str, Any]) -> str:
     """What remains free, in words, after the instance's name: ``"can turn about (0.5, 1,
     1.5): 3 dof"``; empty for a fixed instance. A ``mechanism`` that the reduction does
     not name (a closed loop, a coupled joint, a relation that is no coset) says its dof."""
-    inv = {k: point_text(v) for k, v in invariants.items() if k != "pitch"}
+    inv = {k: _invariant_text(k, v) for k, v in invariants.items() if k != "pitch"}
     phrases = {
         "revolute": "turn about the axis through {point} along {direction}",
         "prismatic": "slide along {direction}",
@@ -172,7 +174,7 @@ def remedy_words(motion: str, mechanism: str, invariants: Mapping[str, Any]) -> 
     about that axis) and a stop off that axis would remove it"``. A mechanism without a
     name (a closed loop, a coupled joint, a relation that is no coset, solved
     numerically) loses at most one dof to each stop on it or on a body it moves with."""
-    inv = {k: point_text(v) for k, v in invariants.items() if k != "pitch"}
+    inv = {k: _invariant_text(k, v) for k, v in invariants.items() if k != "pitch"}
     phrase = _REMEDIES.get(mechanism or motion, "")
     try:
         phrase = phrase.format(**inv)
@@ -271,6 +273,18 @@ class BranchCut:
         }
 
 
+def _invariant_text(key: str, value: Any) -> str:
+    """An invariant for people: directions and normals as ``+Z`` where they are axes,
+    points as ``(x, y, z)``, the pitch as a number (tiny values shown as 0)."""
+    from assemblykit import formatting as fmt
+
+    if key == "pitch":
+        return fmt.number(float(value))
+    if key in ("direction", "normal"):
+        return fmt.direction(np.asarray(value, dtype=np.float64))
+    return fmt.vector(np.asarray(value, dtype=np.float64))
+
+
 def status_of(
     bodies: Mapping[str, BodyInstanceResult],
     conflicts: tuple[Conflict, ...],
@@ -300,6 +314,7 @@ class Solution:
     trace: tuple[TraceStep, ...] = ()
     explain: bool = False
     cut: BranchCut | None = None
+    units: str | None = None
 
     @property
     def status(self) -> str:
@@ -363,22 +378,25 @@ class Solution:
 
     def render(self) -> Group:
         """A rich table of instances, then conflicts and (when explaining) the trace."""
+        from assemblykit import formatting as fmt
+
         table = Table(title=f"RAPT inference: {self.status}")
-        for column in ("instance", "dof", "motion", "solutions", "position", "invariants"):
+        for column in ("instance", "dof", "motion", "solutions"):
             table.add_column(column)
+        table.add_column(fmt.header("position", self.units))
+        table.add_column("invariants")
         for key, b in self.bodies.items():
-            invariants = ", ".join(
-                f"{k}={np.round(np.asarray(v, dtype=float), 6).tolist()}"
-                for k, v in b.invariants.items()
-                if k in INVARIANT_KEYS
-            )
             table.add_row(
                 key,
                 str(b.dof),
                 f"{b.motion} ({b.mechanism})" if b.mechanism else b.motion,
                 "infinite" if b.solutions is None else str(b.solutions),
-                str(np.round(np.asarray(b.pose)[:3, 3], 6).tolist()),
-                invariants,
+                fmt.vector(np.asarray(b.pose)[:3, 3]),
+                ", ".join(
+                    f"{k} {_invariant_text(k, v)}"
+                    for k, v in b.invariants.items()
+                    if k in INVARIANT_KEYS
+                ),
             )
         parts: list[Any] = [table]
         if self.cut is not None:
