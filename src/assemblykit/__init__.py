@@ -65,7 +65,7 @@ The algebra: symmetry groups and their cosets (Liu & Popplestone 1994). A pin in
 >>> on_plane = Coset(SymmetryGroup.planar((0, 0, 1)), np.eye(4))
 >>> both = in_hole.intersect(on_plane)
 >>> both.group
-SymmetryGroup<revolute about line through (0, 0, 0) along (0, 0, 1)>
+SymmetryGroup<revolute about line through (0, 0, 0) along +Z>
 >>> lifted = np.eye(4)
 >>> lifted[2, 3] = 5.0
 >>> in_hole.contains(lifted), on_plane.contains(lifted), both.dof

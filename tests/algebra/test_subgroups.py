@@ -99,7 +99,7 @@ def test_length_tolerance_scales_with_the_model():
 
 def test_invariants_and_describe():
     r = G.revolute((0, 0, 1), Z)
-    assert r.describe() == "revolute about line through (0, 0, 1) along (0, 0, 1)"
+    assert r.describe() == "revolute about line through (0, 0, 1) along +Z"
     inv = G.helical((1, 2, 3), (0, 1, 0), 0.25).invariants
     np.testing.assert_allclose(inv["point"], (1, 2, 3))
     np.testing.assert_allclose(inv["axis"], (0, 1, 0))

@@ -70,7 +70,7 @@ def test_point_in_one_plane_keeps_five_dof_and_the_pose_as_written():
     assert unoriented(v["invariants"]["normal"], X)
     np.testing.assert_allclose(v["invariants"]["point"], [0.5, 0, 0], atol=EXACT)
     assert v["freedom"] == (
-        "v@s1 can slide its point (0.5, 0, 0) in the plane normal to (1, 0, 0)"
+        "v@s1 can slide its point (0.5, 0, 0) in the plane normal to +X"
         " and turn about it: 5 dof; two more point_on_plane on the same point (making a"
         " spherical joint) and relations on the body's orientation would remove it"
     )

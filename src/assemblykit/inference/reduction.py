@@ -77,6 +77,7 @@ from assemblykit.inference.solution import (
     Conflict,
     Solution,
     TraceStep,
+    direction_text,
     freedom_words,
     point_text,
     remedy_words,
@@ -869,21 +870,21 @@ def _point_in_locus(
         m = value.group.axis
         invariants = {"normal": m, "direction": np.cross(rows[0], rows[1]) + 0.0, "point": target}
         words = (
-            f"can slide its point {place} along {point_text(invariants['direction'])}"
-            f" and turn about {point_text(m)} through it: 2 dof"
+            f"can slide its point {place} along {direction_text(invariants['direction'])}"
+            f" and turn about {direction_text(m)} through it: 2 dof"
         )
         found = _Instance(pose, 2, "mechanism", 1, (), invariants, words, "planar-point-on-line")
     elif len(rows) == 1:
         invariants = {"normal": rows[0], "point": target}
         words = (
-            f"can slide its point {place} in the plane normal to {point_text(rows[0])}"
+            f"can slide its point {place} in the plane normal to {direction_text(rows[0])}"
             " and turn about it: 5 dof"
         )
         found = _Instance(pose, 5, "mechanism", 1, (), invariants, words, "point-in-plane")
     else:
         invariants = {"direction": np.cross(rows[0], rows[1]) + 0.0, "point": target}
         words = (
-            f"can slide its point {place} along {point_text(invariants['direction'])}"
+            f"can slide its point {place} along {direction_text(invariants['direction'])}"
             " and turn about it: 4 dof"
         )
         found = _Instance(pose, 4, "mechanism", 1, (), invariants, words, "point-on-line")
@@ -938,8 +939,8 @@ def _line_on_plane(
     name = instance_key(node)
     invariants = {"normal": normal, "direction": flat, "point": placed}
     words = (
-        f"keeps its line through {point_text(placed)} along {point_text(flat)}"
-        f" parallel to the plane normal to {point_text(normal)}: it can slide in the plane"
+        f"keeps its line through {point_text(placed)} along {direction_text(flat)}"
+        f" parallel to the plane normal to {direction_text(normal)}: it can slide in the plane"
         " and turn about the normal and about the line: 4 dof"
     )
     found = _Instance(pose, 4, "mechanism", 1, (), invariants, words, "line-on-plane")

@@ -273,6 +273,13 @@ class BranchCut:
         }
 
 
+def direction_text(direction: Any) -> str:
+    """``+Z`` for a direction along a coordinate axis, else ``(0.6, 0.8, 0)``."""
+    from assemblykit import formatting as fmt
+
+    return fmt.direction(np.asarray(direction, dtype=np.float64))
+
+
 def _invariant_text(key: str, value: Any) -> str:
     """An invariant for people: directions and normals as ``+Z`` where they are axes,
     points as ``(x, y, z)``, the pitch as a number (tiny values shown as 0)."""
@@ -281,7 +288,7 @@ def _invariant_text(key: str, value: Any) -> str:
     if key == "pitch":
         return fmt.number(float(value))
     if key in ("direction", "normal"):
-        return fmt.direction(np.asarray(value, dtype=np.float64))
+        return direction_text(value)
     return fmt.vector(np.asarray(value, dtype=np.float64))
 
 

@@ -399,6 +399,8 @@ class MotionReport:
     def render(self) -> Table:
         """A table: moving set, motion with its invariants, dof, components and the
         unilateral reading."""
+        from assemblykit import formatting as fmt
+
         table = Table(title=f"Motion of each part{f' of {self.source}' if self.source else ''}")
         for column in ("part", "motion", "dof", "components", "unilateral"):
             table.add_column(column)
@@ -406,7 +408,7 @@ class MotionReport:
             data = motion_summary(moved.group)
             reading = moved.unilateral
             if reading.lift_off:
-                rays = ", ".join(np.array2string(r, precision=3) for r in reading.lift_off)
+                rays = ", ".join(fmt.direction(r) for r in reading.lift_off)
                 unilateral = f"lifts off along {rays}"
             elif reading.can_lift_off:
                 unilateral = "lifts off by turning"
