@@ -9,7 +9,10 @@ holds ``compas_assembly/dome_assembly.json``.
 
 Puzzles: multi-move plans (``plan --moves multi``) of BurrTools' example puzzles, with the
 level each stored and the ``time`` BurrTools recorded for the problem, and all 314 solid
-six-piece burrs (bundled under ``tests/data/burrtools``). ``--puzzles`` runs only these.
+six-piece burrs (bundled under ``tests/data/burrtools``); then multi-move plans of
+meshes (contact-change distances from the Minkowski sums of convex pieces): the bundled
+key in steps, guillotine packings and a key in a cage too long for it. ``--puzzles``
+runs only these.
 """
 
 from __future__ import annotations
@@ -25,7 +28,9 @@ import trimesh
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.burrtools import load_puzzle, solution_count
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.packings import box_mesh, guillotine_packing
 from assemblykit.planning.multimove import MultiMovePlan, plan_voxels
+from assemblykit.planning.multimove_mesh import plan_meshes
 from assemblykit.planning.sequence import Plan, plan
 from datasets import dataset
 
@@ -123,8 +128,39 @@ def puzzles() -> None:
     )
 
 
+def caged_key() -> Assembly:
+    """A 2 x 1 x 1 key in a closed cage whose cavity is one unit longer (stuck)."""
+    cage = trimesh.boolean.difference(
+        [box_mesh((-1, -1, -1), (4, 2, 2)), box_mesh((0, 0, 0), (3, 1, 1))], engine="manifold"
+    )
+    return Assembly([Part("cage", cage), Part("key", box_mesh((0, 0, 0), (2, 1, 1)))])
+
+
+def mesh_puzzles() -> None:
+    """Multi-move plans of mesh assemblies (``plan --moves multi`` on meshes)."""
+    print("meshes (--moves multi; loading excluded, convex pieces and directions included)")
+    steps = ROOT / "src" / "assemblykit" / "examples" / "puzzles" / "key_in_steps"
+    cases: list[tuple[str, Callable[[], Assembly]]] = [
+        ("key in steps", lambda: load_assembly(steps)),
+        ("guillotine packing of 6", lambda: guillotine_packing(6, seed=2)),
+        ("guillotine packing of 10", lambda: guillotine_packing(10, seed=2)),
+        ("key in a long cage", caged_key),
+    ]
+    for name, make in cases:
+        assembly = make()
+        start = time.perf_counter()
+        result = plan_meshes(assembly)
+        seconds = time.perf_counter() - start
+        verdict = "feasible" if result.feasible else "stuck"
+        print(
+            f"{name:<28} {len(result.parts):>5} parts {seconds:>8.3f} s  "
+            f"level {result.level or '-'}  {result.states} states  {verdict}"
+        )
+
+
 def main() -> None:
     puzzles()
+    mesh_puzzles()
     if "--puzzles" in sys.argv:
         return
     print("planning (median wall time; loading excluded, contacts and blocking included)")

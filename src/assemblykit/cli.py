@@ -326,22 +326,29 @@ def _plan_input(path: str, tol: Tolerance, as_written: bool, problem: int, solut
 
 
 def _multi_move_plan(
-    loaded: Any, path: str, max_states: int | None, progress: Callable[[str, int, int], None]
+    loaded: Any,
+    path: str,
+    tol: Tolerance,
+    max_states: int | None,
+    progress: Callable[[str, int, int], None],
 ) -> Result:
-    """The multi-move plan of a loaded voxel puzzle, compared with its stored level."""
+    """The multi-move plan of a loaded voxel puzzle, compared with its stored level, or
+    of a mesh assembly."""
     from assemblykit.io.burrtools import VoxelAssembly
     from assemblykit.planning.multimove import MAX_STATES, plan_voxels
+    from assemblykit.planning.multimove_mesh import plan_meshes
 
+    limit = MAX_STATES if max_states is None else max_states
+    if getattr(loaded, "dimension", 3) == 2:
+        raise InputError("--moves multi moves 3D parts: not for a 2D polygon assembly", source=path)
     if not isinstance(loaded, VoxelAssembly):
-        raise InputError(
-            "--moves multi plans voxel puzzles: give a BurrTools .xmpuzzle", source=path
-        )
+        return plan_meshes(loaded, tol, max_states=limit, progress=progress)
     puzzle = loaded.puzzle
     return plan_voxels(
         puzzle.names,
         [p.voxels for p in puzzle.pieces],
         [p.group for p in puzzle.pieces],
-        max_states=MAX_STATES if max_states is None else max_states,
+        max_states=limit,
         reference_level=puzzle.level,
         progress=progress,
     )
@@ -384,8 +391,9 @@ def _gravity(
     type=click.Choice(["monotone", "multi", "rigid"]),
     default="monotone",
     show_default=True,
-    help="monotone: one translation per separation (NDBG); multi: sequences of lattice "
-    "moves for voxel puzzles (.xmpuzzle); rigid: monotone, then turns (screw motions) "
+    help="monotone: one translation per separation (NDBG); multi: sequences of "
+    "translations (lattice moves for .xmpuzzle voxel puzzles, contact-change distances "
+    "for meshes); rigid: monotone, then turns (screw motions) "
     "for what translations leave stuck.",
 )
 @click.option(
@@ -460,8 +468,7 @@ def plan_cmd(
     debug: bool,
 ) -> None:
     """Disassembly (and assembly) sequence by extended translations (Wilson & Latombe
-    1992), or by sequences of lattice moves for interlocking voxel puzzles (--moves
-    multi).
+    1992), or by sequences of translations for interlocking parts (--moves multi).
 
     ASSEMBLY: mesh folder, .yaml manifest, .step, COMPAS .json, or a YAML file of 2D
     polygons 'parts: {name: [[x, y], ...]}' (planned in the plane), or a BurrTools
@@ -495,7 +502,7 @@ def plan_cmd(
         if getattr(loaded, "dimension", 3) == 2 and (html is not None or png is not None):
             raise InputError("--html and --png draw meshes: not for a 2D polygon assembly")
         if moves == "multi":
-            result = _multi_move_plan(loaded, assembly, max_states, update)
+            result = _multi_move_plan(loaded, assembly, tol, max_states, update)
         elif moves == "rigid":
             from assemblykit.planning.screw import plan_with_screws
 

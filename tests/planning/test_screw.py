@@ -145,3 +145,91 @@ def test_a_sealed_hook_has_no_turn_out():
     sealed = cube((-1, -1, -1), (4.5, 2, 2.5)) - cube(*HOOK)
     assembly = Assembly([Part("box", mesh_of(sealed)), Part("hook", mesh_of(cube(*HOOK)))])
     assert screw_removal(assembly, ["hook"]) is None
+
+
+# a wedged latch: a 4 x 1 x 1 tooth on a floor between a wall at x = 0 and one at y = 0,
+# its far end cut by the plane x + y - z = 4 and pressed against a wedge on that plane
+# (the flank); a lip over x in [2.5, 3.5] two units above it and a tall plate across y
+# in [3.6, 4.6] close the way up and the way out in front
+FLANK = np.array([1.0, 1.0, -1.0]) / np.sqrt(3.0)
+
+
+def flank_cut(body: manifold3d.Manifold, keep_below: bool) -> manifold3d.Manifold:
+    side = 1.0 if keep_below else -1.0
+    return body.trim_by_plane(tuple(-side * FLANK), float(-side * FLANK @ [4.0, 0.5, 0.5]))
+
+
+def latch_base() -> manifold3d.Manifold:
+    return (
+        cube((-1, -1, -1), (6, 2, 0))
+        + cube((-1, -1, 0), (0, 1, 4))
+        + cube((-1, -1, 0), (6, 0, 4))
+        + flank_cut(cube((2.5, 0, 0), (6, 2, 1)), keep_below=False)
+        + cube((2.5, -1, 3), (3.5, 1, 3.5))
+        + cube((-1, 3.6, -1), (6, 4.6, 20))
+    )
+
+
+TOOTH = flank_cut(cube((0, 0, 0), (4, 1, 1)), keep_below=True)
+
+
+def latched() -> Assembly:
+    return Assembly([Part("base", mesh_of(latch_base())), Part("tooth", mesh_of(TOOTH))])
+
+
+def screw_is_clear(
+    points: np.ndarray,
+    base: manifold3d.Manifold,
+    point: np.ndarray,
+    axis: np.ndarray,
+    angle: float,
+    pitch: float,
+    leave: np.ndarray,
+) -> bool:
+    """Whether the convex body with vertices ``points``, screwed by ``angle`` about the
+    line (``point``, ``axis``) advancing ``pitch`` per radian along it, then sent along
+    ``leave``, never cuts into ``base`` (hulls of poses a tenth of a degree apart, as
+    :func:`turn_is_clear`)."""
+    poses = [
+        turned(points, point, axis, a) + pitch * a * axis for a in np.linspace(0.0, angle, 501)
+    ]
+    pairs = [*itertools.pairwise(poses), (poses[-1], poses[-1] + 100 * leave)]
+    return all(swept_volume(np.vstack(pair), base) <= NOISE for pair in pairs)
+
+
+def test_a_latch_pressed_on_a_flank_leaves_by_a_screw_that_slides_along_its_axis():
+    turn = screw_removal(latched(), ["tooth"])
+    assert turn is not None and turn.parts == ("tooth",)
+    # no pure turn frees it, so the turn carries a pitch: about -y through the top edge
+    # of the contact with the wall x = 0 (x = 0, z = 1), a point p of the contacts is
+    # pushed along the normal n by ((1 - p_z, 0, p_x) + h (0, -1, 0)) . n; on the flank
+    # (n = (1, 1, -1) / sqrt 3) at its vertex (3, 1, 0) that is (-2 - h) / sqrt 3, so
+    # h >= -2, while the wall y = 0 (n = -y) asks h <= 0: the screw sliding on the flank
+    # advances 2 per radian along +y
+    assert turn.axis @ [0, -1, 0] == pytest.approx(1.0)
+    assert turn.point[[0, 2]] == pytest.approx([0.0, 1.0], abs=1e-5)
+    assert turn.pitch == pytest.approx(-2.0)
+    data = turn.to_dict()
+    assert data["pitch"] == pytest.approx(-2.0)
+    assert data["advance"] == pytest.approx(-2.0 * turn.angle)
+    points = np.asarray(TOOTH.to_mesh().vert_properties)[:, :3]
+    base = latch_base()
+    assert screw_is_clear(points, base, turn.point, turn.axis, turn.angle, turn.pitch, turn.exit)
+    # the same turn without the slide, or a degree shorter, does not get out
+    assert not screw_is_clear(points, base, turn.point, turn.axis, turn.angle, 0.0, turn.exit)
+    short = turn.angle - math.radians(1)
+    assert not screw_is_clear(points, base, turn.point, turn.axis, short, turn.pitch, turn.exit)
+    # and no straight line out of the assembled pose: every axis and diagonal is blocked
+    for d in itertools.product((-1, 0, 1), repeat=3):
+        if any(d):
+            assert swept_volume(np.vstack([points, points + 100 * np.array(d)]), base) > 1e-3
+
+
+def test_plan_with_turns_prints_the_pitch():
+    result = plan_with_screws(latched())
+    # translations alone (any direction of the blocking graph) do not free the tooth
+    assert not result.stages[0].feasible
+    assert result.feasible and [s.pitch for s in result.screws] == [pytest.approx(-2.0)]
+    console = Console(record=True, width=200)
+    console.print(result.render())
+    assert "pitch -2 per rad" in console.export_text()

@@ -13,10 +13,14 @@ pair of bodies; a part with a non-convex body has no such exact decomposition he
 (:func:`convex_bodies` says so) and goes through the projection test of
 :mod:`assemblykit.geometry.occlusion` instead. (manifold3d's ``minkowski_sum`` of two
 non-convex meshes took minutes on a 576-triangle torus, too slow to use here.)
+Where exact obstacles of non-convex parts are needed (multi-move planning,
+:mod:`assemblykit.planning.multimove_mesh`), :func:`convex_pieces` cuts a part into
+convex pieces along the planes of its own faces.
 """
 
 from __future__ import annotations
 
+import manifold3d
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
@@ -24,7 +28,12 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, QhullError
 
 from assemblykit.errors import GeometryError
+from assemblykit.geometry.interference import solid
 from assemblykit.tolerance import Tolerance, current
+
+MAX_CONVEX_PIECES = 64
+"""Most convex pieces :func:`convex_pieces` cuts one part into before giving up (a
+finely tessellated curved part would need hundreds)."""
 
 LP_FIRST = 20_000
 """Vertex pairs beyond which :func:`blocking_cone` first asks :func:`overlap_depth`
@@ -63,6 +72,69 @@ def _convex_within(body: trimesh.Trimesh, tol: Tolerance) -> bool:
     facets = hull.equations
     depth = -(points @ facets[:, :3].T + facets[:, 3]).max(axis=1)
     return bool(depth.max() <= tol.length)
+
+
+def convex_pieces(
+    mesh: trimesh.Trimesh,
+    tol: Tolerance | None = None,
+    limit: int = MAX_CONVEX_PIECES,
+    name: str | None = None,
+) -> list[NDArray[np.float64]]:
+    """Vertex sets of convex pieces whose union is the closed mesh's solid, interiors
+    disjoint: each connected body that is not convex (:func:`_convex_within`; a body
+    with a cavity never is) is split by the plane of one of its own faces that has
+    vertices more than ``tol.length`` on both sides, the plane carrying the most face
+    area first, until every piece is convex. A solid lying on one side of every face
+    plane is convex, and the cuts only use the finitely many planes of the input's
+    faces, so the splitting ends; slivers thinner than the tolerance are dropped.
+    Raises :class:`GeometryError` (about part ``name``) beyond ``limit`` pieces."""
+    tol = tol or current()
+    todo = _bodies(solid(mesh, name), tol)
+    pieces: list[NDArray[np.float64]] = []
+    while todo:
+        body = todo.pop()
+        out = body.to_mesh()
+        piece = trimesh.Trimesh(
+            np.asarray(out.vert_properties, dtype=np.float64)[:, :3],
+            np.asarray(out.tri_verts, dtype=np.int64),
+        )
+        if _convex_within(piece, tol):
+            pieces.append(np.asarray(piece.vertices, dtype=np.float64))
+            continue
+        normal, offset = _cutting_plane(piece, tol, name)
+        for half in body.split_by_plane(tuple(normal), offset):
+            todo.extend(_bodies(half, tol))
+        if len(pieces) + len(todo) > limit:
+            raise GeometryError(f"more than {limit} convex pieces needed", where=name)
+    return pieces
+
+
+def _bodies(body: manifold3d.Manifold, tol: Tolerance) -> list[manifold3d.Manifold]:
+    """The connected bodies of a solid thicker than the tolerance. manifold3d's
+    ``decompose`` also returns a cavity's surface as a shell of its own (of negative
+    volume), so a solid with a cavity stays whole."""
+    shells = body.decompose()
+    if any(s.volume() <= 0 for s in shells):
+        shells = [body]
+    return [s for s in shells if s.volume() > tol.length * s.surface_area()]
+
+
+def _cutting_plane(
+    body: trimesh.Trimesh, tol: Tolerance, name: str | None
+) -> tuple[NDArray[np.float64], float]:
+    """The plane ``(normal, offset)`` of a face of the non-convex ``body`` that has
+    vertices beyond ``tol.length`` on both sides, the one carrying the most face area."""
+    normals = np.asarray(body.face_normals, dtype=np.float64)
+    offsets = np.einsum("ij,ij->i", normals, body.triangles_center)
+    keys = np.round(np.column_stack([normals / tol.angle, offsets / tol.length]))
+    planes, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    area = np.bincount(inverse.ravel(), weights=body.area_faces, minlength=len(planes))
+    for k in np.argsort(-area, kind="stable"):
+        n, c = normals[first[k]], offsets[first[k]]
+        side = body.vertices @ n - c
+        if side.max() > tol.length and side.min() < -tol.length:
+            return n, float(c)
+    raise GeometryError("a non-convex body has no face plane that cuts it", where=name)
 
 
 def obstacle_hull(obstacle: NDArray[np.float64], moving: NDArray[np.float64]) -> ConvexHull:

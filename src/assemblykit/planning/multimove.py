@@ -29,8 +29,9 @@ state's distances for all pairs and directions are one gather.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from collections import deque
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -53,13 +54,24 @@ Progress = Callable[[str, int, int], None]
 
 @dataclass(frozen=True)
 class Move:
-    """``parts`` translate by ``distance`` cells along ``direction`` (a unit lattice
-    vector) relative to the other parts of the subassembly; ``distance`` None means to
-    infinity (the move that separates)."""
+    """``parts`` translate by ``distance`` along the unit ``direction`` relative to the
+    other parts of the subassembly (on the lattice: a whole number of cells along an
+    axis); ``distance`` None means to infinity (the move that separates)."""
 
     parts: tuple[str, ...]
-    direction: tuple[int, int, int]
-    distance: int | None
+    direction: tuple[float, float, float]
+    distance: float | None
+
+    @property
+    def label(self) -> str:
+        """The direction as ``+x`` / ``-z`` when along an axis, else ``(x, y, z)``."""
+        if sorted(abs(c) for c in self.direction) == [0, 0, 1]:
+            return "".join(
+                ("+" if c > 0 else "-") + axis
+                for c, axis in zip(self.direction, "xyz", strict=True)
+                if c
+            )
+        return "(" + ", ".join(f"{float(c) + 0.0:.3f}" for c in self.direction) + ")"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON form: ``parts``, ``direction``, ``distance`` (null: to infinity)."""
@@ -122,7 +134,8 @@ class Separation:
 
 @dataclass(frozen=True)
 class MultiMovePlan:
-    """A multi-move disassembly plan of voxel pieces (module docstring); ``root`` is
+    """A multi-move disassembly plan (module docstring; of meshes:
+    :mod:`assemblykit.planning.multimove_mesh`); ``root`` is
     None for a single piece. ``reference_level`` is a level to compare with (BurrTools'
     stored one), ``max_states`` the limit each search ran under."""
 
@@ -215,13 +228,8 @@ class MultiMovePlan:
                 table.add_row(label, "-", ", ".join(node.parts), node.status, "-")
                 return
             for number, move in enumerate(node.moves, start=1):
-                distance = "inf" if move.distance is None else str(move.distance)
-                direction = "".join(
-                    ("+" if c > 0 else "-") + axis
-                    for c, axis in zip(move.direction, "xyz", strict=True)
-                    if c
-                )
-                table.add_row(label, str(number), ", ".join(move.parts), direction, distance)
+                distance = "inf" if move.distance is None else f"{move.distance:.6g}"
+                table.add_row(label, str(number), ", ".join(move.parts), move.label, distance)
             rows(node.removed, f"{label}.r")
             rows(node.left, f"{label}.l")
 
@@ -389,41 +397,64 @@ def _bits(mask: int, members: Sequence[int]) -> list[int]:
 
 @dataclass(frozen=True)
 class _Split:
-    """A separation found by the search: its ``moves``, the offsets of every piece
+    """A separation found by the search: its ``moves``, the placement of every piece
     before the last one (``final``), the pieces ``removed`` and the states visited."""
 
     moves: tuple[Move, ...]
-    final: NDArray[np.int64]
+    final: NDArray[Any]
     removed: list[int]
     states: int
 
 
-class _Planner:
-    """Breadth-first multi-move search over subassemblies of one set of pieces."""
+Found = tuple[list[int], Move]
+"""A separating move of a state: the pieces it removes and the move to infinity."""
+
+
+class MultiMoveSearch(ABC):
+    """Breadth-first multi-move search over subassemblies, shared by the lattice
+    (:func:`plan_voxels`) and by meshes (:mod:`assemblykit.planning.multimove_mesh`).
+
+    A subclass defines the states: :meth:`origin` (a state from a placement),
+    :meth:`expand` (a state's separating move, else its successors), :meth:`move` (a
+    recorded move as reported) and :meth:`placement`. States are told apart by a key
+    (bytes), so equivalent placements are visited once."""
 
     def __init__(
-        self,
-        names: Sequence[str],
-        voxels: Sequence[NDArray[np.int64]],
-        groups: Sequence[int],
-        max_states: int,
-        progress: Progress,
+        self, names: Sequence[str], groups: Sequence[int], max_states: int, progress: Progress
     ) -> None:
         self.names = list(names)
         self.groups = list(groups)
-        self.tables = _Tables([np.asarray(v, dtype=np.int64).reshape(-1, 3) for v in voxels])
         self.max_states = max_states
         self.progress = progress
         self.done = 0
 
-    def plan(self, members: list[int], offsets: NDArray[np.int64]) -> Separation:
-        """The separation tree of ``members`` starting at ``offsets`` (one row per piece
-        of the whole puzzle; rows of other pieces are ignored)."""
+    @abstractmethod
+    def origin(self, members: list[int], start: NDArray[Any]) -> tuple[bytes, Any]:
+        """The key and state of ``members`` placed as in ``start`` (one row per piece)."""
+
+    @abstractmethod
+    def expand(
+        self, members: list[int], state: Any
+    ) -> tuple[Found | None, Iterable[tuple[bytes, Any, Any]]]:
+        """A separating move of ``state`` when there is one, and the successors as
+        ``(key, state, move)`` (``move`` as given to :meth:`move`)."""
+
+    @abstractmethod
+    def move(self, members: list[int], raw: Any) -> Move:
+        """A successor's recorded move as reported."""
+
+    @abstractmethod
+    def placement(self, members: list[int], state: Any) -> NDArray[Any]:
+        """The placement of ``state`` with one row per piece of the whole."""
+
+    def plan(self, members: list[int], start: NDArray[Any]) -> Separation:
+        """The separation tree of ``members`` starting at ``start`` (one row per piece
+        of the whole; rows of other pieces are ignored)."""
         parts = tuple(self.names[m] for m in members)
         shared = {self.groups[m] for m in members}
         if len(shared) == 1 and 0 not in shared:
             return Separation(parts, (), None, None, "group", 0)
-        found = self._search(members, offsets)
+        found = self._search(members, start)
         self.progress("planning", self.done, len(self.names))
         if not isinstance(found, _Split):
             status, states = found
@@ -444,71 +475,98 @@ class _Planner:
             tuple(self.names[m] for m in found.removed),
         )
 
-    def _search(self, members: list[int], start: NDArray[np.int64]) -> _Split | tuple[str, int]:
-        """Breadth-first search from ``start`` (rows of the whole puzzle) for the fewest
-        moves that separate ``members``: the :class:`_Split`, else ``("stuck", states)``
-        or ``("cut", states)``."""
-        entries = self.tables.subset(members)
-        local = np.array(members)
-        origin = start[local] - start[local[0]]
-        key = origin.tobytes()
-        parents: dict[bytes, tuple[bytes, tuple[int, int, int]] | None] = {key: None}
-        queue = deque([key])
-        steps = np.array(AXES, dtype=np.int64)
-        bits = np.left_shift(1, np.arange(len(members), dtype=np.int64))
-        whole = np.zeros((self.tables.n, 3), dtype=np.int64)
+    def _search(self, members: list[int], start: NDArray[Any]) -> _Split | tuple[str, int]:
+        """Breadth-first search from ``start`` for the fewest moves that separate
+        ``members``: the :class:`_Split`, else ``("stuck", states)`` or
+        ``("cut", states)``."""
+        key, state = self.origin(members, start)
+        parents: dict[bytes, tuple[bytes, Any] | None] = {key: None}
+        queue = deque([(key, state)])
         while queue:
-            key = queue.popleft()
-            offsets = np.frombuffer(key, dtype=np.int64).reshape(-1, 3)
-            whole[local] = offsets
-            free = self.tables.free(whole, entries)[np.ix_(range(6), local, local)]
-            removals, moves = _moves(free)
-            if removals:
-                group, d = min(removals, key=lambda r: (bin(r[0]).count("1"), r[1], r[0]))
-                return self._separated(members, parents, key, offsets, group, d)
-            moved = (moves[:, 0:1] & bits) != 0
-            after = offsets + moved[:, :, None] * (steps[moves[:, 1]] * moves[:, 2:3])[:, None, :]
-            after = after - after[:, :1, :]
-            for row, (group, d, k) in zip(after, moves.tolist(), strict=True):
-                child = row.tobytes()
+            key, state = queue.popleft()
+            found, children = self.expand(members, state)
+            if found is not None:
+                path = []
+                at = parents[key]
+                while at is not None:
+                    path.append(at[1])
+                    at = parents[at[0]]
+                moves = [self.move(members, raw) for raw in reversed(path)]
+                removed, last = found
+                final = self.placement(members, state)
+                return _Split((*moves, last), final, removed, len(parents))
+            for child, after, raw in children:
                 if child not in parents:
-                    parents[child] = (key, (group, d, k))
-                    queue.append(child)
+                    parents[child] = (key, raw)
+                    queue.append((child, after))
             if len(parents) > self.max_states:
                 return ("cut", len(parents))
         return ("stuck", len(parents))
 
-    def _separated(
+
+class _Planner(MultiMoveSearch):
+    """The lattice states of the module docstring: integer offsets, moves from the
+    distance tables; a state is its own key."""
+
+    def __init__(
         self,
-        members: list[int],
-        parents: dict[bytes, tuple[bytes, tuple[int, int, int]] | None],
-        key: bytes,
-        offsets: NDArray[np.int64],
-        group: int,
-        d: int,
-    ) -> _Split:
-        path = []
-        at = parents[key]
-        while at is not None:
-            path.append(at[1])
-            at = parents[at[0]]
-        full = (1 << len(members)) - 1
+        names: Sequence[str],
+        voxels: Sequence[NDArray[np.int64]],
+        groups: Sequence[int],
+        max_states: int,
+        progress: Progress,
+    ) -> None:
+        super().__init__(names, groups, max_states, progress)
+        self.tables = _Tables([np.asarray(v, dtype=np.int64).reshape(-1, 3) for v in voxels])
+        self.steps = np.array(AXES, dtype=np.int64)
+        self.entries: dict[tuple[int, ...], NDArray[np.bool_]] = {}
+
+    def origin(self, members: list[int], start: NDArray[Any]) -> tuple[bytes, Any]:
+        local = np.array(members)
+        key = (start[local] - start[local[0]]).astype(np.int64).tobytes()
+        return key, key
+
+    def expand(
+        self, members: list[int], state: Any
+    ) -> tuple[Found | None, Iterable[tuple[bytes, Any, Any]]]:
+        entries = self.entries.setdefault(tuple(members), self.tables.subset(members))
+        offsets = np.frombuffer(state, dtype=np.int64).reshape(-1, 3)
+        whole = np.zeros((self.tables.n, 3), dtype=np.int64)
+        whole[members] = offsets
+        free = self.tables.free(whole, entries)[np.ix_(range(6), members, members)]
+        removals, moves = _moves(free)
+        if removals:
+            group, d = min(removals, key=lambda r: (bin(r[0]).count("1"), r[1], r[0]))
+            return self._separating(members, group, d), ()
+        bits = np.left_shift(1, np.arange(len(members), dtype=np.int64))
+        moved = (moves[:, 0:1] & bits) != 0
+        step = self.steps[moves[:, 1]] * moves[:, 2:3]
+        after = offsets + moved[:, :, None] * step[:, None, :]
+        after = after - after[:, :1, :]
+        keys = [row.tobytes() for row in after]
+        return None, zip(keys, keys, map(tuple, moves.tolist()), strict=True)
+
+    def move(self, members: list[int], raw: Any) -> Move:
         # the first piece stays put: a group holding it is reported as the others
         # moving the opposite way (the same relative motion)
-        moves = [
-            self._move(full ^ g, dd ^ 1, k, members) if g & 1 else self._move(g, dd, k, members)
-            for g, dd, k in reversed(path)
-        ]
+        group, d, k = raw
+        if group & 1:
+            group, d = ((1 << len(members)) - 1) ^ group, d ^ 1
+        return self._move(group, d, k, members)
+
+    def placement(self, members: list[int], state: Any) -> NDArray[Any]:
+        final = np.zeros((self.tables.n, 3), dtype=np.int64)
+        final[members] = np.frombuffer(state, dtype=np.int64).reshape(-1, 3)
+        return final
+
+    def _separating(self, members: list[int], group: int, d: int) -> Found:
         removed = _bits(group, members)
         if 2 * len(removed) > len(members):
             # report the smaller half as the one removed, moving the other way
             removed = [m for m in members if m not in removed]
             d ^= 1
             group = sum(1 << k for k, m in enumerate(members) if m in removed)
-        moves.append(self._move(group, d, None, members))
-        final = np.zeros((self.tables.n, 3), dtype=np.int64)
-        final[members] = offsets
-        return _Split(tuple(moves), final, removed, len(parents))
+        return removed, self._move(group, d, None, members)
 
     def _move(self, group: int, d: int, k: int | None, members: list[int]) -> Move:
         parts = tuple(self.names[m] for m in _bits(group, members))

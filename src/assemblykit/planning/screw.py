@@ -10,15 +10,22 @@ interlocked set that Γ_g may free, this module looks for a *finite* motion:
   coordinate axes and the cross products of its contact normals (the hinge lines a
   part can pivot on), both ways; a candidate must pass Γ_g's first-order test (no
   contact pushed into, at least one left);
-* each is followed as a screw (pitch 0) in ``samples`` steps up to ``max_angle``; every
-  sampled pose is checked with manifold3d: the moved set may share with the rest no
-  more than the interference threshold (:mod:`assemblykit.geometry.interference`);
+* each is followed as a screw in ``samples`` steps up to ``max_angle``; every sampled
+  pose is checked with manifold3d: the moved set may share with the rest no more than
+  the interference threshold (:mod:`assemblykit.geometry.interference`);
+* pure turns (pitch 0) are tried first; when none works, each line is tried again
+  with a pitch ``h`` (a translation of ``h`` per radian along the axis, a *finite
+  screw motion*): to first order a contact at ``p`` with normal ``n`` is pushed into
+  by ``(omega x (p - c)) . n + h omega . n``, so each contact whose normal is not
+  square to the axis (a thread's flank) bounds ``h`` on one side; the ends of the
+  interval the contacts leave open are the pitches tried, the screw that slides along
+  the flank it presses on;
 * at each pose the set must then leave by a straight translation along a coordinate
   axis: the convex hull of the set before and after a translation longer than the
   model contains the whole sweep, so a hull that meets nothing is a sound exit.
 
-A found motion is a plan step with its axis (a point and a direction), its angle and
-the exit direction that follows. Only sampled poses are checked during the turn: the
+A found motion is a plan step with its axis (a point and a direction), its angle, its
+pitch and the exit direction that follows. Only sampled poses are checked during the turn: the
 step between samples is ``max_angle / samples``.
 """
 
@@ -54,8 +61,8 @@ _EXITS = np.vstack([np.eye(3), -np.eye(3)])
 @dataclass(frozen=True, eq=False)
 class ScrewStep:
     """``parts`` turn by ``angle`` (radians, right-handed) about the line through
-    ``point`` along unit ``axis``, away from ``rest``, then translate along ``exit`` to
-    infinity."""
+    ``point`` along unit ``axis`` while translating ``pitch`` per radian along it, away
+    from ``rest``, then translate along ``exit`` to infinity."""
 
     parts: tuple[str, ...]
     rest: tuple[str, ...]
@@ -63,15 +70,18 @@ class ScrewStep:
     axis: NDArray[np.float64]
     angle: float
     exit: NDArray[np.float64]
+    pitch: float = 0.0
     motion: str = "screw"
 
     def pose(self, fraction: float) -> NDArray[np.float64]:
         """The transform of the moved parts after ``fraction`` of the turn."""
-        return se3.screw(self.point, self.axis, 0.0, self.angle * fraction)
+        return se3.screw(self.point, self.axis, self.pitch, self.angle * fraction)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON form: ``parts``, ``rest``, ``motion`` (``screw``), ``axis`` (``point``,
-        ``direction``), ``angle`` (radians), ``angle_deg``, ``pitch`` (0) and ``exit``."""
+        ``direction``), ``angle`` (radians), ``angle_deg``, ``pitch`` (model units per
+        radian along the axis; 0 for a pure turn), ``advance`` (pitch x angle) and
+        ``exit``."""
         return {
             "parts": list(self.parts),
             "rest": list(self.rest),
@@ -79,16 +89,19 @@ class ScrewStep:
             "axis": {"point": self.point.tolist(), "direction": self.axis.tolist()},
             "angle": self.angle,
             "angle_deg": math.degrees(self.angle),
-            "pitch": 0.0,
+            "pitch": self.pitch,
+            "advance": self.pitch * self.angle,
             "direction": self.exit.tolist(),
             "exit": self.exit.tolist(),
         }
 
 
 def _candidates(
-    points: NDArray[np.float64], normals: NDArray[np.float64], tol: Tolerance
-) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
-    """Rotation lines ``(point, signed axis)`` that pass Γ_g's first-order test."""
+    points: NDArray[np.float64], normals: NDArray[np.float64], tol: Tolerance, pitched: bool
+) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float]]:
+    """Screw lines ``(point, signed axis, pitch)`` that pass Γ_g's first-order test (no
+    contact pushed into, at least one left): pure turns, or with ``pitched`` the ends of
+    the interval of pitches the contacts allow (module docstring)."""
     directions = [*np.eye(3)]
     for a in range(len(normals)):
         for b in range(a + 1, len(normals)):
@@ -106,12 +119,27 @@ def _candidates(
     for axis in axes:
         for sign in (1.0, -1.0):
             omega = sign * axis
+            # along each normal: the turn's velocity of its contact point, and the pitch's
+            along = normals @ omega
             for pivot in pivots:
-                # velocity of each contact point; it must not push along its normal
-                push = np.einsum("ij,ij->i", np.cross(omega, points - pivot), normals)
-                if push.max() <= tol.length and push.min() < -tol.length:
-                    found.append((pivot, omega))
+                turn = np.einsum("ij,ij->i", np.cross(omega, points - pivot), normals)
+                for pitch in _pitches(turn, along, tol) if pitched else [0.0]:
+                    push = turn + pitch * along
+                    if push.max() <= tol.length and push.min() < -tol.length:
+                        found.append((pivot, omega, pitch))
     return found
+
+
+def _pitches(turn: NDArray[np.float64], along: NDArray[np.float64], tol: Tolerance) -> list[float]:
+    """The finite, nonzero ends of the interval of pitches ``h`` with
+    ``turn + h along <= 0`` at every contact (module docstring)."""
+    slanted = np.abs(along) > tol.angle
+    bounds = -turn[slanted] / along[slanted]
+    low = bounds[along[slanted] < 0].max(initial=-np.inf)
+    high = bounds[along[slanted] > 0].min(initial=np.inf)
+    if low > high + tol.length:
+        return []
+    return [float(h) for h in (low, high) if np.isfinite(h) and abs(h) > tol.length]
 
 
 def _placed(body: manifold3d.Manifold, pose: NDArray[np.float64]) -> manifold3d.Manifold:
@@ -138,8 +166,9 @@ def screw_removal(
     max_angle: float = MAX_ANGLE,
     samples: int = SAMPLES,
 ) -> ScrewStep | None:
-    """A turn that takes ``parts`` out of the rest of ``assembly`` followed by a straight
-    exit (module docstring), or None when no candidate works."""
+    """A turn (a pure one if any works, else a screw with a pitch) that takes ``parts``
+    out of the rest of ``assembly`` followed by a straight exit (module docstring), or
+    None when no candidate works."""
     moving = tuple(p for p in assembly.names if p in set(parts))
     rest = tuple(p for p in assembly.names if p not in set(moving))
     if not moving or not rest:
@@ -154,17 +183,20 @@ def screw_removal(
     body, others = solid(moving_mesh), solid(rest_mesh)
     limit = interference_threshold(moving_mesh, rest_mesh, tol)
     reach = 2.0 * assembly.scale
-    for pivot, omega in _candidates(points, normals, tol):
-        axis = omega / np.linalg.norm(omega)
-        for k in range(1, samples + 1):
-            angle = max_angle * k / samples
-            moved = _placed(body, se3.screw(pivot, axis, 0.0, angle))
-            if (moved ^ others).volume() > limit:
-                break
-            leave = _exit(moved, others, reach, limit)
-            if leave is not None:
-                # + 0.0: no negative zeros in what is printed
-                return ScrewStep(moving, rest, pivot + 0.0, axis + 0.0, angle, leave + 0.0)
+    for pitched in (False, True):
+        for pivot, omega, pitch in _candidates(points, normals, tol, pitched):
+            axis = omega / np.linalg.norm(omega)
+            for k in range(1, samples + 1):
+                angle = max_angle * k / samples
+                moved = _placed(body, se3.screw(pivot, axis, pitch, angle))
+                if (moved ^ others).volume() > limit:
+                    break
+                leave = _exit(moved, others, reach, limit)
+                if leave is not None:
+                    # + 0.0: no negative zeros in what is printed
+                    return ScrewStep(
+                        moving, rest, pivot + 0.0, axis + 0.0, angle, leave + 0.0, pitch + 0.0
+                    )
     return None
 
 
@@ -223,7 +255,8 @@ class ScrewPlan:
                 table.add_row(
                     str(number),
                     ", ".join(turn.parts),
-                    f"turn {math.degrees(turn.angle):.1f} deg",
+                    f"turn {math.degrees(turn.angle):.1f} deg"
+                    + (f", pitch {turn.pitch:.4g} per rad" if turn.pitch else ""),
                     axis,
                     ", ".join(f"{x:.3g}" for x in turn.exit),
                 )
