@@ -5,6 +5,7 @@ again state by state from its JSON."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -16,8 +17,10 @@ from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.sequence import plan
 from assemblykit.planning.stability import (
+    CONE_SIDES,
     FRICTION_STEPS,
     Gravity,
+    contact_points,
     equilibrium,
     equilibrium_model,
     gravity_direction,
@@ -244,3 +247,50 @@ def test_the_asap_beam_comes_apart_beams_first_without_holds():
     assert [step["parts"] for step in data["assembly_steps"]] == [
         step["parts"] for step in reversed(data["steps"])
     ]
+
+
+def compas_forces(path) -> tuple[list[tuple[str, str, np.ndarray, np.ndarray]], float]:
+    """The interface forces that compas_cra solved and stored in a COMPAS assembly file:
+    per point (pushing block, pushed block, point, force), and the largest ratio of
+    friction to compression among them."""
+    edges = json.loads(path.read_text())["data"]["graph"]["data"]["edge"]
+    found, ratio = [], 0.0
+    for u, neighbours in edges.items():
+        for v, edge in neighbours.items():
+            for interface in edge["interfaces"] or ():
+                data = interface["data"]
+                frame = data["frame"]["data"]
+                x, y = np.array(frame["xaxis"]), np.array(frame["yaxis"])
+                for point, force in zip(data["points"], data["forces"], strict=True):
+                    normal = force["c_np"] - force["c_nn"]
+                    vector = normal * np.cross(x, y) + force["c_u"] * x + force["c_v"] * y
+                    found.append((u, v, np.array(point["data"]), vector))
+                    ratio = max(ratio, math.hypot(force["c_u"], force["c_v"]) / normal)
+    return found, ratio
+
+
+def test_an_independent_solution_of_the_arch_agrees_with_the_program():
+    # compas_cra's stored interface forces, a solution found by another solver, balance
+    # every free block's weight (density 1, at its volume centroid) as this model states
+    # them; their points are this model's force points, so any friction whose inscribed
+    # pyramid holds them (ratio / cos(pi / 8)) must let the program find the arch standing
+    path = dataset("compas_assembly/arch_assembly.json")
+    assembly = load_assembly(path)
+    forces, ratio = compas_forces(path)
+    wrench = {name: np.zeros(6) for name in assembly.names}
+    for name, part in assembly.parts.items():
+        weight = np.array([0.0, 0.0, -part.volume])
+        wrench[name] += np.r_[weight, np.cross(part.mesh.center_mass, weight)]
+    for pushing, pushed, point, force in forces:
+        wrench[pushed] += np.r_[force, np.cross(point, force)]
+        wrench[pushing] -= np.r_[force, np.cross(point, force)]
+    model = equilibrium_model(assembly)
+    free = [name for name in assembly.names if name not in model.fixed]
+    assert max(np.abs(wrench[name]).max() / assembly.parts[name].volume for name in free) < 1e-4
+    ours = contact_points(assembly, [0, 0, -1]).points
+    assert all(np.linalg.norm(ours - point, axis=1).min() < 1e-6 for _, _, point, _ in forces)
+    enough = ratio / math.cos(math.pi / CONE_SIDES)
+    assert 0.1 < enough < MU
+    assert equilibrium_model(assembly, friction=enough).check().stands
+    needed = model.friction_needed(model.mask(None), model.mask(model.fixed))
+    assert needed is not None and needed <= enough + RESOLUTION
