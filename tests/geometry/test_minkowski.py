@@ -73,6 +73,17 @@ def test_convex_pieces_split_bodies():
     assert sorted(round(float(p[:, 0].mean()), 9) for p in pieces) == [0.0, 3.0]
 
 
+def test_a_hollow_box_is_not_two_convex_solids():
+    """A box with a sealed cavity is two shells, the inner one facing inwards: the part is
+    not convex (its cavity is empty space, not a second solid)."""
+    outer = trimesh.creation.box(extents=(5, 3, 3))
+    cavity = trimesh.creation.box(extents=(3, 1, 1))
+    cavity.invert()
+    hollow = trimesh.util.concatenate([outer, cavity])
+    assert hollow.body_count == 2 and hollow.volume == pytest.approx(45 - 3)
+    assert convex_bodies(hollow) is None
+
+
 def test_a_non_convex_body_has_no_convex_decomposition():
     notch = trimesh.creation.box(extents=(2, 2, 2)).difference(
         trimesh.creation.box(

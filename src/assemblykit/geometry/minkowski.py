@@ -43,8 +43,9 @@ whether the pieces overlap (then the hull of their differences is not needed).""
 def convex_bodies(
     mesh: trimesh.Trimesh, tol: Tolerance | None = None
 ) -> list[NDArray[np.float64]] | None:
-    """Vertex sets of the connected bodies of the mesh when each is convex within the
-    length tolerance, else ``None``.
+    """Vertex sets of the connected bodies of the mesh when each is a convex solid within
+    the length tolerance, else ``None`` (also for a hollow part, whose cavity is a shell
+    facing inwards).
 
     A body counts as convex when none of its vertices or face centres lies deeper than
     ``tol.length`` inside its convex hull: blocks whose polygon faces are not quite
@@ -52,6 +53,9 @@ def convex_bodies(
     moves their surface by at most the tolerance."""
     tol = tol or current()
     bodies = [mesh] if mesh.body_count < 2 else mesh.split(only_watertight=False)
+    # a shell facing inwards bounds a cavity, not a solid: the part is not convex
+    if any(body.is_watertight and body.volume < 0 for body in bodies):
+        return None
     if not all(_convex_within(body, tol) for body in bodies):
         return None
     return [np.asarray(body.vertices, dtype=np.float64) for body in bodies]
