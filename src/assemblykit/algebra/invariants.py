@@ -11,6 +11,7 @@ from __future__ import annotations
 import functools
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -189,8 +190,27 @@ def _pair_measures(a: Invariant, b: Invariant, tol: Tolerance) -> list[tuple[str
     return out
 
 
-def _describe_mismatch(kind: str, value: float, i: int, j: int) -> Mismatch:
-    where = f"between invariants {i} and {j}"
+_NOUNS: dict[type, str] = {
+    PointInvariant: "point",
+    LineInvariant: "axis",
+    PlaneInvariant: "plane",
+    DirectionInvariant: "direction",
+}
+
+
+def _elements(invariants: Sequence[Invariant], i: int, j: int) -> str:
+    """Invariants ``i`` and ``j`` of a feature in words: ``the axis and the plane``, or
+    ``planes 1 and 2`` when they are of one kind (numbered among the feature's own)."""
+    nouns = [_NOUNS[type(v)] for v in invariants]
+    if nouns[i] != nouns[j]:
+        return f"the {nouns[i]} and the {nouns[j]}"
+    rank = [k for k in range(len(nouns)) if nouns[k] == nouns[i]]
+    plural = "axes" if nouns[i] == "axis" else f"{nouns[i]}s"
+    return f"{plural} {rank.index(i) + 1} and {rank.index(j) + 1}"
+
+
+def _describe_mismatch(kind: str, value: float, between: str) -> Mismatch:
+    where = f"between {between}"
     if kind == "angle":
         text = f"angle mismatch {math.degrees(value):.6g}° {where}"
     elif kind == "moment":
@@ -227,9 +247,9 @@ def congruence_mismatch(
         for (kind, vt), (_, vs) in zip(mt, ms, strict=False):
             limit = tol.angle if kind == "angle" else tol.length
             if abs(vt - vs) > limit:
-                return _describe_mismatch(kind, abs(vt - vs), i, j)
+                return _describe_mismatch(kind, abs(vt - vs), _elements(targets, i, j))
         if len(mt) != len(ms):
-            return _describe_mismatch("angle", 0.0, i, j)
+            return _describe_mismatch("angle", 0.0, _elements(targets, i, j))
     return None
 
 

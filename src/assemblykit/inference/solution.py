@@ -59,7 +59,7 @@ class BodyInstanceResult:
     lattice); for a continuum (``dof > 0``) it counts the components found. ``freedom``
     says in words what is free; ``mechanism`` names a freedom that is no Hervé family
     (a higher pair: ``point-in-plane``, ``point-on-line``, ``planar-point-on-line``,
-    ``line-on-plane``).
+    ``line-on-plane``, ``roll-and-slide``; :data:`MECHANISMS`).
     """
 
     body: str
@@ -112,11 +112,30 @@ def point_text(point: Any) -> str:
     return fmt.vector(np.asarray(point, dtype=np.float64))
 
 
-def freedom_words(motion: str, dof: int, invariants: Mapping[str, Any]) -> str:
+MECHANISMS = {
+    "point-in-plane": "can slide its point {point} in the plane normal to {normal} and turn"
+    " about it",
+    "point-on-line": "can slide its point {point} along {direction} and turn about it",
+    "planar-point-on-line": "can slide its point {point} along {direction} and turn about"
+    " {normal} through it",
+    "line-on-plane": "keeps its line through {point} along {direction} parallel to the plane"
+    " normal to {normal}: it can slide in the plane and turn about the normal and about the"
+    " line",
+    "roll-and-slide": "can turn about its line through {point} along {direction} and slide"
+    " that line sideways, keeping it parallel to the plane normal to {normal}",
+}
+"""The freedoms of higher pairs that are no Hervé family, in words (the ``mechanism``
+names of :class:`BodyInstanceResult`; the placeholders are their invariants)."""
+
+
+def freedom_words(motion: str, dof: int, invariants: Mapping[str, Any], mechanism: str = "") -> str:
     """What remains free, in words, after the instance's name: ``"can turn about (0.5, 1,
-    1.5): 3 dof"``; empty for a fixed instance. A ``mechanism`` that the reduction does
-    not name (a closed loop, a coupled joint, a relation that is no coset) says its dof."""
+    1.5): 3 dof"``; empty for a fixed instance. A named ``mechanism`` says its freedom
+    (:data:`MECHANISMS`); one that the reduction does not name (a closed loop, a coupled
+    joint, a relation that is no coset) says its dof."""
     inv = {k: _invariant_text(k, v) for k, v in invariants.items() if k != "pitch"}
+    if dof and mechanism in MECHANISMS:
+        return f"{MECHANISMS[mechanism].format(**inv)}: {dof} dof"
     phrases = {
         "revolute": "turn about the axis through {point} along {direction}",
         "prismatic": "slide along {direction}",
@@ -165,6 +184,9 @@ _REMEDIES = {
     " a revolute about {normal}) and a stop off that axis",
     "line-on-plane": "a second point of the body on the plane (the turn about the line) and"
     " stops in the plane (the slides and the turn about {normal})",
+    "roll-and-slide": "a stop against the slide (an against or point_on_plane on a face whose"
+    " normal leaves the plane of {direction} and {normal}) and a stop off the line (the turn"
+    " about it)",
 }
 
 
@@ -396,7 +418,7 @@ class Solution:
             table.add_row(
                 key,
                 str(b.dof),
-                f"{b.motion} ({b.mechanism})" if b.mechanism else b.motion,
+                b.mechanism or b.motion,
                 "infinite" if b.solutions is None else str(b.solutions),
                 fmt.vector(np.asarray(b.pose)[:3, 3]),
                 ", ".join(
