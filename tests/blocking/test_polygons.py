@@ -3,8 +3,6 @@ on hand-drawn parts whose blocked arcs are derived from their vertices."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -121,17 +119,3 @@ def test_clockwise_points_are_turned_and_self_crossing_ones_refused():
     bow_tie = np.array([[0, 0], [1, 1], [1, 0], [0, 1]], dtype=float)
     with pytest.raises(GeometryError, match=r"parts\.tie"):
         counter_clockwise(bow_tie, "tie", "f.yaml")
-
-
-def test_blocking_imports_nothing_from_io():
-    # a fresh interpreter: every blocking module
-    code = (
-        "import importlib, pkgutil, sys\n"
-        "import assemblykit.blocking as b\n"
-        "for m in pkgutil.iter_modules(b.__path__):\n"
-        "    importlib.import_module('assemblykit.blocking.' + m.name)\n"
-        "print(sorted(n for n in sys.modules if n.startswith('assemblykit.io')))\n"
-    )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.splitlines() == ["[]"]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import ast
 import math
 from pathlib import Path
 
@@ -59,15 +58,3 @@ def test_problem_diagonal() -> None:
         float(np.linalg.norm([5, 4, 12]))
     )
     assert problem_diagonal({"a": {"p": FEATURES["face"]}}, {"a": None}) == 1.0
-
-
-def test_mating_imports_no_higher_layer() -> None:
-    # DESIGN.md §3: mating sits below io, viz, batch and cli.
-    package = Path(__file__).resolve().parents[2] / "src" / "assemblykit" / "mating"
-    higher = ("assemblykit.io", "assemblykit.viz", "assemblykit.batch", "assemblykit.cli")
-    for source in package.glob("*.py"):
-        tree = ast.parse(source.read_text(encoding="utf-8"))
-        names = [
-            node.module or "" for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
-        ] + [a.name for node in ast.walk(tree) if isinstance(node, ast.Import) for a in node.names]
-        assert not [n for n in names if n.startswith(higher)], source.name
