@@ -1,6 +1,8 @@
-"""Higher pairs in closed form: a point held in planes and lines, alone and with a lower
-pair (ALGEBRA.md §3, §5.3; inference/network.py folds the loci, inference/reduction.py
-solves them). Every expected pose and invariant is worked out by hand in the comments."""
+"""Higher pairs in closed form: a point held in planes and lines, a line lying on a plane
+(a cylinder on a plane, an edge on a face), alone and with a lower pair or a point
+(ALGEBRA.md §3, §5.3; inference/network.py folds the loci, inference/reduction.py solves
+them). Every expected pose and invariant is worked out by hand in the comments, and checked
+against the relations' own residuals and the residue solver's Jacobian rank."""
 
 from __future__ import annotations
 
@@ -15,7 +17,7 @@ from assemblykit.features.primitives import Axis, Ball, Hole, Plane, Point, Shaf
 from assemblykit.inference import solve_numeric_only
 from assemblykit.io.spec import load_task
 from assemblykit.model.body import Body
-from assemblykit.model.relations import FeatureRef, Relation
+from assemblykit.model.relations import FeatureRef, Relation, relation_residual
 from assemblykit.model.task import Situation, Task
 
 EXACT = 1e-12
@@ -407,3 +409,258 @@ def test_edge_on_face_is_a_line_in_the_plane():
     assert se3.apply(pose, (0, 0, 2))[2] == pytest.approx(0.0, abs=EXACT)
     assert (pose[:3, :3] @ (0, 1 / SQRT2, 1 / SQRT2))[2] == pytest.approx(0.0, abs=EXACT)
     assert solve_numeric_only(make_task([WORLD, edge], on_face))["slab@s1"].dof == 4
+
+
+# ------------------------------------------------- a line contact with a lower pair
+#
+# The table z = 0 and the wall x = 5 (normal -x) of WORLD; a bearing (a hole of radius 1
+# along x) at the roller's height z = 1 and one at z = 3, and a spindle (an axis) at z = 1.
+# The roller: radius 1, its axle the x axis, its end face at x = 2 facing +x, a lever
+# tip 2 from the axle at (0, 2, 0) and a mark on its surface at (0, 1, 0).
+SHOP = Body(
+    "world",
+    {
+        **WORLD.features,
+        "bearing": Hole((0, 0, 1), X, 1.0),
+        "high": Hole((0, 0, 3), X, 1.0),
+        "spindle": Axis((0, 0, 1), X),
+    },
+    fixed=True,
+)
+WHEEL = Body(
+    "roller",
+    {
+        "axle": Shaft((0, 0, 0), X, 1.0),
+        "end": Plane((2, 0, 0), X),
+        "lever": Point((0, 2, 0)),
+        "mark": Point((0, 1, 0)),
+        "stub": Point((0, 0.5, 0)),
+    },
+)
+LYING = rel("distance", "roller.axle", "world.table", distance=1.0)
+# A slab whose bottom edge runs along x at z = 2 as written, its end face at x = 2.
+SLAB = Body(
+    "slab",
+    {
+        "edge": Axis((0, 0, 2), X),
+        "tilted": Axis((0, 0, 2), (0.6, 0, 0.8)),
+        "end": Plane((2, 0, 0), X),
+        "bottom": Plane((0, 0, 2), (0, 0, -1)),
+        "base": Plane((0, 0, 2.5), (0, 0, -1)),
+    },
+)
+EDGE_DOWN = rel("distance", "slab.edge", "world.table", distance=0.0)
+
+
+def residual_at(bodies: list[Body], pose, *relations: Relation) -> float:
+    """The largest residual of ``relations`` (moving body first, world second) at ``pose``,
+    straight from the relations' definitions (model/relations.py), not the reduction."""
+    features = {f"{b.name}.{k}": f for b in bodies for k, f in b.features.items()}
+    worst = 0.0
+    for r in relations:
+        first, second = (features[f"{ref.body}.{ref.feature}"] for ref in r.refs)
+        residual = relation_residual(r.kind, first, second, r.options)
+        worst = max(worst, float(np.abs(residual(np.asarray(pose))).max()))
+    return worst
+
+
+def about(point, direction, angle: float) -> np.ndarray:
+    """The rotation by ``angle`` about the line through ``point`` along ``direction``."""
+    return (
+        shift(*point)
+        @ se3.rotation(np.asarray(direction, float), angle)
+        @ shift(*(-np.asarray(point, float)))
+    )
+
+
+def test_roller_on_the_table_with_its_end_against_a_wall_rolls_and_slides():
+    relations = (LYING, rel("against", "roller.end", "world.wall"))
+    out = solve([SHOP, WHEEL], *relations)
+    b = out["bodies"]["roller@s1"]
+    # the end face x = 2 goes onto the wall x = 5 (a shift of 3 along x), the axle onto
+    # z = 1 (a lift of 1): the axle (3, 0, 1) + s·x can turn about itself and slide along
+    # y (the wall's planar pair keeps its direction x; the table keeps its height)
+    assert (b["dof"], b["motion"], b["mechanism"]) == (2, "mechanism", "roll-and-slide")
+    np.testing.assert_allclose(b["pose"], shift(3, 0, 1), atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["point"], [3, 0, 1], atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["direction"], X, atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["normal"], Z, atol=EXACT)
+    assert b["freedom"] == (
+        "roller@s1 can turn about its line through (3, 0, 1) along +X and slide that line"
+        " sideways, keeping it parallel to the plane normal to +Z: 2 dof; a stop against the"
+        " slide (an against or point_on_plane on a face whose normal leaves the plane of +X"
+        " and +Z) and a stop off the line (the turn about it) would remove it"
+    )
+    rules = [step["rule"] for step in out["trace"]]
+    assert "higher-pair" in rules and "residue" not in rules
+    # the set as claimed: any turn about the line and slide along y keeps both relations;
+    # a turn about the vertical or a lift does not (so it is no planar coset)
+    pose = np.asarray(b["pose"])
+    assert residual_at([SHOP, WHEEL], pose, *relations) < EXACT
+    moved = shift(0, -1.3) @ about((3, 0, 1), X, 0.7) @ pose
+    assert residual_at([SHOP, WHEEL], moved, *relations) < 1e-12
+    assert residual_at([SHOP, WHEEL], about((3, 0, 1), Z, 0.1) @ pose, *relations) > 0.05
+    assert residual_at([SHOP, WHEEL], shift(0, 0, 0.1) @ pose, *relations) > 0.05
+    # the independent measure of the dof: the residue's Jacobian rank
+    assert solve_numeric_only(make_task([SHOP, WHEEL], *relations))["roller@s1"].dof == 2
+
+
+@pytest.mark.parametrize(("kind", "support"), [("fits", "bearing"), ("coaxial", "spindle")])
+def test_roller_on_the_table_in_a_bearing_at_its_height_is_cylindrical(kind, support):
+    relations = (LYING, rel(kind, "roller.axle", f"world.{support}"))
+    out = solve([SHOP, WHEEL], *relations)
+    b = out["bodies"]["roller@s1"]
+    # the bearing's axis y = 0, z = 1 is the height of an axle resting on the table: the
+    # line contact adds nothing, the roller slides along and turns about that axis
+    assert out["status"] == "underconstrained"
+    assert (b["dof"], b["motion"]) == (2, "cylindrical")
+    assert "mechanism" not in b
+    np.testing.assert_allclose(b["pose"], shift(0, 0, 1), atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["point"][1:], [0, 1], atol=EXACT)
+    assert unoriented(b["invariants"]["direction"], X)
+    assert "residue" not in [step["rule"] for step in out["trace"]]
+    pose = np.asarray(b["pose"])
+    moved = about((0, 0, 1), X, 2.1) @ shift(4.2) @ pose
+    assert residual_at([SHOP, WHEEL], moved, *relations) < 1e-12
+    assert solve_numeric_only(make_task([SHOP, WHEEL], *relations))["roller@s1"].dof == 2
+
+
+def test_roller_on_the_table_in_a_bearing_above_its_height_conflicts_by_the_gap():
+    out = solve([SHOP, WHEEL], LYING, rel("fits", "roller.axle", "world.high"))
+    assert out["status"] == "inconsistent"
+    (conflict,) = out["conflicts"]
+    # the bearing holds the axle at z = 3, the table at z = 1: two apart
+    assert (conflict["kind"], conflict["value"]) == ("distance", pytest.approx(2.0, abs=EXACT))
+    assert set(conflict["relations"]) == {
+        "fits roller.axle world.high @s1",
+        "distance roller.axle world.table @s1",
+    }
+
+
+def test_box_edge_on_the_table_with_its_end_against_a_wall_rolls_and_slides():
+    relations = (EDGE_DOWN, rel("against", "slab.end", "world.wall"))
+    b = solve([SHOP, SLAB], *relations)["bodies"]["slab@s1"]
+    # the edge at z = 2 drops onto z = 0, the end face x = 2 moves onto x = 5: the box
+    # can tip about its edge (3, 0, 0) + s·x and slide along y
+    assert (b["dof"], b["motion"], b["mechanism"]) == (2, "mechanism", "roll-and-slide")
+    np.testing.assert_allclose(b["pose"], shift(3, 0, -2), atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["point"], [3, 0, 0], atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["direction"], X, atol=EXACT)
+    pose = np.asarray(b["pose"])
+    moved = shift(0, 2.5) @ about((3, 0, 0), X, -0.4) @ pose
+    assert residual_at([SHOP, SLAB], moved, *relations) < 1e-12
+    assert solve_numeric_only(make_task([SHOP, SLAB], *relations))["slab@s1"].dof == 2
+
+
+def test_box_on_the_table_with_an_edge_of_its_bottom_on_it_stays_planar():
+    relations = (EDGE_DOWN, rel("against", "slab.bottom", "world.table"))
+    out = solve([SHOP, SLAB], *relations)
+    b = out["bodies"]["slab@s1"]
+    # the edge lies in the bottom face: the planar pair of z, lowered by 2, holds it
+    assert (b["dof"], b["motion"]) == (3, "planar")
+    np.testing.assert_allclose(b["pose"], shift(0, 0, -2), atol=EXACT)
+    assert unoriented(b["invariants"]["normal"], Z)
+    assert "residue" not in [step["rule"] for step in out["trace"]]
+    assert solve_numeric_only(make_task([SHOP, SLAB], *relations))["slab@s1"].dof == 3
+
+
+def test_an_edge_above_the_face_on_the_table_conflicts_by_its_height():
+    out = solve([SHOP, SLAB], EDGE_DOWN, rel("against", "slab.base", "world.table"))
+    (conflict,) = out["conflicts"]
+    # the base face is 0.5 above the edge: on the table, the edge stays 0.5 below it
+    assert (conflict["kind"], conflict["value"]) == ("distance", pytest.approx(0.5, abs=EXACT))
+
+
+def test_a_tilted_edge_cannot_lie_on_the_table_the_planar_pair_keeps_level():
+    tilted = rel("distance", "slab.tilted", "world.table", distance=0.0)
+    out = solve([SHOP, SLAB], tilted, rel("against", "slab.bottom", "world.table"))
+    (conflict,) = out["conflicts"]
+    # the edge along (0.6, 0, 0.8) rises at asin(0.8) from every plane z = const
+    assert conflict["kind"] == "angle"
+    assert conflict["value"] == pytest.approx(np.arcsin(0.8), abs=EXACT)
+
+
+def test_roller_on_the_table_with_a_lever_tip_on_it_is_planar_in_two_rolls():
+    relations = (LYING, rel("point_on_plane", "roller.lever", "world.table"))
+    out = solve([SHOP, WHEEL], *relations)
+    b = out["bodies"]["roller@s1"]
+    # the axle lifted onto z = 1 (no turn needed); the tip (0, 2, 1) is 2 from the axle
+    # and must come down to z = 0: a roll φ about +x puts it at height 1 + 2 sin φ = 0,
+    # φ = -π/6 or -5π/6; the least roll is -π/6, then only slides in the table's plane
+    # and turns about its normal are left: the planar coset, two components
+    assert (b["dof"], b["motion"], b["solutions"]) == (3, "planar", 2)
+    expected = se3.rot_x(-np.pi / 6)
+    expected[:3, 3] = [0, 0, 1]
+    np.testing.assert_allclose(b["pose"], expected, atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["normal"], Z, atol=EXACT)
+    assert "residue" not in [step["rule"] for step in out["trace"]]
+    pose = np.asarray(b["pose"])
+    assert residual_at([SHOP, WHEEL], pose, *relations) < EXACT
+    other = about((0, 0, 1), X, -2 * np.pi / 3) @ pose  # the roll -5π/6
+    assert residual_at([SHOP, WHEEL], other, *relations) < 1e-12
+    moved = shift(1.5, -2) @ about((0, 0, 0), Z, 1.1) @ pose
+    assert residual_at([SHOP, WHEEL], moved, *relations) < 1e-12
+    assert solve_numeric_only(make_task([SHOP, WHEEL], *relations))["roller@s1"].dof == 3
+
+
+def test_a_mark_on_the_roller_surface_touches_the_table_in_one_roll():
+    b = solve([SHOP, WHEEL], LYING, rel("point_on_plane", "roller.mark", "world.table"))["bodies"][
+        "roller@s1"
+    ]
+    # the mark (0, 1, 1) is 1 from the axle, the table 1 below it: sin φ = -1, φ = -π/2
+    assert (b["dof"], b["motion"], b["solutions"]) == (3, "planar", 1)
+    expected = se3.rot_x(-np.pi / 2)
+    expected[:3, 3] = [0, 0, 1]
+    np.testing.assert_allclose(b["pose"], expected, atol=EXACT)
+
+
+def test_a_stub_too_short_to_reach_the_table_conflicts_by_what_it_lacks():
+    out = solve([SHOP, WHEEL], LYING, rel("point_on_plane", "roller.stub", "world.table"))
+    (conflict,) = out["conflicts"]
+    # the stub is 0.5 from the axle, which stays 1 above the table: 0.5 short
+    assert (conflict["kind"], conflict["value"]) == ("distance", pytest.approx(0.5, abs=EXACT))
+    assert len(conflict["relations"]) == 2
+
+
+def test_peg_tip_on_a_plane_along_the_bore_adds_nothing_or_misses_by_its_distance():
+    """The tip lies on the bore's axis, which every pose of the cylindrical pair keeps:
+    its orbit is the axis x = y = 0, in the plane y = 0 and 3 away from y = 3."""
+    flat = solve([PLANT, PEG], IN_BORE, rel("point_on_plane", "peg.tip", "world.side"))
+    b = flat["bodies"]["peg@s1"]
+    assert (b["dof"], b["motion"]) == (2, "cylindrical")
+    np.testing.assert_allclose(b["pose"], np.eye(4), atol=EXACT)
+    assert "residue" not in [step["rule"] for step in flat["trace"]]
+    out = solve([PLANT, PEG], IN_BORE, rel("point_on_plane", "peg.tip", "world.back"))
+    (conflict,) = out["conflicts"]
+    assert (conflict["kind"], conflict["value"]) == ("distance", pytest.approx(3.0, abs=EXACT))
+
+
+def test_peg_tip_on_a_slanted_floor_turns_about_the_bore():
+    """The plane through (0, 0, -5) of normal (1, 0, 1)/√2 crosses the bore's axis at
+    (0, 0, -5): the tip (0, 0, -2) slides down 3 to it, then only the turn about the
+    axis is left (the cylindrical pair met with the sphere about the tip)."""
+    slant = Body("world", {**PLANT.features, "slant": Plane((0, 0, -5), (1, 0, 1))}, fixed=True)
+    relations = (IN_BORE, rel("point_on_plane", "peg.tip", "world.slant"))
+    out = solve([slant, PEG], *relations)
+    b = out["bodies"]["peg@s1"]
+    assert (b["dof"], b["motion"]) == (1, "revolute")
+    np.testing.assert_allclose(b["pose"], shift(0, 0, -3), atol=EXACT)
+    np.testing.assert_allclose(b["invariants"]["point"][:2], [0, 0], atol=EXACT)
+    assert unoriented(b["invariants"]["direction"], Z)
+    assert "residue" not in [step["rule"] for step in out["trace"]]
+    assert solve_numeric_only(make_task([slant, PEG], *relations))["peg@s1"].dof == 1
+
+
+def test_bundled_line_contacts_task():
+    """The crate tips about its edge and slides along the wall; the flap's tip (0, 2, 1)
+    comes down by the roll -atan(1/2) about its hinge (1·cos φ + 2·sin φ = 0), the least
+    of the two, its hinge staying on the x axis."""
+    tip = -np.arctan(0.5)
+    flap = se3.rot_x(tip)
+    for name in ("line_contacts.rapt", "line_contacts.yaml"):
+        out = load_task(TASKS / name).solve().to_dict()["bodies"]
+        crate, hinged = out["crate@s1"], out["flap@s1"]
+        assert (crate["dof"], crate["mechanism"]) == (2, "roll-and-slide")
+        np.testing.assert_allclose(crate["pose"], shift(3, 0, -2), atol=EXACT)
+        assert (hinged["dof"], hinged["motion"], hinged["solutions"]) == (3, "planar", 2)
+        np.testing.assert_allclose(hinged["pose"], flap, atol=EXACT)

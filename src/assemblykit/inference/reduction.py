@@ -77,9 +77,7 @@ from assemblykit.inference.solution import (
     Conflict,
     Solution,
     TraceStep,
-    direction_text,
     freedom_words,
-    point_text,
     remedy_words,
 )
 from assemblykit.tolerance import Tolerance, current, using
@@ -603,7 +601,6 @@ class _Instance:
     solutions: int | None = 1
     alternatives: tuple[np.ndarray, ...] = ()
     invariants: Mapping[str, Any] = field(default_factory=dict)
-    freedom: str = ""
     mechanism: str = ""
 
 
@@ -754,7 +751,7 @@ def _higher_pairs(
 ) -> tuple[dict[Node, _Instance], list[Conflict]] | None:
     """Rule 5 in closed form for a component whose instances hang from the world alone,
     each by at most one coset link and at most one higher pair (:func:`_point_in_locus`,
-    :func:`_line_on_plane`).
+    :func:`_line_on_plane`), or by a line contact and a point (:func:`_line_and_point`).
     None when some instance does not fit that pattern (the residue solver takes it)."""
     if any(k <= component for k in reducer.deferred):
         return None
@@ -773,7 +770,7 @@ def _higher_pairs(
     for node in sorted(nodes):
         edge = reducer.edges.get(frozenset((WORLD, node)))
         value = None if edge is None else edge.oriented(WORLD)
-        if reducer.adjacency.get(node, set()) - {WORLD} or len(own[node]) > 1:
+        if reducer.adjacency.get(node, set()) - {WORLD} or len(own[node]) > 2:
             return None
         if not own[node]:
             if not isinstance(value, Coset):
@@ -782,16 +779,35 @@ def _higher_pairs(
             pose = _EYE if value.contains(_EYE, tol) else np.asarray(value.rep)
             out[node] = _Instance(pose, value.dof, motion, _components(value), (), invariants)
             continue
-        labels = own[node][0].labels if edge is None else edge.labels + own[node][0].labels
-        solve = (
-            _line_on_plane if isinstance(own[node][0].geometry, LineOnPlane) else _point_in_locus
-        )
-        found = solve(reducer, node, own[node][0], value, labels, tol)
+        labels = tuple(label for c in own[node] for label in c.labels)
+        labels = labels if edge is None else edge.labels + labels
+        found = _held(reducer, node, own[node], value, labels, tol)
         if found is None:
             return None
         out[node], miss = found
         conflicts.extend(miss)
     return out, conflicts
+
+
+def _held(
+    reducer: Reducer,
+    node: Node,
+    pairs: list[Constraint],
+    value: Coset | None,
+    labels: tuple[str, ...],
+    tol: Tolerance,
+) -> tuple[_Instance, list[Conflict]] | None:
+    """The closed form for one instance's higher pairs from the world: one point or line
+    contact (with at most one coset ``value``), or a line contact and a point with no
+    coset; None otherwise."""
+    lines = [c for c in pairs if isinstance(c.geometry, LineOnPlane)]
+    if len(pairs) == 1:
+        solve = _line_on_plane if lines else _point_in_locus
+        return solve(reducer, node, pairs[0], value, labels, tol)
+    if len(lines) != 1 or value is not None:
+        return None
+    point = next(c for c in pairs if c is not lines[0])
+    return _line_and_point(reducer, node, lines[0], point, labels, tol)
 
 
 def _point_in_locus(
@@ -801,6 +817,7 @@ def _point_in_locus(
     value: Coset | None,
     labels: tuple[str, ...],
     tol: Tolerance,
+    subject: str = "point",
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A point held in a world locus (a plane or a line, :class:`PointLocus`), alone or
     with a planar coset G(m)·x0 from the world, in closed form (ALGEBRA.md §3, §5.3).
@@ -818,7 +835,8 @@ def _point_in_locus(
       meets Π in a point Q (the revolute coset R(Q, m)·x1, 1 dof), a line (slide along it
       and turn about m through c: 2 dof, not a coset) or nothing (a distance conflict).
 
-    None when the pattern does not apply."""
+    ``subject`` names the point in the trace and conflicts (a line's point stands for
+    the line, :func:`_line_with_coset`). None when the pattern does not apply."""
     geometry = constraint.geometry
     point_rep, point_x = reducer.find(geometry.point_node)
     locus_rep, locus_x = reducer.find(geometry.locus_node)
@@ -845,7 +863,7 @@ def _point_in_locus(
                     f"world -> {name} [{'; '.join(labels)}]",
                     value.dof,
                     met.dof,
-                    f"the point's locus meets its orbit under the joint: {motion}",
+                    f"the {subject}'s locus meets its orbit under the joint: {motion}",
                 )
             )
             return found, []
@@ -854,7 +872,8 @@ def _point_in_locus(
         if met is None:
             return None
         if isinstance(met, float):
-            miss = Conflict.measured(labels, "distance", met, _PARALLEL_MISS, tol)
+            message = _PARALLEL_MISS.format(subject)
+            miss = Conflict.measured(labels, "distance", met, message, tol)
             return _Instance(base, 0, "mechanism", 0), [miss]
         origin, rows = met
     elif len(rows) == 3:
@@ -862,42 +881,68 @@ def _point_in_locus(
     reached = se3.apply(base, corner)
     target = reached - rows.T @ (rows @ (reached - origin))
     pose = se3.translation(target - reached) @ base
-    place = point_text(target)
     if value is not None and len(rows) == 3:
         motion, invariants = _motion(Coset(SymmetryGroup.revolute(target, value.group.axis), pose))
         found = _Instance(pose, 1, motion, 1, (), invariants)
     elif value is not None:
         m = value.group.axis
         invariants = {"normal": m, "direction": np.cross(rows[0], rows[1]) + 0.0, "point": target}
-        words = (
-            f"can slide its point {place} along {direction_text(invariants['direction'])}"
-            f" and turn about {direction_text(m)} through it: 2 dof"
-        )
-        found = _Instance(pose, 2, "mechanism", 1, (), invariants, words, "planar-point-on-line")
+        found = _Instance(pose, 2, "mechanism", 1, (), invariants, "planar-point-on-line")
     elif len(rows) == 1:
         invariants = {"normal": rows[0], "point": target}
-        words = (
-            f"can slide its point {place} in the plane normal to {direction_text(rows[0])}"
-            " and turn about it: 5 dof"
-        )
-        found = _Instance(pose, 5, "mechanism", 1, (), invariants, words, "point-in-plane")
+        found = _Instance(pose, 5, "mechanism", 1, (), invariants, "point-in-plane")
     else:
         invariants = {"direction": np.cross(rows[0], rows[1]) + 0.0, "point": target}
-        words = (
-            f"can slide its point {place} along {direction_text(invariants['direction'])}"
-            " and turn about it: 4 dof"
-        )
-        found = _Instance(pose, 4, "mechanism", 1, (), invariants, words, "point-on-line")
+        found = _Instance(pose, 4, "mechanism", 1, (), invariants, "point-on-line")
     reducer.trace.append(
         TraceStep(
             "higher-pair",
             f"world -> {name} [{'; '.join(labels)}]",
             6 if value is None else value.dof,
             found.dof,
-            f"the point's loci meet in {_LOCI[len(rows)]}",
+            f"the {subject}'s loci meet in {_LOCI[len(rows)]}",
         )
     )
     return found, []
+
+
+def _lay_line(
+    point: np.ndarray, along: np.ndarray, normal: np.ndarray, origin: np.ndarray, tol: Tolerance
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The pose of least motion laying the line through ``point`` along ``along`` parallel
+    to the plane ``normal · (y − origin) = 0``, with the line's point and direction there.
+
+    The smallest rotation turns a onto the plane (about n × a through the line's point),
+    then the line moves straight along the normal n onto the plane. None for a line along
+    the normal (no smallest rotation)."""
+    flat = along - (along @ normal) * normal
+    if np.linalg.norm(flat) <= tol.angle:
+        return None
+    flat = flat / np.linalg.norm(flat)
+    turn = np.cross(along, flat)
+    sine = float(np.linalg.norm(turn))
+    pose = _EYE
+    if sine > tol.angle:
+        pose = rotation_about(point, turn / sine, math.atan2(sine, float(along @ flat)))
+    pose = se3.translation(-float(normal @ (point - origin)) * normal) @ pose
+    return pose, se3.apply(pose, point), flat
+
+
+def _line_in_world(
+    reducer: Reducer, geometry: LineOnPlane
+) -> tuple[Node, Node, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The representatives of a line contact's two instances, with its line's point and
+    direction and its plane's normal and origin in their representatives' frames."""
+    line_rep, line_x = reducer.find(geometry.line_node)
+    plane_rep, plane_x = reducer.find(geometry.plane_node)
+    return (
+        line_rep,
+        plane_rep,
+        se3.apply(line_x, geometry.point),
+        line_x[:3, :3] @ geometry.direction,
+        plane_x[:3, :3] @ geometry.normal,
+        se3.apply(plane_x, geometry.origin),
+    )
 
 
 def _line_on_plane(
@@ -909,51 +954,160 @@ def _line_on_plane(
     tol: Tolerance,
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A line of an instance lying parallel to a world plane at a distance (a cylinder on a
-    plane, :class:`LineOnPlane`) with nothing else, in closed form (ALGEBRA.md §3).
+    plane, an edge on a face: :class:`LineOnPlane`) in closed form (ALGEBRA.md §3).
 
-    The poses form a 4-dof double coset, not a coset: slide in the plane, turn about its
-    normal and about the line. The pose of least motion turns the line's direction a by
-    the smallest rotation onto the plane (about n × a through the line's point), then
-    moves it straight along the normal n to the distance. None with a coset link, a line
-    along the normal (no smallest rotation) or the line on the world."""
-    geometry = constraint.geometry
-    line_rep, line_x = reducer.find(geometry.line_node)
-    plane_rep, plane_x = reducer.find(geometry.plane_node)
-    if value is not None or (line_rep, plane_rep) != (node, WORLD):
+    Alone, the poses form a 4-dof double coset, not a coset: slide in the plane, turn
+    about its normal and about the line; the pose kept is :func:`_lay_line`'s. With a
+    coset from the world, :func:`_line_with_coset`. None for a line along the normal or
+    on the world."""
+    if value is not None:
+        return _line_with_coset(reducer, node, constraint, value, labels, tol)
+    line_rep, plane_rep, point, along, normal, origin = _line_in_world(reducer, constraint.geometry)
+    if (line_rep, plane_rep) != (node, WORLD):
         return None
-    point = se3.apply(line_x, geometry.point)
-    along = line_x[:3, :3] @ geometry.direction
-    normal = plane_x[:3, :3] @ geometry.normal
-    origin = se3.apply(plane_x, geometry.origin)
-    flat = along - (along @ normal) * normal
-    if np.linalg.norm(flat) <= tol.angle:
+    laid = _lay_line(point, along, normal, origin, tol)
+    if laid is None:
         return None
-    flat = flat / np.linalg.norm(flat)
-    turn = np.cross(along, flat)
-    sine = float(np.linalg.norm(turn))
-    pose = _EYE
-    if sine > tol.angle:
-        pose = rotation_about(point, turn / sine, math.atan2(sine, float(along @ flat)))
-    pose = se3.translation(-float(normal @ (point - origin)) * normal) @ pose
-    placed = se3.apply(pose, point)
-    name = instance_key(node)
+    pose, placed, flat = laid
     invariants = {"normal": normal, "direction": flat, "point": placed}
-    words = (
-        f"keeps its line through {point_text(placed)} along {direction_text(flat)}"
-        f" parallel to the plane normal to {direction_text(normal)}: it can slide in the plane"
-        " and turn about the normal and about the line: 4 dof"
-    )
-    found = _Instance(pose, 4, "mechanism", 1, (), invariants, words, "line-on-plane")
+    found = _Instance(pose, 4, "mechanism", 1, (), invariants, "line-on-plane")
     reducer.trace.append(
         TraceStep(
             "higher-pair",
-            f"world -> {name} [{'; '.join(labels)}]",
+            f"world -> {instance_key(node)} [{'; '.join(labels)}]",
             6,
             4,
             "a line parallel to a plane at its distance",
         )
     )
     return found, []
+
+
+def _line_with_coset(
+    reducer: Reducer,
+    node: Node,
+    constraint: Constraint,
+    value: Coset,
+    labels: tuple[str, ...],
+    tol: Tolerance,
+) -> tuple[_Instance, list[Conflict]] | None:
+    """A line contact met with a lower pair H·x0 from the world, in closed form (ALGEBRA.md
+    §3, §5.3), when every rotation of H keeps the plane's normal n or the line's direction
+    a (H in X(n) or in X(a)).
+
+    Then the angle between the line and the plane is the same over the whole coset: not
+    zero, the pair cannot lie flat (an ``angle`` conflict). Zero, every pose of H carries
+    the line to a line parallel to the plane whose height is the height of its point q;
+    the line contact is the point q held in the plane, and :func:`_point_in_locus` meets it
+    with H: a coset (a cylinder coaxial with a bearing at the right height: the
+    ``cylindrical`` pair, the line contact redundant; a box on a table with its edge on
+    the table: ``planar``), a ``distance`` conflict (the bearing at another height), or,
+    with a planar pair along a (a roller or a box edge on a table with its end face
+    against a wall), the 2-dof ``roll-and-slide``: turn about the line and slide it
+    across itself in the plane, not a coset (the two generate the planar group). None
+    when H turns both the normal and the line (the residue solver takes it)."""
+    geometry = constraint.geometry
+    line_rep, plane_rep, _, along, normal, _ = _line_in_world(reducer, geometry)
+    if (line_rep, plane_rep) != (node, WORLD) or _components(value) != 1:
+        return None
+    base = _EYE if value.contains(_EYE, tol) else np.asarray(value.rep, dtype=np.float64)
+    along = base[:3, :3] @ along
+    if not any(
+        SymmetryGroup.schoenflies(kept).includes(value.group, tol) for kept in (normal, along)
+    ):
+        return None
+    tilt = abs(float(along @ normal))
+    if tilt > tol.angle:
+        angle = math.asin(min(tilt, 1.0))
+        miss = Conflict.measured(
+            labels,
+            "angle",
+            angle,
+            f"the joint keeps the line at {math.degrees(angle):.6g} degrees to the plane it"
+            " should lie parallel to",
+            tol,
+        )
+        return _Instance(base, 0, "mechanism", 0), [miss]
+    held = PointLocus(
+        geometry.line_node,
+        geometry.point,
+        geometry.plane_node,
+        geometry.origin,
+        geometry.normal.reshape(1, 3),
+    )
+    found = _point_in_locus(
+        reducer, node, replace(constraint, geometry=held), value, labels, tol, "line point"
+    )
+    if found is None or found[0].mechanism != "planar-point-on-line":
+        return found
+    instance, _ = found
+    invariants = {"point": instance.invariants["point"], "direction": along, "normal": normal}
+    return replace(instance, invariants=invariants, mechanism="roll-and-slide"), []
+
+
+def _line_and_point(
+    reducer: Reducer,
+    node: Node,
+    line: Constraint,
+    point: Constraint,
+    labels: tuple[str, ...],
+    tol: Tolerance,
+) -> tuple[_Instance, list[Conflict]] | None:
+    """A line contact and a point of the same instance held in a parallel world plane (a
+    roller on a table with a lever's tip on the table), in closed form (ALGEBRA.md §3).
+
+    The line laid by :func:`_lay_line` can still turn about itself: the point c, at a
+    distance ρ from the line, then rises by ρ·cos(φ − φ₀) above the line's plane, which
+    must be the height h of its own plane: φ = φ₀ ± arccos(h/ρ), two rolls (one when
+    |h| = ρ, the point grazing its plane). After the roll every pose that keeps both
+    heights is a slide in the plane and a turn about its normal: the ``planar`` coset
+    G(n) through the roll of least angle (3 dof, the number of rolls as its solutions).
+    The point farther than ρ from its plane is a ``distance`` conflict of |h| − ρ; on the
+    line it adds nothing or misses by |h|. None for a plane not parallel to the line's
+    (the residue solver takes it) or instances other than this one and the world."""
+    geometry, spot = line.geometry, point.geometry
+    line_rep, plane_rep, start, along, normal, origin = _line_in_world(reducer, geometry)
+    point_rep, point_x = reducer.find(spot.point_node)
+    locus_rep, locus_x = reducer.find(spot.locus_node)
+    rows = spot.rows @ locus_x[:3, :3].T
+    if (line_rep, plane_rep, point_rep, locus_rep) != (node, WORLD, node, WORLD) or len(rows) != 1:
+        return None
+    laid = _lay_line(start, along, normal, origin, tol)
+    if laid is None or np.linalg.norm(np.cross(rows[0], normal)) > tol.angle:
+        return None
+    pose, placed, flat = laid
+    arm = se3.apply(pose, se3.apply(point_x, spot.point)) - placed
+    arm = arm - (arm @ flat) * flat
+    reach = float(np.linalg.norm(arm))
+    height = float(normal @ (se3.apply(locus_x, spot.origin) - origin))
+    gap = abs(height) - reach
+    if gap > tol.length:
+        message = (
+            f"the point turns about the line at {reach:.6g} from it, and its plane is"
+            f" {abs(height):.6g} from the line's"
+        )
+        return _Instance(pose, 0, "mechanism", 0), [
+            Conflict.measured(labels, "distance", gap, message, tol)
+        ]
+    if reach <= tol.length:
+        return _line_on_plane(reducer, node, line, None, labels, tol)
+    level = math.atan2(float(normal @ np.cross(flat, arm)), float(normal @ arm))
+    spread = math.acos(min(1.0, max(-1.0, height / reach)))
+    rolls = [math.remainder(level + sign * spread, math.tau) for sign in (1, -1)]
+    roll = min(rolls, key=abs)
+    met = Coset(SymmetryGroup.planar(normal), rotation_about(placed, flat, roll) @ pose)
+    motion, invariants = _motion(met)
+    count = 1 if reach * math.sin(spread) <= tol.length else 2
+    reducer.trace.append(
+        TraceStep(
+            "higher-pair",
+            f"world -> {instance_key(node)} [{'; '.join(labels)}]",
+            6,
+            3,
+            f"a line and a point on parallel planes: {count} roll(s) about the line, {motion}",
+        )
+    )
+    return _Instance(met.rep, 3, motion, count, (), invariants), []
 
 
 def _coset_meets_locus(
@@ -973,17 +1127,29 @@ def _coset_meets_locus(
     shortest translation of the group onto the locus (least motion); a locus the
     translations cannot reach is missed by that distance (returned as a float). None
     when the group turns the normals or screws (a fibre that is not a coset, or a helical
-    coupling), for the residue solver or another closed form."""
+    coupling), for the residue solver or another closed form.
+
+    The map is a homomorphism too when every rotation of the group fixes the point (a
+    revolute, cylindrical or spherical group about an axis or centre through it): h·q − q
+    is then h's slide along the group's translations, which its rotations keep; the
+    kernel is the whole group when those slides keep N·y, else the group met with S(q)
+    (a cylinder crossing the locus: the revolute about its axis)."""
     helical = {"helical", "pseudo-planar"}
     keeping = SymmetryGroup.schoenflies(rows[0]) if len(rows) == 1 else SymmetryGroup.translation3()
-    if len(rows) == 3 or not keeping.includes(group, tol):
+    kept = keeping.includes(group, tol)
+    if len(rows) == 3 or not (kept or _fixes(group, reached, tol)):
         return None
-    kernel_of = (
-        SymmetryGroup.planar(rows[0])
-        if len(rows) == 1
-        else SymmetryGroup.prismatic(np.cross(rows[0], rows[1]))
-    )
     shifts = _translations(group.intersect(SymmetryGroup.translation3(), tol))
+    if kept:
+        kernel_of = (
+            SymmetryGroup.planar(rows[0])
+            if len(rows) == 1
+            else SymmetryGroup.prismatic(np.cross(rows[0], rows[1]))
+        )
+    elif np.abs(rows @ shifts.T).max(initial=0.0) <= tol.angle:
+        kernel_of = group
+    else:
+        kernel_of = SymmetryGroup.spherical(reached)
     need = rows @ (origin - reached)
     step = np.zeros(3)
     if len(shifts):
@@ -993,6 +1159,18 @@ def _coset_meets_locus(
     if miss > tol.length:
         return None if str(group.kind) in helical else miss
     return Coset(group.intersect(kernel_of, tol), se3.translation(step))
+
+
+def _fixes(group: SymmetryGroup, point: np.ndarray, tol: Tolerance) -> bool:
+    """Whether every rotation of a connected ``group`` fixes ``point``: a revolute or
+    cylindrical group whose axis passes through it, a spherical group centred on it."""
+    kind = str(group.kind)
+    if kind == "spherical":
+        return bool(np.linalg.norm(point - group.origin) <= tol.length)
+    if kind not in ("revolute", "cylindrical"):
+        return False
+    offset = point - group.origin
+    return bool(np.linalg.norm(offset - (offset @ group.axis) * group.axis) <= tol.length)
 
 
 def _translations(group: SymmetryGroup) -> np.ndarray:
@@ -1007,7 +1185,7 @@ def _translations(group: SymmetryGroup) -> np.ndarray:
 
 _LOCI = {1: "a plane", 2: "a line", 3: "a point"}
 
-_PARALLEL_MISS = "the point's orbit under its joint runs parallel to its locus, at a distance"
+_PARALLEL_MISS = "the {}'s orbit under its joint runs parallel to its locus, at a distance"
 
 
 def _numeric_component(
@@ -1105,7 +1283,6 @@ def _leaf_report(
             base.solutions,
             tuple(a @ x for a in base.alternatives),
             base.invariants,
-            base.freedom,
             base.mechanism,
         )
     return out, conflicts
@@ -1114,7 +1291,7 @@ def _leaf_report(
 def _said(key: str, instance: _Instance) -> str:
     """The sentence saying what of ``key`` is free and which relations would remove it
     (empty when nothing is free)."""
-    text = instance.freedom or freedom_words(instance.motion, instance.dof, instance.invariants)
+    text = freedom_words(instance.motion, instance.dof, instance.invariants, instance.mechanism)
     if not text:
         return ""
     remedy = remedy_words(instance.motion, instance.mechanism, instance.invariants)
