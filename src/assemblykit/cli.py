@@ -17,7 +17,7 @@ import re
 import sys
 import warnings
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, NoReturn, Protocol
+from typing import TYPE_CHECKING, Any, Literal, NoReturn, Protocol
 
 import click
 
@@ -29,6 +29,7 @@ from assemblykit.tolerance import MAX_ANGLE, MAX_REL_LENGTH, MIN_ANGLE, MIN_REL_
 if TYPE_CHECKING:
     from rich.console import Console
 
+    from assemblykit.blocking.ndbg import Motion
     from assemblykit.model.assembly import Assembly
     from assemblykit.planning.stability import Gravity
 
@@ -451,7 +452,7 @@ def plan_cmd(
     png: str | None,
     out: str | None,
     gltf: str | None,
-    plotly: str,
+    plotly: Literal["inline", "cdn"],
     max_hands: int,
     moves: str,
     max_states: int | None,
@@ -510,7 +511,7 @@ def plan_cmd(
                 raise InputError("--moves rigid turns 3D parts: not for a 2D polygon assembly")
             result = plan_with_screws(loaded, tol)
         else:
-            result = plan(
+            monotone = plan(
                 loaded,
                 tol=tol,
                 progress=update,
@@ -518,25 +519,26 @@ def plan_cmd(
                 gravity=_gravity(gravity, friction, holds, fixed),
                 one_at_a_time=one_at_a_time,
             )
-        if html is not None:
-            from assemblykit.viz.viewer import write_report
+            if html is not None:
+                from assemblykit.viz.viewer import write_report
 
-            update("writing the report", 0, 1)
-            write_report(loaded, result, html, plotlyjs=plotly)  # type: ignore[arg-type]
-        if png is not None:
-            from assemblykit.viz.plots import exploded_view_png
+                update("writing the report", 0, 1)
+                write_report(loaded, monotone, html, plotlyjs=plotly)
+            if png is not None:
+                from assemblykit.viz.plots import exploded_view_png
 
-            update("drawing the exploded view", 0, 1)
-            exploded_view_png(loaded, result, png)
-        if out is not None:
-            from assemblykit.io.exports import write_plan
+                update("drawing the exploded view", 0, 1)
+                exploded_view_png(loaded, monotone, png)
+            if out is not None:
+                from assemblykit.io.exports import write_plan
 
-            write_plan(result, out, getattr(loaded, "tolerance", lambda: tol)())
-        if gltf is not None:
-            from assemblykit.io.exports import write_gltf
+                write_plan(monotone, out, getattr(loaded, "tolerance", lambda: tol)())
+            if gltf is not None:
+                from assemblykit.io.exports import write_gltf
 
-            update("writing the glTF scene", 0, 1)
-            write_gltf(loaded, result, gltf, loaded.tolerance())
+                update("writing the glTF scene", 0, 1)
+                write_gltf(loaded, monotone, gltf, loaded.tolerance())
+            result = monotone
     for written in (html, png, out, gltf):
         if written is not None:
             note(f"wrote {written}")
@@ -781,7 +783,7 @@ BLOCKING_MOTIONS = ("infinitesimal", "extended", "rigid")
 @debug_option
 def blocking_cmd(
     assembly: str,
-    motion: str,
+    motion: Motion,
     png: str | None,
     as_json: bool,
     tolerance: float | None,
@@ -793,7 +795,7 @@ def blocking_cmd(
     ASSEMBLY: mesh folder, .yaml manifest, .step, COMPAS .json, or a YAML file of 2D
     polygons 'parts: {name: [[x, y], ...]}'.
     """
-    from assemblykit.blocking.ndbg import blocking_graph
+    from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph, blocking_graph
 
     if png is not None:
         if motion == "rigid":
@@ -801,8 +803,8 @@ def blocking_cmd(
         checked_output(png, "--png", PNG_SUFFIXES)
     tol = tolerance_from(tolerance)
     model = assembly_or_polygons(assembly, tol, as_written)
-    result = blocking_graph(model, motion, tol=tol)  # type: ignore[arg-type]
-    if png is not None:
+    result = blocking_graph(model, motion, tol=tol)
+    if png is not None and isinstance(result, NonDirectionalBlockingGraph):
         from assemblykit.viz.plots import plot_ndbg
 
         plot_ndbg(result, png)

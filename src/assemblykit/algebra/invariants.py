@@ -13,9 +13,10 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
+from numpy.typing import NDArray
 
 from assemblykit.algebra import se3
 from assemblykit.algebra.cosets import Coset, EmptySet, Mismatch
@@ -39,7 +40,7 @@ __all__ = [
 ]
 
 
-def _vec(v: Any) -> np.ndarray:
+def _vec(v: Any) -> NDArray[np.float64]:
     a = np.asarray(v, dtype=np.float64)
     if a.shape != (3,):
         a = a.reshape(3)
@@ -48,7 +49,7 @@ def _vec(v: Any) -> np.ndarray:
     return a
 
 
-def _direction(v: Any, what: str) -> np.ndarray:
+def _direction(v: Any, what: str) -> NDArray[np.float64]:
     a = _vec(v)
     if not float(a @ a) > 0.0:
         raise FeatureError(f"zero {what} vector")
@@ -59,7 +60,7 @@ def _direction(v: Any, what: str) -> np.ndarray:
 class PointInvariant:
     """A point (stabiliser S(point))."""
 
-    point: np.ndarray
+    point: NDArray[np.float64]
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "point", _vec(self.point))
@@ -70,8 +71,8 @@ class LineInvariant:
     """A line through ``point`` along ``direction``; directed lines have stabiliser C,
     undirected ones C ⋊ Z2 (a half-turn flip)."""
 
-    point: np.ndarray
-    direction: np.ndarray
+    point: NDArray[np.float64]
+    direction: NDArray[np.float64]
     directed: bool = True
 
     def __post_init__(self) -> None:
@@ -83,8 +84,8 @@ class LineInvariant:
 class PlaneInvariant:
     """An oriented plane through ``point`` with unit ``normal`` (stabiliser G(normal))."""
 
-    point: np.ndarray
-    normal: np.ndarray
+    point: NDArray[np.float64]
+    normal: NDArray[np.float64]
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "point", _vec(self.point))
@@ -95,7 +96,7 @@ class PlaneInvariant:
 class DirectionInvariant:
     """A free unit vector (stabiliser X(direction))."""
 
-    direction: np.ndarray
+    direction: NDArray[np.float64]
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "direction", _direction(self.direction, "direction"))
@@ -104,7 +105,10 @@ class DirectionInvariant:
 Invariant = PointInvariant | LineInvariant | PlaneInvariant | DirectionInvariant
 
 
-def _trusted(cls: type, **fields: Any) -> Any:
+_I = TypeVar("_I", bound=Invariant)
+
+
+def _trusted(cls: type[_I], **fields: Any) -> _I:
     """An invariant from data already known to be finite and normalised (skips checks:
     transformed and characteristic invariants are built in the hot path)."""
     out = object.__new__(cls)
@@ -113,7 +117,7 @@ def _trusted(cls: type, **fields: Any) -> Any:
     return out
 
 
-def transform_invariant(t: np.ndarray, inv: Invariant) -> Invariant:
+def transform_invariant(t: NDArray[np.float64], inv: Invariant) -> Invariant:
     """The invariant moved by the rigid transform ``t``."""
     r, p = t[:3, :3], t[:3, 3]
     if isinstance(inv, PointInvariant):
@@ -130,7 +134,7 @@ def transform_invariant(t: np.ndarray, inv: Invariant) -> Invariant:
     return _trusted(DirectionInvariant, direction=r @ inv.direction)
 
 
-def _axis_of(inv: Invariant) -> np.ndarray | None:
+def _axis_of(inv: Invariant) -> NDArray[np.float64] | None:
     if isinstance(inv, LineInvariant | DirectionInvariant):
         return inv.direction
     if isinstance(inv, PlaneInvariant):
@@ -141,11 +145,11 @@ def _axis_of(inv: Invariant) -> np.ndarray | None:
 # ----------------------------------------------------------------------------- congruence
 
 
-def _angle(a: np.ndarray, b: np.ndarray) -> float:
+def _angle(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
     return math.atan2(se3.norm(se3.cross(a, b)), float(a @ b))
 
 
-def _perp(v: np.ndarray, u: np.ndarray) -> np.ndarray:
+def _perp(v: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
     return v - (v @ u) * u
 
 
@@ -360,7 +364,7 @@ def _frame_columns(
 
 def tuple_frame(
     invariants: tuple[Invariant, ...] | list[Invariant], tol: Tolerance | None = None
-) -> np.ndarray:
+) -> NDArray[np.float64]:
     """A frame built from the tuple by a rule that commutes with rigid motions up to the
     tuple's stabiliser (§2.5: "the same rule on both sides").
 
@@ -375,7 +379,9 @@ def tuple_frame(
     return se3.matrix_from_columns(columns)
 
 
-def pair_frame(first: Invariant, second: Invariant, tol: Tolerance | None = None) -> np.ndarray:
+def pair_frame(
+    first: Invariant, second: Invariant, tol: Tolerance | None = None
+) -> NDArray[np.float64]:
     """The §2.5 pair frame of two invariants (``tuple_frame`` of the pair)."""
     return tuple_frame((first, second), tol)
 
@@ -434,7 +440,7 @@ _CHARACTERISTIC: dict[Kind, tuple[tuple[int, int], ...]] = {
 }
 
 
-def characteristic_flats(kind: Kind, frame: np.ndarray) -> tuple[_Flat, ...]:
+def characteristic_flats(kind: Kind, frame: NDArray[np.float64]) -> tuple[_Flat, ...]:
     """The characteristic invariants of the connected TR group of ``kind`` placed by
     ``frame`` (§2.4) as float tuples (type code, point, direction)."""
     items = _CHARACTERISTIC.get(kind)
@@ -450,7 +456,9 @@ def characteristic_flats(kind: Kind, frame: np.ndarray) -> tuple[_Flat, ...]:
     )
 
 
-def move_flats(t: np.ndarray, flats: tuple[_Flat, ...], inverse: bool = False) -> tuple[_Flat, ...]:
+def move_flats(
+    t: NDArray[np.float64], flats: tuple[_Flat, ...], inverse: bool = False
+) -> tuple[_Flat, ...]:
     """Float invariants moved by the rigid transform ``t`` (by t^-1 when ``inverse``)."""
     (a, b, c, x), (d, e, f, y), (g, h, i, z) = t[:3].tolist()
     if inverse:
@@ -485,13 +493,13 @@ def _unflatten(flat: _Flat) -> Invariant:
         fields["normal"] = np.array(u)
     elif code == _DIRECTION:
         fields["direction"] = np.array(u)
-    cls = (PointInvariant, LineInvariant, PlaneInvariant, DirectionInvariant)[code]
-    inv = object.__new__(cls)
+    cls: type[Invariant] = (PointInvariant, LineInvariant, PlaneInvariant, DirectionInvariant)[code]
+    inv: Invariant = object.__new__(cls)
     inv.__dict__.update(fields)  # frozen fields filled directly: the data is trusted
     return inv
 
 
-def frame_invariants(kind: Kind, frame: np.ndarray) -> tuple[Invariant, ...]:
+def frame_invariants(kind: Kind, frame: NDArray[np.float64]) -> tuple[Invariant, ...]:
     """The characteristic invariants of the connected TR group of ``kind`` placed by
     ``frame`` (§2.4)."""
     return tuple(_unflatten(f) for f in characteristic_flats(kind, frame))
@@ -602,8 +610,8 @@ def flat_transporter(
                 "the invariants are pairwise congruent but not under a proper rigid motion",
             )
         return EmptySet(found)
-    (r0, r1, r2), t = rot, shift
-    x0 = np.array(((*r0, t[0]), (*r1, t[1]), (*r2, t[2]), (0.0, 0.0, 0.0, 1.0)))
+    (r0, r1, r2), (t0, t1, t2) = rot, shift
+    x0 = np.array(((*r0, t0), (*r1, t1), (*r2, t2), (0.0, 0.0, 0.0, 1.0)))
     return Coset(group, x0)
 
 

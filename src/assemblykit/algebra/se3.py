@@ -8,8 +8,10 @@ the velocity of the point currently at the origin.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from assemblykit.tolerance import Tolerance, current
 
@@ -48,36 +50,38 @@ __all__ = [
 ]
 
 
-def identity() -> np.ndarray:
+def identity() -> NDArray[np.float64]:
     """The identity transform."""
     return np.eye(4)
 
 
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
     """The cross product of two 3-vectors (plain arithmetic: ``np.cross`` is slow on 3-vectors)."""
     a0, a1, a2 = as_floats(a)
     b0, b1, b2 = as_floats(b)
     return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
 
 
-def norm(v: np.ndarray) -> float:
+def norm(v: NDArray[np.float64]) -> float:
     """The Euclidean length of a vector."""
     return math.sqrt(float(v @ v))
 
 
-def unit(v: np.ndarray | tuple[float, ...] | list[float]) -> np.ndarray:
+def unit(v: NDArray[np.float64] | tuple[float, ...] | list[float]) -> NDArray[np.float64]:
     """``v`` scaled to unit length (float64); a zero vector is returned unchanged."""
     a = np.asarray(v, dtype=np.float64)
     n = math.sqrt(float(a @ a))
     return a / n if n > 0.0 else a.copy()
 
 
-def line_classes(vectors: np.ndarray, max_sine: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def line_classes(
+    vectors: NDArray[np.float64], max_sine: float
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int8]]:
     """Group unit vectors that are parallel or antiparallel: each joins the first earlier
     leader whose sine with it is at most ``max_sine``, else leads a new class. Returns
     the leaders, the class of each vector and its orientation (+1 same, -1 opposite)."""
     units = np.asarray(vectors, dtype=np.float64).reshape(-1, 3)
-    leaders: list[np.ndarray] = []
+    leaders: list[NDArray[np.float64]] = []
     index = np.empty(len(units), dtype=np.int64)
     orient = np.empty(len(units), dtype=np.int8)
     for i, n in enumerate(units):
@@ -93,27 +97,27 @@ def line_classes(vectors: np.ndarray, max_sine: float) -> tuple[np.ndarray, np.n
     return np.asarray(leaders, dtype=np.float64).reshape(-1, 3), index, orient
 
 
-def skew(w: np.ndarray) -> np.ndarray:
+def skew(w: NDArray[np.float64]) -> NDArray[np.float64]:
     """The 3x3 matrix ``[w]x`` with ``[w]x @ x == cross(w, x)``."""
     x, y, z = (float(c) for c in w)
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
-def _compose(r: np.ndarray, t: np.ndarray) -> np.ndarray:
+def _compose(r: NDArray[np.float64], t: NDArray[np.float64]) -> NDArray[np.float64]:
     out = np.eye(4)
     out[:3, :3] = r
     out[:3, 3] = t
     return out
 
 
-def translation(v: np.ndarray | tuple[float, ...] | list[float]) -> np.ndarray:
+def translation(v: NDArray[np.float64] | tuple[float, ...] | list[float]) -> NDArray[np.float64]:
     """The pure translation ``Tr(v)``."""
     out = np.eye(4)
     out[:3, 3] = np.asarray(v, dtype=np.float64)
     return out
 
 
-def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
+def _axis_rotation(axis: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
     """Rodrigues' formula for a unit ``axis``: exact at multiples of pi/2 for coordinate axes."""
     k = skew(axis)
     s, c = math.sin(angle), math.cos(angle)
@@ -121,10 +125,10 @@ def _axis_rotation(axis: np.ndarray, angle: float) -> np.ndarray:
 
 
 def rotation(
-    axis: np.ndarray | tuple[float, ...] | list[float],
+    axis: NDArray[np.float64] | tuple[float, ...] | list[float],
     angle: float,
-    point: np.ndarray | tuple[float, ...] | list[float] | None = None,
-) -> np.ndarray:
+    point: NDArray[np.float64] | tuple[float, ...] | list[float] | None = None,
+) -> NDArray[np.float64]:
     """Rotation by ``angle`` (right-handed) about the line through ``point`` along ``axis``."""
     r = _axis_rotation(unit(axis), angle)
     if point is None:
@@ -133,27 +137,27 @@ def rotation(
     return _compose(r, p - r @ p)
 
 
-def rot_x(angle: float) -> np.ndarray:
+def rot_x(angle: float) -> NDArray[np.float64]:
     """``Rx(angle)`` about the x-axis through the origin."""
     return rotation((1.0, 0.0, 0.0), angle)
 
 
-def rot_y(angle: float) -> np.ndarray:
+def rot_y(angle: float) -> NDArray[np.float64]:
     """``Ry(angle)`` about the y-axis through the origin."""
     return rotation((0.0, 1.0, 0.0), angle)
 
 
-def rot_z(angle: float) -> np.ndarray:
+def rot_z(angle: float) -> NDArray[np.float64]:
     """``Rz(angle)`` about the z-axis through the origin."""
     return rotation((0.0, 0.0, 1.0), angle)
 
 
 def screw(
-    point: np.ndarray | tuple[float, ...] | list[float],
-    axis: np.ndarray | tuple[float, ...] | list[float],
+    point: NDArray[np.float64] | tuple[float, ...] | list[float],
+    axis: NDArray[np.float64] | tuple[float, ...] | list[float],
     pitch: float,
     angle: float,
-) -> np.ndarray:
+) -> NDArray[np.float64]:
     """The screw motion ``Tr(pitch*angle*u) . Rot_L(angle)`` about the line L = (point, axis).
 
     ALGEBRA.md §1: ``Scr(theta; p) = Tr(0, 0, p theta) Rz(theta)`` placed on L.
@@ -164,7 +168,7 @@ def screw(
     return out
 
 
-def inverse(t: np.ndarray) -> np.ndarray:
+def inverse(t: NDArray[np.float64]) -> NDArray[np.float64]:
     """The inverse of a rigid transform (transpose of the rotation, no general inversion;
     scalar arithmetic, which beats numpy calls on 4x4 matrices)."""
     (a, b, c, x), (d, e, f, y), (g, h, i, z) = t[:3].tolist()
@@ -178,7 +182,9 @@ def inverse(t: np.ndarray) -> np.ndarray:
     )
 
 
-def as_floats(v: np.ndarray | tuple[float, ...] | list[float]) -> tuple[float, float, float]:
+def as_floats(
+    v: NDArray[np.float64] | tuple[float, ...] | list[float],
+) -> tuple[float, float, float]:
     """The three coordinates of a 3-vector as Python floats (fast scalar arithmetic)."""
     a, b, c = v.tolist() if isinstance(v, np.ndarray) else v
     return float(a), float(b), float(c)
@@ -188,7 +194,12 @@ def frame_from_floats(
     origin: tuple[float, float, float],
     z_axis: tuple[float, float, float],
     x_hint: tuple[float, float, float] | None = None,
-) -> tuple[tuple[float, float, float], ...]:
+) -> tuple[
+    tuple[float, float, float],
+    tuple[float, float, float],
+    tuple[float, float, float],
+    tuple[float, float, float],
+]:
     """The columns (x, y, z, origin) of :func:`frame`, in plain float arithmetic (the
     frame construction is on the hot path of every transporter)."""
     zx, zy, zz = z_axis
@@ -218,17 +229,17 @@ def frame_from_floats(
     return x, y, (zx, zy, zz), origin
 
 
-def matrix_from_columns(columns: tuple[tuple[float, float, float], ...]) -> np.ndarray:
+def matrix_from_columns(columns: tuple[tuple[float, float, float], ...]) -> NDArray[np.float64]:
     """The 4x4 transform with rotation columns x, y, z and translation ``columns[3]``."""
     (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (o0, o1, o2) = columns
     return np.array(((x0, y0, z0, o0), (x1, y1, z1, o1), (x2, y2, z2, o2), (0.0, 0.0, 0.0, 1.0)))
 
 
 def frame(
-    origin: np.ndarray | tuple[float, ...] | list[float],
-    z_axis: np.ndarray | tuple[float, ...] | list[float],
-    x_hint: np.ndarray | tuple[float, ...] | list[float] | None = None,
-) -> np.ndarray:
+    origin: NDArray[np.float64] | tuple[float, ...] | list[float],
+    z_axis: NDArray[np.float64] | tuple[float, ...] | list[float],
+    x_hint: NDArray[np.float64] | tuple[float, ...] | list[float] | None = None,
+) -> NDArray[np.float64]:
     """A right-handed frame at ``origin`` whose +z is ``z_axis``.
 
     The x axis is ``x_hint`` made perpendicular to z; without a usable hint it is the
@@ -238,18 +249,18 @@ def frame(
     return matrix_from_columns(frame_from_floats(as_floats(origin), as_floats(z_axis), hint))
 
 
-def apply(t: np.ndarray, points: np.ndarray) -> np.ndarray:
+def apply(t: NDArray[np.float64], points: NDArray[np.float64]) -> NDArray[np.float64]:
     """Points (shape (3,) or (n, 3)) mapped by ``t``."""
     p = np.asarray(points, dtype=np.float64)
     return p @ t[:3, :3].T + t[:3, 3]
 
 
-def apply_direction(t: np.ndarray, dirs: np.ndarray) -> np.ndarray:
+def apply_direction(t: NDArray[np.float64], dirs: NDArray[np.float64]) -> NDArray[np.float64]:
     """Free vectors (shape (3,) or (n, 3)) rotated by ``t`` (translation ignored)."""
     return np.asarray(dirs, dtype=np.float64) @ t[:3, :3].T
 
 
-def hat(xi: np.ndarray) -> np.ndarray:
+def hat(xi: NDArray[np.float64]) -> NDArray[np.float64]:
     """The 4x4 matrix of the twist ``(omega; v)``: ``[[omega]x, v; 0, 0]``."""
     out = np.zeros((4, 4))
     out[:3, :3] = skew(xi[:3])
@@ -257,12 +268,12 @@ def hat(xi: np.ndarray) -> np.ndarray:
     return out
 
 
-def vee(m: np.ndarray) -> np.ndarray:
+def vee(m: NDArray[np.float64]) -> NDArray[np.float64]:
     """The twist ``(omega; v)`` of a 4x4 matrix of se(3) (inverse of :func:`hat`)."""
     return np.array([m[2, 1], m[0, 2], m[1, 0], m[0, 3], m[1, 3], m[2, 3]], dtype=np.float64)
 
 
-def _left_jacobian(w: np.ndarray, theta: float) -> np.ndarray:
+def _left_jacobian(w: NDArray[np.float64], theta: float) -> NDArray[np.float64]:
     """``V`` with ``exp(hat(w, v)) = (exp(w), V v)`` (closed form, ALGEBRA.md §1)."""
     k = skew(w)
     if theta < _SERIES_SWITCH:
@@ -273,11 +284,11 @@ def _left_jacobian(w: np.ndarray, theta: float) -> np.ndarray:
     return np.eye(3) + a * k + b * (k @ k)
 
 
-def rotation_matrix(w: np.ndarray) -> np.ndarray:
+def rotation_matrix(w: NDArray[np.float64] | Sequence[float]) -> NDArray[np.float64]:
     """The rotation ``exp(skew(w))`` of the rotation vector ``w`` (Rodrigues' formula)."""
-    w = np.asarray(w, dtype=np.float64)
-    theta = math.sqrt(float(w @ w))
-    k = skew(w)
+    v = np.asarray(w, dtype=np.float64)
+    theta = math.sqrt(float(v @ v))
+    k = skew(v)
     if theta < _SERIES_SWITCH:
         return np.eye(3) + k + 0.5 * (k @ k)
     return (
@@ -285,7 +296,7 @@ def rotation_matrix(w: np.ndarray) -> np.ndarray:
     )
 
 
-def rotation_vector(r: np.ndarray) -> np.ndarray:
+def rotation_vector(r: NDArray[np.float64]) -> NDArray[np.float64]:
     """The rotation vector (axis times angle in [0, pi]) of the rotation matrix ``r``.
 
     Through the unit quaternion, taken from the largest of its four squared components
@@ -313,7 +324,7 @@ def rotation_vector(r: np.ndarray) -> np.ndarray:
     return q * (2.0 * math.atan2(sine, w) / sine)
 
 
-def exp(xi: np.ndarray) -> np.ndarray:
+def exp(xi: NDArray[np.float64]) -> NDArray[np.float64]:
     """The exponential of the twist ``xi = (omega; v)`` in closed form."""
     xi = np.asarray(xi, dtype=np.float64)
     w, v = xi[:3], xi[3:]
@@ -321,7 +332,7 @@ def exp(xi: np.ndarray) -> np.ndarray:
     return _compose(rotation_matrix(w), _left_jacobian(w, theta) @ v)
 
 
-def log(t: np.ndarray) -> np.ndarray:
+def log(t: NDArray[np.float64]) -> NDArray[np.float64]:
     """A twist ``xi`` with ``exp(xi) == t`` and rotation angle in [0, pi].
 
     The logarithm is multivalued (at angle pi and by 2 pi periodicity); it is used for
@@ -333,7 +344,7 @@ def log(t: np.ndarray) -> np.ndarray:
     return np.concatenate((w, v))
 
 
-def adjoint(t: np.ndarray) -> np.ndarray:
+def adjoint(t: NDArray[np.float64]) -> NDArray[np.float64]:
     """The 6x6 adjoint: ``Ad_T (omega; v) = (R omega; R v + t x R omega)``."""
     r, p = t[:3, :3], t[:3, 3]
     out = np.zeros((6, 6))
@@ -343,12 +354,12 @@ def adjoint(t: np.ndarray) -> np.ndarray:
     return out
 
 
-def rotation_angle(t: np.ndarray) -> float:
+def rotation_angle(t: NDArray[np.float64]) -> float:
     """The rotation angle of ``t`` in [0, pi] (robust near 0 and pi)."""
     return float(np.linalg.norm(rotation_vector(t[:3, :3])))
 
 
-def is_rigid(t: np.ndarray, tol: Tolerance | None = None) -> bool:
+def is_rigid(t: NDArray[np.float64], tol: Tolerance | None = None) -> bool:
     """Whether ``t`` is a proper rigid transform within the angular tolerance."""
     tol = tol or current()
     a = np.asarray(t, dtype=np.float64)
@@ -360,7 +371,7 @@ def is_rigid(t: np.ndarray, tol: Tolerance | None = None) -> bool:
     return ortho <= tol.angle and bottom <= tol.angle and float(np.linalg.det(r)) > 0.0
 
 
-def random_transform(rng: np.random.Generator, scale: float = 10.0) -> np.ndarray:
+def random_transform(rng: np.random.Generator, scale: float = 10.0) -> NDArray[np.float64]:
     """A random rigid transform: uniform rotation and translation in ``[-scale, scale]^3``."""
     from scipy.spatial.transform import Rotation
 

@@ -14,6 +14,7 @@ from enum import StrEnum
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from assemblykit.algebra import se3
 from assemblykit.algebra.caching import cached
@@ -98,9 +99,9 @@ class _Sub:
     """A linear subspace of R^3 in closed form: dim 1 keeps its direction, dim 2 its normal."""
 
     dim: int
-    vec: np.ndarray | None = None
+    vec: NDArray[np.float64] | None = None
 
-    def perp_projector(self) -> np.ndarray:
+    def perp_projector(self) -> NDArray[np.float64]:
         """The orthogonal projector onto the complement of the subspace."""
         if self.dim == 0:
             return np.eye(3)
@@ -110,7 +111,7 @@ class _Sub:
         outer = np.outer(self.vec, self.vec)
         return np.eye(3) - outer if self.dim == 1 else outer
 
-    def residual(self, w: np.ndarray) -> float:
+    def residual(self, w: NDArray[np.float64]) -> float:
         """Length of the component of ``w`` outside the subspace."""
         if self.dim == 3:
             return 0.0
@@ -121,7 +122,7 @@ class _Sub:
             return se3.norm(w - (w @ self.vec) * self.vec)
         return abs(float(w @ self.vec))
 
-    def project(self, w: np.ndarray) -> np.ndarray:
+    def project(self, w: NDArray[np.float64]) -> NDArray[np.float64]:
         """The orthogonal projection of ``w`` onto the subspace."""
         return w - self.perp_projector() @ w
 
@@ -139,14 +140,14 @@ class _Sub:
         return (1.0 - outer[0], -outer[1], -outer[2], 1.0 - outer[3], -outer[4], 1.0 - outer[5])
 
 
-def _parallel(a: np.ndarray, b: np.ndarray, tol: Tolerance) -> bool:
+def _parallel(a: NDArray[np.float64], b: NDArray[np.float64], tol: Tolerance) -> bool:
     a0, a1, a2 = se3.as_floats(a)
     b0, b1, b2 = se3.as_floats(b)
     c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
     return math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) <= tol.angle
 
 
-def _unit_cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def _unit_cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
     """The unit vector along a x b (a and b not parallel)."""
     a0, a1, a2 = se3.as_floats(a)
     b0, b1, b2 = se3.as_floats(b)
@@ -248,8 +249,8 @@ def psd_solve(m: Sym3, rhs: Vec3, tol: Tolerance) -> Vec3:
 
 
 def _affine_meet_point(
-    na: np.ndarray, sa: _Sub, nb: np.ndarray, sb: _Sub, tol: Tolerance
-) -> np.ndarray:
+    na: NDArray[np.float64], sa: _Sub, nb: NDArray[np.float64], sb: _Sub, tol: Tolerance
+) -> NDArray[np.float64]:
     """A point of (na + sa) ∩ (nb + sb), known to be non-empty: the least-squares
     point nearest to ``na`` (so a frame origin already valid is kept)."""
     pa, (b00, b01, b02, b11, b12, b22) = sa.perp_sym(), sb.perp_sym()
@@ -268,12 +269,12 @@ def _affine_meet_point(
 # ----------------------------------------------------------------------------- canonical K
 
 
-def _canonical_basis(kind: Kind, pitch: float) -> np.ndarray:
+def _canonical_basis(kind: Kind, pitch: float) -> NDArray[np.float64]:
     """The canonical Lie algebra basis (6 x dim, (omega; v)) of K (ALGEBRA.md §2.1 table)."""
     e = np.eye(6)
     rz, tx, ty, tz = e[:, 2], e[:, 3], e[:, 4], e[:, 5]
     sz = rz + pitch * tz
-    cols: dict[Kind, list[np.ndarray]] = {
+    cols: dict[Kind, list[NDArray[np.float64]]] = {
         Kind.FIXED: [],
         Kind.REVOLUTE: [rz],
         Kind.PRISMATIC: [tz],
@@ -290,7 +291,9 @@ def _canonical_basis(kind: Kind, pitch: float) -> np.ndarray:
     return np.column_stack(cols[kind]) if cols[kind] else np.zeros((6, 0))
 
 
-def _canonical_element(kind: Kind, pitch: float, params: np.ndarray) -> np.ndarray:
+def _canonical_element(
+    kind: Kind, pitch: float, params: NDArray[np.float64]
+) -> NDArray[np.float64]:
     """k(params) of the canonical family (ALGEBRA.md §5.1 normal form).
 
     Parameters: R, H (theta); T (s); C (theta, s); T2 (a, b); T3 (a, b, c);
@@ -338,7 +341,7 @@ def _helix_residual(pitch: float, tz: float, theta: float) -> float:
     return abs(pitch * d)
 
 
-def _in_canonical(kind: Kind, pitch: float, g: np.ndarray, tol: Tolerance) -> bool:
+def _in_canonical(kind: Kind, pitch: float, g: NDArray[np.float64], tol: Tolerance) -> bool:
     """Membership of a canonical-frame element in K (ALGEBRA.md §2.3 predicate table)."""
     if kind is Kind.FREE:
         return True
@@ -354,7 +357,7 @@ def _in_canonical(kind: Kind, pitch: float, g: np.ndarray, tol: Tolerance) -> bo
         if kind is Kind.PRISMATIC:
             return math.hypot(t[0], t[1]) <= length
         if kind is Kind.TRANSLATION2:
-            return abs(t[2]) <= length
+            return abs(float(t[2])) <= length
         return True
     # Rotation about z (R, H, C, G, Y, X): "R ∥ z".
     if math.sqrt(r[0, 2] ** 2 + r[1, 2] ** 2 + (r[2, 2] - 1.0) ** 2) > ang:
@@ -363,13 +366,13 @@ def _in_canonical(kind: Kind, pitch: float, g: np.ndarray, tol: Tolerance) -> bo
         return True
     theta = math.atan2(r[1, 0], r[0, 0])
     if kind is Kind.PLANAR:
-        return abs(t[2]) <= length
+        return abs(float(t[2])) <= length
     if kind is Kind.PSEUDO_PLANAR:
         return _helix_residual(pitch, t[2], theta) <= length
     if math.hypot(t[0], t[1]) > length:
         return False
     if kind is Kind.REVOLUTE:
-        return abs(t[2]) <= length
+        return abs(float(t[2])) <= length
     if kind is Kind.HELICAL:
         return _helix_residual(pitch, t[2], theta) <= length
     return True
@@ -391,15 +394,15 @@ class Locus:
     """
 
     kind: str
-    point: np.ndarray | None = None
-    direction: np.ndarray | None = None
+    point: NDArray[np.float64] | None = None
+    direction: NDArray[np.float64] | None = None
     radius: float = 0.0
     pitch: float = 0.0
-    through: np.ndarray | None = None
+    through: NDArray[np.float64] | None = None
     members: tuple[Locus, ...] = ()
-    steps: tuple[np.ndarray, ...] = ()
+    steps: tuple[NDArray[np.float64], ...] = ()
 
-    def contains(self, p: np.ndarray, tol: Tolerance | None = None) -> bool:
+    def contains(self, p: NDArray[np.float64], tol: Tolerance | None = None) -> bool:
         """Whether the point ``p`` lies on the locus."""
         tol = tol or current()
         q = np.asarray(p, dtype=np.float64)
@@ -428,7 +431,7 @@ class Locus:
             return abs(along) <= tol.length and abs(rho - self.radius) <= tol.length
         return self._helix_contains(d, along, radial, rho, tol)
 
-    def distance(self, points: np.ndarray) -> np.ndarray:
+    def distance(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         """The distances of ``points`` (n x 3) from the locus, for the kinds a closed
         curve or surface has: point, circle, line, cylinder, plane, sphere, space.
 
@@ -440,13 +443,12 @@ class Locus:
         if self.kind in ("helix", "union") or self.point is None:
             raise GroupError(f"no distance to a {self.kind} locus")
         d = q - self.point
-        if self.kind == "point":
-            return np.linalg.norm(d, axis=1)
-        if self.kind == "sphere":
-            return np.abs(np.linalg.norm(d, axis=1) - self.radius)
+        if self.kind in ("point", "sphere"):
+            r: NDArray[np.float64] = np.linalg.norm(d, axis=1)
+            return r if self.kind == "point" else np.abs(r - self.radius)
         assert self.direction is not None
         along = d @ self.direction
-        rho = np.linalg.norm(d - along[:, None] * self.direction, axis=1)
+        rho: NDArray[np.float64] = np.linalg.norm(d - along[:, None] * self.direction, axis=1)
         if self.kind == "plane":
             return np.abs(along)
         if self.kind == "line":
@@ -456,7 +458,12 @@ class Locus:
         return np.hypot(along, rho - self.radius)
 
     def _helix_contains(
-        self, d: np.ndarray, along: float, radial: np.ndarray, rho: float, tol: Tolerance
+        self,
+        d: NDArray[np.float64],
+        along: float,
+        radial: NDArray[np.float64],
+        rho: float,
+        tol: Tolerance,
     ) -> bool:
         assert self.through is not None and self.point is not None and self.direction is not None
         u = self.direction
@@ -468,7 +475,7 @@ class Locus:
         angle = math.atan2(float(se3.cross(radial0, radial) @ u), float(radial0 @ radial))
         return _helix_residual(self.pitch, along - along0, angle) <= tol.length
 
-    def _union_contains(self, q: np.ndarray, tol: Tolerance) -> bool:
+    def _union_contains(self, q: NDArray[np.float64], tol: Tolerance) -> bool:
         if not self.steps:
             return any(m.contains(q, tol) for m in self.members)
         step = self.steps[0]
@@ -493,15 +500,17 @@ class SymmetryGroup:
     """
 
     kind: Kind
-    frame: np.ndarray = field(default_factory=lambda: np.eye(4))
+    frame: NDArray[np.float64] = field(default_factory=lambda: np.eye(4))
     pitch: float = 0.0
-    reps: tuple[np.ndarray, ...] = (_EYE4,)
-    lattice: tuple[np.ndarray, ...] = ()
+    reps: tuple[NDArray[np.float64], ...] = (_EYE4,)
+    lattice: tuple[NDArray[np.float64], ...] = ()
 
     # ------------------------------------------------------------------ constructors
 
     @classmethod
-    def connected(cls, kind: Kind | str, frame: np.ndarray, pitch: float = 0.0) -> SymmetryGroup:
+    def connected(
+        cls, kind: Kind | str, frame: NDArray[np.float64], pitch: float = 0.0
+    ) -> SymmetryGroup:
         """The connected group F K(kind, pitch) F^-1; a zero pitch gives R or G."""
         k = Kind(kind)
         if k in _HELICAL and pitch == 0.0:
@@ -616,22 +625,22 @@ class SymmetryGroup:
         return SymmetryGroup(self.kind, self.frame, self.pitch)
 
     @cached
-    def frame_inverse(self) -> np.ndarray:
+    def frame_inverse(self) -> NDArray[np.float64]:
         """F^-1 (cached: every membership test uses it)."""
         return se3.inverse(self.frame)
 
     @property
-    def axis(self) -> np.ndarray:
+    def axis(self) -> NDArray[np.float64]:
         """The +z of the frame: axis, direction or normal of G0."""
         return self.frame[:3, 2]
 
     @property
-    def origin(self) -> np.ndarray:
+    def origin(self) -> NDArray[np.float64]:
         """The frame origin: a point on the axis, or the centre."""
         return self.frame[:3, 3]
 
     @cached
-    def algebra(self) -> np.ndarray:
+    def algebra(self) -> NDArray[np.float64]:
         """The world Lie algebra basis Ad_F (canonical basis), 6 x dof."""
         return se3.adjoint(self.frame) @ _canonical_basis(self.kind, self.pitch)
 
@@ -653,7 +662,7 @@ class SymmetryGroup:
         return out
 
     @cached
-    def _translation_part(self) -> tuple[_Sub, tuple[np.ndarray, float] | None]:
+    def _translation_part(self) -> tuple[_Sub, tuple[NDArray[np.float64], float] | None]:
         """G0 ∩ T3 = {t in V : t.u in c Z} as (V, (u, c) or None) (§2.4, lattice rows)."""
         k, u = self.kind, self.axis
         if k in (Kind.FIXED, Kind.REVOLUTE, Kind.SPHERICAL):
@@ -677,7 +686,7 @@ class SymmetryGroup:
 
     def element(
         self, params: Any = (), component: int = 0, steps: tuple[int, ...] = ()
-    ) -> np.ndarray:
+    ) -> NDArray[np.float64]:
         """F k(params) F^-1 . lambda . reps[component], lambda = prod lattice[i]^steps[i]."""
         k = _canonical_element(self.kind, self.pitch, np.atleast_1d(np.asarray(params, float)))
         g = self.frame @ k @ self.frame_inverse
@@ -685,7 +694,9 @@ class SymmetryGroup:
             g = g @ np.linalg.matrix_power(gen if n >= 0 else se3.inverse(gen), abs(n))
         return g @ self.reps[component]
 
-    def sample(self, rng: np.random.Generator, n: int = 1, scale: float = 10.0) -> list[np.ndarray]:
+    def sample(
+        self, rng: np.random.Generator, n: int = 1, scale: float = 10.0
+    ) -> list[NDArray[np.float64]]:
         """``n`` random members (angles in [-pi, pi], lengths in [-scale, scale])."""
         out = []
         for _ in range(n):
@@ -695,7 +706,7 @@ class SymmetryGroup:
             out.append(self.element(params, int(rng.integers(len(self.reps))), steps))
         return out
 
-    def _angle_params(self) -> np.ndarray:
+    def _angle_params(self) -> NDArray[np.float64]:
         k = self.kind
         flags = {
             Kind.REVOLUTE: [1],
@@ -711,12 +722,12 @@ class SymmetryGroup:
 
     # ------------------------------------------------------------------ membership
 
-    def _in_connected(self, g: np.ndarray, tol: Tolerance) -> bool:
+    def _in_connected(self, g: NDArray[np.float64], tol: Tolerance) -> bool:
         if self.kind is Kind.FREE:
             return True
         return _in_canonical(self.kind, self.pitch, self.frame_inverse @ g @ self.frame, tol)
 
-    def contains(self, t: np.ndarray, tol: Tolerance | None = None) -> bool:
+    def contains(self, t: NDArray[np.float64], tol: Tolerance | None = None) -> bool:
         """Whether ``t`` is in G (ALGEBRA.md §2.3, with reps and lattice projection)."""
         tol = tol or current()
         for gamma in self.reps:
@@ -729,14 +740,14 @@ class SymmetryGroup:
         return False
 
     @cached
-    def _lattice_projection(self) -> tuple[np.ndarray, np.ndarray]:
+    def _lattice_projection(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Directions W where G0 never translates and each generator's translation is additive,
         and the generators' coordinates along them (for integer projection, §2.3)."""
         w = self._quotient_directions()
         coords = np.column_stack([w.T @ gen[:3, 3] for gen in self.lattice])
         return w, coords
 
-    def _quotient_directions(self) -> np.ndarray:
+    def _quotient_directions(self) -> NDArray[np.float64]:
         k = self.kind
         if k is Kind.FIXED:
             space = _Sub(3)
@@ -760,7 +771,7 @@ class SymmetryGroup:
             basis = f[:, 2:] if space.dim == 1 else f[:, :2]
         return basis
 
-    def _in_lattice_coset(self, g: np.ndarray, tol: Tolerance) -> bool:
+    def _in_lattice_coset(self, g: NDArray[np.float64], tol: Tolerance) -> bool:
         w, coords = self._lattice_projection
         k, *_ = np.linalg.lstsq(coords, w.T @ g[:3, 3], rcond=None)
         steps = tuple(round(float(x)) for x in k)
@@ -800,7 +811,7 @@ class SymmetryGroup:
 
     # ------------------------------------------------------------------ transforms
 
-    def conjugate(self, t: np.ndarray) -> SymmetryGroup:
+    def conjugate(self, t: NDArray[np.float64]) -> SymmetryGroup:
         """T G T^-1 (ALGEBRA.md §2.3 conjugation)."""
         ti = se3.inverse(t)
         reps = tuple(_EYE4 if g is _EYE4 else t @ g @ ti for g in self.reps)
@@ -810,8 +821,8 @@ class SymmetryGroup:
 
     def with_discrete(
         self,
-        reps: tuple[np.ndarray, ...] = (),
-        lattice: tuple[np.ndarray, ...] = (),
+        reps: tuple[NDArray[np.float64], ...] = (),
+        lattice: tuple[NDArray[np.float64], ...] = (),
         tol: Tolerance | None = None,
     ) -> SymmetryGroup:
         """G0 . Gamma for the discrete part ``reps``/``lattice`` (closure under G0 checked)."""
@@ -837,8 +848,8 @@ class SymmetryGroup:
 
     def with_known_discrete(
         self,
-        reps: tuple[np.ndarray, ...] = (),
-        lattice: tuple[np.ndarray, ...] = (),
+        reps: tuple[NDArray[np.float64], ...] = (),
+        lattice: tuple[NDArray[np.float64], ...] = (),
         tol: Tolerance | None = None,
     ) -> SymmetryGroup:
         """G0 . Gamma for a discrete part known to form a group with G0 (components of an
@@ -890,7 +901,7 @@ class SymmetryGroup:
         from assemblykit.algebra.cosets import Coset, EmptySet  # cosets build on groups
 
         c0 = _connected_meet(self.connected_part, other.connected_part, tol)
-        found: list[np.ndarray] = []
+        found: list[NDArray[np.float64]] = []
         for a in self.reps:
             for b in other.reps:
                 met = Coset(self.connected_part, a).intersect(Coset(other.connected_part, b), tol)
@@ -914,7 +925,7 @@ class SymmetryGroup:
             return members[0]
         return Locus("union", members=tuple(members), steps=tuple(g[:3, 3] for g in self.lattice))
 
-    def _connected_orbit(self, x: np.ndarray, tol: Tolerance) -> Locus:
+    def _connected_orbit(self, x: NDArray[np.float64], tol: Tolerance) -> Locus:
         k, u, n = self.kind, self.axis, self.origin
         d = x - n
         radial = d - (d @ u) * u
@@ -979,7 +990,7 @@ _IDENTITY = SymmetryGroup(Kind.FIXED, _EYE4)
 # ----------------------------------------------------------------------------- helpers
 
 
-def _scaled(basis: np.ndarray, tol: Tolerance) -> np.ndarray:
+def _scaled(basis: NDArray[np.float64], tol: Tolerance) -> NDArray[np.float64]:
     """Twists with the v rows in units of the model scale (angles and lengths comparable)."""
     out = np.array(basis, dtype=np.float64)
     out[3:] /= tol.scale
@@ -990,16 +1001,18 @@ def _rank_threshold(tol: Tolerance) -> float:
     return max(tol.angle, tol.rel_length)
 
 
-def _dedupe(g0: SymmetryGroup, elements: list[np.ndarray], tol: Tolerance) -> list[np.ndarray]:
+def _dedupe(
+    g0: SymmetryGroup, elements: list[NDArray[np.float64]], tol: Tolerance
+) -> list[NDArray[np.float64]]:
     """One representative per G0-coset, in order of first appearance."""
-    out: list[np.ndarray] = []
+    out: list[NDArray[np.float64]] = []
     for g in elements:
         if not any(g0.contains(g @ se3.inverse(f), tol) for f in out):
             out.append(g)
     return out
 
 
-def _null_space(m: np.ndarray, tol: Tolerance) -> np.ndarray:
+def _null_space(m: NDArray[np.float64], tol: Tolerance) -> NDArray[np.float64]:
     _, s, vt = np.linalg.svd(m)
     rank = int(np.sum(s > _rank_threshold(tol)))
     return vt[rank:].T
@@ -1013,7 +1026,7 @@ def _tr_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> SymmetryGrou
     """
     (lin_a, va), (lin_b, vb) = a._tr_shape, b._tr_shape
     v = _sub_meet(va, vb, tol)
-    u: np.ndarray | None = None
+    u: NDArray[np.float64] | None = None
     if "none" in (lin_a, lin_b):
         lin = "none"
     elif lin_a == "line" and lin_b == "line":
@@ -1044,7 +1057,9 @@ def _tr_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> SymmetryGrou
     return _tr_group(lin, u, center, v)
 
 
-def _tr_group(lin: str, u: np.ndarray | None, center: np.ndarray, v: _Sub) -> SymmetryGroup:
+def _tr_group(
+    lin: str, u: NDArray[np.float64] | None, center: NDArray[np.float64], v: _Sub
+) -> SymmetryGroup:
     """The TR group with rotation part ``lin`` (about ``u`` through ``center``) and V = ``v``."""
     origin = (0.0, 0.0, 0.0)
     if lin == "none":
@@ -1063,7 +1078,7 @@ def _tr_group(lin: str, u: np.ndarray | None, center: np.ndarray, v: _Sub) -> Sy
     return SymmetryGroup(kind, se3.frame(center, u))
 
 
-def classify_algebra(basis: np.ndarray, tol: Tolerance | None = None) -> SymmetryGroup:
+def classify_algebra(basis: NDArray[np.float64], tol: Tolerance | None = None) -> SymmetryGroup:
     """The connected group whose Lie algebra is spanned by ``basis`` (6 x k) (§2.1 steps 1-5)."""
     tol = tol or current()
     if basis.shape[1] == 0:
@@ -1110,7 +1125,9 @@ def classify_algebra(basis: np.ndarray, tol: Tolerance | None = None) -> Symmetr
     raise NumericError(f"not a subalgebra of se(3): rotation rank {r_w}, translation rank {r_t}")
 
 
-def _screw_generator(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> np.ndarray | None:
+def _screw_generator(
+    a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance
+) -> NDArray[np.float64] | None:
     """The discrete screw of H/Y(p) ∩ H/Y(q) about a common axis, p != q (§2.4 table).
 
     Solving p theta = q (theta + 2 pi m) gives theta in (2 pi q / (p - q)) Z.
@@ -1132,7 +1149,9 @@ def _screw_generator(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> np.n
     return a.element(params)
 
 
-def _translation_lattice(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> list[np.ndarray]:
+def _translation_lattice(
+    a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance
+) -> list[NDArray[np.float64]]:
     """Generators of the discrete part of (G0a ∩ T3) ∩ (G0b ∩ T3) (§2.4 lattice rows)."""
     (va, ca), (vb, cb) = a._translation_part, b._translation_part
     w = _sub_meet(va, vb, tol)
@@ -1218,7 +1237,7 @@ def _is_cyclic(g: SymmetryGroup) -> bool:
     return g.kind is Kind.FIXED and len(g.reps) == 1 and len(g.lattice) == 1
 
 
-def one_parameter(tau: np.ndarray, tol: Tolerance | None = None) -> SymmetryGroup | None:
+def one_parameter(tau: NDArray[np.float64], tol: Tolerance | None = None) -> SymmetryGroup | None:
     """The connected one-parameter group {exp(s log tau)} through a lattice generator
     that translates along its axis (a translation: T; a screw: H), else ``None``.
 
@@ -1234,14 +1253,18 @@ def one_parameter(tau: np.ndarray, tol: Tolerance | None = None) -> SymmetryGrou
     return group
 
 
-def lattice_parameter(line: SymmetryGroup, tau: np.ndarray, g: np.ndarray) -> float:
+def lattice_parameter(
+    line: SymmetryGroup, tau: NDArray[np.float64], g: NDArray[np.float64]
+) -> float:
     """s with g = exp(s log tau), for g in the one-parameter group ``line`` through tau:
     rotations about the axis leave the translation along it additive."""
     u = line.axis
     return float(u @ g[:3, 3]) / float(u @ tau[:3, 3])
 
 
-def _cyclic_meet(tau: np.ndarray, b: SymmetryGroup, tol: Tolerance) -> SymmetryGroup | None:
+def _cyclic_meet(
+    tau: NDArray[np.float64], b: SymmetryGroup, tol: Tolerance
+) -> SymmetryGroup | None:
     """<tau> ∩ B in closed form: with L the one-parameter group through tau, L ∩ B is L
     (every power), {I} (none but I) or <exp(c log tau)>, and tau^k is in B iff k is in
     cZ; for c = r/n in lowest terms that is rZ (the lcm rule of §2.4), and an

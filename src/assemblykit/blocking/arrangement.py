@@ -60,7 +60,7 @@ class Arrangement:
     links_low: NDArray[np.int64]
     links_high: NDArray[np.int64]
     links_circle: NDArray[np.int64]
-    links_sign: NDArray[np.int8]
+    links_sign: NDArray[np.int64]
     root: int
     root_signs: NDArray[np.int8]
 
@@ -115,7 +115,9 @@ def snap_normals(
     return line_classes(units / np.linalg.norm(units, axis=1, keepdims=True), tol.angle)
 
 
-def _links(rows: list[tuple[int, int, int, int]]) -> tuple[NDArray[np.int64], ...]:
+def _links(
+    rows: list[tuple[int, int, int, int]],
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
     arr = np.asarray(rows, dtype=np.int64).reshape(-1, 4)
     return arr[:, 0], arr[:, 1], arr[:, 2], arr[:, 3]
 
@@ -208,7 +210,8 @@ def _vertices(
 
     def pair_id(a: NDArray[np.int64], b: NDArray[np.int64]) -> NDArray[np.int64]:
         lo, hi = np.minimum(a, b), np.maximum(a, b)
-        return lo * c - lo * (lo + 1) // 2 + (hi - lo - 1)
+        ids: NDArray[np.int64] = lo * c - lo * (lo + 1) // 2 + (hi - lo - 1)
+        return ids
 
     found = [
         np.nonzero(triple_signs(normals, ii[lo : lo + _CHUNK], jj[lo : lo + _CHUNK]) == 0)

@@ -28,9 +28,9 @@ class DirectionalBlockingGraph:
     arcs: frozenset[tuple[str, str]] = field(default_factory=frozenset)
 
     @cached_property
-    def graph(self) -> nx.DiGraph:
+    def graph(self) -> nx.DiGraph[str]:
         """The graph as a networkx DiGraph over every part."""
-        g = nx.DiGraph()
+        g: nx.DiGraph[str] = nx.DiGraph()
         g.add_nodes_from(self.parts)
         g.add_edges_from(self.arcs)
         return g
@@ -55,7 +55,7 @@ class DirectionalBlockingGraph:
         return sorted(comps, key=lambda c: (-len(c), sorted(c)))
 
     @cached_property
-    def condensation(self) -> nx.DiGraph:
+    def condensation(self) -> nx.DiGraph[int]:
         """The acyclic graph of the components; node attribute ``members`` (networkx)."""
         return nx.condensation(self.graph)
 

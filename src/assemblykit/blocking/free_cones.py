@@ -135,8 +135,9 @@ def _chart_point(direction: NDArray[np.float64]) -> tuple[int, NDArray[np.float6
 
 def _to_directions(c: int, uv: NDArray[np.float64]) -> NDArray[np.float64]:
     e, a, b = CHARTS[c]
-    d = e[None, :] + uv[:, :1] * a[None, :] + uv[:, 1:2] * b[None, :]
-    return d / np.linalg.norm(d, axis=1, keepdims=True)
+    d: NDArray[np.float64] = e[None, :] + uv[:, :1] * a[None, :] + uv[:, 1:2] * b[None, :]
+    lengths: NDArray[np.float64] = np.linalg.norm(d, axis=1, keepdims=True)
+    return d / lengths
 
 
 @dataclass(frozen=True, eq=False)
@@ -148,7 +149,7 @@ class Faces:
     thin: NDArray[np.float64]
 
 
-def _faces(polygons: Sequence[tuple[int, Any]], tol: Tolerance) -> Faces:
+def _faces(polygons: Sequence[tuple[int, shapely.Polygon]], tol: Tolerance) -> Faces:
     wide: list[tuple[float, NDArray[np.float64]]] = []
     thin: list[tuple[float, NDArray[np.float64]]] = []
     for c, poly in polygons:
@@ -169,7 +170,7 @@ def _faces(polygons: Sequence[tuple[int, Any]], tol: Tolerance) -> Faces:
 def free_faces(blocked: ChartSet, tol: Tolerance) -> Faces:
     """A direction in every face of the complement of ``blocked``."""
     square = shapely.box(-1.0, -1.0, 1.0, 1.0)
-    polygons = []
+    polygons: list[tuple[int, shapely.Polygon]] = []
     for c, region in enumerate(blocked.regions):
         rest = shapely.difference(square, region)
         polygons.extend((c, p) for p in shapely.get_parts(rest) if isinstance(p, shapely.Polygon))
@@ -180,7 +181,7 @@ def overlay_faces(sets: Sequence[ChartSet], tol: Tolerance, limit: int = 20_000)
     """A direction in every face of the overlay of the sets' boundaries (the arrangement
     refined by the obstacle boundaries), at most ``limit`` faces per chart."""
     square = shapely.box(-1.0, -1.0, 1.0, 1.0)
-    polygons = []
+    polygons: list[tuple[int, shapely.Polygon]] = []
     for c in range(len(CHARTS)):
         lines = [square.boundary] + [
             s.regions[c].boundary for s in sets if not s.regions[c].is_empty

@@ -20,7 +20,7 @@ import weakref
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal, Protocol
+from typing import TYPE_CHECKING, Any, Literal, Protocol, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -98,7 +98,7 @@ class ConstraintTable:
             columns[key].append(np.asarray(term.normals, dtype=np.float64).reshape(-1, 3))
         keys = sorted(columns)
         stacked = [np.concatenate(columns[k]) for k in keys]
-        owner = np.concatenate([np.full(len(s), i) for i, s in enumerate(stacked)] or [[]])
+        owner = np.concatenate([np.full(len(s), i) for i, s in enumerate(stacked)] or [np.zeros(0)])
         flat = np.concatenate(stacked) if stacked else np.zeros((0, 3))
         base = np.zeros((0, 3)) if normals is None else normals
         circles, circle_of, orient = snap_normals(np.concatenate([base, flat]), tol)
@@ -122,7 +122,7 @@ class ConstraintTable:
         """Column counts for regions with the given sides of every circle (direct)."""
         return (signs > 0).astype(np.float64) @ self.plus + (signs < 0) @ self.minus
 
-    def arcs(self, weights: NDArray[np.float64]) -> NDArray[np.bool_]:
+    def arcs(self, weights: NDArray[np.float64] | NDArray[np.int16]) -> NDArray[np.bool_]:
         """Which slots block, from column counts."""
         satisfied = weights >= self.need
         if len(self.starts) == weights.shape[1]:  # one column per slot
@@ -228,7 +228,8 @@ class NonDirectionalBlockingGraph:
     def _direction(self, direction: ArrayLike) -> NDArray[np.float64]:
         d = np.asarray(direction, dtype=np.float64).ravel()
         d = np.r_[d, np.zeros(3 - len(d))]
-        return d / np.linalg.norm(d)
+        unit: NDArray[np.float64] = d / np.linalg.norm(d)
+        return unit
 
     def dbg(self, direction: ArrayLike) -> DirectionalBlockingGraph:
         """G(d, A) for any direction (2- or 3-vector), computed directly from the terms."""
@@ -428,12 +429,12 @@ class NonDirectionalBlockingGraph:
         plus, minus, need = t.plus.copy(), t.minus.copy(), t.need.copy()
         moving, blocker = t.slot_moving.copy(), t.slot_blocker.copy()
         packed = self.packed.copy()
-        for s, pad in zip(inner, placed, strict=True):
-            col, new_col = t.starts[pad], added.starts[s]
+        for s, slot in zip(inner, placed, strict=True):
+            col, new_col = t.starts[slot], added.starts[s]
             plus[:, col], minus[:, col] = added.plus[:, new_col], added.minus[:, new_col]
             need[col] = added.need[new_col]
-            moving[pad], blocker[pad] = added.slot_moving[s], added.slot_blocker[s]
-            packed[:, pad // 8] |= (arcs[:, s].astype(np.uint8) << (7 - pad % 8)).astype(np.uint8)
+            moving[slot], blocker[slot] = added.slot_moving[s], added.slot_blocker[s]
+            packed[:, slot // 8] |= (arcs[:, s].astype(np.uint8) << (7 - slot % 8)).astype(np.uint8)
         align = -len(t.starts) % 8
         last = moving[-1] if len(moving) else 0
         new_cols = _expand(added.starts[outer], added_sizes[outer])
@@ -587,6 +588,33 @@ def _subset(assembly: AssemblyLike, parts: Iterable[str] | None) -> tuple[str, .
     return tuple(n for n in names if n in wanted)
 
 
+@overload
+def blocking_graph(
+    assembly: AssemblyLike,
+    motion: Literal["infinitesimal", "extended"] = ...,
+    parts: Iterable[str] | None = None,
+    tol: Tolerance | None = None,
+) -> NonDirectionalBlockingGraph: ...
+
+
+@overload
+def blocking_graph(
+    assembly: AssemblyLike,
+    motion: Literal["rigid"],
+    parts: Iterable[str] | None = None,
+    tol: Tolerance | None = None,
+) -> RigidBlockingGraph: ...
+
+
+@overload
+def blocking_graph(
+    assembly: AssemblyLike,
+    motion: Motion,
+    parts: Iterable[str] | None = None,
+    tol: Tolerance | None = None,
+) -> NonDirectionalBlockingGraph | RigidBlockingGraph: ...
+
+
 def blocking_graph(
     assembly: AssemblyLike,
     motion: Motion = "infinitesimal",
@@ -626,7 +654,6 @@ def blocking_graph(
         and not all_convex(assembly, names)
     ):
         local = blocking_graph(assembly, "infinitesimal", names, tol)
-        assert isinstance(local, NonDirectionalBlockingGraph)
         graphs[key] = sampled_ndbg(assembly, names, local, tol)
     if key not in graphs:
         terms = [

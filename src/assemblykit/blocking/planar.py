@@ -74,8 +74,8 @@ def _ccw_vertices(piece: Polygon) -> NDArray[np.float64]:
 
 def _left(v: NDArray[np.float64]) -> NDArray[np.float64]:
     """``v`` turned a quarter turn counter-clockwise, as a unit 3-vector (z = 0)."""
-    n = np.array([-v[1], v[0], 0.0])
-    return n / np.linalg.norm(n)
+    n = np.array([-v[1], v[0], 0.0], dtype=np.float64)
+    return n / float(np.linalg.norm(n))
 
 
 def blocked_normals(

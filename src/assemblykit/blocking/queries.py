@@ -31,12 +31,12 @@ from assemblykit.blocking.extended import extended_arcs, extended_free
 from assemblykit.blocking.free_cones import blocked_sets, exact_free_directions, overlay_faces
 from assemblykit.blocking.ndbg import (
     AssemblyLike,
+    Motion,
     NonDirectionalBlockingGraph,
     blocking_graph,
     blocking_terms,
     build_ndbg,
 )
-from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import UnknownNameError
 from assemblykit.tolerance import Tolerance
 
@@ -45,14 +45,14 @@ _AXES = np.concatenate([np.eye(3), -np.eye(3)])
 
 def removable_subassemblies(
     assembly: AssemblyLike,
-    motion: str = "extended",
+    motion: Motion = "extended",
     parts: Iterable[str] | None = None,
     tol: Tolerance | None = None,
     max_size: int | None = None,
 ) -> list[Removal]:
     """All directly removable subassemblies (up to ``max_size`` parts) with the
     directions that free them, from the NDBG of the motion."""
-    return blocking_graph(assembly, motion, parts, tol).removable(max_size)  # type: ignore[no-any-return]
+    return blocking_graph(assembly, motion, parts, tol).removable(max_size)
 
 
 def _local_graph(
@@ -106,7 +106,7 @@ def _extra_directions(
     graph = _local_graph(assembly, subassembly, tol)
     if graph is None:
         return directions
-    free = ~np.any(graph.table.direct_arcs(directions, tol), axis=1)
+    free: NDArray[np.bool_] = ~np.any(graph.table.direct_arcs(directions, tol), axis=1)
     return directions[free]
 
 
@@ -123,7 +123,7 @@ def locally_free_directions(
 def can_extract(
     assembly: AssemblyLike,
     subassembly: Iterable[str],
-    motion: str = "extended",
+    motion: Motion = "extended",
     tol: Tolerance | None = None,
 ) -> Removal | None:
     """The directions (or twist) along which ``subassembly`` leaves the rest without
@@ -136,7 +136,6 @@ def can_extract(
     chosen = frozenset(moving)
     if motion == "rigid":
         graph = blocking_graph(assembly, "rigid", tol=tol)
-        assert isinstance(graph, RigidBlockingGraph)
         twist = graph.free_twist(moving)
         return None if twist is None else Removal(chosen, (twist,))
     directions, dims = _local_free_regions(assembly, moving, tol)
@@ -157,7 +156,7 @@ def can_extract(
 
 def removable_parts(
     assembly: AssemblyLike,
-    motion: str = "extended",
+    motion: Motion = "extended",
     parts: Iterable[str] | None = None,
     tol: Tolerance | None = None,
 ) -> list[Removal]:
@@ -253,7 +252,7 @@ def _removable_first(
 def parts_to_remove_before(
     assembly: AssemblyLike,
     part: str,
-    motion: str = "extended",
+    motion: Motion = "extended",
     tol: Tolerance | None = None,
 ) -> frozenset[str]:
     """The smallest set of other parts that must leave before ``part`` can be taken

@@ -60,7 +60,8 @@ def _patch_hull_points(patch: PlanarPatch) -> NDArray[np.float64]:
         hull = ConvexHull(np.column_stack([poly @ e1, poly @ e2]))
     except QhullError:
         return poly
-    return poly[hull.vertices]
+    vertices: NDArray[np.intp] = hull.vertices
+    return poly[vertices]
 
 
 def contact_points(contact: Contact) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -100,8 +101,8 @@ def world_twist(
     about ``origin`` with its rotation multiplied by ``scale`` (as in :func:`wrenches`)."""
     omega = x[:3] / scale
     v = x[3:] - np.cross(omega, origin)
-    twist = np.r_[omega, v]
-    return twist / np.linalg.norm(twist)
+    twist = np.concatenate([omega, v])
+    return twist / float(np.linalg.norm(twist))
 
 
 @dataclass(frozen=True, eq=False)
@@ -182,7 +183,7 @@ class RigidBlockingGraph:
         solves to about 1e-7, so optima below the mesh angle tolerance count as zero."""
         pts, nrm = self.constraints(subassembly)
         if len(pts) == 0:
-            return np.r_[0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+            return np.array([0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
         origin = pts.mean(axis=0)
         rows = wrenches(pts, nrm, origin, self.tol.scale)
         result = linprog(
@@ -246,7 +247,7 @@ class RigidBlockingGraph:
         ]
 
     def _candidates(self, max_size: int) -> list[frozenset[str]]:
-        graph = nx.Graph()
+        graph: nx.Graph[str] = nx.Graph()
         graph.add_nodes_from(self.parts)
         graph.add_edges_from(c.pair for c in self.contacts)
         found: set[frozenset[str]] = set()
@@ -276,9 +277,9 @@ class RigidBlockingGraph:
                     found[subset].extend(twists)
         for subset in self._candidates(max_size or RIGID_MAX_SIZE):
             if subset not in found:
-                twist = self.free_twist(subset)
-                if twist is not None:
-                    found[subset].append(twist)
+                witness = self.free_twist(subset)
+                if witness is not None:
+                    found[subset].append(witness)
         removals = [Removal(s, tuple(t)) for s, t in found.items()]
         return sorted(removals, key=lambda r: (len(r.parts), sorted(r.parts)))
 

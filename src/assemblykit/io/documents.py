@@ -39,7 +39,7 @@ _ALIAS_LIMITS = yaml_rs.AliasLimits(
 _BaseLoader: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
-class _UniqueKeyLoader(_BaseLoader):  # type: ignore[misc, valid-type]
+class _UniqueKeyLoader(_BaseLoader):
     """A safe YAML loader that rejects a key given twice in one mapping and resolves each
     distinct plain scalar's type once (generated files repeat ``0``, ``plane``, ``-1``
     thousands of times; PyYAML tries its regular expressions on every occurrence)."""

@@ -13,7 +13,7 @@ imported inside the methods because they themselves take an :class:`Assembly`.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
@@ -117,7 +117,7 @@ class Assembly:
     def __len__(self) -> int:
         return len(self.parts)
 
-    def __iter__(self):  # type: ignore[no-untyped-def]
+    def __iter__(self) -> Iterator[Part]:
         return iter(self.parts.values())
 
     def __getitem__(self, name: str) -> Part:

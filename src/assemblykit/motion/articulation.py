@@ -133,7 +133,7 @@ def gear_meshes(joints: Sequence[Revolute], tol: Tolerance) -> list[GearMesh]:
 def gear_trains(meshes: Iterable[GearMesh], tol: Tolerance) -> list[GearTrain]:
     """The gear trains (connected components of the meshes) with their coupled motion."""
     meshes = list(meshes)
-    graph = nx.Graph()
+    graph: nx.Graph[str] = nx.Graph()
     for m in meshes:
         graph.add_edge(m.a, m.b)
     trains = []

@@ -21,9 +21,9 @@ from assemblykit.motion.freedom import Motion, MotionSolver
 from assemblykit.tolerance import Tolerance
 
 
-def contact_graph(assembly: Assembly, tol: Tolerance | None = None) -> nx.Graph:
+def contact_graph(assembly: Assembly, tol: Tolerance | None = None) -> nx.Graph[str]:
     """Parts as nodes (assembly order), an edge between every two parts in contact."""
-    graph = nx.Graph()
+    graph: nx.Graph[str] = nx.Graph()
     graph.add_nodes_from(assembly.names)
     graph.add_edges_from(c.pair for c in assembly.contacts(tol))
     return graph

@@ -145,7 +145,7 @@ class DirectionTable:
         """The DBG of direction ``k`` induced on ``members``: arc i→j when j blocks i."""
         columns = self._active(members)
         columns = columns[self.slots[k, columns]]
-        graph = nx.DiGraph()
+        graph: nx.DiGraph[int] = nx.DiGraph()
         graph.add_nodes_from(_bits(members))
         graph.add_edges_from(
             zip(self.moving[columns].tolist(), self.blocker[columns].tolist(), strict=True)
@@ -227,7 +227,7 @@ class ExtendedDirections:
     def graph(self, k: int, members: int) -> nx.DiGraph:
         """The Γ_e DBG along direction ``k`` induced on ``members`` (blocking is
         pairwise, so the arcs found for one subassembly serve every other)."""
-        graph = nx.DiGraph()
+        graph: nx.DiGraph[int] = nx.DiGraph()
         graph.add_nodes_from(_bits(members))
         graph.add_edges_from(
             (i, j) for i, mask in self.blockers(k, members, members).items() for j in _bits(mask)
@@ -539,7 +539,7 @@ class AssemblyStep:
         }
 
 
-def format_direction(direction: Sequence[float]) -> str:
+def format_direction(direction: Sequence[float] | NDArray[np.float64]) -> str:
     """A direction as ``(x, y, z)`` with 3 decimals (``-0.000`` printed as ``0.000``)."""
     return "(" + ", ".join(f"{float(x) + 0.0:.3f}" for x in np.round(direction, 3)) + ")"
 
@@ -1192,5 +1192,5 @@ def separable_by_translations(
     names = list(assembly.names) if parts is None else list(parts)
     if len(names) <= 1:
         return True
-    whole = assembly if len(names) == len(assembly.names) else assembly.subset(names)  # type: ignore[attr-defined]
+    whole = assembly if len(names) == len(assembly.names) else assembly.subset(names)
     return plan(whole, tol, max_and_or_parts=0).feasible
