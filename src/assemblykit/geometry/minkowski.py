@@ -97,7 +97,7 @@ def convex_pieces(
     pieces: list[NDArray[np.float64]] = []
     while todo:
         body = todo.pop()
-        out = body.to_mesh()
+        out = body.to_mesh64()
         piece = trimesh.Trimesh(
             np.asarray(out.vert_properties, dtype=np.float64)[:, :3],
             np.asarray(out.tri_verts, dtype=np.int64),
