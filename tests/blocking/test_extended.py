@@ -10,7 +10,7 @@ import trimesh
 from blocking_helpers import mesh_assembly
 
 from assemblykit.blocking.extended import extended_dbg, extended_free, obstacles
-from assemblykit.blocking.free_cones import exact_free_directions
+from assemblykit.blocking.free_cones import ChartSet, _distinct_cones, exact_free_directions
 from assemblykit.blocking.ndbg import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
 from assemblykit.geometry.minkowski import triangle_cones
@@ -196,3 +196,17 @@ def test_triangle_cones_of_a_face_above_a_face():
     # coplanar faces (in contact) have no cone with an interior
     _, flat = triangle_cones(tri, tri + np.array([0.5, 0.5, 0.0]), None, None)
     assert not flat.any()
+
+
+def test_repeated_cones_give_the_same_blocked_set():
+    """Cones repeated with their rows scaled and reordered are one cone: the union built
+    from the repeats equals the union of the distinct cones, and holds as many of them."""
+    rng = np.random.default_rng(3)
+    cones = rng.normal(size=(5, 3, 3))
+    repeats = np.concatenate([cones, 2.5 * cones[:, ::-1], cones[:, [1, 0, 2]]])
+    assert len(_distinct_cones(repeats)) == 5
+    once, thrice = ChartSet.from_cones(cones), ChartSet.from_cones(repeats)
+    for a, b in zip(once.regions, thrice.regions, strict=True):
+        assert a.symmetric_difference(b).area <= 1e-12
+    for d in rng.normal(size=(200, 3)):
+        assert once.contains(d) == thrice.contains(d)

@@ -54,6 +54,8 @@ class _Obstacles:
         self.pieces: dict[str, list[NDArray[np.float64]] | None] = {}
         self.cones: dict[tuple[str, str, Tolerance], list[NDArray[np.float64]]] = {}
         self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
+        # exact blocked sets (free_cones.blocked_by), by moving parts, blocker, tolerance
+        self.blocked: dict[tuple[tuple[str, ...], str, Tolerance], Any] = {}
         names = list(assembly.names)
         self.names = names
         bounds = np.array([assembly.parts[n].mesh.bounds for n in names]).reshape(-1, 2, 3)

@@ -70,6 +70,7 @@ class ChartSet:
     def from_cones(cls, normals: NDArray[np.float64]) -> ChartSet:
         """The union of the open cones ``{d : n . d > 0 for each row}`` (``cones x rows x 3``,
         zero rows impose nothing)."""
+        normals = _distinct_cones(normals)
         regions = []
         for frame in CHARTS:
             pieces = [
@@ -94,6 +95,24 @@ class ChartSet:
         """Whether the direction lies inside the set (not on its boundary)."""
         c, uv = _chart_point(direction)
         return bool(self.regions[c].contains(shapely.Point(*uv)))
+
+
+def _distinct_cones(normals: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The cones (``cones x rows x 3``) with repeats removed: a cone is the set of its
+    rows' directions, so rows are scaled to unit length and put in one order before
+    equal cones are merged (pairs of triangles from parallel faces repeat them often)."""
+    if len(normals) < 2:
+        return normals
+    length = np.linalg.norm(normals, axis=2, keepdims=True)
+    unit = np.where(length > 0, normals / np.where(length > 0, length, 1.0), 0.0)
+    # any fixed order of the rows will do: equal rows sort together
+    weight = np.array([1.0, np.sqrt(2.0), np.sqrt(3.0)])
+    order = np.argsort(unit @ weight, axis=1, kind="stable")
+    ordered = np.take_along_axis(unit, order[:, :, None], axis=1)
+    _, first = np.unique(
+        np.round(ordered.reshape(len(ordered), -1), 12) + 0.0, axis=0, return_index=True
+    )
+    return ordered[np.sort(first)]
 
 
 def _clip(normals: NDArray[np.float64], frame: NDArray[np.float64]) -> NDArray[np.object_]:
@@ -196,10 +215,23 @@ def blocked_by(
     assembly: Any, moving: Iterable[str], blocker: str, tol: Tolerance
 ) -> ChartSet | None:
     """The directions along which ``blocker`` blocks some part of ``moving`` (Wilson & Latombe 1992
-    §5), or ``None`` when there are more triangle pairs than :data:`TRIANGLE_PAIRS`."""
+    §5), or ``None`` when there are more triangle pairs than :data:`TRIANGLE_PAIRS`.
+    Computed once per assembly, moving set, blocker and tolerance."""
     from assemblykit.blocking.extended import obstacles
 
     cache = obstacles(assembly)
+    key = (tuple(sorted(set(moving))), blocker, tol)
+    if key not in cache.blocked:
+        cache.blocked[key] = _blocked_by(assembly, cache, key[0], blocker, tol)
+    found: ChartSet | None = cache.blocked[key]
+    return found
+
+
+def _blocked_by(
+    assembly: Any, cache: Any, moving: tuple[str, ...], blocker: str, tol: Tolerance
+) -> ChartSet | None:
+    """:func:`blocked_by` computed: the union of the cones of every pair of convex
+    pieces, or of front and back triangles of non-convex parts."""
     rows: list[NDArray[np.float64]] = []
     for name in moving:
         shift = cache.backout(name, blocker, tol)
