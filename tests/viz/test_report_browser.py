@@ -289,3 +289,26 @@ def test_a_large_report_is_quick_small_large_on_screen_and_highlights_step_one(
     shown = show_step_one(browser)
     check_step_one(shown, assembly, plan.steps[0].parts)
     assert shown["caption"].startswith(f"Step 1 of {len(plan.steps)}: ")
+
+
+def test_on_a_phone_the_report_fits_the_screen_and_still_shows_the_model(
+    browser: DevTools, gearbox_report: Path
+):
+    """A 390 x 844 phone screen: nothing runs off the side (no sideways scrolling), the
+    3D view spans most of the width, and the assembled model fills a third of it."""
+    browser.send(
+        "Emulation.setDeviceMetricsOverride",
+        width=390,
+        height=844,
+        deviceScaleFactor=1,
+        mobile=True,
+    )
+    try:
+        scene = browser.open(gearbox_report)
+        assert browser.evaluate("document.documentElement.scrollWidth") <= 390
+        assert 300 <= scene["width"] <= 390 and scene["height"] > 250
+        width, height = painted_box(browser.screenshot(scene))
+        assert width > 1 / 3 and height > 1 / 3
+        check_step_one(show_step_one(browser), load_assembly(DEMO), LIFTED)
+    finally:
+        browser.send("Emulation.clearDeviceMetricsOverride")

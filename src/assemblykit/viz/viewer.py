@@ -71,12 +71,14 @@ PlotlyJs = Literal["inline", "cdn"]
 
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 72em; }
-table { border-collapse: collapse; margin: 0.5em 0 1.5em; }
+table { border-collapse: collapse; margin: 0.5em 0 1.5em; display: block; max-width: 100%;
+  overflow-x: auto; }
 th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertical-align: top; }
 th { background: #f2f2f2; }
 tr.current td { background: #fff6d5; }
 .infeasible { color: #b00020; }
 #assembly-view { max-width: 56em; }
+@media (max-width: 40em) { body { margin: 0.6em; } #step-label { min-width: 6em; } }
 .controls { display: flex; align-items: center; gap: 0.8em; margin: 0.4em 0; max-width: 56em; }
 .controls input[type=range] { flex: 1; }
 #step-label { min-width: 9em; font-variant-numeric: tabular-nums; }
@@ -543,6 +545,7 @@ def report_html(
     body += [table.to_html() for table in extra]
     return (
         '<!DOCTYPE html>\n<html><head><meta charset="utf-8">'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">'
         f"<title>{html.escape(name)}: disassembly plan</title>"
         f"<style>{STYLE}</style></head><body>\n" + "\n".join(body) + "\n</body></html>\n"
     )
