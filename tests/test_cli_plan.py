@@ -9,21 +9,11 @@ from pathlib import Path
 
 import pytest
 
-from assemblykit.cli import main
+from cli_runs import run
 
 ROOT = Path(__file__).resolve().parents[1]
 DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
-
-
-def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    try:
-        main(list(argv))
-        code = 0
-    except SystemExit as done:
-        code = int(done.code or 0)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_plan_json_html_and_png(capsys, tmp_path):

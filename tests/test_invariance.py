@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import yaml
 
-from assemblykit.cli import main
+from cli_runs import run as cli_run
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "src" / "assemblykit" / "examples"
 LENGTHS = frozenset({"radius", "height", "size"})
@@ -24,14 +24,9 @@ SCALES = (1e-3, 1e3)
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> dict[str, Any]:
-    try:
-        main(list(argv))
-        code = 0
-    except SystemExit as done:
-        code = int(done.code or 0)
-    captured = capsys.readouterr()
-    assert code == 0, captured.err
-    return json.loads(captured.out)
+    code, out, err = cli_run(capsys, *argv)
+    assert code == 0, err
+    return json.loads(out)
 
 
 Map = Callable[[np.ndarray], np.ndarray]

@@ -8,27 +8,16 @@ import json
 from pathlib import Path
 
 import numpy as np
-import pytest
 import trimesh
 
-from assemblykit.cli import main
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.exports import CSV_COLUMNS, write_gltf, write_plan
 from assemblykit.planning.sequence import Plan, Step
+from cli_runs import run
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
 UP = np.array([0.0, 0.0, 1.0])
-
-
-def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    try:
-        main(list(argv))
-        code = 0
-    except SystemExit as done:
-        code = int(done.code or 0)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_plan_writes_the_step_table_and_the_exploded_gltf(capsys, tmp_path):

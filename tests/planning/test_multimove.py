@@ -12,9 +12,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assemblykit.cli import main
 from assemblykit.io.burrtools import load_puzzle, solution_count
 from assemblykit.planning.multimove import Move, MultiMovePlan, Separation, plan_voxels
+from cli_runs import run
 from datasets import dataset
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -167,16 +167,6 @@ def test_json_has_the_tree_the_level_and_the_plan_keys():
         "distance": None,
     }
     assert [s["motion"] for s in data["steps"]] == ["translation"] * 3
-
-
-def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    try:
-        main(list(argv))
-        code = 0
-    except SystemExit as done:
-        code = int(done.code or 0)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_plan_command_moves_multi(capsys):
