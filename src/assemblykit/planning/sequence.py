@@ -47,6 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from rich.console import Group
 from rich.table import Table
 
+from assemblykit import formatting as fmt
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.extended import extended_arcs
 from assemblykit.errors import InputError
@@ -269,8 +270,6 @@ class Step:
     least friction needed (:mod:`assemblykit.planning.stability`)."""
 
     def __repr__(self) -> str:
-        from assemblykit import formatting as fmt
-
         return fmt.summary(
             "Step", f"{fmt.name_list(self.parts)} along {fmt.direction(self.direction)}"
         )
@@ -314,6 +313,10 @@ class Interlock:
         }
 
 
+AndOrNode = frozenset[str] | tuple[str, frozenset[str], frozenset[str]]
+"""A node of an :class:`AndOrGraph`: a subassembly (OR) or ``("split", left, right)`` (AND)."""
+
+
 @dataclass(frozen=True, eq=False)
 class AndOrGraph:
     """The AND/OR graph of all feasible two-handed partitions (seed 004, "order").
@@ -323,7 +326,7 @@ class AndOrGraph:
     subassembly it splits. ``plans`` counts distinct disassembly trees of the whole.
     """
 
-    graph: nx.DiGraph
+    graph: nx.DiGraph[AndOrNode]
     plans: int
 
     @property
@@ -426,8 +429,6 @@ class Plan:
         }
 
     def __repr__(self) -> str:
-        from assemblykit import formatting as fmt
-
         return fmt.summary(
             "Plan",
             "feasible" if self.feasible else f"infeasible, stuck: {fmt.name_list(self.stuck)}",
@@ -437,8 +438,6 @@ class Plan:
 
     def _repr_html_(self) -> str:
         """The steps as a table (notebooks)."""
-        from assemblykit import formatting as fmt
-
         rows = [
             (
                 str(k),
@@ -466,7 +465,7 @@ class Plan:
                 str(number),
                 ", ".join(step.parts),
                 format_direction(step.direction),
-                _abbreviate(step.held),
+                fmt.name_list(step.held),
             )
         return table
 
@@ -488,7 +487,7 @@ class Plan:
                 ", ".join(step.parts),
                 format_direction(step.direction),
                 step.motion,
-                _abbreviate(step.rest),
+                fmt.name_list(step.rest),
             ]
             if step.stability is not None:
                 cells += step.stability.cells()
@@ -507,7 +506,7 @@ class Plan:
                         ", ".join(group),
                         format_direction(direction),
                         "translation, together",
-                        _abbreviate(move.groups[0]),
+                        fmt.name_list(move.groups[0]),
                     )
             table.caption = f"needs {self.hands.summary()}"
         elif self.hands is not None and self.hands.needed is None:
@@ -540,13 +539,9 @@ class AssemblyStep:
 
 
 def format_direction(direction: Sequence[float] | NDArray[np.float64]) -> str:
-    """A direction as ``(x, y, z)`` with 3 decimals (``-0.000`` printed as ``0.000``)."""
-    return "(" + ", ".join(f"{float(x) + 0.0:.3f}" for x in np.round(direction, 3)) + ")"
-
-
-def _abbreviate(names: Sequence[str], limit: int = 4) -> str:
-    shown = ", ".join(names[:limit])
-    return shown if len(names) <= limit else f"{shown}, ... ({len(names)} parts)"
+    """A direction for tables: ``+Z`` along an axis, else ``(x, y, z)`` (the shared
+    formatter, :func:`assemblykit.formatting.direction`)."""
+    return fmt.direction(np.asarray(direction, dtype=np.float64))
 
 
 def _bits(mask: int) -> Iterable[int]:
@@ -833,7 +828,7 @@ def and_or_graph(table: DirectionTable) -> AndOrGraph:
     used, so the count is a lower bound when Γ_e differs within a region of Γ_t."""
     names = table.names
     masks = [table.masks(k) for k in range(len(table.directions))]
-    graph = nx.DiGraph()
+    graph: nx.DiGraph[AndOrNode] = nx.DiGraph()
 
     def label(mask: int) -> frozenset[str]:
         return frozenset(names[i] for i in _bits(mask))
