@@ -151,6 +151,41 @@ def test_touching_pairs_and_areas_agree_with_compas_assembly(name, measured, jac
         assert found[pair] == pytest.approx(ref[pair], rel=1e-6)
 
 
+# The cross vault's two halves meet on a crown line where compas_assembly lists five
+# joints (5-6, 7-8, 9-14, 10-13, 11-12). In the file those blocks are sunk into each
+# other: the faces overlap fully, parallel within 1.3e-4 rad, 5.0e-4 to 6.7e-4 (up to
+# 4.3e-5 of the vault's size) apart on the wrong side, more than the measured precision
+# 1.8e-4 (precision.py does not count faces sunk into each other as joints). At that
+# precision they are not faces in contact; what touches there are slivers as wide as the
+# sinking, where the neighbours' side faces coincide. A tolerance beyond the sinking
+# (--tolerance 5e-5) finds exactly compas_assembly's 452 pairs and their areas.
+CROWN = {frozenset(p) for p in [("5", "6"), ("7", "8"), ("9", "14"), ("10", "13"), ("11", "12")]}
+
+
+def test_the_cross_vaults_crown_joints_are_sunk_beyond_its_precision():
+    from assemblykit.geometry.interference import overlap_volume
+
+    path = dataset("compas_assembly/crossvault_assembly.json")
+    asm = load_compas(path)
+    ref = _reference(path)
+    found = {frozenset(c.pair): c for c in asm.contacts()}
+    assert ref.keys() - found.keys() == CROWN
+    slivers = found.keys() - ref.keys()
+    assert len(slivers) == 8
+    assert all(0 < found[pair].area < 5e-4 for pair in slivers)
+    length = asm.tolerance().length
+    for pair in CROWN:
+        a, b = sorted(pair)
+        # shared volume over the joint's area: how deep the faces are sunk on average
+        depth = overlap_volume(asm[a].mesh, asm[b].mesh) / ref[pair]
+        assert length < depth < 4.3e-5 * asm.scale
+    loose = Tolerance.relative(5e-5)
+    found = {frozenset(c.pair): c.area for c in asm.contacts(loose)}
+    assert found.keys() == ref.keys()
+    for pair in ref:
+        assert found[pair] == pytest.approx(ref[pair], rel=1e-6)
+
+
 def _square(half: float) -> np.ndarray:
     return np.array([[-half, -half, 0], [half, -half, 0], [half, half, 0], [-half, half, 0]])
 

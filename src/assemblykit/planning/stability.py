@@ -24,13 +24,14 @@ who judged the states by rigid-body simulation instead.
 * fixed parts (ground, fixture) and held parts take any wrench.
 
 A set of parts stands when non-negative generator weights balance every free part's
-weight (six equations per part). The program minimises the absolute residuals
-(slacks) of those equations, each scaled by the part's weight and the model's size: it
-is always feasible, the state stands when every residual is within the tolerance, and
-the parts left with a residual are those that cannot be in equilibrium (they would
-fall). Loads are homogeneous in rigid-block equilibrium (scaling gravity scales every
-force), so the margin reported is the least friction coefficient with which the state
-stands, found by bisection.
+weight (six equations per part). A first program asks whether the equations alone have
+a solution; when they have none, a second one minimises the absolute residuals (slacks)
+of those equations, each scaled by the part's weight and the model's size: it is always
+feasible, and the parts left with a residual beyond the tolerance are those that cannot
+be in equilibrium (they would fall). Both are solved by HiGHS's interior point method
+within :data:`LP_TIME_LIMIT`. Loads are homogeneous in rigid-block equilibrium (scaling
+gravity scales every force), so the margin reported is the least friction coefficient
+with which the state stands, found by bisection.
 """
 
 from __future__ import annotations
@@ -63,6 +64,14 @@ FRICTION_STEPS = 5
 LP_FEASIBILITY = 1e-7
 """HiGHS's primal feasibility tolerance (its default, passed explicitly): residuals below
 it are the solver's rounding, not a fall."""
+
+LP_TIME_LIMIT = 120.0
+"""Seconds one equilibrium program may take before :class:`NumericError` (a bound; the
+largest program measured, the 527-block dome's, takes 20 to 45 s on two shared cores:
+benchmarks/bench_stability.py). Both programs are solved by HiGHS's interior
+point method: the nearly balanced states of a vault make the dual simplex method
+degenerate (minutes of pivots on the cross vault where the interior point method needs
+about 50 iterations)."""
 
 DOWN = (0.0, 0.0, -1.0)
 
@@ -279,15 +288,17 @@ class EquilibriumModel:
             out[free] = np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
             return out
         matrix = self.normal_part[rows][:, columns] + mu * self.tangent_part[rows][:, columns]
-        options = {"primal_feasibility_tolerance": LP_FEASIBILITY}
+        options = {"primal_feasibility_tolerance": LP_FEASIBILITY, "time_limit": LP_TIME_LIMIT}
         found = linprog(
             np.zeros(len(columns)),
             A_eq=matrix.tocsc(),
             b_eq=-self.load[rows],
             bounds=(0, None),
-            method="highs",
+            method="highs-ipm",
             options=options,
         )
+        if found.status not in (0, 2):
+            raise NumericError(f"equilibrium program failed: {found.message}")
         if found.status == 0:
             return out
         size = len(rows)
@@ -299,11 +310,11 @@ class EquilibriumModel:
             A_eq=system,
             b_eq=-self.load[rows],
             bounds=(0, None),
-            method="highs",
+            method="highs-ipm",
             options=options,
         )
         if result.status != 0:
-            raise NumericError(f"equilibrium program failed: {result.message}")
+            raise NumericError(f"equilibrium slack program failed: {result.message}")
         slack = result.x[len(columns) :]
         residual = np.abs(slack[:size] - slack[size:]).reshape(-1, 6).max(axis=1)
         out[free] = residual
@@ -329,11 +340,17 @@ class EquilibriumModel:
             residuals=tuple(float(residual[i]) for i in free),
         )
 
-    def friction_needed(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> float | None:
+    def friction_needed(
+        self,
+        present: NDArray[np.bool_],
+        fixed: NDArray[np.bool_],
+        falls: NDArray[np.bool_] | None = None,
+    ) -> float | None:
         """The least friction coefficient, within ``friction / 2**FRICTION_STEPS`` (the
         upper end of the bisection: one with which the state is shown to stand), with
-        which ``present`` stands; ``None`` when ``friction`` itself does not suffice."""
-        if self.falling(present, fixed).any():
+        which ``present`` stands; ``None`` when ``friction`` itself does not suffice.
+        ``falls``: :meth:`falling` at ``friction``, when already known."""
+        if (self.falling(present, fixed) if falls is None else falls).any():
             return None
         if not self.falling(present, fixed, 0.0).any():
             return 0.0
@@ -616,7 +633,7 @@ class StateJudge:
         found = self.assess(members, moved)
         names = self.model.names
         needed: list[float | None] = [
-            self.model.friction_needed(present, fixed)
+            self.model.friction_needed(present, fixed, self.falling(present, fixed))
             for present, fixed in found.states
             if (present & ~fixed).any()
         ]
