@@ -152,12 +152,12 @@ def compute(command: Command, path: str, rel_tolerance: float | None = None) -> 
     if command == "plan":
         from assemblykit.planning.sequence import plan
 
-        result = plan(assembly, tol=tol)
+        data = plan(assembly, tol=tol).to_dict()
     else:
         from assemblykit.motion.freedom import motion
 
-        result = motion(assembly)
-    return cast(dict[str, Any], jsonable(result.to_dict(), assembly.tolerance(tol)))
+        data = motion(assembly).to_dict()
+    return cast(dict[str, Any], jsonable(data, assembly.tolerance(tol)))
 
 
 class _Stopped(Exception):

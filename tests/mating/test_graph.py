@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from assemblykit.algebra import Kind, se3
-from assemblykit.features import Hole, Plane, Shaft
+from assemblykit.algebra import EmptySet, Kind, se3
+from assemblykit.features import Hole, Plane, Shaft, Thread
 from assemblykit.io.problem import load_problem, parse_problem
 from assemblykit.mating.graph import (
     RARITY,
@@ -63,6 +63,23 @@ def test_relative_position_is_the_single_seat(example1: MatingProblem) -> None:
     )
     expected = se3.translation((20, 0, 1)) @ se3.rotation((0, 1, 0), np.pi)
     np.testing.assert_allclose(flipped.rep, expected, atol=1e-12)
+
+
+def test_an_empty_later_pair_makes_the_pairing_empty() -> None:
+    # Thread leads 3 tol apart: the same surface for matable (pitches lead/2π are within
+    # tol), but fits needs equal leads, so the second pair's coset is empty.
+    lead = 1.0
+    first = [Plane((0, 0, 0), (0, 0, 1)), Thread((0, 0, 0), (0, 0, 1), 5.0, lead, male=True)]
+    second = [
+        Plane((0, 0, 0), (0, 0, -1)),
+        Thread((0, 0, 0), (0, 0, 1), 5.0, lead + 3 * TOL.length, male=False),
+    ]
+    (pairing,) = pairings(first, second, TOL)
+    assert pairing == ((0, 0, "against"), (1, 1, "fits"))
+    empty = pair_coset(first, second, pairing, TOL)
+    assert isinstance(empty, EmptySet) and empty.proven
+    assert empty.mismatch.kind == "pitch"
+    assert empty.mismatch.value == pytest.approx(3 * TOL.length)
 
 
 def test_candidates_of_goal_1(example1: MatingProblem) -> None:

@@ -589,7 +589,8 @@ def feature_from_dict(name: str, data: Mapping[str, Any], where: str | None = No
         raise SchemaError(f"a {kind} needs {', '.join(missing)}", where=where)
     for key in _ANGLE_KEYS & set(values):
         values[key] = parse_angle(values[key], f"{where}.{key}")
+    build: Callable[..., Feature] = cls  # each subclass's own fields, checked above
     try:
-        return cls(name=name, **values)
+        return build(name=name, **values)
     except FeatureError as error:
         raise FeatureError(error.detail, where=where) from None

@@ -428,6 +428,7 @@ def _axial_overlap(
     """The common interval of two surfaces' extents, measured along ``axis`` from ``origin``."""
 
     def span(s: Surface) -> tuple[float, float]:
+        assert s.axis is not None  # surfaces with an extent along an axis have one
         base = float((s.point - origin) @ axis)
         ends = [base + e * float(s.axis @ axis) for e in s.extent]
         return min(ends), max(ends)
@@ -585,18 +586,22 @@ def find_contacts(
     for k in parts_in_pairs:
         part = assembly.parts[names[k]]
         if part.surfaces or curved_part[k]:
-            found = tuple(s for s in assembly.surfaces(names[k], tol) if s.kind != "plane")
-            surfaces[int(k)] = found
+            curved_surfaces = tuple(
+                s for s in assembly.surfaces(names[k], tol) if s.kind != "plane"
+            )
+            surfaces[int(k)] = curved_surfaces
             start = stack.face_start[k]
-            excluded[start : start + len(part.mesh.faces)] = faces_on(found, len(part.mesh.faces))
+            excluded[start : start + len(part.mesh.faces)] = faces_on(
+                curved_surfaces, len(part.mesh.faces)
+            )
 
     group_part = stack.part[seg.order[seg.start[:-1]]]
     usable = seg.flat & (np.bincount(seg.group, weights=excluded, minlength=len(seg.flat)) == 0)
     g, h = _planar_matches(stack, seg, group_part, usable, part_lo, part_hi, pairs, tol)
     k, patches = _planar_patches(stack, seg, g, h, tol)
     planar: dict[tuple[int, int], list[PlanarPatch]] = {}
-    for m, patch in zip(k, patches, strict=True):
-        planar.setdefault((int(group_part[g[m]]), int(group_part[h[m]])), []).append(patch)
+    for m, flat in zip(k, patches, strict=True):
+        planar.setdefault((int(group_part[g[m]]), int(group_part[h[m]])), []).append(flat)
 
     curved: dict[tuple[int, int], list[CurvedPatch]] = {}
     for a, b in pairs:

@@ -133,7 +133,7 @@ def arc_angles(arcs: NDArray[np.float64], step: float) -> NDArray[np.float64]:
     for lo, hi in arcs:
         if hi - lo >= TURN:
             count = math.ceil(TURN / step)
-            angles.append(np.arange(count) * (TURN / count))
+            angles.append(np.arange(count, dtype=np.float64) * (TURN / count))
         else:
             count = max(1, math.ceil((hi - lo) / step))
             angles.append(np.linspace(lo, hi, count + 1))

@@ -60,6 +60,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from assemblykit.algebra.se3 import line_classes
+from assemblykit.features.primitives import Feature
 from assemblykit.tolerance import Tolerance, current
 
 SurfaceKind = Literal["plane", "cylinder", "cone", "sphere", "torus"]
@@ -97,7 +98,7 @@ class Surface:
     convex: bool = True
     extent: tuple[float, float] = (0.0, 0.0)
 
-    def feature(self) -> Any:
+    def feature(self) -> Feature:
         """The :mod:`assemblykit.features` primitive of this surface (Liu 1997 §2)."""
         from assemblykit.features.primitives import (
             Ball,
@@ -109,20 +110,20 @@ class Surface:
             Torus,
         )
 
-        if self.kind == "plane":
-            return Plane(point=self.point, normal=self.axis)
-        if self.kind == "cylinder":
-            cls = Shaft if self.convex else Hole
-            return cls(point=self.point, axis=self.axis, radius=self.radius, directed=False)
         if self.kind == "sphere":
             return (Ball if self.convex else Socket)(point=self.point, radius=self.radius)
+        axis = self.axis
+        assert axis is not None
+        if self.kind == "plane":
+            return Plane(point=self.point, normal=axis)
+        if self.kind == "cylinder":
+            cls = Shaft if self.convex else Hole
+            return cls(point=self.point, axis=axis, radius=self.radius, directed=False)
         if self.kind == "cone":
-            return Cone(
-                point=self.point, axis=self.axis, half_angle=self.half_angle, male=self.convex
-            )
+            return Cone(point=self.point, axis=axis, half_angle=self.half_angle, male=self.convex)
         return Torus(
             point=self.point,
-            axis=self.axis,
+            axis=axis,
             major_radius=self.radius,
             minor_radius=self.minor_radius,
             male=self.convex,
@@ -634,7 +635,7 @@ def faces_on(surfaces: tuple[Surface, ...], n_faces: int) -> NDArray[np.bool_]:
 def planes(seg: Segmentation, excluded: NDArray[np.bool_]) -> tuple[Surface, ...]:
     """The flat coplanar groups (planar faces) not on ``excluded`` faces, as planes."""
     found = []
-    for g in np.flatnonzero(seg.flat):
+    for g in np.flatnonzero(seg.flat).tolist():
         ids = seg.faces_of(g)
         if excluded[ids].any():
             continue

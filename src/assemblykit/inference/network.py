@@ -37,6 +37,8 @@ from assemblykit.algebra import Coset, EmptySet, Mismatch, SymmetryGroup, se3
 from assemblykit.errors import SchemaError
 from assemblykit.inference.numeric import (
     Constraint,
+    Node,
+    Residual,
     gear_residual,
     mirror_residual,
     rack_residual,
@@ -53,7 +55,6 @@ from assemblykit.model.relations import (
 from assemblykit.model.task import Action, Situation, Task
 from assemblykit.tolerance import Tolerance, current
 
-Node = tuple[str, str]
 WORLD: Node = ("world", "")
 
 
@@ -91,9 +92,9 @@ class Network:
         """The node of a body instance (the world for a fixed body)."""
         return WORLD if body in self.fixed else (body, situation)
 
-    def graph(self) -> nx.MultiGraph:
+    def graph(self) -> nx.MultiGraph[Node]:
         """The undirected multigraph of instances and coset links (link index as key)."""
-        graph = nx.MultiGraph()
+        graph: nx.MultiGraph[Node] = nx.MultiGraph()
         graph.add_node(WORLD)
         graph.add_nodes_from(self.instances)
         for index, link in enumerate(self.links):
@@ -105,9 +106,14 @@ class Network:
         residual = link.make_residual()
         return Constraint(
             (link.source, link.target),
-            lambda poses: residual(se3.inverse(poses[0]) @ poses[1]),
+            _between(residual),
             link.labels,
         )
+
+
+def _between(relative: Callable[[np.ndarray], np.ndarray]) -> Residual:
+    """A residual of X = inv(L_source)·L_target as one of the poses (L_source, L_target)."""
+    return lambda poses: relative(se3.inverse(poses[0]) @ poses[1])
 
 
 def _plain_value(value: Any) -> Hashable:
@@ -411,7 +417,7 @@ def _fold_point_loci(
         rest.append(
             Constraint(
                 (source, target),
-                lambda poses, r=residual: r(se3.inverse(poses[0]) @ poses[1]),
+                _between(residual),
                 labels,
                 located,
             )
@@ -465,7 +471,7 @@ def _relation_part(
         residual = relation_residual(relation.kind, first, second, options)
         return Constraint(
             (source, target),
-            lambda poses: residual(se3.inverse(poses[0]) @ poses[1]),
+            _between(residual),
             (label,),
             _geometry(relation.kind, options, (target, first), (source, second)),
         )
@@ -500,7 +506,10 @@ def build_network(task: Task) -> Network:
             links.extend(_transition(task, situation, situations[index - 1], fixed))
         for relation in situation.relations:
             part = _relation_part(task, situation, relation, node, cosets)
-            (links if isinstance(part, Link) else constraints).append(part)
+            if isinstance(part, Link):
+                links.append(part)
+            else:
+                constraints.append(part)
     folded, constraints = _fold_point_loci(constraints, current())
     return Network(
         instances,

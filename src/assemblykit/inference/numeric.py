@@ -31,6 +31,8 @@ from assemblykit.algebra import se3
 from assemblykit.tolerance import Tolerance, current
 
 Residual = Callable[[Sequence[np.ndarray]], np.ndarray]
+Node = tuple[str, str]
+"""A body instance ``(body, situation)``: a node of the network (Corner et al. 1983 §III)."""
 
 
 @dataclass(frozen=True)
@@ -41,7 +43,7 @@ class Constraint:
     ``geometry`` describes the relation when the reduction has a closed form for it.
     """
 
-    nodes: tuple[Hashable, ...]
+    nodes: tuple[Node, ...]
     residual: Residual
     labels: tuple[str, ...] = ()
     geometry: Any = None

@@ -348,9 +348,16 @@ class Reducer:
             self.trace.append(TraceStep("branch", self._edge_text(edge), 0, 0, "one point"))
             self.merges.append(key)
 
+    def links(self, among: set[Node] | None = None) -> Iterator[tuple[Node, Node]]:
+        """The two ends of each live link (only those between nodes of ``among`` if given)."""
+        for key in self.edges:
+            if among is None or key <= among:
+                first, second = key
+                yield first, second
+
     def cycles(self) -> Iterator[list[Node]]:
         """Cycles of 3 or 4 live links (rule 4)."""
-        graph = nx.Graph(list(self.edges))
+        graph: nx.Graph[Node] = nx.Graph(list(self.links()))
         return (c for c in nx.simple_cycles(graph, length_bound=CYCLE_LENGTH) if len(c) >= 3)
 
     def reduce_cycle(self, cycle: list[Node]) -> bool:
@@ -556,8 +563,8 @@ def revolute_loop(
     because the circles miss, the distance between them; None when the pattern does not
     apply (not three revolutes, non-parallel axes, or a continuum).
     """
-    axes = [_axis(v) for v in (first, second, closing)]
-    if any(a is None for a in axes):
+    axes = [axis for v in (first, second, closing) if (axis := _axis(v)) is not None]
+    if len(axes) < 3:
         return None
     (p1, u1), (p2, _), (p3, u3) = axes  # the joint axis point p2 is in j's frame
     x_first, x_close = first.rep, closing.rep
@@ -648,11 +655,11 @@ def explore(reducer: Reducer, max_branches: int) -> tuple[list[Reducer], int]:
 
 def _components_of(network: Network, reducer: Reducer) -> list[set[Node]]:
     """Connected groups of representatives (live links and general constraints)."""
-    graph = nx.Graph()
+    graph: nx.Graph[Node] = nx.Graph()
     graph.add_node(WORLD)
     for node in network.instances:
         graph.add_node(reducer.find(node)[0])
-    graph.add_edges_from(tuple(key) for key in reducer.edges)
+    graph.add_edges_from(reducer.links())
     for constraint in network.constraints:
         reps = [reducer.find(n)[0] for n in constraint.nodes]
         graph.add_edges_from(itertools.pairwise(reps))
@@ -668,9 +675,9 @@ def _tree_sets(
     identity) when the link holds there, the link's representative otherwise."""
     poses = {root: np.eye(4)}
     sets: dict[Node, Any] = {}
-    tree = nx.Graph()
+    tree: nx.Graph[Node] = nx.Graph()
     tree.add_nodes_from(component)
-    tree.add_edges_from(tuple(k) for k in reducer.edges if k <= component)
+    tree.add_edges_from(reducer.links(component))
     for parent, child in nx.bfs_edges(tree, root):
         link = reducer.edges[frozenset((parent, child))].oriented(parent)
         as_written = link.contains(se3.inverse(poses[parent]), reducer.tol)
@@ -1242,7 +1249,8 @@ def _numeric_component(
     isolated = first.total_dof == 0
     for n in unknowns:
         dof = first.dof[n]
-        motion, invariants = ("fixed", {}) if dof == 0 else ("mechanism", {})
+        motion = "fixed" if dof == 0 else "mechanism"
+        invariants: Mapping[str, Any] = {}
         link = reducer.edges.get(frozenset((WORLD, n)))
         options = [link.oriented(WORLD) if link else None, (candidates or {}).get(n)]
         match = next(

@@ -391,9 +391,7 @@ def load_puzzle(path: str | Path, problem: int = 0, solution: int = 0) -> VoxelP
     )
 
 
-_CUBE = np.array(
-    [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]]
-)
+_CUBE = ((0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1))
 # the outward quad (counter-clockwise seen from outside) of each face direction
 _QUADS = {
     (-1, 0, 0): (0, 4, 7, 3),
@@ -414,19 +412,21 @@ def voxel_mesh(voxels: NDArray[np.int64], source: str | None = None) -> trimesh.
     surface is a closed 2-manifold even where a piece touches itself along an edge (the
     repair of :func:`assemblykit.io.meshes.repaired` handles separate solids only).
     :class:`GeometryError` names ``source`` if the result is not closed."""
-    filled = {tuple(c) for c in voxels.tolist()}
+    filled: set[tuple[int, int, int]] = {(x, y, z) for x, y, z in voxels.tolist()}
     corners: list[list[tuple[int, int, int]]] = []
-    owner: list[tuple[int, ...]] = []
-    for cell in sorted(filled):
-        for normal, quad in _QUADS.items():
-            if (cell[0] + normal[0], cell[1] + normal[1], cell[2] + normal[2]) not in filled:
-                corners.append([tuple(int(x) for x in _CUBE[k] + cell) for k in quad])
-                owner.append(cell)
+    owner: list[tuple[int, int, int]] = []
+    for x, y, z in sorted(filled):
+        for (ux, uy, uz), quad in _QUADS.items():
+            if (x + ux, y + uy, z + uz) not in filled:
+                corners.append(
+                    [(x + dx, y + dy, z + dz) for dx, dy, dz in (_CUBE[k] for k in quad)]
+                )
+                owner.append((x, y, z))
     # corner slot 4 q + k of quad q; slots across an edge two quads share are one vertex
     sides: dict[tuple[tuple[int, int, int], ...], list[int]] = {}
-    for q, quad in enumerate(corners):
+    for q, ring in enumerate(corners):
         for k in range(4):
-            sides.setdefault(tuple(sorted((quad[k], quad[(k + 1) % 4]))), []).append(q)
+            sides.setdefault(tuple(sorted((ring[k], ring[(k + 1) % 4]))), []).append(q)
     joins: list[tuple[int, int]] = []
     for edge, quads in sides.items():
         pairs = [tuple(quads)] if len(quads) == 2 else []

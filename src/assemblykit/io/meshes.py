@@ -143,10 +143,11 @@ def _split_at_shared_edges(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
         if keep[k] and groups[k] == groups[k + 1]
     ]
     labels = trimesh.graph.connected_component_labels(pairs, node_count=len(mesh.faces))
-    bodies = [
-        mesh.submesh([np.flatnonzero(labels == label)], append=True, only_watertight=False)
-        for label in np.unique(labels)
-    ]
+    bodies: list[trimesh.Trimesh] = []
+    for label in np.unique(labels):
+        body = mesh.submesh([np.flatnonzero(labels == label)], append=True, only_watertight=False)
+        assert isinstance(body, trimesh.Trimesh)  # append=True joins the faces in one mesh
+        bodies.append(body)
     if not all(body.is_watertight for body in bodies):
         return mesh
     vertices = np.vstack([body.vertices for body in bodies])
@@ -210,7 +211,9 @@ def load_mesh_folder(
             f"no mesh files ({', '.join(MESH_SUFFIXES)}) in folder", source=str(folder)
         )
     states = _final_states(folder / "config.json")
-    parts, measured, reach = [], [], []
+    parts: list[Part] = []
+    measured: list[Precision] = []
+    reach: list[float] = []
     for file in files:
         state = states.get(file.stem)
         pose = np.eye(4) if state is None else pose_from_state(state)
@@ -220,12 +223,13 @@ def load_mesh_folder(
         if state is not None:
             radius = float(np.linalg.norm(mesh.vertices, axis=1).max())
             rounding = pose_precision(list(states.values()), radius)
+        if rounding is not None:
             measured.append(rounding)
         reach.append(0.0 if rounding is None else rounding.length)
         parts.append(Part(file.stem, placed(mesh, pose), pose, source=str(file)))
     if settle and any(reach):
         parts = _settled(parts, reach)
-    return _assembly(parts, None, False, str(folder), tol, combined(p for p in measured if p))
+    return _assembly(parts, None, False, str(folder), tol, combined(measured))
 
 
 def _settled(parts: list[Part], reach: Sequence[float]) -> list[Part]:
@@ -247,9 +251,8 @@ def _settled(parts: list[Part], reach: Sequence[float]) -> list[Part]:
         pose[:3, 3] += shift
         mesh = part.mesh.copy()
         mesh.apply_translation(shift)
-        settled.append(
-            Part(part.name, mesh, pose, part.surfaces, part.source, (*map(float, shift),))
-        )
+        x, y, z = shift.tolist()
+        settled.append(Part(part.name, mesh, pose, part.surfaces, part.source, (x, y, z)))
     return settled
 
 

@@ -12,6 +12,7 @@ both syntaxes share one validation and every error names ``file: line N``.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -80,9 +81,9 @@ def rapt_to_dict(text: str, source: str | None = None) -> tuple[dict[str, Any], 
     try:
         return _Builder().transform(tree)
     except VisitError as failure:
-        error = failure.orig_exc
-        if isinstance(error, SchemaError):
-            raise SchemaError(error.detail, source=source, where=error.where) from None
+        cause = failure.orig_exc
+        if isinstance(cause, SchemaError):
+            raise SchemaError(cause.detail, source=source, where=cause.where) from None
         raise
 
 
@@ -150,7 +151,7 @@ def _action_text(items: list[Any]) -> str:
     return text
 
 
-def _expected(names: set[str] | frozenset[str]) -> str:
+def _expected(names: Iterable[str]) -> str:
     """Terminal names as the words a user would type."""
     by_name = {t.name: t for t in parser().terminals}
     words = set()

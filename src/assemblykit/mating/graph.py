@@ -119,8 +119,9 @@ def pairings(
     if kinds is None:
         kinds = [[matable(a, b, tol) for b in second] for a in first]
     for order in itertools.permutations(range(len(second))):
-        if all(kinds[i][j] for i, j in enumerate(order)):
-            yield tuple((i, j, kinds[i][j]) for i, j in enumerate(order))  # type: ignore[misc]
+        pairing = tuple((i, j, kind) for i, j in enumerate(order) if (kind := kinds[i][j]))
+        if len(pairing) == len(order):
+            yield pairing
 
 
 def pair_coset(
@@ -131,12 +132,14 @@ def pair_coset(
 ) -> Coset | EmptySet:
     """The relative position allowed by all the paired primitives at once: the
     intersection of their relation cosets (Liu & Popplestone 1990 eq. (3), ALGEBRA.md §2.5)."""
-    result: Coset | EmptySet | None = None
+    result: Coset | None = None
     for i, j, kind in pairing:
         step = relation_coset(kind, first[i], second[j], tol=tol)
-        result = step if result is None else result.intersect(step, tol=tol)  # type: ignore[union-attr]
-        if isinstance(result, EmptySet):
-            return result
+        if result is not None and isinstance(step, Coset):
+            step = result.intersect(step, tol=tol)
+        if isinstance(step, EmptySet):
+            return step
+        result = step
     assert result is not None
     return result
 
@@ -235,8 +238,8 @@ class ConstraintGraph:
     ``Graph``), ``bottom`` (compound features joined by candidate pairs, ``MultiGraph``),
     and the ``initial`` and node-consistent ``domains`` of the goals."""
 
-    top: nx.Graph
-    bottom: nx.MultiGraph
+    top: nx.Graph[tuple[str, str | int]]
+    bottom: nx.MultiGraph[tuple[str, str]]
     initial: Domains
     domains: Domains
 
@@ -244,8 +247,8 @@ class ConstraintGraph:
 def build_graph(problem: MatingProblem) -> ConstraintGraph:
     """Set up the two-layer graph with the candidate pairs of every goal and apply node
     consistency (Liu & Popplestone 1990 step one)."""
-    top = nx.Graph()
-    bottom = nx.MultiGraph()
+    top: nx.Graph[tuple[str, str | int]] = nx.Graph()
+    bottom: nx.MultiGraph[tuple[str, str]] = nx.MultiGraph()
     for body in problem.bodies.values():
         top.add_node(("body", body.name))
         bottom.add_nodes_from((body.name, c) for c in body.compounds)

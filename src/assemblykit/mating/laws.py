@@ -183,7 +183,9 @@ class Clashes:
             coset = candidate.coset if candidate.goal.first == name else candidate.coset.inverse()
             if not sweepable(coset):
                 return False
-            movers.append(mover(name, self.problem.bodies[name].mesh, coset, tol))
+            mesh = self.problem.bodies[name].mesh
+            assert mesh is not None  # others() names only bodies with a mesh
+            movers.append(mover(name, mesh, coset, tol))
         return judge_pair(movers[0], movers[1], tol).verdict is Verdict.BLOCKED
 
 

@@ -92,9 +92,11 @@ def locus_meet(a: Locus, b: Locus, tol: Tolerance) -> list[np.ndarray] | None:
     (:func:`circle_sphere` then the other's plane). ``None`` when there is no closed form
     here (coincident circles, other kinds of loci)."""
     if a.kind == "point":
-        return [a.point] if b.contains(a.point, tol) else []  # type: ignore[list-item]
+        assert a.point is not None
+        return [a.point] if b.contains(a.point, tol) else []
     if b.kind == "point":
-        return [b.point] if a.contains(b.point, tol) else []  # type: ignore[list-item]
+        assert b.point is not None
+        return [b.point] if a.contains(b.point, tol) else []
     if a.kind != "circle" or b.kind != "circle":
         return None
     assert b.point is not None and b.direction is not None

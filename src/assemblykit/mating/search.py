@@ -321,17 +321,17 @@ def _solve_cp_sat(domains: Domains) -> list[dict[int, Candidate]]:
         raise MissingExtraError("ortools", "csp", "a large mating search") from None
     model = cp_model.CpModel()
     choice = {
-        (g, i): model.NewBoolVar(f"g{g}_{i}") for g, d in domains.items() for i in range(len(d))
+        (g, i): model.new_bool_var(f"g{g}_{i}") for g, d in domains.items() for i in range(len(d))
     }
     users: dict[tuple[str, str], list[Any]] = {}
     for g, d in domains.items():
-        model.AddExactlyOne(choice[(g, i)] for i in range(len(d)))
+        model.add_exactly_one(choice[(g, i)] for i in range(len(d)))
         for i, c in enumerate(d):
             for feature in c.uses:
                 users.setdefault(feature, []).append(choice[(g, i)])
     for variables in users.values():
         if len(variables) > 1:
-            model.AddAtMostOne(variables)
+            model.add_at_most_one(variables)
 
     class _Collect(cp_model.CpSolverSolutionCallback):
         def __init__(self) -> None:
@@ -341,7 +341,7 @@ def _solve_cp_sat(domains: Domains) -> list[dict[int, Candidate]]:
         def on_solution_callback(self) -> None:
             self.rows.append(
                 tuple(
-                    next(i for i in range(len(d)) if self.Value(choice[(g, i)]))
+                    next(i for i in range(len(d)) if self.value(choice[(g, i)]))
                     for g, d in domains.items()
                 )
             )
@@ -350,7 +350,7 @@ def _solve_cp_sat(domains: Domains) -> list[dict[int, Candidate]]:
     solver.parameters.enumerate_all_solutions = True
     solver.parameters.num_workers = 1
     collect = _Collect()
-    solver.Solve(model, collect)
+    solver.solve(model, collect)
     goals = list(domains)
     return [
         {g: domains[g][i] for g, i in zip(goals, row, strict=True)} for row in sorted(collect.rows)
@@ -584,7 +584,7 @@ def _candidates(body: Mover) -> list[tuple[float, ...]]:
     axes = []
     for (lo, hi), weight in zip(body.span, body.weights(), strict=True):
         steps = np.linspace(lo, hi, WITNESS_STEPS + 1)
-        axes.append(sorted({0.0, *map(float, steps)}, key=lambda t, w=weight: abs(t) * w))
+        axes.append(sorted({0.0, *map(float, steps)}, key=lambda t: abs(t) * weight))
     grid = [tuple(p) for p in itertools.product(*axes)]
     weights = body.weights()
     grid.sort(key=lambda p: math.hypot(*(t * w for t, w in zip(p, weights, strict=True))))

@@ -227,8 +227,9 @@ def _describe(feature: Feature) -> str:
 def _check(kind: str, first: Feature, second: Feature, where: str | None) -> RelationSpec:
     spec = _spec(kind, where)
     accepted = (first.type_name, second.type_name) in spec.accepts
-    if accepted and kind == "fits" and isinstance(first, Cone | Torus | Thread | Prism):
-        accepted = first.male != second.male  # type: ignore[attr-defined]
+    sided = Cone | Torus | Thread | Prism
+    if accepted and kind == "fits" and isinstance(first, sided) and isinstance(second, sided):
+        accepted = first.male != second.male
     if not accepted:
         raise FeatureError(
             f"{kind} cannot relate the {_describe(first)} and the {_describe(second)}", where=where
@@ -273,7 +274,7 @@ def _fits_mismatch(first: Feature, second: Feature, tol: Tolerance) -> EmptySet 
     hand, sides and size; the first failing one as an inconsistency."""
     checks: list[tuple[str, float, float, str, float]] = []
     match first, second:
-        case ((Shaft() | Hole() | Ball() | Socket()), _):
+        case ((Shaft() | Hole() | Ball() | Socket()), (Shaft() | Hole() | Ball() | Socket())):
             checks.append(("radius", first.radius, second.radius, "radius", tol.length))
         case Cone(), Cone():
             checks.append(("angle", first.half_angle, second.half_angle, "half-angle", tol.angle))
@@ -392,7 +393,7 @@ def _parameter_residual(first: Feature, second: Feature) -> NDArray[np.float64]:
     """Constant entries that are zero iff the ``fits`` parameters agree (lengths; the
     half-angle difference is taken as its chord on the unit circle times the radius 1)."""
     match first, second:
-        case ((Shaft() | Hole() | Ball() | Socket()), _):
+        case ((Shaft() | Hole() | Ball() | Socket()), (Shaft() | Hole() | Ball() | Socket())):
             return np.array([first.radius - second.radius])
         case Cone(), Cone():
             return np.array([math.sin(first.half_angle - second.half_angle)])
@@ -411,7 +412,7 @@ def _parameter_residual(first: Feature, second: Feature) -> NDArray[np.float64]:
 
 def _fits_residual(
     first: Feature, second: Feature, directed: bool, scale: float
-) -> Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]:
+) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
     """Residual of ``fits`` (and ``coaxial``) on the pair of frames (G₂ = X·F₂, F₁)."""
     f1 = second.frame()
     inv_f1 = se3.inverse(f1)
@@ -467,7 +468,7 @@ def relation_residual(
     arm = tol.arm
     f1, f2 = second.frame(), first.frame()
     d1, o1 = f1[:3, 2], f1[:3, 3]
-    fits: Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]] | None = None
+    fits: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None
     if kind in ("fits", "coaxial"):
         pair = (first, second) if kind == "fits" else (_axis_of(first), _axis_of(second))
         directed = _is_directed(pair[0]) and _is_directed(pair[1])

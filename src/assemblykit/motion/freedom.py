@@ -41,6 +41,8 @@ from assemblykit.motion.unilateral import UnilateralReading, unilateral_readings
 from assemblykit.tolerance import Tolerance
 
 Vector = NDArray[np.float64]
+ContactFeature = Plane | Ball | Socket | Shaft | Hole | Cone
+"""The oriented primitive features a contact patch becomes (Liu 1997 Def. 2.1.2)."""
 
 
 def subassembly_key(names: Iterable[str]) -> str:
@@ -65,40 +67,42 @@ def _curved_samples(patch: CurvedPatch, inside: bool) -> tuple[NDArray, NDArray]
     return points, normals if inside else -normals
 
 
-def _patch_feature(patch: CurvedPatch, inside: bool) -> Feature:
+def _patch_feature(patch: CurvedPatch, inside: bool) -> ContactFeature:
     """The oriented primitive feature of the moving side of a curved patch."""
     if patch.kind == "spherical":
         return (Ball if inside else Socket)(point=patch.center, radius=patch.radius)
+    assert patch.axis is not None
     if patch.kind == "cylindrical":
         cls = Shaft if inside else Hole
         return cls(point=patch.center, axis=patch.axis, radius=patch.radius, directed=False)
     return Cone(point=patch.center, axis=patch.axis, half_angle=patch.half_angle, male=inside)
 
 
-def _same_feature(f: Feature, g: Feature, tol: Tolerance) -> bool:
+def _same_feature(f: ContactFeature, g: ContactFeature, tol: Tolerance) -> bool:
     """Whether two features are the same oriented surface (so one is kept)."""
     if type(f) is not type(g):
         return False
-    if isinstance(f, Plane):
+    if isinstance(f, Plane) and isinstance(g, Plane):
         return bool(
             np.linalg.norm(f.normal - g.normal) <= tol.angle
             and abs(float(f.normal @ (g.point - f.point))) <= tol.length
         )
-    if isinstance(f, Ball | Socket):
+    if isinstance(f, Ball | Socket) and isinstance(g, Ball | Socket):
         return bool(
             np.linalg.norm(f.point - g.point) <= tol.length
             and abs(f.radius - g.radius) <= tol.length
         )
-    on_line = np.linalg.norm(np.cross(g.point - f.point, f.axis)) <= tol.length
+    assert isinstance(f, Shaft | Hole | Cone) and isinstance(g, Shaft | Hole | Cone)
     parallel = np.linalg.norm(np.cross(f.axis, g.axis)) <= tol.angle
-    if isinstance(f, Cone):
+    if isinstance(f, Cone) or isinstance(g, Cone):
         same_apex = np.linalg.norm(f.point - g.point) <= tol.length
         return bool(same_apex and f.axis @ g.axis > 0 and parallel)
+    on_line = np.linalg.norm(np.cross(g.point - f.point, f.axis)) <= tol.length
     return bool(on_line and parallel and abs(f.radius - g.radius) <= tol.length)
 
 
-def _distinct(features: Iterable[Feature], tol: Tolerance) -> tuple[Feature, ...]:
-    kept: list[Feature] = []
+def _distinct(features: Iterable[ContactFeature], tol: Tolerance) -> tuple[ContactFeature, ...]:
+    kept: list[ContactFeature] = []
     for feature in features:
         if not any(_same_feature(feature, k, tol) for k in kept):
             kept.append(feature)
@@ -112,11 +116,11 @@ def boundary_contacts(contacts: Iterable[Contact], moving: frozenset[str]) -> li
 
 def moving_features(
     contacts: Iterable[Contact], moving: frozenset[str], tol: Tolerance
-) -> tuple[tuple[Feature, ...], ContactSamples]:
+) -> tuple[tuple[ContactFeature, ...], ContactSamples]:
     """The compound feature of ``moving`` (its oriented contact surfaces, Liu 1997
     Def. 3.0.1) and the sampled contact points with normals out of ``moving``; contacts
     inside ``moving`` or inside the rest are skipped."""
-    features: list[Feature] = []
+    features: list[ContactFeature] = []
     points: list[NDArray] = []
     normals: list[NDArray] = []
     for contact in boundary_contacts(contacts, moving):
@@ -204,7 +208,7 @@ class Motion(GroupMotion):
 
     parts: tuple[str, ...]
     group: SymmetryGroup | None
-    features: tuple[Feature, ...]
+    features: tuple[ContactFeature, ...]
     touching: tuple[str, ...]
     unilateral: UnilateralReading
 
@@ -234,7 +238,7 @@ class Motion(GroupMotion):
         return out
 
 
-def _feature_key(feature: Feature, anchor: Vector, tol: Tolerance) -> tuple[Any, ...]:
+def _feature_key(feature: ContactFeature, anchor: Vector, tol: Tolerance) -> tuple[Any, ...]:
     """The feature seen from ``anchor``, rounded to the tolerance: equal keys mean the
     same oriented surface up to the translation between the anchors."""
 
@@ -282,7 +286,7 @@ class MotionSolver:
             self._by_part.setdefault(contact.a, []).append(contact)
             self._by_part.setdefault(contact.b, []).append(contact)
 
-    def group(self, features: Sequence[Feature], anchor: Vector) -> SymmetryGroup:
+    def group(self, features: Sequence[ContactFeature], anchor: Vector) -> SymmetryGroup:
         """The symmetry group of the compound feature (Liu 1997 Props 3.2.6-3.2.8, 5.0.9)."""
         key = tuple(sorted(_feature_key(f, anchor, self.tol) for f in features))
         if key not in self._groups:

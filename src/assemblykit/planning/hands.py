@@ -281,7 +281,7 @@ class _HandsSearch:
             return 1, []
         search = _Search(self.table, self.table, self.sizes, lambda *_: None, [], [])
         search.disassemble(members)
-        needed: int | None = 2
+        needed = 2
         moves: list[HandsMove] = []
         index = {name: i for i, name in enumerate(self.table.names)}
         for locked in search.locked:

@@ -373,7 +373,7 @@ def _merged(moves: NDArray[np.int64], full: int) -> NDArray[np.int64]:
     keys = moves[:, 1] * _INF + moves[:, 2]
     starts = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]])
     ends = np.r_[starts[1:], len(moves)]
-    extra = []
+    extra: list[tuple[int, int, int]] = []
     for start, end in zip(starts.tolist(), ends.tolist(), strict=True):
         if end - start < 2:
             continue

@@ -14,7 +14,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -50,12 +50,15 @@ class PlanarExtended(DirectionTable):
         return set(range(len(self.directions)))
 
 
+_Table = TypeVar("_Table", bound=DirectionTable)
+
+
 def _slots_table(
-    cls: type[DirectionTable],
+    cls: type[_Table],
     ndbg: NonDirectionalBlockingGraph,
     directions: NDArray[np.float64],
     tol: Tolerance,
-) -> DirectionTable:
+) -> _Table:
     """``ndbg``'s DBGs at ``directions``, computed directly from its terms."""
     return cls(
         tuple(ndbg.parts),
@@ -83,7 +86,7 @@ def planar_tables(
     area = areas(model)
     return (
         _slots_table(DirectionTable, local, directions, tol),
-        _slots_table(PlanarExtended, grown, directions, tol),  # type: ignore[arg-type]
+        _slots_table(PlanarExtended, grown, directions, tol),
         tuple(area[name] for name in model.names),
     )
 

@@ -159,6 +159,13 @@ def _exit(
     return None
 
 
+def _joined(assembly: Assembly, names: Iterable[str]) -> trimesh.Trimesh:
+    """One mesh of the parts ``names``."""
+    mesh = trimesh.util.concatenate([assembly[n].mesh for n in names])
+    assert isinstance(mesh, trimesh.Trimesh)  # meshes concatenate to a mesh
+    return mesh
+
+
 def screw_removal(
     assembly: Assembly,
     parts: Iterable[str],
@@ -178,8 +185,7 @@ def screw_removal(
     points, normals = graph.constraints(moving)
     if len(points) == 0:
         return None
-    moving_mesh = trimesh.util.concatenate([assembly[n].mesh for n in moving])
-    rest_mesh = trimesh.util.concatenate([assembly[n].mesh for n in rest])
+    moving_mesh, rest_mesh = _joined(assembly, moving), _joined(assembly, rest)
     body, others = solid(moving_mesh), solid(rest_mesh)
     limit = interference_threshold(moving_mesh, rest_mesh, tol)
     reach = 2.0 * assembly.scale

@@ -196,7 +196,7 @@ def mating_figure(problem: MatingProblem, result: MatingResult) -> Figure:
             edge_color=[color[view.goal]],
             width=3.2 if view.chosen else 1.0 if faded else 1.6,
             alpha=FADED if faded else 1.0,
-            style=LAW_STYLES[view.pruned_by] if faded else "-",
+            style="-" if view.pruned_by is None else LAW_STYLES[view.pruned_by],
         )
         patch.set_gid(pair_gid(view))
     nx.draw_networkx_nodes(

@@ -21,6 +21,7 @@ from assemblykit import formatting as fmt
 from assemblykit.io.outputs import atomic_output
 
 if TYPE_CHECKING:
+    from matplotlib.cm import ScalarMappable
     from matplotlib.figure import Figure
 
     from assemblykit.geometry.contacts import Contact
@@ -147,7 +148,7 @@ def exploded_view_png(
         if k == 0:
             title = f"assembled: {fmt.count(len(assembly.names), 'part')}"
         else:
-            step = plan.steps[k - 1]
+            removal = plan.steps[k - 1]
             d = frames.directions[k - 1]
             start = (
                 drawn.arrows[k - 1].bounds.mean(axis=0) - d * ARROW_FRACTION * assembly.scale / 2
@@ -161,8 +162,8 @@ def exploded_view_png(
                 zorder=10,
             )
             title = (
-                f"step {k} of {len(plan.steps)}: {fmt.count(len(step.parts), 'part')} "
-                f"along {fmt.direction(step.direction, assembly.tolerance())}"
+                f"step {k} of {len(plan.steps)}: {fmt.count(len(removal.parts), 'part')} "
+                f"along {fmt.direction(removal.direction, assembly.tolerance())}"
             )
         for setter, low, high in zip(
             (axes.set_xlim, axes.set_ylim, axes.set_zlim), lo, hi, strict=True
@@ -254,7 +255,7 @@ def plot_ndbg(
     score = (n + 1) * arrangement.dims.astype(np.int64) - moving_blocked(slots).sum(axis=1)
     chosen = int(np.argmax(score)) if region is None else region
     figure = plt.figure(figsize=(15, 5))
-    maps = []
+    maps: list[ScalarMappable] = []
     if arrangement.dimension == 2:
         axes = figure.add_subplot(1, 3, (1, 2))
         theta = np.linspace(0, 2 * np.pi, 720)

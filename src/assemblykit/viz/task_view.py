@@ -32,7 +32,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from assemblykit import formatting as fmt
 from assemblykit.algebra import se3
@@ -151,7 +151,7 @@ class _Pen:
         self.gid, self.color = gid, color
         return self
 
-    def _keep(self, artist: Artist, points: NDArray) -> Artist:
+    def _keep(self, artist: Artist, points: ArrayLike) -> Artist:
         artist.set_gid(self.gid)
         self.seen.append(np.asarray(points, dtype=np.float64).reshape(-1, 3))
         return artist
@@ -161,7 +161,7 @@ class _Pen:
         (drawn,) = self.axes.plot(*points.T, color=self.color, **style)
         return self._keep(drawn, points)
 
-    def lines(self, segments: NDArray, **style: Any) -> Artist:
+    def lines(self, segments: NDArray | Sequence[NDArray], **style: Any) -> Artist:
         drawn = Line3DCollection(segments, colors=self.color, **style)
         self.axes.add_collection3d(drawn)
         return self._keep(drawn, segments)

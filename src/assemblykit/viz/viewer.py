@@ -238,6 +238,7 @@ def _arrow_mesh(
     cone = trimesh.creation.cone(radius=2.5 * radius, height=head, sections=ARROW_SECTIONS)
     cone.apply_translation((0, 0, length - head))
     arrow = trimesh.util.concatenate([shaft, cone])
+    assert isinstance(arrow, trimesh.Trimesh)  # meshes concatenate to a mesh
     arrow.apply_transform(se3.frame(start, direction))
     return arrow
 
