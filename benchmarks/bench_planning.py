@@ -3,9 +3,13 @@ the tests), the dome, and synthetic stacks of growing size.
 
 Run ``python benchmarks/bench_planning.py``. Each figure is the median wall time of
 ``REPEATS`` runs on a freshly loaded assembly (contacts and blocking graphs included);
-the beam, the crossvault (184 blocks) and the dome (527 blocks, candidate directions from
-each block's own arrangement) run once. The dome is skipped unless ``$ASSEMBLYKIT_DATA``
-holds ``compas_assembly/dome_assembly.json``.
+the beam runs once. The crossvault (184 blocks) and the dome (527 blocks, candidate
+directions from each block's own arrangement) are printed next to their targets (2 s and
+5 s), and the dome's peak memory (resident set of a process that loads and plans it
+alone) next to its target of 2 GB. The dome is skipped unless ``$ASSEMBLYKIT_DATA`` holds
+``compas_assembly/dome_assembly.json``. Growth: plan times of guillotine box packings of
+25 to 400 parts and the exponent of a power law fitted to them (target: at most 1.5).
+The machine the figures come from is printed first.
 
 Puzzles: multi-move plans (``plan --moves multi``) of BurrTools' example puzzles, with the
 level each stored and the ``time`` BurrTools recorded for the problem, and all 314 solid
@@ -17,12 +21,17 @@ runs only these.
 
 from __future__ import annotations
 
+import os
+import platform
+import resource
 import statistics
+import subprocess
 import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import trimesh
 
 from assemblykit.io.assembly import load_assembly
@@ -37,6 +46,14 @@ from datasets import dataset
 ROOT = Path(__file__).resolve().parents[1]
 REPEATS = 3
 STACK_SIZES = (5, 10, 20, 40, 80)
+PACKING_SIZES = (25, 50, 100, 200, 400)
+TARGETS = {"compas crossvault": 2.0, "compas dome": 5.0}
+"""Plan time targets in seconds (median wall time)."""
+MEMORY_TARGET = 2.0
+"""Peak memory of the dome's plan, GB."""
+GROWTH_TARGET = 1.5
+"""Largest exponent of plan time in the number of parts of box packings."""
+DOME = "compas_assembly/dome_assembly.json"
 PUZZLES = ("CubeInCage", "DraculasDentalDesaster", "PelikanBurr", "AlPackino")
 
 
@@ -64,9 +81,53 @@ def timed(make: Callable[[], Assembly], repeats: int) -> tuple[float, Plan]:
 
 def row(name: str, parts: int, seconds: float, result: Plan) -> None:
     verdict = "feasible" if result.feasible else "infeasible"
+    target = TARGETS.get(name)
+    versus = "" if target is None else f"  (target <= {target:g} s: {meets(seconds <= target)})"
     print(
         f"{name:<28} {parts:>5} parts {seconds:>8.3f} s  {len(result.steps):>4} steps  "
-        f"{result.directions:>6} directions  {verdict}  {parts / seconds:>8.1f} parts/s"
+        f"{result.directions:>6} directions  {verdict}  {parts / seconds:>8.1f} parts/s{versus}"
+    )
+
+
+def meets(ok: bool) -> str:
+    return "met" if ok else "NOT MET"
+
+
+def machine() -> str:
+    """The machine the figures come from."""
+    return (
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"Python {platform.python_version()}, numpy {np.__version__}"
+    )
+
+
+def peak_memory_gb() -> float:
+    """Peak resident set of this process, GB (``ru_maxrss`` is in kB on Linux)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
+
+
+def dome_memory() -> None:
+    """Load and plan the dome alone and print the process's peak memory."""
+    path = dataset(DOME)
+    if path is None:
+        return
+    plan(load_assembly(path))
+    print(f"{peak_memory_gb():.3f}")
+
+
+def growth() -> None:
+    """Plan times of guillotine packings (random boxes, ``seed = n``) and the fitted
+    exponent of time in the number of parts."""
+    print("growth (guillotine box packings, median wall time)")
+    seconds = []
+    for n in PACKING_SIZES:
+        median, result = timed(lambda n=n: guillotine_packing(n, seed=n), REPEATS)
+        seconds.append(median)
+        row(f"box packing of {n}", n, median, result)
+    exponent = float(np.polyfit(np.log(PACKING_SIZES), np.log(seconds), 1)[0])
+    print(
+        f"growth exponent {PACKING_SIZES[0]}-{PACKING_SIZES[-1]} parts: n^{exponent:.2f} "
+        f"(target <= n^{GROWTH_TARGET:g}: {meets(exponent <= GROWTH_TARGET)})"
     )
 
 
@@ -159,6 +220,10 @@ def mesh_puzzles() -> None:
 
 
 def main() -> None:
+    if "--dome-memory" in sys.argv:
+        dome_memory()
+        return
+    print(f"machine: {machine()}; shared with other work, wall times are noisy")
     puzzles()
     mesh_puzzles()
     if "--puzzles" in sys.argv:
@@ -170,8 +235,8 @@ def main() -> None:
         ("asap beam", dataset("asap_beam_assembly"), 1),
         ("compas stack", dataset("compas_assembly/stack_assembly.json"), REPEATS),
         ("compas arch", dataset("compas_assembly/arch_assembly.json"), REPEATS),
-        ("compas crossvault", dataset("compas_assembly/crossvault_assembly.json"), 1),
-        ("compas dome", dataset("compas_assembly/dome_assembly.json"), 1),
+        ("compas crossvault", dataset("compas_assembly/crossvault_assembly.json"), REPEATS),
+        ("compas dome", dataset(DOME), REPEATS),
     ]
     for name, path, repeats in cases:
         if path is None:
@@ -182,6 +247,16 @@ def main() -> None:
     for n in STACK_SIZES:
         seconds, result = timed(lambda n=n: stack(n), REPEATS)
         row(f"synthetic stack of {n}", n, seconds, result)
+    if dataset(DOME) is not None:
+        alone = subprocess.run(
+            [sys.executable, __file__, "--dome-memory"], capture_output=True, text=True, check=True
+        )
+        peak = float(alone.stdout.split()[-1])
+        print(
+            f"dome plan peak memory (load and plan alone): {peak:.2f} GB "
+            f"(target < {MEMORY_TARGET:g} GB: {meets(peak < MEMORY_TARGET)})"
+        )
+    growth()
 
 
 if __name__ == "__main__":

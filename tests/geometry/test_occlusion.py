@@ -101,3 +101,26 @@ def test_a_side_face_whose_shadow_is_thinner_than_the_tolerance_casts_none(scale
     triangle = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 5e-5, 1]], [[0, 1, 2]], process=False)
     view = shadows([triangle], [0, 0, 1], Tolerance(scale=scale).for_mesh())
     assert len(view.owner) == kept
+
+
+def test_triangle_overlaps_match_shapely_intersections():
+    import shapely
+
+    from assemblykit.geometry.occlusion import triangle_overlaps
+
+    rng = np.random.default_rng(3)
+    first = rng.uniform(0.0, 1.0, (3000, 3, 2))
+    second = rng.uniform(0.0, 1.0, (3000, 3, 2))
+    second[:50] = first[:50]  # the same triangle
+    second[50:100] = first[50:100, ::-1]  # the same, wound the other way
+    second[100:150, :2] = first[100:150, :2]  # a shared edge
+    second[150:200] = first[150:200] + 2.0  # apart
+    points, corner, area, perimeter = triangle_overlaps(first, second)
+    overlap = shapely.intersection(shapely.polygons(first), shapely.polygons(second))
+    np.testing.assert_allclose(area, shapely.area(overlap), atol=1e-12)
+    solid = shapely.area(overlap) > 1e-9
+    np.testing.assert_allclose(perimeter[solid], shapely.length(overlap)[solid], atol=1e-12)
+    assert not corner[150:200].any()
+    # the same polygons, vertices in order around them
+    found = [shapely.Polygon(points[k, corner[k]]) for k in np.flatnonzero(solid)]
+    assert shapely.area(shapely.symmetric_difference(found, overlap[solid])).max() < 1e-12

@@ -433,3 +433,52 @@ def test_plan_blocking_and_motion_agree_that_the_ball_joint_ball_lifts_out():
     assert reading.can_lift_off and min(r[2] for r in reading.lift_off) > 0.97
     volumes, touching = swept_overlaps(asm, "ball", first.direction, DISTANCES)
     assert np.all(volumes <= touching)
+
+
+def test_free_bits_past_one_byte_count_the_free_movers_of_shrinking_sets():
+    rng = np.random.default_rng(11)
+    names = tuple(f"p{i}" for i in range(19))
+    arcs = [
+        [(i, j) for i in range(19) for j in range(19) if i != j and rng.random() < 0.15]
+        for _ in range(30)
+    ]
+    tab = table_from(names, rng.normal(size=(30, 3)), arcs)
+    members = (1 << 19) - 1
+    while sequence._several(members):
+        movers = members & int(rng.integers(1 << 19))
+        blocked = np.zeros((30, 19), dtype=bool)
+        for k, per_direction in enumerate(arcs):
+            for i, j in per_direction:
+                blocked[k, i] |= bool(members >> j & 1)
+        chosen = np.array([bool(movers >> i & 1) for i in range(19)])
+        expected = ~blocked & chosen
+        bits = tab.free_bits(members, movers)
+        assert [sequence._row_mask(row) for row in bits] == [
+            sum(1 << int(i) for i in np.flatnonzero(row)) for row in expected
+        ]
+        np.testing.assert_array_equal(np.bitwise_count(bits).sum(axis=1), expected.sum(axis=1))
+        members &= ~(1 << int(rng.choice([i for i in range(19) if members >> i & 1])))
+
+
+@pytest.mark.parametrize("sizes", [(1, 1, 1, 1), (0, 1, 3, 2, 1, 3, 1)])
+def test_term_slots_match_the_terms_one_at_a_time(sizes):
+    from assemblykit.blocking.constraints import BlockingTerm
+    from assemblykit.tolerance import Tolerance
+
+    rng = np.random.default_rng(len(sizes))
+    tol = Tolerance()
+    terms = [BlockingTerm("a", "b", rng.normal(size=(m, 3))) for m in sizes]
+    owners = [int(s) for s in rng.integers(0, 3, len(terms))]
+    directions = rng.normal(size=(2500, 3))  # more than one chunk
+    directions[0] = 0.0  # on every circle: blocked by no term with normals
+    expected = np.zeros((len(directions), 3), dtype=bool)
+    for term, s in zip(terms, owners, strict=True):
+        expected[:, s] |= np.all(directions @ term.normals.T > tol.angle, axis=1)
+    found = sequence._term_slots(directions, terms, owners, 3, tol)
+    np.testing.assert_array_equal(found, expected)
+    # one term per slot, given out of slot order
+    single = [BlockingTerm("a", "b", rng.normal(size=(1, 3))) for _ in range(4)]
+    expected = np.column_stack([directions @ t.normals[0] > tol.angle for t in single])
+    order = [2, 0, 3, 1]
+    found = sequence._term_slots(directions, [single[s] for s in order], order, 4, tol)
+    np.testing.assert_array_equal(found, expected)

@@ -158,17 +158,23 @@ def extended_terms(assembly: Any, tol: Tolerance) -> list[BlockingTerm]:
     return terms
 
 
-def sweep_candidates(assembly: Any, moving: str, direction: NDArray[np.float64]) -> list[str]:
-    """Parts whose bounding spheres the bounding sphere of ``moving`` meets when swept
-    along ``direction`` to infinity (a superset of its possible blockers)."""
+def sweep_candidates(
+    assembly: Any, movers: list[str], direction: NDArray[np.float64], among: Iterable[str]
+) -> list[list[str]]:
+    """Per part of ``movers``, the other parts of ``among`` whose bounding spheres its
+    bounding sphere meets when swept along ``direction`` to infinity (a superset of its
+    possible blockers), for all movers at once."""
     cache = obstacles(assembly)
-    i = cache.names.index(moving)
-    rel = cache.centers - cache.centers[i]
+    index = {name: k for k, name in enumerate(cache.names)}
+    rows = np.array([index[name] for name in movers], dtype=np.int64)
+    columns = np.array(sorted({index[name] for name in among}), dtype=np.int64)
+    rel = cache.centers[columns][None, :, :] - cache.centers[rows][:, None, :]
     along = rel @ direction
-    across = np.linalg.norm(rel - along[:, None] * direction, axis=1)
-    reach = cache.radii + cache.radii[i]
-    near = np.where(along > 0, across, np.linalg.norm(rel, axis=1)) <= reach
-    return [n for k, n in enumerate(cache.names) if near[k] and k != i]
+    across = np.linalg.norm(rel - along[:, :, None] * direction, axis=2)
+    reach = cache.radii[columns][None, :] + cache.radii[rows][:, None]
+    near = np.where(along > 0, across, np.linalg.norm(rel, axis=2)) <= reach
+    near &= rows[:, None] != columns[None, :]
+    return [[cache.names[columns[k]] for k in np.flatnonzero(row)] for row in near]
 
 
 def extended_arcs(
@@ -185,14 +191,13 @@ def extended_arcs(
     d = np.asarray(direction, dtype=np.float64).ravel()
     d = d / np.linalg.norm(d)
     cache = obstacles(assembly)
-    among = set(blockers)
+    moving_parts = list(movers)
+    near_parts = sweep_candidates(assembly, moving_parts, d, blockers)
     arcs: set[tuple[str, str]] = set()
     projected: list[tuple[str, str]] = []
-    for moving in movers:
-        for blocker in sweep_candidates(assembly, moving, d):
-            if blocker not in among or not any(
-                blocks_along(c, d)[0] for c in cache.cones_of(moving, blocker, tol)
-            ):
+    for moving, near in zip(moving_parts, near_parts, strict=True):
+        for blocker in near:
+            if not any(blocks_along(c, d)[0] for c in cache.cones_of(moving, blocker, tol)):
                 continue
             if cache.convex(moving) and cache.convex(blocker):
                 arcs.add((moving, blocker))

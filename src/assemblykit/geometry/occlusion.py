@@ -14,14 +14,14 @@ some overlap the depth of ``j`` exceeds that of ``i`` by more than the length to
 (faces in contact give 0). The excess is measured across the faces (times the larger
 ``|n . d|`` of the two): coincident faces nearly parallel to ``d`` differ along ``d`` by
 their rounding error divided by that cosine, not by an overlap. The broad phase is
-shapely's STRtree with an affine depth bound, the overlaps one vectorised shapely
-intersection; overlaps thinner than the length tolerance (shared
-edges) have no area and are left out. Triangles within the angle tolerance of parallel
-to ``d`` project to nothing and are skipped, and so are those whose projection is
-thinner than the length tolerance (a side face tilted by vertex noise): every overlap
-with them would be too thin to count. Meshes that do not bound a volume (open or
-inconsistently wound) use all their triangles on both sides, which is still exact, only
-slower.
+shapely's STRtree over the triangles' bounding boxes with an affine depth bound, the
+overlaps every pair's triangles clipped by one another at once (Sutherland & Hodgman
+1974, in numpy); overlaps thinner than the length tolerance (shared edges) have no area
+and are left out. Triangles within the angle tolerance of parallel to ``d`` project to
+nothing and are skipped, and so are those whose projection is thinner than the length
+tolerance (a side face tilted by vertex noise): every overlap with them would be too
+thin to count. Meshes that do not bound a volume (open or inconsistently wound) use
+all their triangles on both sides, which is still exact, only slower.
 """
 
 from __future__ import annotations
@@ -53,13 +53,13 @@ class Shadows:
     """The non-vertical triangles of several meshes seen along a direction.
 
     ``owner`` is the mesh of each triangle; ``facing`` +1 forwards, -1 backwards, 0 both
-    (a mesh that bounds no volume); ``polygons`` the projected triangles (shapely);
+    (a mesh that bounds no volume); ``flat`` the projected triangles (t x 3 x 2);
     ``plane`` rows ``(a, b, c)`` with depth ``a u + b v + c`` at ``(u, v)``; ``low`` and
     ``high`` each triangle's depth range and ``box`` its ``(umin, vmin, umax, vmax)``."""
 
     owner: NDArray[np.int64]
     facing: NDArray[np.int8]
-    polygons: NDArray[np.object_]
+    flat: NDArray[np.float64]
     plane: NDArray[np.float64]
     low: NDArray[np.float64]
     high: NDArray[np.float64]
@@ -126,12 +126,59 @@ def shadows(
     return Shadows(
         np.concatenate(owner) if owner else np.zeros(0, np.int64),
         np.concatenate(facing) if facing else np.zeros(0, np.int8),
-        shapely.polygons(tri[:, :, :2]),
+        tri[:, :, :2],
         plane,
         tri[:, :, 2].min(axis=1),
         tri[:, :, 2].max(axis=1),
         np.column_stack([tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)]),
     )
+
+
+def triangle_overlaps(
+    subject: NDArray[np.float64], clip: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
+    """The overlaps of pairs of plane triangles (``n x 3 x 2`` each), all pairs at once:
+    ``subject`` clipped by the three edges of ``clip`` (Sutherland & Hodgman 1974).
+
+    Returns ``points`` (``n x m x 2``) with ``corner[k, i]`` telling which are vertices
+    of overlap ``k`` (the first ones, in order around it), and each overlap's area and
+    perimeter (both 0 when the triangles do not overlap)."""
+    if not len(subject):
+        return subject, np.zeros((0, 3), dtype=bool), np.zeros(0), np.zeros(0)
+    # counter-clockwise clip triangles: the inside of an edge a -> b is on its left
+    edges = clip[:, 1] - clip[:, 0], clip[:, 2] - clip[:, 0]
+    turned = edges[0][:, 0] * edges[1][:, 1] - edges[0][:, 1] * edges[1][:, 0] < 0
+    clip = np.where(turned[:, None, None], clip[:, ::-1], clip)
+    points, corner = subject, np.ones(subject.shape[:2], dtype=bool)
+    for e in range(3):
+        a, edge = clip[:, e, None], (clip[:, (e + 1) % 3] - clip[:, e])[:, None]
+        after = _following(corner)
+        side = edge[..., 0] * (points[..., 1] - a[..., 1]) - edge[..., 1] * (
+            points[..., 0] - a[..., 0]
+        )
+        side_after = np.take_along_axis(side, after, axis=1)
+        inside = corner & (side >= 0)
+        crossing = corner & ((side >= 0) != (side_after >= 0))
+        t = side / np.where(crossing, side - side_after, 1.0)
+        ahead = np.take_along_axis(points, after[..., None], axis=1)
+        candidates = np.stack([points, points + t[..., None] * (ahead - points)], axis=2)
+        kept = np.stack([inside, crossing], axis=2).reshape(len(points), -1)
+        # the kept points first, in their order around the overlap
+        order = np.argsort(~kept, axis=1, kind="stable")[:, : max(int(kept.sum(1).max()), 1)]
+        points = np.take_along_axis(candidates.reshape(len(points), -1, 2), order[..., None], 1)
+        corner = np.take_along_axis(kept, order, axis=1)
+    step = np.take_along_axis(points, _following(corner)[..., None], axis=1) - points
+    step[~corner] = 0.0
+    twice = points[..., 0] * step[..., 1] - points[..., 1] * step[..., 0]
+    area = np.abs(np.where(corner, twice, 0.0).sum(axis=1)) / 2
+    return points, corner, area, np.linalg.norm(step, axis=2).sum(axis=1)
+
+
+def _following(corner: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """Per row, the index of the next vertex around the polygon of the first
+    ``corner.sum(1)`` points (the last one's is the first)."""
+    index = np.arange(corner.shape[1])
+    return np.where(index + 1 < corner.sum(axis=1)[:, None], index + 1, 0)
 
 
 def occluded_pairs(
@@ -146,8 +193,10 @@ def occluded_pairs(
     forward = np.flatnonzero((view.facing >= 0) & np.any(allowed, axis=0)[view.owner])
     if not len(backward) or not len(forward):
         return set()
-    tree = shapely.STRtree(view.polygons[forward])
-    hits = tree.query(view.polygons[backward])
+    # the tree only compares bounding boxes: each box's diagonal has the same and is
+    # cheaper to make than the triangle
+    diagonals = shapely.linestrings(np.stack([view.box[:, :2], view.box[:, 2:]], axis=1))
+    hits = shapely.STRtree(diagonals[forward]).query(diagonals[backward])
     back, front = backward[hits[0]], forward[hits[1]]
     keep = allowed[view.owner[back], view.owner[front]]
     back, front = back[keep], front[keep]
@@ -165,10 +214,10 @@ def occluded_pairs(
         pair = view.owner[b] * size + view.owner[f]
         fresh = ~np.isin(pair, [i * size + j for i, j in found])
         b, f, pair = b[fresh], f[fresh], pair[fresh]
-        overlap = shapely.intersection(view.polygons[b], view.polygons[f])
-        thick = shapely.area(overlap) > tol.length * shapely.length(overlap)
-        uv, which = shapely.get_coordinates(overlap[thick], return_index=True)
-        b, f, pair = b[thick][which], f[thick][which], pair[thick][which]
+        points, corner, area, perimeter = triangle_overlaps(view.flat[b], view.flat[f])
+        which, at = np.nonzero(corner & (area > tol.length * perimeter)[:, None])
+        uv = points[which, at]
+        b, f, pair = b[which], f[which], pair[which]
         excess = (view.depth(f, uv) - view.depth(b, uv)) * np.maximum(view.cos[f], view.cos[b])
         found |= {(int(p // size), int(p % size)) for p in np.unique(pair[excess > tol.length])}
     return found

@@ -111,7 +111,13 @@ class DirectionTable:
         return np.flatnonzero(inside[self.moving] & inside[self.blocker])
 
     def free_parts(self, members: int) -> NDArray[np.bool_]:
-        """``free[k, i]``: part i of ``members`` has no blocker in ``members`` along k.
+        """``free[k, i]``: part i of ``members`` has no blocker in ``members`` along k."""
+        bits = self.free_bits(members, members)
+        return np.unpackbits(bits, axis=1, count=len(self.names), bitorder="little").astype(bool)
+
+    def free_bits(self, members: int, movers: int) -> NDArray[np.uint8]:
+        """Per direction, the parts of ``movers`` with no blocker in ``members``, packed
+        (bit ``i`` of row ``k`` read little-endian, as :func:`_row_mask` does).
 
         The search asks this of shrinking sets: when ``members`` is a subset of the set
         asked last, only the parts that had a blocker among the parts since removed are
@@ -120,21 +126,31 @@ class DirectionTable:
         last = self._last.get("blocked")
         if last is not None and last[0] & members == members:
             removed = self.vector(last[0] & ~members)
-            blocked = last[1].copy()
+            blocked = last[1]
             for i in np.unique(self.moving[removed[self.blocker]]):
                 if inside[i]:
-                    blocked[:, i] = self._blocked_part(int(i), inside)
+                    column = self._blocked_part(int(i), inside).astype(np.uint8)
+                    byte, bit = divmod(int(i), 8)
+                    blocked[:, byte] &= np.uint8(~(1 << bit) & 0xFF)
+                    blocked[:, byte] |= column << np.uint8(bit)
         else:
-            blocked = np.zeros((len(self.directions), len(self.names)), dtype=bool)
+            unpacked = np.zeros((len(self.directions), len(self.names)), dtype=bool)
             columns = self._active(members)
             if len(columns):
-                movers = self.moving[columns]
-                starts = np.flatnonzero(np.r_[True, movers[1:] != movers[:-1]])
-                blocked[:, movers[starts]] = np.logical_or.reduceat(
-                    self.slots[:, columns], starts, axis=1
+                owners = self.moving[columns]
+                starts = np.flatnonzero(np.r_[True, owners[1:] != owners[:-1]])
+                # every slot is active in the first call: no copy of the table then
+                active = (
+                    self.slots if len(columns) == self.slots.shape[1] else self.slots[:, columns]
                 )
+                # maximum over 0/1 bytes is logical or, and much faster along rows
+                unpacked[:, owners[starts]] = np.maximum.reduceat(
+                    active.view(np.uint8), starts, axis=1
+                ).view(bool)
+            blocked = np.packbits(unpacked, axis=1, bitorder="little")
         self._last["blocked"] = (members, blocked)
-        return ~blocked & inside
+        chosen = np.packbits(self.vector(movers & members), bitorder="little")
+        return ~blocked & chosen
 
     def _blocked_part(self, i: int, inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
         """Per direction, whether part ``i`` has a blocker among ``inside``."""
@@ -567,6 +583,12 @@ def _union(masks: Iterable[int]) -> int:
     return total
 
 
+def _row_mask(row: NDArray[np.uint8]) -> int:
+    """The bit mask held by one row of little-endian packed bits (``np.packbits(...,
+    bitorder="little")``)."""
+    return int.from_bytes(row.tobytes(), "little")
+
+
 def _count(mask: int) -> int:
     return bin(mask).count("1")
 
@@ -668,15 +690,14 @@ def _choose_removal(
     k, sets)``, when given, picks among the free sets of direction ``k`` those to move
     (one at a time, or only removals that leave stable states).
     """
-    free = translations.free_parts(members)
-    free[:, _base(members, volumes)] = False
-    counts = free.sum(axis=1)
+    free = translations.free_bits(members, members & ~(1 << _base(members, volumes)))
+    counts = np.bitwise_count(free).sum(axis=1, dtype=np.int64)
 
     def chosen(k: int, sets: list[int]) -> list[int]:
         return sets if narrow is None or not sets else narrow(members, k, sets)
 
     def singles(k: int) -> list[int]:
-        held = extended.blockers(k, _mask(np.flatnonzero(free[k])), members)
+        held = extended.blockers(k, _row_mask(free[k]), members)
         return chosen(k, [1 << i for i, mask in held.items() if not mask])
 
     def groups(k: int) -> list[int]:
@@ -684,7 +705,8 @@ def _choose_removal(
 
     choice = None
     if counts.any():
-        bounds = {int(k): int(counts[k]) for k in np.flatnonzero(counts)}
+        candidates = np.flatnonzero(counts)
+        bounds = dict(zip(candidates.tolist(), counts[candidates].tolist(), strict=True))
         choice = _best_direction(translations, bounds, singles, previous)
     if choice is None:
         bounds = _group_bounds(translations, members, volumes)
@@ -714,9 +736,14 @@ def _best_direction(
         direction = translations.directions[k]
         return (moved, float(np.abs(direction).max()), float(direction[2]), -k)
 
+    # the candidates by decreasing rank, sorted on arrays (tens of thousands on the dome)
+    keys = np.fromiter(bounds, dtype=np.int64, count=len(bounds))
+    moved = np.fromiter(bounds.values(), dtype=np.int64, count=len(bounds))
+    directions = translations.directions[keys]
+    order = np.lexsort((keys, -directions[:, 2], -np.abs(directions).max(axis=1), -moved))
     best: tuple[tuple[float, ...], int, list[int]] | None = None
     patience = LOOK_AHEAD
-    for k in sorted(bounds, key=lambda k: rank(k, bounds[k]), reverse=True):
+    for k in keys[order].tolist():
         if best is not None:
             if rank(k, bounds[k]) <= best[0] or patience == 0:
                 break
@@ -907,12 +934,8 @@ def local_table(
     )
     pairs = sorted({(index[t.moving], index[t.blocker]) for t in terms})
     column = {pair: s for s, pair in enumerate(pairs)}
-    slots = np.zeros((len(directions), len(pairs)), dtype=bool)
-    for term in terms:
-        s = column[(index[term.moving], index[term.blocker])]
-        # a direction on a circle (edge, vertex) is on neither side: within the angle
-        # tolerance, as the arrangement's snapping has it
-        slots[:, s] |= np.all(directions @ term.normals.T > tol.angle, axis=1)
+    owners = [column[(index[t.moving], index[t.blocker])] for t in terms]
+    slots = _term_slots(directions, terms, owners, len(pairs), tol)
     ends = np.array(pairs, dtype=np.int64).reshape(-1, 2)
     return DirectionTable(names, directions, slots, *ends.T)
 
@@ -965,16 +988,69 @@ def translation_slots(
         (int(i), int(j)): s
         for s, (i, j) in enumerate(zip(table.moving, table.blocker, strict=True))
     }
-    terms = blocking_terms(assembly, "infinitesimal", tol)
+    kept = [
+        (term, column[pair])
+        for term in blocking_terms(assembly, "infinitesimal", tol)
+        if (pair := (index[term.moving], index[term.blocker])) in column
+    ]
 
     def slots(directions: NDArray[np.float64]) -> NDArray[np.bool_]:
-        out = np.zeros((len(directions), len(table.moving)), dtype=bool)
-        for term in terms:
-            s = column.get((index[term.moving], index[term.blocker]))
-            if s is not None:
-                out[:, s] |= np.all(directions @ np.atleast_2d(term.normals).T > tol.angle, axis=1)
-        return out
+        return _term_slots(
+            directions, [t for t, _ in kept], [s for _, s in kept], len(table.moving), tol
+        )
 
+    return slots
+
+
+TERM_CHUNK = 256
+"""Directions whose inner products with every term normal :func:`_term_slots` holds at
+once (a few MB on the dome: the chunk stays in cache)."""
+
+
+def _term_slots(
+    directions: NDArray[np.float64],
+    terms: Sequence[BlockingTerm],
+    owners: Sequence[int],
+    count: int,
+    tol: Tolerance,
+) -> NDArray[np.bool_]:
+    """``slots[k, s]``: some term of slot ``s`` (``owners[t]`` is term ``t``'s slot) holds
+    strictly along direction ``k``, every normal ``n`` of it with ``n . d > tol.angle``: a
+    direction on a circle (edge, vertex) is on neither side, within the angle tolerance,
+    as the arrangement's snapping has it. All terms at once, a chunk of directions at a
+    time."""
+    # column-major: the search gathers the slots of one moving part over every direction
+    slots = np.zeros((len(directions), count), dtype=bool, order="F")
+    sizes = np.array([len(np.atleast_2d(t.normals)) for t in terms], dtype=np.int64)
+    always = np.array(owners, dtype=np.int64)[sizes == 0]
+    slots[:, always] = True  # a term without normals holds everywhere
+    used = [t for t, size in zip(terms, sizes.tolist(), strict=True) if size]
+    if not used:
+        return slots
+    normals = np.vstack([np.atleast_2d(t.normals) for t in used]).T.copy()
+    firsts = np.r_[0, np.cumsum(sizes[sizes > 0])[:-1]]
+    slot_of = np.array(owners, dtype=np.int64)[sizes > 0]
+    order = np.argsort(slot_of, kind="stable")
+    ordered = slot_of[order]
+    starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]])
+    single = bool((sizes[sizes > 0] == 1).all())
+    # one normal per term and one term per slot (COMPAS vaults): no reduction, the
+    # normals put in slot order
+    direct = single and np.array_equal(ordered, np.arange(count))
+    if direct:
+        normals = normals[:, order]
+    for lo in range(0, len(directions), TERM_CHUNK):
+        chunk = directions[lo : lo + TERM_CHUNK]
+        inner = chunk[:, :1] * normals[0] + chunk[:, 1:2] * normals[1] + chunk[:, 2:] * normals[2]
+        if direct:
+            slots[lo : lo + TERM_CHUNK] |= inner > tol.angle
+            continue
+        ahead = (inner > tol.angle).view(np.uint8)
+        # minimum and maximum over 0/1 bytes: "all normals" per term, "any term" per slot
+        held = ahead if single else np.minimum.reduceat(ahead, firsts, axis=1)
+        slots[lo : lo + TERM_CHUNK, ordered[starts]] |= np.maximum.reduceat(
+            held[:, order], starts, axis=1
+        ).view(bool)
     return slots
 
 
