@@ -130,6 +130,39 @@ def test_line_classes_group_parallel_and_antiparallel_vectors():
     assert orient.tolist() == [1, 1, -1, 1, 1]
 
 
+def test_line_classes_join_the_nearest_earlier_leader():
+    """A vector within reach of two leaders joins the nearer one, not the first; a
+    leader found after a vector never takes it."""
+    turned = [np.array([np.cos(t), np.sin(t), 0.0]) for t in (0.0, 0.16, 0.3)]
+    a, v, b = turned
+    leaders, index, orient = se3.line_classes(np.array([a, v, b, -v]), 0.2)
+    np.testing.assert_array_equal(leaders, [a, b])
+    assert index.tolist() == [0, 0, 1, 1]  # sin 0.16 to a, sin 0.14 to b
+    assert orient.tolist() == [1, 1, 1, -1]
+
+
+@given(st.lists(st.tuples(*[st.floats(-1, 1) for _ in range(3)]), max_size=40), st.floats(0, 1))
+@settings(max_examples=200, deadline=None)
+def test_line_classes_match_one_vector_at_a_time(rows, max_sine):
+    """The classes equal those of taking the vectors one by one, each joining the first
+    nearest earlier leader within ``max_sine`` or leading a new class."""
+    vectors = np.array([r for r in rows if np.linalg.norm(r) > 1e-3]).reshape(-1, 3)
+    vectors /= np.maximum(np.linalg.norm(vectors, axis=1, keepdims=True), 1e-300)
+    leaders: list[np.ndarray] = []
+    expected = []
+    for v in vectors:
+        sines = [np.linalg.norm(np.cross(u, v)) for u in leaders]
+        if sines and min(sines) <= max_sine:
+            k = int(np.argmin(sines))
+            expected.append((k, 1 if leaders[k] @ v > 0 else -1))
+        else:
+            leaders.append(v)
+            expected.append((len(leaders) - 1, 1))
+    found, index, orient = se3.line_classes(vectors, max_sine)
+    np.testing.assert_array_equal(found, np.array(leaders).reshape(-1, 3))
+    assert list(zip(index.tolist(), orient.tolist(), strict=True)) == expected
+
+
 rotation_vectors = st.builds(
     lambda axis, angle: angle * np.asarray(axis) / np.linalg.norm(axis),
     st.tuples(*[st.floats(-1, 1) for _ in range(3)]).filter(lambda a: np.linalg.norm(a) > 1e-3),

@@ -81,20 +81,28 @@ def line_classes(
     leader whose sine with it is at most ``max_sine``, else leads a new class. Returns
     the leaders, the class of each vector and its orientation (+1 same, -1 opposite)."""
     units = np.asarray(vectors, dtype=np.float64).reshape(-1, 3)
-    leaders: list[NDArray[np.float64]] = []
-    index = np.empty(len(units), dtype=np.int64)
-    orient = np.empty(len(units), dtype=np.int8)
-    for i, n in enumerate(units):
-        if leaders:
-            stack = np.asarray(leaders)
-            sines = np.linalg.norm(np.cross(stack, n), axis=1)
-            k = int(np.argmin(sines))
-            if sines[k] <= max_sine:
-                index[i], orient[i] = k, 1 if stack[k] @ n > 0 else -1
-                continue
-        leaders.append(n)
-        index[i], orient[i] = len(leaders) - 1, 1
-    return np.asarray(leaders, dtype=np.float64).reshape(-1, 3), index, orient
+    # leader by leader: the next leader is the first later vector none of the earlier
+    # ones takes; each vector keeps the first nearest of the leaders before it
+    x, y, z = units.T.copy()
+    best = np.full(len(units), np.inf)
+    index = np.zeros(len(units), dtype=np.int64)
+    leads: list[int] = []
+    i = 0
+    while i < len(units):
+        leads.append(i)
+        a, b, c, tail = x[i], y[i], z[i], slice(i + 1, None)
+        turn = (b * z[tail] - c * y[tail], c * x[tail] - a * z[tail], a * y[tail] - b * x[tail])
+        sines = np.sqrt(turn[0] * turn[0] + turn[1] * turn[1] + turn[2] * turn[2])
+        nearer = np.flatnonzero(sines < best[i + 1 :]) + i + 1
+        best[nearer] = sines[nearer - i - 1]
+        index[nearer] = len(leads) - 1
+        apart = np.flatnonzero(best[i + 1 :] > max_sine)
+        i = i + 1 + int(apart[0]) if len(apart) else len(units)
+    leaders = units[leads]
+    index[leads] = np.arange(len(leads))
+    orient = np.where(np.einsum("ij,ij->i", leaders[index], units) > 0, 1, -1).astype(np.int8)
+    orient[leads] = 1
+    return leaders.reshape(-1, 3), index, orient
 
 
 def skew(w: NDArray[np.float64]) -> NDArray[np.float64]:

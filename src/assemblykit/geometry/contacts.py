@@ -603,15 +603,15 @@ def find_contacts(
     for m, flat in zip(k, patches, strict=True):
         planar.setdefault((int(group_part[g[m]]), int(group_part[h[m]])), []).append(flat)
 
+    triangles = {
+        k: [_surface_triangles(assembly, names[k], s) for s in found]
+        for k, found in surfaces.items()
+    }
     curved: dict[tuple[int, int], list[CurvedPatch]] = {}
     for a, b in pairs:
-        for sa in surfaces.get(int(a), ()):
-            for sb in surfaces.get(int(b), ()):
-                triangles = (
-                    _surface_triangles(assembly, names[a], sa),
-                    _surface_triangles(assembly, names[b], sb),
-                )
-                patch = curved_contact(sa, sb, (names[a], names[b]), triangles, tol)
+        for sa, ta in zip(surfaces.get(int(a), ()), triangles.get(int(a), ()), strict=True):
+            for sb, tb in zip(surfaces.get(int(b), ()), triangles.get(int(b), ()), strict=True):
+                patch = curved_contact(sa, sb, (names[a], names[b]), (ta, tb), tol)
                 if patch is not None:
                     curved.setdefault((int(a), int(b)), []).append(patch)
 

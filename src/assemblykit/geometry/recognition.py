@@ -524,10 +524,9 @@ def split_surfaces(
     # a face between two parallel rounded edges would join them: within each set of
     # joined groups, drop the groups much wider across the axis than the typical strip
     label = _components(len(nodes), pairs)
-    width = np.array([_width(vertices, faces, seg, g, axes[cluster == c][0]) for g, c in nodes])
-    typical = np.zeros(len(nodes))
-    for members in _classes(label):
-        typical[members] = np.median(width[members])
+    first = np.unique(cluster, return_index=True)[1]
+    width = _widths(vertices, faces, seg, nodes[:, 0], axes[first[nodes[:, 1]]])
+    typical = _medians(width, label)
     narrow = width <= STRIP_WIDTHS * typical
     kept = narrow[pairs[:, 0]] & narrow[pairs[:, 1]]
     adjacency, edges, axes, pairs = adjacency[kept], edges[kept], axes[kept], pairs[kept]
@@ -577,33 +576,54 @@ def _merged(
     surfaces: list[Surface],
 ) -> tuple[Surface, ...]:
     """``surfaces`` with the pieces of one sphere (same centre and radius) or one
-    cylinder (same axis line and radius) fitted again as one surface."""
+    cylinder (same axis line and radius) fitted again as one surface: each joins the
+    first earlier one it lies on whose union with it still fits."""
     merged: list[Surface] = []
+    kinds = np.empty(len(surfaces), dtype=object)
+    radii = np.empty(len(surfaces))
+    points = np.empty((len(surfaces), 3))
+    axes = np.zeros((len(surfaces), 3))
+
+    def keep(k: int, surface: Surface) -> None:
+        kinds[k], radii[k], points[k] = surface.kind, surface.radius, surface.point
+        if surface.axis is not None:
+            axes[k] = surface.axis
+
     for surface in surfaces:
-        for k, other in enumerate(merged):
-            if _same_surface(surface, other, tol):
-                ids = np.concatenate([other.faces, surface.faces])
-                union = _fit_faces(vertices, faces, seg, tol, ids, (surface.kind,))
-                if union is not None:
-                    merged[k] = union
-                    break
+        n = len(merged)
+        same = _same_surfaces(surface, kinds[:n], radii[:n], points[:n], axes[:n], tol)
+        for k in np.flatnonzero(same).tolist():
+            ids = np.concatenate([merged[k].faces, surface.faces])
+            union = _fit_faces(vertices, faces, seg, tol, ids, (surface.kind,))
+            if union is not None:
+                merged[k] = union
+                keep(k, union)
+                break
         else:
             merged.append(surface)
+            keep(n, surface)
     return tuple(merged)
 
 
-def _same_surface(a: Surface, b: Surface, tol: Tolerance) -> bool:
-    """Whether two spheres, or two cylinders, lie on one surface within the tolerance."""
-    if a.kind != b.kind or a.kind not in ("sphere", "cylinder"):
-        return False
-    if abs(a.radius - b.radius) > tol.length:
-        return False
-    offset = b.point - a.point
+def _same_surfaces(
+    a: Surface,
+    kinds: NDArray[np.object_],
+    radii: NDArray[np.float64],
+    points: NDArray[np.float64],
+    axes: NDArray[np.float64],
+    tol: Tolerance,
+) -> NDArray[np.bool_]:
+    """Per surface given by its kind, radius, point and axis (rows), whether it and the
+    sphere or cylinder ``a`` lie on one sphere, or one cylinder, within the tolerance."""
+    if a.kind not in ("sphere", "cylinder"):
+        return np.zeros(len(kinds), dtype=bool)
+    same = (kinds == a.kind) & (np.abs(a.radius - radii) <= tol.length)
+    offset = points - a.point
     if a.kind == "sphere":
-        return bool(np.linalg.norm(offset) <= tol.length)
-    assert a.axis is not None and b.axis is not None
-    parallel = np.linalg.norm(np.cross(a.axis, b.axis)) <= tol.angle
-    return bool(parallel and np.linalg.norm(np.cross(offset, a.axis)) <= tol.length)
+        return same & (np.linalg.norm(offset, axis=1) <= tol.length)
+    assert a.axis is not None
+    parallel = np.linalg.norm(np.cross(a.axis, axes), axis=1) <= tol.angle
+    return same & parallel & (np.linalg.norm(np.cross(offset, a.axis), axis=1) <= tol.length)
 
 
 def _classes(label: NDArray[np.int64]) -> list[NDArray[np.int64]]:
@@ -612,16 +632,32 @@ def _classes(label: NDArray[np.int64]) -> list[NDArray[np.int64]]:
     return np.split(order, np.flatnonzero(np.diff(label[order])) + 1)
 
 
-def _width(
+def _widths(
     vertices: NDArray[np.float64],
     faces: NDArray[np.int64],
     seg: Segmentation,
-    group: int,
-    axis: NDArray[np.float64],
-) -> float:
-    """How wide coplanar group ``group`` is across ``axis``, within its plane."""
-    across = np.cross(seg.normal[group], axis)
-    return float(np.ptp(vertices[faces[seg.faces_of(group)]].reshape(-1, 3) @ across))
+    groups: NDArray[np.int64],
+    axes: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """How wide each coplanar group ``groups[i]`` is across ``axes[i]``, within its plane."""
+    across = np.cross(seg.normal[groups], axes)
+    sizes = seg.start[groups + 1] - seg.start[groups]
+    row = np.repeat(np.arange(len(groups)), sizes)
+    offset = np.arange(len(row)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+    corners = vertices[faces[seg.order[seg.start[groups][row] + offset]]]
+    spread = np.einsum("ijk,ik->ij", corners, across[row]).ravel()
+    bounds = 3 * (np.cumsum(sizes) - sizes)
+    return np.maximum.reduceat(spread, bounds) - np.minimum.reduceat(spread, bounds)
+
+
+def _medians(values: NDArray[np.float64], label: NDArray[np.int64]) -> NDArray[np.float64]:
+    """Per entry, the median of ``values`` over the entries of its label."""
+    order = np.lexsort((values, label))
+    ends = np.flatnonzero(np.diff(label[order])) + 1
+    starts = np.concatenate([[0], ends])
+    sizes = np.diff(np.concatenate([starts, [len(order)]]))
+    middle = 0.5 * (values[order[starts + (sizes - 1) // 2]] + values[order[starts + sizes // 2]])
+    return middle[np.repeat(np.arange(len(starts)), sizes)][np.argsort(order)]
 
 
 def faces_on(surfaces: tuple[Surface, ...], n_faces: int) -> NDArray[np.bool_]:
