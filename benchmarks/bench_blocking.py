@@ -237,7 +237,7 @@ def bench_queries() -> None:
     """Query times (Γ_e) on guillotine packings of n boxes."""
     from assemblykit.blocking.queries import can_extract, parts_to_remove_before
     from assemblykit.model.packings import guillotine_packing
-    from assemblykit.planning.sequence import separable_by_translations
+    from assemblykit.planning.planner import separable_by_translations
 
     print("\nqueries on box packings (CPU seconds)")
     for n in (20, 50, 100):

@@ -40,7 +40,8 @@ from assemblykit.model.assembly import Assembly, Part
 from assemblykit.model.packings import box_mesh, guillotine_packing
 from assemblykit.planning.multimove import MultiMovePlan, plan_voxels
 from assemblykit.planning.multimove_mesh import plan_meshes
-from assemblykit.planning.sequence import Plan, plan
+from assemblykit.planning.planner import plan
+from assemblykit.planning.sequence import Plan
 from datasets import dataset
 
 ROOT = Path(__file__).resolve().parents[1]

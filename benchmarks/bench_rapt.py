@@ -47,7 +47,7 @@ import yaml
 
 from assemblykit.features.primitives import Plane
 from assemblykit.inference.reduction import solve_numeric_only, solve_task
-from assemblykit.io.spec import load_task
+from assemblykit.io.tasks import load_task
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Situation, Task
@@ -200,7 +200,7 @@ CHAIN = 40
 _OURS_COLD = """
 import sys, time
 start = time.perf_counter()
-from assemblykit.io.spec import load_task
+from assemblykit.io.tasks import load_task
 solution = load_task(sys.argv[1]).solve()
 assert solution.status == "solved", solution.status
 print(time.perf_counter() - start)

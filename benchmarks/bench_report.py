@@ -18,7 +18,8 @@ from pathlib import Path
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.exports import write_gltf, write_plan
 from assemblykit.model.assembly import Assembly
-from assemblykit.planning.sequence import Plan, plan
+from assemblykit.planning.planner import plan
+from assemblykit.planning.sequence import Plan
 from assemblykit.viz.plots import exploded_view_png
 from assemblykit.viz.viewer import write_report
 from datasets import dataset

@@ -32,7 +32,7 @@ import numpy as np
 import scipy
 
 from assemblykit.io.assembly import load_assembly
-from assemblykit.planning.sequence import plan
+from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import Gravity, equilibrium_model
 from assemblykit.tolerance import Tolerance
 from datasets import dataset

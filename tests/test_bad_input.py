@@ -27,7 +27,7 @@ from assemblykit.io.documents import MAX_DEPTH, read_yaml
 from assemblykit.io.meshes import load_manifest, load_mesh_folder
 from assemblykit.io.outputs import atomic_output
 from assemblykit.io.problem import load_problem
-from assemblykit.io.spec import load_task
+from assemblykit.io.tasks import load_task
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "src" / "assemblykit" / "examples"
 

@@ -150,12 +150,12 @@ def test_ctrl_c_stops_a_batch_and_keeps_its_finished_lines(
 
 LOUD_LOAD = """
 import numpy as np
-import assemblykit.io.spec as spec
-quiet = spec.load_task
+import assemblykit.io.tasks as tasks
+quiet = tasks.load_task
 def loud(path):
     np.array([0.0]) / 0.0  # numpy: RuntimeWarning: invalid value encountered in divide
     return quiet(path)
-spec.load_task = loud
+tasks.load_task = loud
 """
 
 

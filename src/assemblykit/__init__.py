@@ -82,11 +82,11 @@ from assemblykit.errors import AssemblyKitError
 __version__ = "0.1.0"
 
 _PUBLIC = {
-    "load_task": "assemblykit.io.spec",
+    "load_task": "assemblykit.io.tasks",
     "load_assembly": "assemblykit.io.assembly",
     "motion": "assemblykit.motion.freedom",
-    "blocking_graph": "assemblykit.blocking.ndbg",
-    "plan": "assemblykit.planning.sequence",
+    "blocking_graph": "assemblykit.blocking.graphs",
+    "plan": "assemblykit.planning.planner",
     "load_problem": "assemblykit.io.problem",
     "mate": "assemblykit.mating.search",
     "Tolerance": "assemblykit.tolerance",

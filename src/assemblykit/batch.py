@@ -150,7 +150,7 @@ def compute(command: Command, path: str, rel_tolerance: float | None = None) -> 
     tol = None if rel_tolerance is None else Tolerance(rel_length=rel_tolerance)
     assembly = load_assembly(path, tol=tol)
     if command == "plan":
-        from assemblykit.planning.sequence import plan
+        from assemblykit.planning.planner import plan
 
         data = plan(assembly, tol=tol).to_dict()
     else:

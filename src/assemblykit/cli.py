@@ -275,7 +275,7 @@ def solve_cmd(
 
     TASK: task file, .yaml, .yml, .json or .rapt.
     """
-    from assemblykit.io.spec import load_task
+    from assemblykit.io.tasks import load_task
     from assemblykit.tolerance import using
 
     if png is not None:
@@ -475,7 +475,7 @@ def plan_cmd(
     polygons 'parts: {name: [[x, y], ...]}' (planned in the plane), or a BurrTools
     .xmpuzzle (placed as its stored --solution of --problem).
     """
-    from assemblykit.planning.sequence import plan
+    from assemblykit.planning.planner import plan
 
     if moves != "monotone" and (html is not None or png is not None):
         raise InputError(f"--html and --png draw translation plans: not with --moves {moves}")
@@ -655,7 +655,7 @@ def _is_task_file(path: str) -> bool:
 def _task_motion(path: str, tol: Tolerance, as_json: bool) -> None:
     """Emit the motion of every body of the task at ``path`` from its relations."""
     from assemblykit.inference.reduction import model_scale
-    from assemblykit.io.spec import load_task
+    from assemblykit.io.tasks import load_task
     from assemblykit.motion.relational import task_motion
 
     task = load_task(path)
@@ -795,7 +795,8 @@ def blocking_cmd(
     ASSEMBLY: mesh folder, .yaml manifest, .step, COMPAS .json, or a YAML file of 2D
     polygons 'parts: {name: [[x, y], ...]}'.
     """
-    from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph, blocking_graph
+    from assemblykit.blocking.graphs import blocking_graph
+    from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 
     if png is not None:
         if motion == "rigid":

@@ -21,7 +21,8 @@ from rich.text import Text
 
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.report import jsonable
-from assemblykit.planning.sequence import Plan, Progress, plan
+from assemblykit.planning.planner import plan
+from assemblykit.planning.sequence import Plan, Progress
 from assemblykit.tolerance import Tolerance
 from assemblykit.viz.viewer import ReportTable, write_report
 

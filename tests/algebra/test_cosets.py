@@ -22,6 +22,7 @@ from assemblykit.algebra import (
     PointInvariant,
     SymmetryGroup,
     cosets,
+    intersect_groups,
     se3,
     transform_invariant,
     transporter,
@@ -480,7 +481,7 @@ def test_helical_closed_forms_contain_a_shared_position_and_are_equivariant(seed
             m = a.intersect(b)
         assert isinstance(m, Coset)
         assert m.contains(point) and a.contains(m.rep) and b.contains(m.rep)
-        assert m.group.equals(a.group.intersect(b.group))
+        assert m.group.equals(intersect_groups(a.group, b.group))
 
 
 # ----------------------------------------------------------------------------- lattice cosets
@@ -499,7 +500,9 @@ def test_discrete_screw_coset_meets_a_key_every_other_step(no_numeric_search):
     """H(1) ∩ H(3) = <Scr(-3 pi; 1)>: rotation pi per step, so a key (no rotation)
     meets the coset through Tr(0, 0, 4 pi) only at even steps, the nearest being
     Tr(0, 0, 4 pi - 6 pi . 0) ... i.e. heights 4 pi + 6 pi Z."""
-    screws = SymmetryGroup.helical(ORIGIN, Z, 1.0).intersect(SymmetryGroup.helical(ORIGIN, Z, 3.0))
+    screws = intersect_groups(
+        SymmetryGroup.helical(ORIGIN, Z, 1.0), SymmetryGroup.helical(ORIGIN, Z, 3.0)
+    )
     lattice = Coset(screws, tr(0, 0, 4 * math.pi))
     key = Coset(SymmetryGroup.prismatic(Z), np.eye(4))
     c = lattice.intersect(key)

@@ -202,7 +202,8 @@ def test_moved_flats_agree_with_transform_invariant(seed):
 
 
 def test_flat_transporter_reports_the_congruence_failure():
-    from assemblykit.algebra.invariants import characteristic_flats, flat_transporter
+    from assemblykit.algebra.cosets import flat_transporter
+    from assemblykit.algebra.invariants import characteristic_flats
 
     targets = characteristic_flats(Kind.PLANAR, np.eye(4))
     # Two floors 1 apart on the body-1 side, 2 apart on the body-2 side.

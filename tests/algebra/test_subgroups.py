@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assemblykit.algebra import Kind, Locus, SymmetryGroup, se3
-from assemblykit.algebra.subgroups import _connected_meet, classify_algebra, psd_solve
+from assemblykit.algebra import Kind, Locus, SymmetryGroup, intersect_groups, se3
+from assemblykit.algebra.subgroups import classify_algebra, connected_meet, psd_solve
 from assemblykit.errors import GroupError
 from assemblykit.tolerance import Tolerance
 
@@ -148,53 +148,59 @@ def test_classify_algebra_recovers_the_group(group):
 def test_tr_intersection_table():
     x, y = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)
     # W2 algebra check: G(z) ∩ G(x) = T(y)
-    t = G.planar(Z).intersect(G.planar(x))
+    t = intersect_groups(G.planar(Z), G.planar(x))
     assert t.kind is Kind.PRISMATIC and t.equals(G.prismatic(y))
-    assert G.prismatic(x).intersect(G.prismatic(y)).kind is Kind.FIXED
-    assert G.translation2(Z).intersect(G.translation2(x)).equals(G.prismatic(y))
-    assert G.revolute(ORIGIN, Z).intersect(G.revolute((1, 0, 0), Z)).kind is Kind.FIXED
-    assert G.revolute(ORIGIN, Z).intersect(G.spherical((0, 0, 4))).equals(G.revolute(ORIGIN, Z))
-    assert G.revolute(ORIGIN, Z).intersect(G.spherical((1, 0, 4))).kind is Kind.FIXED
-    assert G.cylindrical(ORIGIN, Z).intersect(G.cylindrical((3, 0, 0), Z)).equals(G.prismatic(Z))
+    assert intersect_groups(G.prismatic(x), G.prismatic(y)).kind is Kind.FIXED
+    assert intersect_groups(G.translation2(Z), G.translation2(x)).equals(G.prismatic(y))
+    assert intersect_groups(G.revolute(ORIGIN, Z), G.revolute((1, 0, 0), Z)).kind is Kind.FIXED
+    assert intersect_groups(G.revolute(ORIGIN, Z), G.spherical((0, 0, 4))).equals(
+        G.revolute(ORIGIN, Z)
+    )
+    assert intersect_groups(G.revolute(ORIGIN, Z), G.spherical((1, 0, 4))).kind is Kind.FIXED
+    assert intersect_groups(G.cylindrical(ORIGIN, Z), G.cylindrical((3, 0, 0), Z)).equals(
+        G.prismatic(Z)
+    )
     # W4: C(z) ∩ G(z) = R(z); W7: C(x-axis at height 5) ∩ G(z) = T(x)
-    assert G.cylindrical(ORIGIN, Z).intersect(G.planar(Z)).equals(G.revolute(ORIGIN, Z))
-    assert G.cylindrical((0, 0, 5), x).intersect(G.planar(Z)).equals(G.prismatic(x))
-    assert G.cylindrical(ORIGIN, Z).intersect(G.schoenflies(x)).equals(G.prismatic(Z))
+    assert intersect_groups(G.cylindrical(ORIGIN, Z), G.planar(Z)).equals(G.revolute(ORIGIN, Z))
+    assert intersect_groups(G.cylindrical((0, 0, 5), x), G.planar(Z)).equals(G.prismatic(x))
+    assert intersect_groups(G.cylindrical(ORIGIN, Z), G.schoenflies(x)).equals(G.prismatic(Z))
     # W9: S(N1) ∩ S(N2) = R(line N1 N2); W11: S(N) ∩ G(z) = R(N, z)
-    assert G.spherical(ORIGIN).intersect(G.spherical((0, 0, 10))).equals(G.revolute(ORIGIN, Z))
-    assert G.spherical((0, 0, 1)).intersect(G.planar(Z)).equals(G.revolute((0, 0, 1), Z))
-    assert G.planar(Z).intersect(G.schoenflies(x)).equals(G.translation2(Z))
-    assert G.schoenflies(Z).intersect(G.schoenflies(x)).equals(G.translation3())
+    assert intersect_groups(G.spherical(ORIGIN), G.spherical((0, 0, 10))).equals(
+        G.revolute(ORIGIN, Z)
+    )
+    assert intersect_groups(G.spherical((0, 0, 1)), G.planar(Z)).equals(G.revolute((0, 0, 1), Z))
+    assert intersect_groups(G.planar(Z), G.schoenflies(x)).equals(G.translation2(Z))
+    assert intersect_groups(G.schoenflies(Z), G.schoenflies(x)).equals(G.translation3())
 
 
 def test_helical_lattice_rows_of_the_table():
     p = 1.5 / (2 * math.pi)
     h = G.helical(ORIGIN, Z, p)
     # W16: H(z, p) ∩ T(z) = <Tr(0, 0, 2 pi p)> = {Tr(0, 0, 1.5 k)}
-    lat = h.intersect(G.prismatic(Z))
+    lat = intersect_groups(h, G.prismatic(Z))
     assert lat.dof == 0 and lat.n_components == math.inf
     for k in (-2, 1, 3):
         assert lat.contains(tr(0, 0, 1.5 * k))
     assert not lat.contains(tr(0, 0, 1.0))
     assert not lat.contains(se3.rot_z(0.1))
     # H ∩ C on a parallel distinct axis and H ∩ G(v), v ⊥ u: the same lattice
-    assert h.intersect(G.cylindrical((1, 0, 0), Z)).equals(lat)
-    assert h.intersect(G.planar((1, 0, 0))).equals(lat)
-    assert h.intersect(G.revolute(ORIGIN, Z)).kind is Kind.FIXED
-    assert h.intersect(G.revolute(ORIGIN, Z)).n_components == 1
-    assert h.intersect(G.cylindrical(ORIGIN, Z)).equals(h)
+    assert intersect_groups(h, G.cylindrical((1, 0, 0), Z)).equals(lat)
+    assert intersect_groups(h, G.planar((1, 0, 0))).equals(lat)
+    assert intersect_groups(h, G.revolute(ORIGIN, Z)).kind is Kind.FIXED
+    assert intersect_groups(h, G.revolute(ORIGIN, Z)).n_components == 1
+    assert intersect_groups(h, G.cylindrical(ORIGIN, Z)).equals(h)
     # Y(u, p) ∩ C(N, u) = H(N, u, p); Y ∩ G(u) = T2(u); Y ∩ T3 = T2(u) x <Tr(2 pi p u)>
     y = G.pseudo_planar(Z, p)
-    assert y.intersect(G.cylindrical((2, 0, 0), Z)).equals(G.helical((2, 0, 0), Z, p))
-    assert y.intersect(G.planar(Z)).equals(G.translation2(Z))
-    yt = y.intersect(G.translation3())
+    assert intersect_groups(y, G.cylindrical((2, 0, 0), Z)).equals(G.helical((2, 0, 0), Z, p))
+    assert intersect_groups(y, G.planar(Z)).equals(G.translation2(Z))
+    yt = intersect_groups(y, G.translation3())
     assert yt.kind is Kind.TRANSLATION2 and yt.n_components == math.inf
     assert yt.contains(tr(7, -3, 3.0)) and not yt.contains(tr(7, -3, 2.0))
 
 
 def test_discrete_screw_group_of_two_pitches():
     # H(p) ∩ H(q), same axis: <Scr(phi; q)> with phi = 2 pi p / (q - p); p=1, q=3: phi = pi.
-    s = G.helical(ORIGIN, Z, 1.0).intersect(G.helical(ORIGIN, Z, 3.0))
+    s = intersect_groups(G.helical(ORIGIN, Z, 1.0), G.helical(ORIGIN, Z, 3.0))
     assert s.dof == 0 and s.n_components == math.inf
     g = se3.screw(ORIGIN, Z, 3.0, math.pi)
     assert s.contains(g) and s.contains(g @ g) and s.contains(se3.inverse(g))
@@ -204,8 +210,8 @@ def test_discrete_screw_group_of_two_pitches():
 def test_lattices_of_incommensurate_periods_meet_trivially():
     a = G.lattice_group([tr(0, 0, 1.0)])
     b = G.lattice_group([tr(0, 0, math.sqrt(2))])
-    assert a.intersect(b).n_components == 1
-    c = a.intersect(G.lattice_group([tr(0, 0, 1.5)]))
+    assert intersect_groups(a, b).n_components == 1
+    c = intersect_groups(a, G.lattice_group([tr(0, 0, 1.5)]))
     assert c.contains(tr(0, 0, 3.0)) and not c.contains(tr(0, 0, 1.5))
 
 
@@ -213,35 +219,37 @@ def test_cyclic_lattice_meets_by_the_lcm_rule():
     """<Tr(0,0,1.5)> ∩ B in closed form (§2.4 "Finite parts"): the lcm of the periods."""
     a = G.lattice_group([tr(0, 0, 1.5)])
     steps = {
-        "lead 1": a.intersect(G.helical(ORIGIN, Z, 1.0 / (2 * math.pi))),
-        "lead 0.6": a.intersect(G.helical(ORIGIN, Z, 0.6 / (2 * math.pi))),
-        "lattice 1": a.intersect(G.lattice_group([tr(0, 0, 1.0)])),
-        "lattice 0.5": a.intersect(G.lattice_group([tr(0, 0, -0.5)])),
+        "lead 1": intersect_groups(a, G.helical(ORIGIN, Z, 1.0 / (2 * math.pi))),
+        "lead 0.6": intersect_groups(a, G.helical(ORIGIN, Z, 0.6 / (2 * math.pi))),
+        "lattice 1": intersect_groups(a, G.lattice_group([tr(0, 0, 1.0)])),
+        "lattice 0.5": intersect_groups(a, G.lattice_group([tr(0, 0, -0.5)])),
     }
     for name, met in steps.items():
         assert met.kind is Kind.FIXED and len(met.lattice) == 1, name
         assert abs(met.lattice[0][2, 3]) == pytest.approx(3.0 if name != "lattice 0.5" else 1.5)
-    assert a.intersect(G.prismatic(Z)).lattice[0][2, 3] == pytest.approx(1.5)
+    assert intersect_groups(a, G.prismatic(Z)).lattice[0][2, 3] == pytest.approx(1.5)
     # Incommensurate lead, or a direction the lattice never reaches: only I.
-    assert a.intersect(G.helical(ORIGIN, Z, math.sqrt(2) / (2 * math.pi))).n_components == 1
-    assert a.intersect(G.prismatic((1, 0, 0))).n_components == 1
+    assert intersect_groups(a, G.helical(ORIGIN, Z, math.sqrt(2) / (2 * math.pi))).n_components == 1
+    assert intersect_groups(a, G.prismatic((1, 0, 0))).n_components == 1
 
 
 def test_discrete_screw_lattice_meets_in_closed_form():
     """<Scr(-3 pi; 1)> (from H(1) ∩ H(3)) rotates by pi per step."""
-    s = G.helical(ORIGIN, Z, 1.0).intersect(G.helical(ORIGIN, Z, 3.0))
+    s = intersect_groups(G.helical(ORIGIN, Z, 1.0), G.helical(ORIGIN, Z, 3.0))
     # No rotation: every second step, a translation by -6 pi.
     np.testing.assert_allclose(
-        s.intersect(G.prismatic(Z)).lattice[0], tr(0, 0, -6 * math.pi), atol=1e-12
+        intersect_groups(s, G.prismatic(Z)).lattice[0], tr(0, 0, -6 * math.pi), atol=1e-12
     )
     # No axial motion: only I.
-    assert s.intersect(G.revolute(ORIGIN, Z)).n_components == 1
+    assert intersect_groups(s, G.revolute(ORIGIN, Z)).n_components == 1
     # H(2): -3 pi k = 2 (-3 pi k + 2 pi m) holds for k in 4Z.
     np.testing.assert_allclose(
-        s.intersect(G.helical(ORIGIN, Z, 2.0)).lattice[0], tr(0, 0, -12 * math.pi), atol=1e-12
+        intersect_groups(s, G.helical(ORIGIN, Z, 2.0)).lattice[0],
+        tr(0, 0, -12 * math.pi),
+        atol=1e-12,
     )
     # Its own group: all of it.
-    assert s.intersect(G.helical(ORIGIN, Z, 3.0)).equals(s)
+    assert intersect_groups(s, G.helical(ORIGIN, Z, 3.0)).equals(s)
 
 
 def test_one_parameter_groups_through_lattice_generators():
@@ -271,10 +279,12 @@ def test_finite_parts_w14():
     c4 = tuple(se3.rot_z(k * math.pi / 2) for k in range(4))
     peg = G.prismatic(Z).with_discrete(reps=c4)
     assert peg.n_components == 4 and peg.dof == 1
-    met = peg.intersect(G.planar(Z))
+    met = intersect_groups(peg, G.planar(Z))
     assert met.kind is Kind.FIXED and met.n_components == 4
     assert met.equals(G.cyclic(ORIGIN, Z, 4))
-    assert G.cyclic(ORIGIN, Z, 4).intersect(G.cyclic(ORIGIN, Z, 6)).equals(G.cyclic(ORIGIN, Z, 2))
+    assert intersect_groups(G.cyclic(ORIGIN, Z, 4), G.cyclic(ORIGIN, Z, 6)).equals(
+        G.cyclic(ORIGIN, Z, 2)
+    )
 
 
 def test_with_discrete_rejects_non_groups():
@@ -359,11 +369,11 @@ def assert_meet_sound_and_equivariant(
     rng: np.random.Generator, a: SymmetryGroup, b: SymmetryGroup
 ) -> None:
     """Sampled members of a ∩ b lie in both, and the meet commutes with conjugation."""
-    m = a.intersect(b)
+    m = intersect_groups(a, b)
     for x in m.sample(rng, 3):
         assert a.contains(x) and b.contains(x)
     t = se3.random_transform(rng)
-    assert a.conjugate(t).intersect(b.conjugate(t)).equals(m.conjugate(t))
+    assert intersect_groups(a.conjugate(t), b.conjugate(t)).equals(m.conjugate(t))
 
 
 def _tr_group(rng: np.random.Generator) -> SymmetryGroup:
@@ -400,7 +410,7 @@ def test_closed_form_tr_meet_agrees_with_the_lie_algebra_route(seed):
     tol = Tolerance()
     null = _null_space(_scaled(np.hstack((a.algebra, -b.algebra)), tol), tol)
     via_algebra = classify_algebra(a.algebra @ null[: a.dof], tol)
-    assert _connected_meet(a, b, tol).equals(via_algebra)
+    assert connected_meet(a, b, tol).equals(via_algebra)
 
 
 def _any_group(rng: np.random.Generator) -> SymmetryGroup:
@@ -458,3 +468,19 @@ def test_locus_distance_of_a_point_by_hand(kind, radius, expected):
 def test_a_helix_has_no_closed_form_distance():
     with pytest.raises(GroupError):
         Locus("helix", point=np.zeros(3), direction=np.array([0.0, 0.0, 1.0])).distance(np.zeros(3))
+
+
+
+def test_the_method_intersect_is_the_group_meet():
+    """``SymmetryGroup.intersect`` (the public method) is :func:`intersect_groups`, for
+    connected groups and for finite ones (the turns of a square about z meet those of a
+    hexagon in the half turns: C4 ∩ C6 = C2, 2 components)."""
+    cylinder = SymmetryGroup.cylindrical((0, 0, 0), (0, 0, 1))
+    plane = SymmetryGroup.planar((0, 0, 1))
+    assert cylinder.intersect(plane).equals(intersect_groups(cylinder, plane))
+    assert cylinder.intersect(plane).kind is Kind.REVOLUTE
+    square = SymmetryGroup.cyclic((0, 0, 0), (0, 0, 1), 4)
+    hexagon = SymmetryGroup.cyclic((0, 0, 0), (0, 0, 1), 6)
+    met = square.intersect(hexagon)
+    assert met.equals(intersect_groups(square, hexagon))
+    assert (met.dof, met.n_components) == (0, 2)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from assemblykit.blocking.constraints import infinitesimal_terms
-from assemblykit.blocking.ndbg import blocking_graph
+from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.queries import can_extract, locally_free_directions
 from assemblykit.io.assembly import load_assembly
 from curved_parts import (

@@ -11,7 +11,7 @@ from blocking_helpers import mesh_assembly
 
 from assemblykit.blocking.extended import extended_dbg, extended_free, obstacles
 from assemblykit.blocking.free_cones import ChartSet, _distinct_cones, exact_free_directions
-from assemblykit.blocking.ndbg import blocking_graph
+from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.io.assembly import load_assembly

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from blocking_helpers import ContactAssembly, compas_folder, cylinder, random_box_contacts, square
 
-from assemblykit.blocking.ndbg import blocking_graph
+from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.geometry.contacts import Contact
 from assemblykit.io.polygons import load_polygons

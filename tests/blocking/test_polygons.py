@@ -10,7 +10,8 @@ import pytest
 from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
-from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph, blocking_graph
+from assemblykit.blocking.graphs import blocking_graph
+from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 from assemblykit.blocking.planar import blocked_normals, convex_pieces
 from assemblykit.blocking.polygons import PolygonAssembly, counter_clockwise
 from assemblykit.errors import GeometryError

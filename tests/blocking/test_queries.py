@@ -21,7 +21,7 @@ from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import Contact
 from assemblykit.model.packings import box_mesh as box
 from assemblykit.model.packings import guillotine_packing
-from assemblykit.planning.sequence import plan, separable_by_translations
+from assemblykit.planning.planner import plan, separable_by_translations
 
 GAP = 0.01
 

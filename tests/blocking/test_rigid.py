@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from blocking_helpers import ContactAssembly, square
 
-from assemblykit.blocking.ndbg import blocking_graph
+from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.rigid import RIGID_MAX_HYPERPLANES
 from assemblykit.geometry.contacts import Contact, PlanarPatch
 

@@ -15,7 +15,7 @@ import assemblykit
 from assemblykit.algebra import se3
 from assemblykit.features.primitives import Axis, Ball, Hole, Plane, Point, Shaft
 from assemblykit.inference import solve_numeric_only
-from assemblykit.io.spec import load_task
+from assemblykit.io.tasks import load_task
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation, relation_residual
 from assemblykit.model.task import Situation, Task

@@ -16,7 +16,7 @@ from assemblykit.algebra import Coset, SymmetryGroup, se3
 from assemblykit.features.primitives import Ball, Hole, Plane, Point, Prism, Shaft, Socket, Thread
 from assemblykit.inference import solve_numeric_only
 from assemblykit.inference.reduction import model_scale, revolute_loop
-from assemblykit.io.spec import load_task
+from assemblykit.io.tasks import load_task
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Action, Situation, Task

@@ -127,7 +127,7 @@ def test_solids_meeting_along_an_edge_load_as_one_piece(tmp_path):
 
 
 def test_contacts_and_blocking_of_a_piece_with_cubes_meeting_along_an_edge(tmp_path):
-    from assemblykit.blocking.ndbg import blocking_graph
+    from assemblykit.blocking.graphs import blocking_graph
 
     edge_piece(tmp_path / "piece.obj")
     trimesh.creation.box(bounds=[[0, 0, 1], [1, 1, 2]]).export(tmp_path / "lid.stl")

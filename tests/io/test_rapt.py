@@ -12,7 +12,7 @@ import assemblykit
 from assemblykit.errors import FeatureError, SchemaError, TaskSyntaxError, UnknownNameError
 from assemblykit.features import Cone, Frame, Prism, Shaft, Thread, Torus
 from assemblykit.io.rapt import parse_rapt, rapt_to_dict, task_to_rapt
-from assemblykit.io.spec import load_task
+from assemblykit.io.tasks import load_task
 from assemblykit.model.relations import FeatureRef
 
 EXAMPLES = Path(assemblykit.__file__).parent / "examples" / "tasks"

@@ -15,7 +15,8 @@ import yaml
 import assemblykit
 from assemblykit.errors import FeatureError, InputError, SchemaError, UnknownNameError
 from assemblykit.features import Ball, Hole, Plane, Shaft
-from assemblykit.io.spec import load_task, parse_task, task_to_dict
+from assemblykit.io.spec import parse_task, task_to_dict
+from assemblykit.io.tasks import load_task
 from assemblykit.model.relations import FeatureRef
 
 EXAMPLES = Path(assemblykit.__file__).parent / "examples" / "tasks"

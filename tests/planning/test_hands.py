@@ -14,7 +14,7 @@ from assemblykit.blocking.planar import convex_pieces
 from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.io.polygons import load_polygons
 from assemblykit.planning.hands import hands_needed, partitions
-from assemblykit.planning.sequence import plan
+from assemblykit.planning.planner import plan
 
 PLANAR = Path(__file__).resolve().parents[2] / "src" / "assemblykit" / "examples" / "planar"
 FAR = 100.0

@@ -18,7 +18,7 @@ from assemblykit.model.assembly import Assembly, Part
 from assemblykit.model.packings import guillotine_cells
 from assemblykit.planning.multimove import MultiMovePlan, Separation
 from assemblykit.planning.multimove_mesh import plan_meshes
-from assemblykit.planning.sequence import plan
+from assemblykit.planning.planner import plan
 from assemblykit.tolerance import Tolerance
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float]]

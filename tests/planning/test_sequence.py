@@ -10,10 +10,11 @@ import pytest
 import trimesh
 
 from assemblykit.blocking.extended import extended_dbg, extended_free
-from assemblykit.blocking.ndbg import blocking_graph, blocking_terms
+from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning import sequence
+from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import (
     DirectionTable,
     ExtendedDirections,
@@ -22,7 +23,6 @@ from assemblykit.planning.sequence import (
     and_or_graph,
     local_table,
     minimal_interlocked,
-    plan,
     separable,
     translation_table,
 )

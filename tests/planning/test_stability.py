@@ -15,7 +15,7 @@ import trimesh
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
-from assemblykit.planning.sequence import plan
+from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import (
     CONE_SIDES,
     FRICTION_STEPS,

@@ -6,7 +6,7 @@ import numpy as np
 import trimesh
 from matplotlib.image import imread
 
-from assemblykit.blocking.ndbg import blocking_graph
+from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.sequence import Plan, Step
 from assemblykit.viz.plots import _count_colors, exploded_view_png, plot_ndbg, storyboard_frames

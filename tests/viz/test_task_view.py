@@ -12,7 +12,7 @@ from matplotlib.image import imread
 
 import assemblykit
 from assemblykit.algebra import se3
-from assemblykit.io.spec import load_task
+from assemblykit.io.tasks import load_task
 from assemblykit.viz.task_view import (
     LEGEND_HEIGHT,
     PANEL_SIZE,

@@ -1,7 +1,15 @@
 """The algebra of assemblykit (layer 0): SE(3), Hervé's symmetry subgroups, cosets,
 characteristic invariants and transporters (ALGEBRA.md §1-§2, §5)."""
 
-from assemblykit.algebra.cosets import Chain, Coset, EmptySet, Mismatch
+from assemblykit.algebra.cosets import (
+    Chain,
+    Coset,
+    EmptySet,
+    Mismatch,
+    intersect_groups,
+    stabilizer,
+    transporter,
+)
 from assemblykit.algebra.invariants import (
     DirectionInvariant,
     Invariant,
@@ -10,9 +18,7 @@ from assemblykit.algebra.invariants import (
     PointInvariant,
     congruence_mismatch,
     pair_frame,
-    stabilizer,
     transform_invariant,
-    transporter,
 )
 from assemblykit.algebra.subgroups import Kind, Locus, SymmetryGroup
 
@@ -30,6 +36,7 @@ __all__ = [
     "PointInvariant",
     "SymmetryGroup",
     "congruence_mismatch",
+    "intersect_groups",
     "pair_frame",
     "stabilizer",
     "transform_invariant",

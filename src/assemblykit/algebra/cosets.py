@@ -4,7 +4,10 @@
 A relation between body 1 and body 2 is the set of relative positions X = L1^-1 L2;
 for lower pairs it is a right coset H . x0 with H in body 1's frame. Intersections
 are cosets of the intersected group or empty; products are cosets only when the two
-groups permute (otherwise a :class:`Chain`).
+groups permute (otherwise a :class:`Chain`). Transporters of characteristic invariants
+(:mod:`assemblykit.algebra.invariants` finds X0 and Stab) are cosets too, and so are the
+components of a group with discrete parts, which is why group intersection
+(:func:`intersect_groups`) lives here.
 """
 
 from __future__ import annotations
@@ -18,8 +21,10 @@ from typing import Any
 import numpy as np
 
 from assemblykit import formatting as fmt
+from assemblykit.algebra import invariants as inv
 from assemblykit.algebra import se3
 from assemblykit.algebra.caching import cached
+from assemblykit.algebra.invariants import Invariant, LineInvariant, Mismatch
 from assemblykit.algebra.lattices import IntegerPoints, commensurate, integer_points
 from assemblykit.algebra.subgroups import (
     Kind,
@@ -30,13 +35,23 @@ from assemblykit.algebra.subgroups import (
     _Sub,
     _tr_meet,
     classify_algebra,
+    connected_meet,
+    lattice_meet,
     lattice_parameter,
     one_parameter,
 )
 from assemblykit.errors import GroupError, NumericError
 from assemblykit.tolerance import Tolerance, current
 
-__all__ = ["Chain", "Coset", "EmptySet", "Mismatch"]
+__all__ = [
+    "Chain",
+    "Coset",
+    "EmptySet",
+    "Mismatch",
+    "intersect_groups",
+    "stabilizer",
+    "transporter",
+]
 
 #: Starts of the deterministic multi-start least squares (ALGEBRA.md §2.5 "Numeric fallback").
 NUMERIC_STARTS = 24
@@ -83,16 +98,6 @@ _PRODUCT_GROUPS = frozenset(
         (Kind.PSEUDO_PLANAR, Kind.HELICAL),
     )
 )
-
-
-@dataclass(frozen=True)
-class Mismatch:
-    """Why a set is empty: ``kind`` (angle, distance, radius, moment, handedness, pitch,
-    sides, type, residual), its size (radians or model units) and a one-line message."""
-
-    kind: str
-    value: float
-    message: str
 
 
 @dataclass(frozen=True)
@@ -166,8 +171,6 @@ class Coset:
         """The characteristic invariants of a TR group H as floats (§2.4), and the same
         moved by x0^-1: the objects of body 2 that the relation maps onto them (§2.5
         transporter; cached for repeated intersections)."""
-        from assemblykit.algebra import invariants as inv  # invariants build Coset values
-
         body1 = inv.characteristic_flats(self.group.kind, self.group.frame)
         return body1, inv.move_flats(self.rep, body1, inverse=True)
 
@@ -291,7 +294,7 @@ def _lattice_coset_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
     lat, other = (p, q) if p.group.lattice else (q, p)
     if len(lat.group.lattice) != 1 or other.group.lattice:
         raise GroupError("intersection of cosets of these lattice groups is not supported")
-    group = p.group.intersect(q.group, tol)
+    group = intersect_groups(p.group, q.group, tol)
     if lat.group.kind is Kind.FIXED:
         found = _cyclic_coset_meet(lat, other, group, tol)
         if found is not None:
@@ -363,8 +366,6 @@ def _cyclic_coset_meet(
 
 
 def _connected_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
-    from assemblykit.algebra import invariants as inv  # invariants build Coset values
-
     for point, other in ((p, q), (q, p)):
         if point.dof == 0:
             if other.contains(point.rep, tol):
@@ -373,7 +374,7 @@ def _connected_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
                 return EmptySet(Mismatch("residual", 1.0, "the fixed position is not in the set"))
     if p.group.is_tr and q.group.is_tr:
         (ta, sa), (tb, sb) = p.transporter_flats, q.transporter_flats
-        return inv.flat_transporter(ta + tb, sa + sb, _tr_meet(p.group, q.group, tol), tol)
+        return flat_transporter(ta + tb, sa + sb, _tr_meet(p.group, q.group, tol), tol)
     if p.group.is_tr or q.group.is_tr:
         helical, other = (q, p) if p.group.is_tr else (p, q)
         found = _helical_meet(helical, other, tol)
@@ -428,7 +429,7 @@ def _helical_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet | None
         step = se3.translation(u * (h.pitch * (theta + 2.0 * math.pi * turns) - shift))
         c = step @ d @ p.rep
         if p.contains(c, tol) and q.contains(c, tol):
-            return Coset(p.group.intersect(q.group, tol), c)
+            return Coset(intersect_groups(p.group, q.group, tol), c)
         miss = _helix_residual(h.pitch, shift, theta)
         if miss <= tol.length:
             return None
@@ -437,7 +438,7 @@ def _helical_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet | None
     c = step @ d @ p.rep
     if not (p.contains(c, tol) and q.contains(c, tol)):
         return None
-    return Coset(p.group.intersect(q.group, tol), c)
+    return Coset(intersect_groups(p.group, q.group, tol), c)
 
 
 def _steepest_translation(v: _Sub, u: np.ndarray) -> np.ndarray:
@@ -469,7 +470,7 @@ def _numeric_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
     from scipy.optimize import least_squares  # imported here: only numeric cases need it
 
     a, b = p.group, q.group
-    group = a.intersect(b, tol)
+    group = intersect_groups(a, b, tol)
     na = a.dof
     length = max(tol.scale, se3.norm(p.rep[:3, 3]), se3.norm(q.rep[:3, 3]))
     angles = np.concatenate((a._angle_params(), b._angle_params()))
@@ -626,3 +627,89 @@ def _close_to_identity(d: np.ndarray, tol: Tolerance) -> bool:
         float(np.max(np.abs(d[:3, :3] - np.eye(3)))) <= tol.angle
         and se3.norm(d[:3, 3]) <= tol.length
     )
+
+
+# ----------------------------------------------------------------------------- transporters
+
+
+def flat_transporter(
+    targets: tuple[Any, ...], sources: tuple[Any, ...], group: SymmetryGroup, tol: Tolerance
+) -> Coset | EmptySet:
+    """The transporter of directed float invariants whose targets have stabiliser
+    ``group`` (§2.5 closed form, :func:`assemblykit.algebra.invariants.flat_transport`)."""
+    found = inv.flat_transport(targets, sources, tol)
+    if isinstance(found, Mismatch):
+        return EmptySet(found)
+    return Coset(group, found)
+
+
+def _directed_transporter(
+    targets: tuple[Invariant, ...], sources: tuple[Invariant, ...], tol: Tolerance
+) -> Coset | EmptySet:
+    found = inv.directed_transport(targets, sources, tol)
+    if isinstance(found, Mismatch):
+        return EmptySet(found)
+    return Coset(*found)
+
+
+def transporter(
+    targets: tuple[Invariant, ...] | list[Invariant],
+    sources: tuple[Invariant, ...] | list[Invariant],
+    tol: Tolerance | None = None,
+) -> Coset | EmptySet:
+    """{X in SE(3) : X . sources[i] = targets[i] for all i} (ALGEBRA.md §2.5).
+
+    ``targets`` are in body-1 coordinates, ``sources`` in body-2 coordinates. Empty when
+    the tuples are not congruent (the first failing test is reported); undirected lines
+    give a union over the direction choices, i.e. extra components.
+    """
+    tol = tol or current()
+    choices = inv.direction_choices(tuple(targets), tuple(sources))
+    if isinstance(choices, Mismatch):
+        return EmptySet(choices)
+    directed_t, variants = choices
+    results = [_directed_transporter(directed_t, s, tol) for s in variants]
+    if len(results) == 1:
+        return results[0]
+    cosets = [r for r in results if isinstance(r, Coset)]
+    if not cosets:
+        return results[0]
+    base = cosets[0]
+    reps = tuple(c.rep @ se3.inverse(base.rep) for c in cosets[1:])
+    return Coset(base.group.with_known_discrete(reps=reps, tol=tol), base.rep)
+
+
+def stabilizer(
+    invariants: tuple[Invariant, ...] | list[Invariant], tol: Tolerance | None = None
+) -> SymmetryGroup:
+    """The group fixing every invariant; undirected lines contribute flips (§2.4)."""
+    tol = tol or current()
+    invs = tuple(invariants)
+    if all(not isinstance(i, LineInvariant) or i.directed for i in invs):
+        return inv.directed_stabilizer(invs, tol)
+    result = transporter(invs, invs, tol)
+    assert isinstance(result, Coset)
+    return result.group
+
+
+def intersect_groups(
+    a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance | None = None
+) -> SymmetryGroup:
+    """G ∩ G' (ALGEBRA.md §2.4): the connected part, the helical residue and the finite
+    parts, these met as cosets of the connected parts (§2.5)."""
+    tol = tol or current()
+    if a.is_connected and b.is_connected:
+        return connected_meet(a, b, tol)
+    if a.lattice or b.lattice:
+        return lattice_meet(a, b, tol)
+    c0 = connected_meet(a.connected_part, b.connected_part, tol)
+    found: list[np.ndarray] = []
+    for x in a.reps:
+        for y in b.reps:
+            met = Coset(a.connected_part, x).intersect(Coset(b.connected_part, y), tol)
+            if isinstance(met, EmptySet):
+                continue
+            found.append(met.rep)
+    if not found:
+        return c0
+    return c0.with_known_discrete(reps=tuple(found), lattice=c0.lattice, tol=tol)

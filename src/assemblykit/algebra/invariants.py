@@ -19,7 +19,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.algebra import se3
-from assemblykit.algebra.cosets import Coset, EmptySet, Mismatch
 from assemblykit.algebra.subgroups import Kind, SymmetryGroup, Vec3, _tr_meet, psd_solve
 from assemblykit.errors import FeatureError
 from assemblykit.tolerance import Tolerance, current
@@ -28,16 +27,25 @@ __all__ = [
     "DirectionInvariant",
     "Invariant",
     "LineInvariant",
+    "Mismatch",
     "PlaneInvariant",
     "PointInvariant",
     "characteristic_invariants",
     "congruence_mismatch",
     "pair_frame",
-    "stabilizer",
     "transform_invariant",
-    "transporter",
     "tuple_frame",
 ]
+
+
+@dataclass(frozen=True)
+class Mismatch:
+    """Why a set is empty: ``kind`` (angle, distance, radius, moment, handedness, pitch,
+    sides, type, residual), its size (radians or model units) and a one-line message."""
+
+    kind: str
+    value: float
+    message: str
 
 
 def _vec(v: Any) -> NDArray[np.float64]:
@@ -399,7 +407,7 @@ def _single_stabilizer(inv: Invariant) -> SymmetryGroup:
     return SymmetryGroup.schoenflies(inv.direction)
 
 
-def _directed_stabilizer(invariants: tuple[Invariant, ...], tol: Tolerance) -> SymmetryGroup:
+def directed_stabilizer(invariants: tuple[Invariant, ...], tol: Tolerance) -> SymmetryGroup:
     """Stab of the tuple with every line taken as directed: the meet of the TR stabilisers."""
     if not invariants:
         return SymmetryGroup.free()
@@ -407,19 +415,6 @@ def _directed_stabilizer(invariants: tuple[Invariant, ...], tol: Tolerance) -> S
     for inv in invariants[1:]:
         group = _tr_meet(group, _single_stabilizer(inv), tol)
     return group
-
-
-def stabilizer(
-    invariants: tuple[Invariant, ...] | list[Invariant], tol: Tolerance | None = None
-) -> SymmetryGroup:
-    """The group fixing every invariant; undirected lines contribute flips (§2.4)."""
-    tol = tol or current()
-    invs = tuple(invariants)
-    if all(not isinstance(i, LineInvariant) or i.directed for i in invs):
-        return _directed_stabilizer(invs, tol)
-    result = transporter(invs, invs, tol)
-    assert isinstance(result, Coset)
-    return result.group
 
 
 # The objects of a group frame (origin o, axes x, y, z) whose directed stabiliser is the
@@ -575,25 +570,12 @@ def _relative(target: tuple[Vec3, ...], source: tuple[Vec3, ...]) -> tuple[_Rows
     return (rows[0], rows[1], rows[2]), (shift[0], shift[1], shift[2])
 
 
-def _directed_transporter(
-    targets: tuple[Invariant, ...],
-    sources: tuple[Invariant, ...],
-    tol: Tolerance,
-    group: SymmetryGroup | None = None,
-) -> Coset | EmptySet:
-    """The transporter of directed tuples; ``group`` is Stab(targets) when already known."""
-    flat_t = tuple(_flat(i) for i in targets)
-    flat_s = tuple(_flat(i) for i in sources)
-    stab = group if group is not None else _directed_stabilizer(targets, tol)
-    return flat_transporter(flat_t, flat_s, stab, tol)
-
-
-def flat_transporter(
-    targets: tuple[_Flat, ...], sources: tuple[_Flat, ...], group: SymmetryGroup, tol: Tolerance
-) -> Coset | EmptySet:
-    """The transporter of directed float invariants whose targets have stabiliser
-    ``group`` (§2.5 closed form: X0 = Frame(targets) . Frame(sources)^-1, then every
-    source checked to land on its target; the first failing congruence test otherwise)."""
+def flat_transport(
+    targets: tuple[_Flat, ...], sources: tuple[_Flat, ...], tol: Tolerance
+) -> NDArray[np.float64] | Mismatch:
+    """The representative X0 of the transporter of directed float invariants (§2.5
+    closed form: X0 = Frame(targets) . Frame(sources)^-1, then every source checked to
+    land on its target), or the first failing congruence test when one does not."""
     rot, shift = _relative(_frame_columns(targets, tol), _frame_columns(sources, tol))
     angle, length = tol.angle, tol.length
     worst = 0.0
@@ -609,55 +591,56 @@ def flat_transporter(
                 worst,
                 "the invariants are pairwise congruent but not under a proper rigid motion",
             )
-        return EmptySet(found)
+        return found
     (r0, r1, r2), (t0, t1, t2) = rot, shift
-    x0 = np.array(((*r0, t0), (*r1, t1), (*r2, t2), (0.0, 0.0, 0.0, 1.0)))
-    return Coset(group, x0)
+    return np.array(((*r0, t0), (*r1, t1), (*r2, t2), (0.0, 0.0, 0.0, 1.0)))
+
+
+def directed_transport(
+    targets: tuple[Invariant, ...], sources: tuple[Invariant, ...], tol: Tolerance
+) -> tuple[SymmetryGroup, NDArray[np.float64]] | Mismatch:
+    """The transporter of directed tuples as (Stab(targets), X0), or the first failing
+    congruence test (§2.5)."""
+    flat_t = tuple(_flat(i) for i in targets)
+    flat_s = tuple(_flat(i) for i in sources)
+    stab = directed_stabilizer(targets, tol)
+    found = flat_transport(flat_t, flat_s, tol)
+    if isinstance(found, Mismatch):
+        return found
+    return stab, found
 
 
 def _flip(line: LineInvariant) -> LineInvariant:
     return LineInvariant(line.point, -line.direction, directed=True)
 
 
-def transporter(
-    targets: tuple[Invariant, ...] | list[Invariant],
-    sources: tuple[Invariant, ...] | list[Invariant],
-    tol: Tolerance | None = None,
-) -> Coset | EmptySet:
-    """{X in SE(3) : X . sources[i] = targets[i] for all i} (ALGEBRA.md §2.5).
-
-    ``targets`` are in body-1 coordinates, ``sources`` in body-2 coordinates. Empty when
-    the tuples are not congruent (the first failing test is reported); undirected lines
-    give a union over the direction choices, i.e. extra components.
-    """
-    tol = tol or current()
-    tgt, src = tuple(targets), tuple(sources)
-    found = _shape_mismatch(tgt, src)
+def direction_choices(
+    targets: tuple[Invariant, ...], sources: tuple[Invariant, ...]
+) -> tuple[tuple[Invariant, ...], list[tuple[Invariant, ...]]] | Mismatch:
+    """The targets with every line directed, and one directed source tuple per choice
+    of direction of the lines undirected on either side (§2.5: a union over the
+    direction choices); a "type" mismatch when the tuples do not correspond."""
+    found = _shape_mismatch(targets, sources)
     if found is not None:
-        return EmptySet(found)
+        return found
     free = [
         i
-        for i, (t, s) in enumerate(zip(tgt, src, strict=True))
+        for i, (t, s) in enumerate(zip(targets, sources, strict=True))
         if isinstance(t, LineInvariant)
         and isinstance(s, LineInvariant)
         and not (t.directed and s.directed)
     ]
-    directed_t = tuple(_as_directed(t) for t in tgt)
+    directed_t = tuple(_as_directed(t) for t in targets)
     if not free:
-        return _directed_transporter(directed_t, tuple(_as_directed(s) for s in src), tol)
-    results: list[Coset | EmptySet] = []
+        return directed_t, [tuple(_as_directed(s) for s in sources)]
+    choices: list[tuple[Invariant, ...]] = []
     for signs in itertools.product((False, True), repeat=len(free)):
-        flipped = list(_as_directed(s) for s in src)
+        flipped = list(_as_directed(s) for s in sources)
         for i, flip in zip(free, signs, strict=True):
             if flip:
                 flipped[i] = _flip(flipped[i])  # type: ignore[arg-type]
-        results.append(_directed_transporter(directed_t, tuple(flipped), tol))
-    cosets = [r for r in results if isinstance(r, Coset)]
-    if not cosets:
-        return results[0]
-    base = cosets[0]
-    reps = tuple(c.rep @ se3.inverse(base.rep) for c in cosets[1:])
-    return Coset(base.group.with_known_discrete(reps=reps, tol=tol), base.rep)
+        choices.append(tuple(flipped))
+    return directed_t, choices
 
 
 def _as_directed(inv: Invariant) -> Invariant:

@@ -16,11 +16,10 @@ A whole breadth-first layer is updated at once with array operations.
 
 from __future__ import annotations
 
-import weakref
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal, Protocol, overload
+from typing import Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -33,14 +32,10 @@ from assemblykit.blocking.arrangement import (
     snap_normals,
     sphere_arrangement,
 )
-from assemblykit.blocking.constraints import BlockingTerm, infinitesimal_terms
+from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal, removal_table
-from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import Contact
 from assemblykit.tolerance import Tolerance
-
-if TYPE_CHECKING:
-    from assemblykit.blocking.rigid import RigidBlockingGraph
 
 Motion = Literal["infinitesimal", "extended", "rigid"]
 _CHUNK = 8192
@@ -546,121 +541,3 @@ def build_ndbg(
     return NonDirectionalBlockingGraph(
         tuple(parts), motion, arrangement, table, packed, contacts, tol
     )
-
-
-_TERMS: weakref.WeakKeyDictionary[Any, dict[tuple[str, Tolerance], list[BlockingTerm]]] = (
-    weakref.WeakKeyDictionary()
-)
-
-
-_GRAPHS: weakref.WeakKeyDictionary[
-    Any, dict[tuple[str, tuple[str, ...], Tolerance], NonDirectionalBlockingGraph]
-] = weakref.WeakKeyDictionary()
-
-
-def blocking_terms(assembly: AssemblyLike, motion: str, tol: Tolerance) -> list[BlockingTerm]:
-    """The blocking terms of the whole assembly for a motion, computed once per
-    assembly and tolerance (subsets filter them)."""
-    cache = _TERMS.setdefault(assembly, {})
-    key = (motion, tol)
-    if key not in cache:
-        if motion == "extended" and getattr(assembly, "dimension", 3) == 2:
-            from assemblykit.blocking.planar import planar_extended_terms
-
-            cache[key] = planar_extended_terms(assembly, tol)
-        elif motion == "extended":
-            from assemblykit.blocking.extended import extended_terms
-
-            cache[key] = extended_terms(assembly, tol)
-        else:
-            cache[key] = infinitesimal_terms(assembly.contacts(tol))
-    return cache[key]
-
-
-def _subset(assembly: AssemblyLike, parts: Iterable[str] | None) -> tuple[str, ...]:
-    names = list(assembly.names)
-    if parts is None:
-        return tuple(names)
-    wanted = set(parts)
-    unknown = wanted - set(names)
-    if unknown:
-        raise UnknownNameError(f"no part named {sorted(unknown)[0]!r}")
-    return tuple(n for n in names if n in wanted)
-
-
-@overload
-def blocking_graph(
-    assembly: AssemblyLike,
-    motion: Literal["infinitesimal", "extended"] = ...,
-    parts: Iterable[str] | None = None,
-    tol: Tolerance | None = None,
-) -> NonDirectionalBlockingGraph: ...
-
-
-@overload
-def blocking_graph(
-    assembly: AssemblyLike,
-    motion: Literal["rigid"],
-    parts: Iterable[str] | None = None,
-    tol: Tolerance | None = None,
-) -> RigidBlockingGraph: ...
-
-
-@overload
-def blocking_graph(
-    assembly: AssemblyLike,
-    motion: Motion,
-    parts: Iterable[str] | None = None,
-    tol: Tolerance | None = None,
-) -> NonDirectionalBlockingGraph | RigidBlockingGraph: ...
-
-
-def blocking_graph(
-    assembly: AssemblyLike,
-    motion: Motion = "infinitesimal",
-    parts: Iterable[str] | None = None,
-    tol: Tolerance | None = None,
-) -> NonDirectionalBlockingGraph | RigidBlockingGraph:
-    """The NDBG of ``assembly`` (or of the sub-assembly ``parts``) for infinitesimal
-    translations (Γ_t), extended translations (Γ_e) or infinitesimal rigid motions (Γ_g,
-    :class:`~assemblykit.blocking.rigid.RigidBlockingGraph`). Contacts and pairwise
-    obstacles are computed once per assembly; subsets filter them; each NDBG is kept
-    while the assembly lives, and once the whole assembly's is known, a sub-assembly's
-    is derived from it by :meth:`NonDirectionalBlockingGraph.without_parts` (same
-    regions, finer than the sub-assembly needs but still regular)."""
-    if motion not in ("infinitesimal", "extended", "rigid"):
-        raise ValueError(f"unknown motion {motion!r}")
-    tol = assembly.tolerance(tol)
-    names = _subset(assembly, parts)
-    inside = set(names)
-    contacts = [c for c in assembly.contacts(tol) if c.a in inside and c.b in inside]
-    if motion == "rigid":
-        from assemblykit.blocking.rigid import RigidBlockingGraph
-
-        return RigidBlockingGraph(names, tuple(contacts), tol)
-    from assemblykit.blocking.extended import all_convex, sampled_ndbg
-
-    graphs = _GRAPHS.setdefault(assembly, {})
-    key = (motion, names, tol)
-    whole = graphs.get((motion, tuple(assembly.names), tol))
-    if key not in graphs and whole is not None:
-        # a sub-assembly of an assembly already analysed: drop the other parts' slots
-        graphs[key] = whole.without_parts(set(whole.parts) - inside)
-    planar = getattr(assembly, "dimension", 3) == 2  # polygons: exact terms, any shape
-    if (
-        key not in graphs
-        and motion == "extended"
-        and not planar
-        and not all_convex(assembly, names)
-    ):
-        local = blocking_graph(assembly, "infinitesimal", names, tol)
-        graphs[key] = sampled_ndbg(assembly, names, local, tol)
-    if key not in graphs:
-        terms = [
-            t
-            for t in blocking_terms(assembly, motion, tol)
-            if t.moving in inside and t.blocker in inside
-        ]
-        dimension = getattr(assembly, "dimension", 3)
-        graphs[key] = build_ndbg(names, motion, terms, len(contacts), tol, dimension)
-    return graphs[key]

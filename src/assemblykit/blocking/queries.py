@@ -29,12 +29,11 @@ from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import Removal
 from assemblykit.blocking.extended import extended_arcs, extended_free
 from assemblykit.blocking.free_cones import blocked_sets, exact_free_directions, overlay_faces
+from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.blocking.ndbg import (
     AssemblyLike,
     Motion,
     NonDirectionalBlockingGraph,
-    blocking_graph,
-    blocking_terms,
     build_ndbg,
 )
 from assemblykit.errors import UnknownNameError

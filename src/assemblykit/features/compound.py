@@ -19,7 +19,7 @@ from enum import Enum
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.algebra import Coset, EmptySet, SymmetryGroup, se3
+from assemblykit.algebra import Coset, EmptySet, SymmetryGroup, intersect_groups, se3
 from assemblykit.errors import FeatureError
 from assemblykit.features.primitives import (
     Ball,
@@ -284,7 +284,7 @@ def compound_group(features: Sequence[Feature], tol: Tolerance | None = None) ->
         if order != identity_order
     ]
     base = functools.reduce(
-        lambda group, feature: group.intersect(feature.group(), tol),
+        lambda group, feature: intersect_groups(group, feature.group(), tol),
         features[1:],
         features[0].group(),
     )

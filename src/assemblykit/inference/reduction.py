@@ -42,7 +42,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from assemblykit.algebra import Coset, EmptySet, Locus, SymmetryGroup, se3
+from assemblykit.algebra import Coset, EmptySet, Locus, SymmetryGroup, intersect_groups, se3
 from assemblykit.inference.loops import (
     Circle,
     LoopPoses,
@@ -1146,7 +1146,7 @@ def _coset_meets_locus(
     kept = keeping.includes(group, tol)
     if len(rows) == 3 or not (kept or _fixes(group, reached, tol)):
         return None
-    shifts = _translations(group.intersect(SymmetryGroup.translation3(), tol))
+    shifts = _translations(intersect_groups(group, SymmetryGroup.translation3(), tol))
     if kept:
         kernel_of = (
             SymmetryGroup.planar(rows[0])
@@ -1165,7 +1165,7 @@ def _coset_meets_locus(
     miss = float(np.linalg.norm(rows @ step - need))
     if miss > tol.length:
         return None if str(group.kind) in helical else miss
-    return Coset(group.intersect(kernel_of, tol), se3.translation(step))
+    return Coset(intersect_groups(group, kernel_of, tol), se3.translation(step))
 
 
 def _fixes(group: SymmetryGroup, point: np.ndarray, tol: Tolerance) -> bool:

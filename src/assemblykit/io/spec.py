@@ -13,14 +13,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import MISSING, fields
-from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StringConstraints, ValidationError
 
 from assemblykit.errors import InputError, SchemaError
 from assemblykit.features.primitives import FEATURE_TYPES, Feature, feature_from_dict, parse_angle
-from assemblykit.io.documents import read_json, read_text, read_yaml
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
 from assemblykit.model.task import Action, Situation, Task
@@ -60,26 +58,6 @@ class TaskModel(_Model):
     units: Literal[UNITS] = "mm"  # type: ignore[valid-type]
     bodies: dict[Name, BodyModel]
     situations: list[SituationModel]
-
-
-def load_task(path: str | Path) -> Task:
-    """Read and validate a task file: ``.yaml``/``.yml``, ``.json`` or ``.rapt``."""
-    path = Path(path)
-    source = path.name
-    text = read_text(path, "task file")
-    suffix = path.suffix.lower()
-    if suffix == ".rapt":
-        from assemblykit.io.rapt import parse_rapt
-
-        return parse_rapt(text, source)
-    if suffix in (".yaml", ".yml"):
-        return parse_task(read_yaml(text, source), source)
-    if suffix == ".json":
-        return parse_task(read_json(text, source), source)
-    raise InputError(
-        f"unknown task file type {path.suffix!r} (expected .yaml, .yml, .json or .rapt)",
-        source=source,
-    )
 
 
 def parse_task(

@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 from rich.table import Table
 
-from assemblykit.algebra import SymmetryGroup, se3
+from assemblykit.algebra import SymmetryGroup, intersect_groups, se3
 from assemblykit.errors import UnknownNameError
 from assemblykit.features import compound_group
 from assemblykit.features.primitives import Ball, Cone, Feature, Hole, Plane, Shaft, Socket
@@ -300,7 +300,7 @@ class MotionSolver:
         2-congruent features only add discrete components (Liu 1997 Props 3.2.8,
         5.0.9), so it is the identity component of G₁ ∩ ... ∩ Gₙ (Prop 3.2.6)."""
         groups = [f.group().connected_part for f in features]
-        return functools.reduce(lambda g, h: g.intersect(h, tol=self.tol), groups)
+        return functools.reduce(lambda g, h: intersect_groups(g, h, tol=self.tol), groups)
 
     def boundary(self, members: frozenset[str]) -> list[Contact]:
         """The contacts between ``members`` and the rest (through a per-part index)."""

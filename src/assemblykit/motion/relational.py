@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from rich.table import Table
 
-from assemblykit.algebra import Coset, SymmetryGroup
+from assemblykit.algebra import Coset, SymmetryGroup, intersect_groups
 from assemblykit.inference import Solution
 from assemblykit.inference.reduction import model_scale
 from assemblykit.model.relations import RELATIONS, Relation, relation_coset
@@ -181,7 +181,11 @@ def situation_motions(
         used = tuple(relation_label(r) for r, g in mine if isinstance(g, SymmetryGroup))
         ignored = tuple(f"{relation_label(r)}: {g}" for r, g in mine if isinstance(g, str))
         touching = sorted({ref.body for relation, _ in mine for ref in relation.refs} - {name})
-        group = functools.reduce(lambda g, h: g.intersect(h, tol=tol), groups) if groups else None
+        group = (
+            functools.reduce(lambda g, h: intersect_groups(g, h, tol=tol), groups)
+            if groups
+            else None
+        )
         motions.append(RelationMotion(name, situation, group, used, tuple(touching), ignored))
     return motions
 

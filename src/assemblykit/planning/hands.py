@@ -37,17 +37,18 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from rich.table import Table
 
-from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph, blocking_graph
+from assemblykit.blocking.graphs import blocking_graph
+from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 from assemblykit.planning.sequence import (
     DirectionTable,
+    Hands,
+    HandsMove,
     _bits,
     _mask,
     _Search,
     _several,
     direction_table,
-    format_direction,
 )
 from assemblykit.tolerance import Tolerance
 
@@ -56,88 +57,6 @@ MAX_HANDS = 4
 
 HANDS_MAX_PARTS = 8
 """The largest set split into groups (the partitions grow as k^n / k!)."""
-
-
-@dataclass(frozen=True, eq=False)
-class HandsMove:
-    """One k-handed operation: ``groups[0]`` stays and every other group translates with
-    velocity ``velocities[g]`` (``velocities[0]`` is zero) at the same time."""
-
-    groups: tuple[tuple[str, ...], ...]
-    velocities: NDArray[np.float64]
-
-    @property
-    def hands(self) -> int:
-        """The number of groups moved relative to one another."""
-        return len(self.groups)
-
-    @property
-    def speeds(self) -> tuple[float, ...]:
-        """The speed of each group (0 for the fixed one)."""
-        return tuple(float(np.linalg.norm(v)) for v in self.velocities)
-
-    @property
-    def directions(self) -> tuple[NDArray[np.float64], ...]:
-        """The unit direction of each group (the zero vector for the fixed one)."""
-        return tuple(
-            v / s if s > 0 else np.zeros_like(v)
-            for v, s in zip(self.velocities, self.speeds, strict=True)
-        )
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``groups`` (the fixed one first), unit ``directions``, ``speeds``."""
-        return {
-            "groups": [list(g) for g in self.groups],
-            "directions": [[float(x) + 0.0 for x in d] for d in self.directions],
-            "speeds": [round(s, 12) + 0.0 for s in self.speeds],
-        }
-
-
-@dataclass(frozen=True, eq=False)
-class Hands:
-    """How many hands take the assembly apart: ``needed`` (``None`` when more than
-    ``max_hands``), and the operations with more than two hands, in order."""
-
-    needed: int | None
-    max_hands: int
-    moves: tuple[HandsMove, ...] = ()
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``needed``, ``max_hands``, the ``groups``, ``directions`` and
-        ``speeds`` of the first operation with more than two hands, and all ``moves``."""
-        first = self.moves[0].to_dict() if self.moves else {}
-        return {
-            "needed": self.needed,
-            "max_hands": self.max_hands,
-            "groups": first.get("groups", []),
-            "directions": first.get("directions", []),
-            "speeds": first.get("speeds", []),
-            "moves": [move.to_dict() for move in self.moves],
-        }
-
-    def summary(self) -> str:
-        """One line: how many hands, e.g. ``3 hands`` or ``more than 4 hands``."""
-        if self.needed is None:
-            return f"more than {self.max_hands} hands"
-        return f"{self.needed} hand" + ("s" if self.needed > 1 else "")
-
-    def render(self) -> Table:
-        """A rich table of the operations with more than two hands."""
-        table = Table(title=f"Hands: {self.summary()}")
-        for column in ("operation", "group", "parts", "direction", "speed"):
-            table.add_column(column)
-        for number, move in enumerate(self.moves, start=1):
-            for g, (group, direction, speed) in enumerate(
-                zip(move.groups, move.directions, move.speeds, strict=True)
-            ):
-                table.add_row(
-                    str(number) if g == 0 else "",
-                    "fixed" if g == 0 else str(g),
-                    ", ".join(group),
-                    "-" if g == 0 else format_direction(direction),
-                    "-" if g == 0 else f"{speed:.3g}",
-                )
-        return table
 
 
 def _sizes(assembly: Any) -> dict[str, float]:

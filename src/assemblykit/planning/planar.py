@@ -21,7 +21,8 @@ from numpy.typing import NDArray
 from scipy.optimize import linprog
 
 from assemblykit.blocking.arrangement import circle_partition, snap_normals
-from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph, blocking_graph
+from assemblykit.blocking.graphs import blocking_graph
+from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 from assemblykit.blocking.rigid import RIGID_MAX_SIZE, RigidBlockingGraph, wrenches
 from assemblykit.planning.sequence import DirectionTable, Progress, _mask, _Search
 from assemblykit.tolerance import Tolerance

@@ -46,7 +46,8 @@ from assemblykit.algebra import se3
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.geometry.interference import interference_threshold, solid
 from assemblykit.model.assembly import Assembly
-from assemblykit.planning.sequence import Plan, plan
+from assemblykit.planning.planner import plan
+from assemblykit.planning.sequence import Plan
 from assemblykit.tolerance import Tolerance
 
 MAX_ANGLE = math.pi / 2
@@ -272,7 +273,7 @@ class ScrewPlan:
 
 
 def plan_with_screws(assembly: Assembly, tol: Tolerance | None = None) -> ScrewPlan:
-    """:func:`~assemblykit.planning.sequence.plan`, then, while it stops at a stuck set,
+    """:func:`~assemblykit.planning.planner.plan`, then, while it stops at a stuck set,
     a turn (:func:`screw_removal`) of one of its parts and a plan of the others."""
     stages = [plan(assembly, tol=tol)]
     screws: list[ScrewStep] = []

@@ -37,7 +37,7 @@ every two-handed partition accepted by Γ_e is built too, and its plans are coun
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import cache
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -50,13 +50,11 @@ from rich.table import Table
 from assemblykit import formatting as fmt
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.extended import extended_arcs
-from assemblykit.errors import InputError
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
-    from assemblykit.planning.hands import Hands
-    from assemblykit.planning.stability import Gravity, GravityReport, StepStability
+    from assemblykit.planning.stability import GravityReport, StepStability
 
 Progress = Callable[[str, int, int], None]
 Narrow = Callable[[int, int, list[int]], list[int]]
@@ -362,6 +360,88 @@ class AndOrGraph:
             "partitions": self.partitions,
             "plans": self.plans,
         }
+
+
+@dataclass(frozen=True, eq=False)
+class HandsMove:
+    """One k-handed operation: ``groups[0]`` stays and every other group translates with
+    velocity ``velocities[g]`` (``velocities[0]`` is zero) at the same time."""
+
+    groups: tuple[tuple[str, ...], ...]
+    velocities: NDArray[np.float64]
+
+    @property
+    def hands(self) -> int:
+        """The number of groups moved relative to one another."""
+        return len(self.groups)
+
+    @property
+    def speeds(self) -> tuple[float, ...]:
+        """The speed of each group (0 for the fixed one)."""
+        return tuple(float(np.linalg.norm(v)) for v in self.velocities)
+
+    @property
+    def directions(self) -> tuple[NDArray[np.float64], ...]:
+        """The unit direction of each group (the zero vector for the fixed one)."""
+        return tuple(
+            v / s if s > 0 else np.zeros_like(v)
+            for v, s in zip(self.velocities, self.speeds, strict=True)
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``groups`` (the fixed one first), unit ``directions``, ``speeds``."""
+        return {
+            "groups": [list(g) for g in self.groups],
+            "directions": [[float(x) + 0.0 for x in d] for d in self.directions],
+            "speeds": [round(s, 12) + 0.0 for s in self.speeds],
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class Hands:
+    """How many hands take the assembly apart: ``needed`` (``None`` when more than
+    ``max_hands``), and the operations with more than two hands, in order."""
+
+    needed: int | None
+    max_hands: int
+    moves: tuple[HandsMove, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``needed``, ``max_hands``, the ``groups``, ``directions`` and
+        ``speeds`` of the first operation with more than two hands, and all ``moves``."""
+        first = self.moves[0].to_dict() if self.moves else {}
+        return {
+            "needed": self.needed,
+            "max_hands": self.max_hands,
+            "groups": first.get("groups", []),
+            "directions": first.get("directions", []),
+            "speeds": first.get("speeds", []),
+            "moves": [move.to_dict() for move in self.moves],
+        }
+
+    def summary(self) -> str:
+        """One line: how many hands, e.g. ``3 hands`` or ``more than 4 hands``."""
+        if self.needed is None:
+            return f"more than {self.max_hands} hands"
+        return f"{self.needed} hand" + ("s" if self.needed > 1 else "")
+
+    def render(self) -> Table:
+        """A rich table of the operations with more than two hands."""
+        table = Table(title=f"Hands: {self.summary()}")
+        for column in ("operation", "group", "parts", "direction", "speed"):
+            table.add_column(column)
+        for number, move in enumerate(self.moves, start=1):
+            for g, (group, direction, speed) in enumerate(
+                zip(move.groups, move.directions, move.speeds, strict=True)
+            ):
+                table.add_row(
+                    str(number) if g == 0 else "",
+                    "fixed" if g == 0 else str(g),
+                    ", ".join(group),
+                    "-" if g == 0 else format_direction(direction),
+                    "-" if g == 0 else f"{speed:.3g}",
+                )
+        return table
 
 
 @dataclass(frozen=True, eq=False)
@@ -851,8 +931,9 @@ def minimal_interlocked(table: DirectionTable, members: int) -> int:
 def and_or_graph(table: DirectionTable) -> AndOrGraph:
     """The AND/OR graph of every two-handed partition of the whole set that ``table``
     (Γ_e) accepts, and the number of disassembly trees it holds (seed 004, "order").
-    :func:`plan` gives it one direction per distinct DBG of Γ_t plus those its search
-    used, so the count is a lower bound when Γ_e differs within a region of Γ_t."""
+    :func:`~assemblykit.planning.planner.plan` gives it one direction per distinct DBG
+    of Γ_t plus those its search used, so the count is a lower bound when Γ_e differs
+    within a region of Γ_t."""
     names = table.names
     masks = [table.masks(k) for k in range(len(table.directions))]
     graph: nx.DiGraph[AndOrNode] = nx.DiGraph()
@@ -899,7 +980,7 @@ def translation_table(assembly: Assembly, tol: Tolerance) -> DirectionTable:
     most ``FULL_ARRANGEMENT_REGIONS``), else those of each part's own arrangement
     (:func:`local_table`)."""
     from assemblykit.blocking.arrangement import snap_normals
-    from assemblykit.blocking.ndbg import blocking_graph, blocking_terms
+    from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 
     terms = blocking_terms(assembly, "infinitesimal", tol)
     rows = [t.normals for t in terms]
@@ -981,7 +1062,7 @@ def translation_slots(
     """Γ_t along new directions over the slots of ``table``: a slot blocks when one of its
     infinitesimal terms holds strictly (beyond the angle tolerance, as the arrangement's
     snapping has it)."""
-    from assemblykit.blocking.ndbg import blocking_terms
+    from assemblykit.blocking.graphs import blocking_terms
 
     index = {name: i for i, name in enumerate(table.names)}
     column = {
@@ -1052,216 +1133,3 @@ def _term_slots(
             held[:, order], starts, axis=1
         ).view(bool)
     return slots
-
-
-def rigid_may_free(assembly: Assembly, parts: Iterable[str], tol: Tolerance | None = None) -> bool:
-    """Whether some DBG of Γ_g (infinitesimal rigid motions) of the sub-assembly
-    ``parts`` frees a proper part of it: the necessary condition of seed 004 ("a
-    necessary condition for a subassembly S to be directly removable")."""
-    from assemblykit.blocking.ndbg import blocking_graph
-
-    if getattr(assembly, "dimension", 3) == 2:
-        # polygons move in their plane: lifting off it would free every part
-        from assemblykit.planning.planar import planar_rigid_may_free
-
-        return planar_rigid_may_free(assembly, parts, assembly.tolerance(tol))
-    return bool(blocking_graph(assembly, motion="rigid", parts=parts, tol=tol).removable())
-
-
-def plan(
-    assembly: Assembly,
-    tol: Tolerance | None = None,
-    max_and_or_parts: int = 8,
-    progress: Progress | None = None,
-    max_hands: int = 4,
-    *,
-    gravity: Gravity | None = None,
-    one_at_a_time: bool = False,
-) -> Plan:
-    """Plan the disassembly of ``assembly`` by extended translations (seed 004).
-
-    ``progress(stage, done, total)`` is called as the work advances. The result is
-    feasible when every part is separated; otherwise ``interlocked`` holds the minimal
-    sets that no candidate direction separates, each classified with Γ_t and Γ_g
-    (module doc), and ``hands`` whether up to ``max_hands`` hands take them apart
-    (:mod:`assemblykit.planning.hands`). A polygon assembly is planned in the plane
-    (:mod:`assemblykit.planning.planar`).
-
-    ``one_at_a_time`` moves one free set per step. Under ``gravity``
-    (:mod:`assemblykit.planning.stability`) every step moves one free set too, the
-    ground's fixed parts stay, and a step is taken only when what remains (and the
-    moved set, held at its base) stands with at most ``gravity.holds`` parts held; when
-    no step does, the one leaving the fewest parts falling is taken and reported as not
-    standing.
-    """
-    tol = assembly.tolerance(tol)
-    names = tuple(assembly.names)
-    report: Progress = progress or (lambda stage, done, total: None)
-    report("blocking graph (infinitesimal translations)", 0, len(names))
-    if getattr(assembly, "dimension", 3) == 2:
-        from assemblykit.planning.planar import planar_search
-
-        if gravity is not None or one_at_a_time:
-            raise InputError("--gravity and --one-at-a-time need 3D parts, not 2D polygons")
-
-        planar = planar_search(assembly, tol, report)
-        return finish_plan(assembly, planar, tol, max_and_or_parts, max_hands, report)
-    translations = translation_table(assembly, tol)
-    extended = ExtendedDirections(assembly, translations.directions, tol)
-    volumes = tuple(assembly.parts[name].volume for name in names)
-    search = _Search(
-        translations,
-        extended,
-        volumes,
-        report,
-        [],
-        [],
-        exact_candidates(assembly, tol),
-        translation_slots(assembly, translations, tol),
-        (one_set,) if one_at_a_time else (),
-    )
-    if gravity is None:
-        search.disassemble(_mask(range(len(names))))
-        return finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
-    return _plan_under_gravity(assembly, search, gravity, tol, max_and_or_parts, max_hands)
-
-
-def _plan_under_gravity(
-    assembly: Assembly,
-    search: _Search,
-    gravity: Gravity,
-    tol: Tolerance,
-    max_and_or_parts: int,
-    max_hands: int,
-) -> Plan:
-    """:func:`plan` under gravity: the fixed parts outweigh every other so that one of
-    them is the base that stays, and :class:`~assemblykit.planning.stability.StateJudge`
-    picks and judges the steps."""
-    from assemblykit.planning.stability import GravityReport, StateJudge, equilibrium_model
-
-    search.progress("equilibrium equations", 0, 1)
-    model = equilibrium_model(
-        assembly,
-        gravity.direction,
-        gravity.friction,
-        gravity.fixed,
-        dict(gravity.densities),
-        tol,
-    )
-    fixed = set(model.fixed)
-    total = sum(search.volumes)
-    search.volumes = tuple(
-        v + total if name in fixed else v
-        for name, v in zip(model.names, search.volumes, strict=True)
-    )
-    everything = _mask(range(len(model.names)))
-    judge = StateJudge(
-        model,
-        gravity.holds,
-        search.translations.vector,
-        lambda members: _base(members, search.volumes),
-        _base(everything, search.volumes),
-    )
-    search.narrowers = (judge.stable, judge.fewest_falling)
-    search.judge = judge.judge
-    search.disassemble(everything)
-    result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
-    whole = model.check()
-    present = model.mask(None)
-    return replace(
-        result,
-        gravity=GravityReport(
-            settings=gravity,
-            fixed=model.fixed,
-            whole=whole,
-            friction_needed=model.friction_needed(present, present & judge.fixed),
-            stable=whole.stands
-            and all(step.stability is None or step.stability.stands for step in search.steps),
-        ),
-    )
-
-
-def finish_plan(
-    assembly: Any,
-    search: _Search,
-    tol: Tolerance,
-    max_and_or_parts: int,
-    max_hands: int,
-    report: Progress,
-) -> Plan:
-    """The plan of a finished search: each set where it stopped, reported whole (its
-    minimal interlocked subset and the parts that subset holds), the AND/OR graph of a
-    small assembly, and the hands that take the stopped sets apart."""
-    from assemblykit.planning.hands import Hands, hands_needed
-
-    names = search.translations.names
-    translations = search.translations
-    # ExtendedDirections, or PlanarExtended for polygons: both give table and evaluated
-    extended: Any = search.extended
-    interlocks = tuple(
-        _interlock(
-            assembly,
-            names,
-            minimal_interlocked(extended.table(translations.incomplete(members), members), members),
-            members,
-            translations,
-            tol,
-        )
-        for members in search.locked
-    )
-    and_or = None
-    if 1 < len(names) <= max_and_or_parts:
-        # one direction per distinct DBG of Γ_t, and those the search already swept
-        directions = set(distinct_directions(translations)) | extended.evaluated
-        and_or = and_or_graph(extended.table(directions))
-    hands = Hands(min(2, len(names)), max_hands)
-    if search.locked and max_hands > 2:
-        report("hands", 0, len(search.locked))
-        # each stopped set on its own: its groups never need the parts already removed
-        found = [
-            hands_needed(assembly, [names[i] for i in _bits(members)], max_hands, tol)
-            for members in search.locked
-        ]
-        needed = [h.needed for h in found]
-        hands = Hands(
-            None if None in needed else max(n for n in needed if n is not None),
-            max_hands,
-            tuple(move for h in found for move in h.moves),
-        )
-    elif search.locked:
-        hands = Hands(None, max_hands)
-    report("done", len(names), len(names))
-    return Plan(names, tuple(search.steps), interlocks, and_or, len(translations.directions), hands)
-
-
-def _interlock(
-    assembly: Assembly,
-    names: Sequence[str],
-    members: int,
-    locked: int,
-    translations: DirectionTable,
-    tol: Tolerance,
-) -> Interlock:
-    parts = tuple(names[i] for i in _bits(members))
-    return Interlock(
-        parts=parts,
-        translation_locked=not separable(translations, members),
-        rigid_may_free=rigid_may_free(assembly, parts, tol),
-        held=tuple(names[i] for i in _bits(locked & ~members)),
-    )
-
-
-def separable_by_translations(
-    assembly: Any, parts: Iterable[str] | None = None, tol: Tolerance | None = None
-) -> bool:
-    """Whether the assembly comes completely apart with extended translations, one
-    subassembly moving at a time (seed 004, conclusion). Removing parts only removes
-    obstacles, so any removable subassembly can be taken first and a greedy
-    disassembly decides it: this is the planner's search
-    (:func:`plan`), with its candidate directions (Γ_t
-    regions, then the faces of the exact free sets), so the two always agree."""
-    names = list(assembly.names) if parts is None else list(parts)
-    if len(names) <= 1:
-        return True
-    whole = assembly if len(names) == len(assembly.names) else assembly.subset(names)
-    return plan(whole, tol, max_and_or_parts=0).feasible

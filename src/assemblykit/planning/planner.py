@@ -1,0 +1,246 @@
+"""The disassembly planner (seed 004): the greedy search over the candidate directions
+of :mod:`assemblykit.planning.sequence`, in the plane for polygons
+(:mod:`assemblykit.planning.planar`), under gravity
+(:mod:`assemblykit.planning.stability`), and the plan it gives: the sets left
+interlocked, classified with Γ_t and Γ_g, the AND/OR graph of a small assembly and the
+hands that take the stopped sets apart (:mod:`assemblykit.planning.hands`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import replace
+from typing import TYPE_CHECKING, Any
+
+from assemblykit.blocking.graphs import blocking_graph
+from assemblykit.errors import InputError
+from assemblykit.planning.hands import hands_needed
+from assemblykit.planning.planar import planar_rigid_may_free, planar_search
+from assemblykit.planning.sequence import (
+    DirectionTable,
+    ExtendedDirections,
+    Hands,
+    Interlock,
+    Plan,
+    Progress,
+    _base,
+    _bits,
+    _mask,
+    _Search,
+    and_or_graph,
+    distinct_directions,
+    exact_candidates,
+    minimal_interlocked,
+    one_set,
+    separable,
+    translation_slots,
+    translation_table,
+)
+from assemblykit.planning.stability import Gravity, GravityReport, StateJudge, equilibrium_model
+from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
+
+
+def rigid_may_free(assembly: Assembly, parts: Iterable[str], tol: Tolerance | None = None) -> bool:
+    """Whether some DBG of Γ_g (infinitesimal rigid motions) of the sub-assembly
+    ``parts`` frees a proper part of it: the necessary condition of seed 004 ("a
+    necessary condition for a subassembly S to be directly removable")."""
+    if getattr(assembly, "dimension", 3) == 2:
+        # polygons move in their plane: lifting off it would free every part
+        return planar_rigid_may_free(assembly, parts, assembly.tolerance(tol))
+    return bool(blocking_graph(assembly, motion="rigid", parts=parts, tol=tol).removable())
+
+
+def plan(
+    assembly: Assembly,
+    tol: Tolerance | None = None,
+    max_and_or_parts: int = 8,
+    progress: Progress | None = None,
+    max_hands: int = 4,
+    *,
+    gravity: Gravity | None = None,
+    one_at_a_time: bool = False,
+) -> Plan:
+    """Plan the disassembly of ``assembly`` by extended translations (seed 004).
+
+    ``progress(stage, done, total)`` is called as the work advances. The result is
+    feasible when every part is separated; otherwise ``interlocked`` holds the minimal
+    sets that no candidate direction separates, each classified with Γ_t and Γ_g
+    (module doc), and ``hands`` whether up to ``max_hands`` hands take them apart
+    (:mod:`assemblykit.planning.hands`). A polygon assembly is planned in the plane
+    (:mod:`assemblykit.planning.planar`).
+
+    ``one_at_a_time`` moves one free set per step. Under ``gravity``
+    (:mod:`assemblykit.planning.stability`) every step moves one free set too, the
+    ground's fixed parts stay, and a step is taken only when what remains (and the
+    moved set, held at its base) stands with at most ``gravity.holds`` parts held; when
+    no step does, the one leaving the fewest parts falling is taken and reported as not
+    standing.
+    """
+    tol = assembly.tolerance(tol)
+    names = tuple(assembly.names)
+    report: Progress = progress or (lambda stage, done, total: None)
+    report("blocking graph (infinitesimal translations)", 0, len(names))
+    if getattr(assembly, "dimension", 3) == 2:
+        if gravity is not None or one_at_a_time:
+            raise InputError("--gravity and --one-at-a-time need 3D parts, not 2D polygons")
+
+        planar = planar_search(assembly, tol, report)
+        return finish_plan(assembly, planar, tol, max_and_or_parts, max_hands, report)
+    translations = translation_table(assembly, tol)
+    extended = ExtendedDirections(assembly, translations.directions, tol)
+    volumes = tuple(assembly.parts[name].volume for name in names)
+    search = _Search(
+        translations,
+        extended,
+        volumes,
+        report,
+        [],
+        [],
+        exact_candidates(assembly, tol),
+        translation_slots(assembly, translations, tol),
+        (one_set,) if one_at_a_time else (),
+    )
+    if gravity is None:
+        search.disassemble(_mask(range(len(names))))
+        return finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
+    return _plan_under_gravity(assembly, search, gravity, tol, max_and_or_parts, max_hands)
+
+
+def _plan_under_gravity(
+    assembly: Assembly,
+    search: _Search,
+    gravity: Gravity,
+    tol: Tolerance,
+    max_and_or_parts: int,
+    max_hands: int,
+) -> Plan:
+    """:func:`plan` under gravity: the fixed parts outweigh every other so that one of
+    them is the base that stays, and :class:`~assemblykit.planning.stability.StateJudge`
+    picks and judges the steps."""
+    search.progress("equilibrium equations", 0, 1)
+    model = equilibrium_model(
+        assembly,
+        gravity.direction,
+        gravity.friction,
+        gravity.fixed,
+        dict(gravity.densities),
+        tol,
+    )
+    fixed = set(model.fixed)
+    total = sum(search.volumes)
+    search.volumes = tuple(
+        v + total if name in fixed else v
+        for name, v in zip(model.names, search.volumes, strict=True)
+    )
+    everything = _mask(range(len(model.names)))
+    judge = StateJudge(
+        model,
+        gravity.holds,
+        search.translations.vector,
+        lambda members: _base(members, search.volumes),
+        _base(everything, search.volumes),
+    )
+    search.narrowers = (judge.stable, judge.fewest_falling)
+    search.judge = judge.judge
+    search.disassemble(everything)
+    result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
+    whole = model.check()
+    present = model.mask(None)
+    return replace(
+        result,
+        gravity=GravityReport(
+            settings=gravity,
+            fixed=model.fixed,
+            whole=whole,
+            friction_needed=model.friction_needed(present, present & judge.fixed),
+            stable=whole.stands
+            and all(step.stability is None or step.stability.stands for step in search.steps),
+        ),
+    )
+
+
+def finish_plan(
+    assembly: Any,
+    search: _Search,
+    tol: Tolerance,
+    max_and_or_parts: int,
+    max_hands: int,
+    report: Progress,
+) -> Plan:
+    """The plan of a finished search: each set where it stopped, reported whole (its
+    minimal interlocked subset and the parts that subset holds), the AND/OR graph of a
+    small assembly, and the hands that take the stopped sets apart."""
+    names = search.translations.names
+    translations = search.translations
+    # ExtendedDirections, or PlanarExtended for polygons: both give table and evaluated
+    extended: Any = search.extended
+    interlocks = tuple(
+        _interlock(
+            assembly,
+            names,
+            minimal_interlocked(extended.table(translations.incomplete(members), members), members),
+            members,
+            translations,
+            tol,
+        )
+        for members in search.locked
+    )
+    and_or = None
+    if 1 < len(names) <= max_and_or_parts:
+        # one direction per distinct DBG of Γ_t, and those the search already swept
+        directions = set(distinct_directions(translations)) | extended.evaluated
+        and_or = and_or_graph(extended.table(directions))
+    hands = Hands(min(2, len(names)), max_hands)
+    if search.locked and max_hands > 2:
+        report("hands", 0, len(search.locked))
+        # each stopped set on its own: its groups never need the parts already removed
+        found = [
+            hands_needed(assembly, [names[i] for i in _bits(members)], max_hands, tol)
+            for members in search.locked
+        ]
+        needed = [h.needed for h in found]
+        hands = Hands(
+            None if None in needed else max(n for n in needed if n is not None),
+            max_hands,
+            tuple(move for h in found for move in h.moves),
+        )
+    elif search.locked:
+        hands = Hands(None, max_hands)
+    report("done", len(names), len(names))
+    return Plan(names, tuple(search.steps), interlocks, and_or, len(translations.directions), hands)
+
+
+def _interlock(
+    assembly: Assembly,
+    names: Sequence[str],
+    members: int,
+    locked: int,
+    translations: DirectionTable,
+    tol: Tolerance,
+) -> Interlock:
+    parts = tuple(names[i] for i in _bits(members))
+    return Interlock(
+        parts=parts,
+        translation_locked=not separable(translations, members),
+        rigid_may_free=rigid_may_free(assembly, parts, tol),
+        held=tuple(names[i] for i in _bits(locked & ~members)),
+    )
+
+
+def separable_by_translations(
+    assembly: Any, parts: Iterable[str] | None = None, tol: Tolerance | None = None
+) -> bool:
+    """Whether the assembly comes completely apart with extended translations, one
+    subassembly moving at a time (seed 004, conclusion). Removing parts only removes
+    obstacles, so any removable subassembly can be taken first and a greedy
+    disassembly decides it: this is the planner's search
+    (:func:`plan`), with its candidate directions (Γ_t
+    regions, then the faces of the exact free sets), so the two always agree."""
+    names = list(assembly.names) if parts is None else list(parts)
+    if len(names) <= 1:
+        return True
+    whole = assembly if len(names) == len(assembly.names) else assembly.subset(names)
+    return plan(whole, tol, max_and_or_parts=0).feasible
