@@ -236,6 +236,19 @@ def test_the_compas_arch_is_planned_with_its_holds_listed():
     assert_every_state_stands(assembly, data)
 
 
+def test_declared_fixed_parts_are_never_moved():
+    """The arch's springers declared fixed (a fixture): the 28 other blocks come off one
+    at a time and the springers stay, so the assembly order starts on them."""
+    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    data = plan(assembly, gravity=Gravity(holds=3, fixed=("0", "29")), max_and_or_parts=0).to_dict()
+    assert data["feasible"] and data["gravity"]["fixed"] == ["0", "29"]
+    moved = [name for step in data["steps"] for name in step["parts"]]
+    assert sorted(moved, key=int) == [str(k) for k in range(1, 29)]
+    assert data["steps"][-1]["rest"] == ["0", "29"]
+    assert {"0", "29"}.isdisjoint(n for s in data["assembly_steps"] for n in s["parts"])
+    assert_every_state_stands(assembly, data)
+
+
 @pytest.mark.slow
 def test_the_asap_beam_comes_apart_beams_first_without_holds():
     assembly = load_assembly(dataset("asap_beam_assembly"))

@@ -74,7 +74,8 @@ def plan(
 
     ``one_at_a_time`` moves one free set per step. Under ``gravity``
     (:mod:`assemblykit.planning.stability`) every step moves one free set too, the
-    ground's fixed parts stay, and a step is taken only when what remains (and the
+    fixed parts stay (declared ones are never moved; the default ones, resting on the
+    lowest plane, are taken off it last), and a step is taken only when what remains (and the
     moved set, held at its base) stands with at most ``gravity.holds`` parts held; when
     no step does, the one leaving the fewest parts falling is taken and reported as not
     standing.
@@ -145,6 +146,10 @@ def _plan_under_gravity(
     )
     search.narrowers = (judge.stable, judge.fewest_falling)
     search.judge = judge.judge
+    if gravity.fixed is not None:
+        # declared fixed parts (a fixture) never move; the default ones only rest on the
+        # ground, and are taken off it last
+        search.ground = _mask(k for k, name in enumerate(model.names) if name in fixed)
     search.disassemble(everything)
     result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
     whole = model.check()

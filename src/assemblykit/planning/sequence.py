@@ -848,6 +848,9 @@ class _Search:
     """Ways to pick the free sets a step moves, tried in turn (none: every free set)."""
     judge: Callable[[int, int], StepStability] | None = None
     """The stability of moving a set out of a set (planning under gravity)."""
+    ground: int = 0
+    """Parts that stay where they are (fixed parts declared under gravity): a set holding
+    nothing else is not taken apart."""
 
     def _choose(self, members: int, previous: int | None) -> tuple[int, list[int]] | None:
         """The next removal from ``members``: each narrower in turn, then the same once
@@ -883,7 +886,7 @@ class _Search:
         pending = [members]
         while pending:
             current = pending.pop()
-            while _several(current):
+            while _several(current) and current & ~self.ground:
                 choice = self._choose(current, previous)
                 if choice is None:
                     self.locked.append(current)
