@@ -346,16 +346,22 @@ RAILED = Body(
 ON_RAIL = (ON_TABLE, rel("against", "box.left", "world.end"))
 
 
-def test_peg_in_a_bore_resting_on_the_floor_turns_about_its_axis():
-    out = solve([PLANT, PEG], IN_BORE, rel("point_on_plane", "peg.tip", "world.floor"))
-    b = out["bodies"]["peg@s1"]
-    # the tip (0, 0, -2) slides down the bore's axis onto z = -5: a drop of 3, then only
-    # the turn about the axis is left (the cylinder met with the planar group of z)
+def assert_turns_in_the_bore_dropped_by_three(b: dict, out: dict) -> None:
+    """The peg came down the bore's axis by 3 onto its support, in closed form, and only
+    the turn about the axis is left."""
     assert (b["dof"], b["motion"]) == (1, "revolute")
     np.testing.assert_allclose(b["pose"], shift(0, 0, -3), atol=EXACT)
     np.testing.assert_allclose(b["invariants"]["point"][:2], [0, 0], atol=EXACT)
     assert unoriented(b["invariants"]["direction"], Z)
     assert "residue" not in [step["rule"] for step in out["trace"]]
+
+
+def test_peg_in_a_bore_resting_on_the_floor_turns_about_its_axis():
+    out = solve([PLANT, PEG], IN_BORE, rel("point_on_plane", "peg.tip", "world.floor"))
+    b = out["bodies"]["peg@s1"]
+    # the tip (0, 0, -2) slides down the bore's axis onto z = -5: a drop of 3, then only
+    # the turn about the axis is left (the cylinder met with the planar group of z)
+    assert_turns_in_the_bore_dropped_by_three(b, out)
 
 
 def test_a_slide_stopped_by_a_point_on_a_plane_is_fixed():
@@ -643,11 +649,7 @@ def test_peg_tip_on_a_slanted_floor_turns_about_the_bore():
     relations = (IN_BORE, rel("point_on_plane", "peg.tip", "world.slant"))
     out = solve([slant, PEG], *relations)
     b = out["bodies"]["peg@s1"]
-    assert (b["dof"], b["motion"]) == (1, "revolute")
-    np.testing.assert_allclose(b["pose"], shift(0, 0, -3), atol=EXACT)
-    np.testing.assert_allclose(b["invariants"]["point"][:2], [0, 0], atol=EXACT)
-    assert unoriented(b["invariants"]["direction"], Z)
-    assert "residue" not in [step["rule"] for step in out["trace"]]
+    assert_turns_in_the_bore_dropped_by_three(b, out)
     assert solve_numeric_only(make_task([slant, PEG], *relations))["peg@s1"].dof == 1
 
 
