@@ -41,6 +41,9 @@ PER_REGION_SAMPLE = 2_000
 REPEATS = 3
 DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "compas_assembly"
 TOL = Tolerance()
+EXTENDED_PAIR_TARGET = 14.3e-3 / 10
+"""Exact extended DBG on the ASAP beam, CPU seconds per direction and ordered pair: ten
+times faster than the 14.3 ms first measured."""
 
 
 def synthetic(c: int, seed: int = 0) -> tuple[tuple[str, ...], list[Contact]]:
@@ -195,11 +198,14 @@ def bench_exact_extended() -> None:
     triangles = sum(len(beam.parts[n].mesh.faces) for n in names)
     directions = [*np.eye(3), *-np.eye(3), np.array([1.0, 1.0, 1.0]), np.array([0.3, -1.0, 0.2])]
     times = [timed(extended_dbg, beam, d, names, tol, repeats=1)[2] for d in directions]
+    per_pair = float(np.median(times)) / (len(names) * (len(names) - 1))
     print(
         f"\nexact extended DBG, ASAP beam ({len(names)} parts, {triangles} triangles): "
         f"median {np.median(times):.3f} s, max {max(times):.3f} s CPU per direction "
-        f"(the first computes the hulls' cones), median "
-        f"{np.median(times) / (len(names) * (len(names) - 1)) * 1000:.1f} ms per ordered pair"
+        f"(the first finds which parts are convex), median "
+        f"{per_pair * 1000:.1f} ms per ordered pair (target <= "
+        f"{EXTENDED_PAIR_TARGET * 1000:.2g} ms: "
+        f"{'met' if per_pair <= EXTENDED_PAIR_TARGET else 'NOT MET'})"
     )
 
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import assemblykit
-from assemblykit.geometry.contacts import stack_parts
+from assemblykit.geometry.contacts import assembly_contacts, stack_parts
 from assemblykit.geometry.precision import combined, coordinate_precision
 from assemblykit.geometry.recognition import segment
 from assemblykit.io.assembly import load_assembly
@@ -56,9 +56,9 @@ def noisy(asm: Assembly, level: float, seed: int = 7) -> Assembly:
 
 def figures(asm: Assembly, tol: Tolerance | None) -> tuple[int, int, int, dict[str, str], float]:
     """Flat groups, contact pairs, planar patches, motion kinds and the plan time."""
-    stack = stack_parts(asm)
+    stack = stack_parts(p.mesh for p in asm)
     groups = int(segment(stack.vertices, stack.faces, asm.tolerance(tol)).flat.sum())
-    contacts = asm.contacts(tol)
+    contacts = assembly_contacts(asm, tol)
     patches = sum(len(c.planar) for c in contacts)
     parts = assemblykit.motion(asm, tol=tol).to_dict()["parts"]
     kinds = {name: entry["motion"] for name, entry in parts.items()}

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import scipy
 
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io.assembly import load_assembly
 from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import Gravity, equilibrium_model
@@ -56,7 +57,7 @@ def whole(name: str, path: Path | None, tol: Tolerance | None = None) -> bool | 
         print(f"{name:<24} skipped (not bundled; set ASSEMBLYKIT_DATA)")
         return None
     assembly = load_assembly(path)
-    assembly.contacts(tol)
+    assembly_contacts(assembly, tol)
     start = time.perf_counter()
     model = equilibrium_model(assembly, tol=tol)
     built = time.perf_counter() - start
@@ -106,7 +107,7 @@ def state_programs(path: Path | None, tol: Tolerance) -> None:
         print(f"{'crossvault states':<24} skipped (not bundled; set ASSEMBLYKIT_DATA)")
         return
     assembly = load_assembly(path)
-    assembly.contacts(tol)
+    assembly_contacts(assembly, tol)
     model = equilibrium_model(assembly, tol=tol)
     top = max(assembly.names, key=lambda n: float(assembly.parts[n].mesh.center_mass[2]))
     for label, parts in (("whole", None), (f"without {top}", set(assembly.names) - {top})):

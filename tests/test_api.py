@@ -21,6 +21,7 @@ DOCUMENTED = (
     "assemblykit",
     "assemblykit.formatting",
     "assemblykit.io.exports",
+    "assemblykit.render",
     "assemblykit.viz.explode",
     "assemblykit.viz.plots",
     "assemblykit.viz.task_view",
@@ -118,3 +119,24 @@ def test_coset_and_mating_reprs_say_it_in_words():
     assert repr(arms) == "MatingResult(no solution, goal 1 emptied by the arc consistency law)"
     for shown in (repr(problem), repr(arms)):
         assert "array" not in shown and str(EXAMPLES) not in shown
+
+
+def test_the_loaded_values_carry_the_methods_the_model_leaves_to_the_algorithms():
+    from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
+    from assemblykit.inference import solve_task
+    from assemblykit.model.assembly import Assembly
+    from assemblykit.model.task import Task
+
+    assert not hasattr(Task, "solve") and not hasattr(Assembly, "contacts")
+    task = assemblykit.load_task(EXAMPLES / "tasks" / "peg_in_block.rapt")
+    assert isinstance(task, Task) and isinstance(task, assemblykit.Task)
+    assert task.solve().to_dict() == solve_task(task).to_dict()
+    hinge = assemblykit.load_assembly(EXAMPLES / "motion" / "hinge" / "hinge.yaml")
+    assert isinstance(hinge, Assembly) and isinstance(hinge, assemblykit.Assembly)
+    assert hinge.contacts() is assembly_contacts(hinge)
+    assert hinge.surfaces("door") is assembly_surfaces(hinge, "door")
+    assert [type(f) for f in hinge.features("door")] == [
+        type(s.feature()) for s in hinge.surfaces("door")
+    ]
+    door = hinge.subset(["door"])
+    assert isinstance(door, assemblykit.Assembly) and door.contacts() == []

@@ -25,9 +25,9 @@ from assemblykit.errors import AssemblyKitError, InputError
 from assemblykit.io.compas import load_compas
 from assemblykit.io.documents import MAX_DEPTH, read_yaml
 from assemblykit.io.meshes import load_manifest, load_mesh_folder
-from assemblykit.io.outputs import atomic_output
 from assemblykit.io.problem import load_problem
 from assemblykit.io.tasks import load_task
+from assemblykit.outputs import atomic_output
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "src" / "assemblykit" / "examples"
 

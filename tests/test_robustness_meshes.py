@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import assemblykit
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.precision import combined, coordinate_precision
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
@@ -52,7 +53,7 @@ def _contacts(asm: Assembly, tol: Tolerance | None = None) -> dict[tuple[str, st
     """Per touching pair, which kinds of patches it has (``planar``, ``curved``, both)."""
     return {
         c.pair: "+".join(k for k, n in (("planar", c.planar), ("curved", c.curved)) if n)
-        for c in asm.contacts(tol)
+        for c in assembly_contacts(asm, tol)
     }
 
 

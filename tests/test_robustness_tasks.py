@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import assemblykit
+from assemblykit.inference import solve_task
 from assemblykit.inference.reduction import model_scale
 from assemblykit.io.documents import read_text, read_yaml
 from assemblykit.io.spec import parse_task
@@ -34,7 +35,7 @@ def load(path: Path) -> dict[str, Any]:
 def solve(data: dict[str, Any], tol: Tolerance | None = None) -> Any:
     task = parse_task(data)
     with using(tol or DEFAULT):
-        return task.solve()
+        return solve_task(task)
 
 
 def answers(solution: Any) -> tuple[str, tuple[tuple[str, int, str], ...]]:

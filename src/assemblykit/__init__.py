@@ -82,8 +82,10 @@ from assemblykit.errors import AssemblyKitError
 __version__ = "0.1.0"
 
 _PUBLIC = {
-    "load_task": "assemblykit.io.tasks",
-    "load_assembly": "assemblykit.io.assembly",
+    "load_task": "assemblykit.api.task",
+    "load_assembly": "assemblykit.api.assembly",
+    "Task": "assemblykit.api.task",
+    "Assembly": "assemblykit.api.assembly",
     "motion": "assemblykit.motion.freedom",
     "blocking_graph": "assemblykit.blocking.graphs",
     "plan": "assemblykit.planning.planner",

@@ -49,10 +49,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal, cast
 
-from rich.console import Group
-from rich.table import Table
-from rich.text import Text
-
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
 
 Engine = Literal["local", "dask"]
@@ -125,20 +121,6 @@ class BatchSummary:
             "missing": len(self.missing),
             "failed": [failure.to_dict() for failure in self.failed],
         }
-
-    def render(self) -> Group:
-        """A one-row rich table of the counts, then one line per failed input."""
-        data = self.to_dict()
-        keys = ("total", "skipped", "ok", "error", "timeout", "missing")
-        table = Table(title=f"batch -> {self.out}")
-        for key in keys:
-            table.add_column(key)
-        table.add_row(*(str(data[key]) for key in keys))
-        lines = [
-            Text(f"{f.status}: {f.input}: {f.error}", no_wrap=True, overflow="ignore")
-            for f in self.failed
-        ]
-        return Group(table, *lines)
 
 
 def compute(command: Command, path: str, rel_tolerance: float | None = None) -> dict[str, Any]:

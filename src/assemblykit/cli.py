@@ -23,7 +23,7 @@ import click
 
 from assemblykit import __version__
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
-from assemblykit.io.outputs import HTML_SUFFIXES, PNG_SUFFIXES, checked_output
+from assemblykit.outputs import HTML_SUFFIXES, PNG_SUFFIXES, checked_output
 from assemblykit.tolerance import MAX_ANGLE, MAX_REL_LENGTH, MIN_ANGLE, MIN_REL_LENGTH, Tolerance
 
 if TYPE_CHECKING:
@@ -123,11 +123,10 @@ ASSEMBLY_HELP = "ASSEMBLY: mesh folder, .yaml manifest, .step or COMPAS .json."
 
 
 class Result(Protocol):
-    """What every command returns: JSON via ``to_dict`` and a readable rendering."""
+    """What every command returns: JSON via ``to_dict``; :func:`assemblykit.render.render`
+    gives its readable form."""
 
     def to_dict(self) -> dict[str, Any]: ...
-
-    def render(self) -> Any: ...
 
 
 def tolerance_from(option: float | None, angle: float | None = None) -> Tolerance:
@@ -157,13 +156,21 @@ def assembly_or_polygons(path: str, tol: Tolerance, as_written: bool) -> Any:
     return loaded_assembly(path, tol, as_written)
 
 
-def emit(result: Result, as_json: bool) -> None:
-    """Print a result: JSON on stdout, or its rich rendering."""
+def emit(result: Result, as_json: bool, rounding: Tolerance | None = None) -> None:
+    """Print a result: JSON on stdout, its numbers rounded by the model's tolerance
+    ``rounding`` when given (io.report), or its rich rendering."""
     if as_json:
-        sys.stdout.write(json.dumps(result.to_dict(), indent=2) + "\n")
+        data: Any = result.to_dict()
+        if rounding is not None:
+            from assemblykit.io.report import jsonable
+
+            data = jsonable(data, rounding)
+        sys.stdout.write(json.dumps(data, indent=2) + "\n")
     else:
+        from assemblykit.render import render
+
         # lines longer than the width (a trace, a path) are wrapped or kept, never cut
-        console().print(result.render(), crop=False)
+        console().print(render(result), crop=False)
 
 
 def note(message: str) -> None:
@@ -275,6 +282,7 @@ def solve_cmd(
 
     TASK: task file, .yaml, .yml, .json or .rapt.
     """
+    from assemblykit.inference import solve_task
     from assemblykit.io.tasks import load_task
     from assemblykit.tolerance import using
 
@@ -283,7 +291,7 @@ def solve_cmd(
     # The engine scales the policy to the model's size; only the relative part comes from here.
     with using(tolerance_from(tolerance, angle_tolerance)):
         loaded = load_task(task)
-        result = loaded.solve(explain=explain, max_branches=max_branches)
+        result = solve_task(loaded, explain=explain, max_branches=max_branches)
         if png is not None:
             from assemblykit.viz.task_view import write_task_png
 
@@ -568,8 +576,10 @@ def demo_cmd(out: str, as_json: bool, tolerance: float | None, debug: bool) -> N
     if as_json:
         emit(result, as_json)
     else:
+        from assemblykit.render import render
+
         # soft wrap: the report's path must stay whole to be copied
-        console().print(result.render(), soft_wrap=True)
+        console().print(render(result), soft_wrap=True)
 
 
 @command
@@ -659,7 +669,7 @@ def _task_motion(path: str, tol: Tolerance, as_json: bool) -> None:
     from assemblykit.motion.relational import task_motion
 
     task = load_task(path)
-    emit(_RoundedResult(task_motion(task, tol), tol.with_scale(model_scale(task))), as_json)
+    emit(task_motion(task, tol), as_json, tol.with_scale(model_scale(task)))
 
 
 @command
@@ -714,23 +724,7 @@ def motion_cmd(
         from assemblykit.viz.motion_view import write_motion_html
 
         write_motion_html(loaded, result.report, html)
-    emit(_RoundedResult(result, loaded.tolerance(tol)), as_json)
-
-
-class _RoundedResult:
-    """A result whose JSON numbers are rounded by the model's tolerance (io.report)."""
-
-    def __init__(self, result: Result, tol: Tolerance) -> None:
-        self.result = result
-        self.tol = tol
-
-    def to_dict(self) -> dict[str, Any]:
-        from assemblykit.io.report import jsonable
-
-        return jsonable(self.result.to_dict(), self.tol)  # type: ignore[return-value]
-
-    def render(self) -> Any:
-        return self.result.render()
+    emit(result, as_json, loaded.tolerance(tol))
 
 
 @command

@@ -15,9 +15,7 @@ import time
 from dataclasses import dataclass
 from importlib.resources import files
 from pathlib import Path
-from typing import Any, cast
-
-from rich.text import Text
+from typing import TYPE_CHECKING, Any, cast
 
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.report import jsonable
@@ -25,6 +23,9 @@ from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import Plan, Progress
 from assemblykit.tolerance import Tolerance
 from assemblykit.viz.viewer import ReportTable, write_report
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
 
 REPORT_NAME = "gearbox_report.html"
 
@@ -52,14 +53,6 @@ class DemoResult:
             "motion": self.motion,
         }
 
-    def render(self) -> Text:
-        """One line saying what was found and where the report is."""
-        verdict = "feasible" if self.plan.feasible else "infeasible"
-        return Text(
-            f"Gearbox ({len(self.plan.parts)} parts): {verdict} plan in "
-            f"{len(self.plan.steps)} steps.\nReport written to {self.report}"
-        )
-
 
 def run_demo(
     out: str | Path = ".", tol: Tolerance | None = None, progress: Progress | None = None
@@ -80,7 +73,7 @@ def run_demo(
 
 
 def _motion(
-    assembly: Any, tol: Tolerance | None
+    assembly: Assembly, tol: Tolerance | None
 ) -> tuple[dict[str, Any] | None, ReportTable | None]:
     """The motion analysis as JSON and as a table of the report, when the motion module
     is part of this install."""

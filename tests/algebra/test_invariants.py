@@ -241,3 +241,19 @@ def test_transporter_of_a_point_and_two_axial_lines_at_any_tolerance(rel):
     assert isinstance(found, Coset)
     assert found.group.kind is Kind.REVOLUTE
     assert found.contains(se3.translation(np.array([5.0, 5.0, 10.0])), Tolerance())
+
+
+def test_mismatch_kinds_are_their_documented_strings():
+    """Mismatch kinds compare, format and serialise as the strings they stand for."""
+    import json
+
+    from assemblykit.algebra import MismatchKind
+
+    found = congruence_mismatch(
+        [PointInvariant((0, 0, 0)), PointInvariant((1, 0, 0))],
+        [PointInvariant((0, 0, 0)), PointInvariant((3, 0, 0))],
+    )
+    assert found is not None and found.kind is MismatchKind.DISTANCE
+    assert found.kind == "distance" and f"{found.kind}" == "distance"
+    assert json.dumps({"kind": found.kind}) == '{"kind": "distance"}'
+    assert {str(k) for k in MismatchKind} >= {"angle", "distance", "handedness", "residual"}

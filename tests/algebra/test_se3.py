@@ -196,3 +196,78 @@ def test_rotation_vector_of_half_turns_and_identity():
     assert np.abs(se3.rotation_vector(half_x)).tolist() == pytest.approx([math.pi, 0.0, 0.0])
     quarter_z = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     assert se3.rotation_vector(quarter_z) == pytest.approx([0.0, 0.0, math.pi / 2])
+
+
+unit_axes = st.tuples(*(st.floats(-1.0, 1.0) for _ in range(3))).filter(
+    lambda v: math.sqrt(sum(c * c for c in v)) > 1e-3
+)
+
+
+@given(unit_axes)
+@settings(max_examples=200, deadline=None)
+def test_axis_basis_is_orthonormal_and_right_handed(v):
+    n = se3.unit(np.array(v))
+    u, w = se3.axis_basis(n)
+    frame = np.column_stack([u, w, n])
+    np.testing.assert_allclose(frame.T @ frame, np.eye(3), atol=1e-12)
+    assert np.linalg.det(frame) == pytest.approx(1.0)
+
+
+@given(seeds)
+@settings(max_examples=50, deadline=None)
+def test_axis_basis_of_rows_is_the_basis_of_each_row(seed):
+    rows = np.random.default_rng(seed).normal(size=(5, 3))
+    rows /= np.linalg.norm(rows, axis=1, keepdims=True)
+    u, w = se3.axis_basis(rows)
+    for i, n in enumerate(rows):
+        one_u, one_w = se3.axis_basis(n)
+        np.testing.assert_allclose(u[i], one_u, atol=1e-15)
+        np.testing.assert_allclose(w[i], one_w, atol=1e-15)
+
+
+@given(seeds)
+@settings(max_examples=100, deadline=None)
+def test_poses_equal_is_symmetric_and_scales_with_the_tolerance(seed):
+    rng = np.random.default_rng(seed)
+    a = se3.random_transform(rng)
+    tol = Tolerance(scale=10.0)
+    near = se3.translation((0.5 * tol.length, 0.0, 0.0)) @ a
+    far = se3.translation((2.0 * tol.length, 0.0, 0.0)) @ a
+    assert se3.poses_equal(a, a, tol)
+    assert se3.poses_equal(a, near, tol) and se3.poses_equal(near, a, tol)
+    assert not se3.poses_equal(a, far, tol) and not se3.poses_equal(far, a, tol)
+    # the same offsets measured on a model ten times larger are within tolerance
+    assert se3.poses_equal(a, far, Tolerance(scale=100.0))
+    turned = se3.rotation((0.0, 0.0, 1.0), 10.0 * tol.angle) @ a
+    assert not se3.poses_equal(a, turned, tol) and not se3.poses_equal(turned, a, tol)
+
+
+def test_poses_equal_from_numeric_solvers_takes_the_looser_mesh_tolerance():
+    tol = Tolerance()
+    a = np.eye(4)
+    b = se3.translation((0.5 * (tol.length + tol.mesh_length), 0.0, 0.0))
+    assert tol.mesh_length > tol.length
+    assert not se3.poses_equal(a, b, tol)
+    assert se3.poses_equal(a, b, tol, numeric=True)
+
+
+def test_random_starts_are_deterministic_and_scaled():
+    angles = np.array([True, False, True])
+    first = list(se3.random_starts(angles, 5.0, 6))
+    again = list(se3.random_starts(angles, 5.0, 6))
+    assert len(first) == 6 and np.array_equal(first[0], np.zeros(3))
+    assert all(np.array_equal(x, y) for x, y in zip(first, again, strict=True))
+    stacked = np.array(first[1:])
+    assert np.all(np.abs(stacked[:, [0, 2]]) <= math.pi)
+    assert np.all(np.abs(stacked[:, 1]) <= 5.0)
+
+
+def test_multistart_least_squares_finds_both_roots_of_a_two_root_system():
+    # (x - 1)(x + 2) = 0 with y = x: the roots (1, 1) and (-2, -2)
+    def residual(p: np.ndarray) -> np.ndarray:
+        return np.array([(p[0] - 1.0) * (p[0] + 2.0), p[1] - p[0]])
+
+    starts = [np.array([3.0, 0.0]), np.array([-4.0, 0.0])]
+    roots = [fit.x for fit in se3.multistart_least_squares(residual, starts, method="lm")]
+    np.testing.assert_allclose(roots[0], (1.0, 1.0), atol=1e-9)
+    np.testing.assert_allclose(roots[1], (-2.0, -2.0), atol=1e-9)

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from assemblykit.geometry.contacts import Contact, CurvedPatch, PlanarPatch
+from assemblykit.geometry.contacts import Contact, CurvedPatch, PlanarPatch, assembly_contacts
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance, current
 from datasets import dataset
@@ -29,6 +29,9 @@ class ContactAssembly:
 
     def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
         return tol or current()
+
+
+assembly_contacts.register(ContactAssembly, ContactAssembly.contacts)
 
 
 def square(normal, center=(0.0, 0.0, 0.0), half=0.5) -> PlanarPatch:

@@ -10,6 +10,7 @@ import pytest
 from assemblykit.blocking.constraints import infinitesimal_terms
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.queries import can_extract, locally_free_directions
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io.assembly import load_assembly
 from curved_parts import (
     BALL_JOINT,
@@ -53,7 +54,7 @@ def test_the_groove_lets_the_rod_out_along_the_closed_upper_half_circle_only() -
 
 
 def test_the_groove_terms_are_three_half_spaces_each_way() -> None:
-    (contact,) = rod_in_groove(through=True).contacts()
+    (contact,) = assembly_contacts(rod_in_groove(through=True))
     terms = infinitesimal_terms([contact])
     rows = {(t.moving, tuple(np.round(t.normals[0], 6) + 0.0)) for t in terms if t.moving == "rod"}
     assert rows == {("rod", (-1.0, 0.0, 0.0)), ("rod", (0.0, 0.0, -1.0)), ("rod", (1.0, 0.0, 0.0))}

@@ -9,10 +9,12 @@ import pytest
 import trimesh
 from blocking_helpers import mesh_assembly
 
-from assemblykit.blocking.extended import extended_dbg, extended_free, obstacles
+from assemblykit.blocking.cache import BlockingCache
+from assemblykit.blocking.extended import extended_dbg, extended_free
 from assemblykit.blocking.free_cones import ChartSet, _distinct_cones, exact_free_directions
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.packings import box_mesh as box
@@ -81,7 +83,9 @@ def test_a_layer_thinner_than_the_interference_policy_is_a_contact():
     assert not extended_free(asm, ["post"], [0, 0, -1], tol)
     assert not extended_free(asm, ["post"], [1, 0, -1], tol)
     # the post is tested backed out of the plate by the layer, straight up
-    np.testing.assert_allclose(obstacles(asm).backout("post", "plate", tol), [0, 0, layer])
+    np.testing.assert_allclose(
+        BlockingCache.of(asm).obstacles.backout("post", "plate", tol), [0, 0, layer]
+    )
     # a real interference stays an obstacle in every direction
     deep = post_on_plate(0.1)
     assert not any(extended_free(deep, ["post"], d, tol) for d in ([0, 0, 1], [1, 0, 0], [0, 1, 1]))
@@ -89,7 +93,7 @@ def test_a_layer_thinner_than_the_interference_policy_is_a_contact():
 
 def test_interlocked_rings_have_no_removable_subassembly():
     asm = mesh_assembly({"r1": ring([0, 0, 0], "xy"), "r2": ring([1.25, 0, 0], "xz")})
-    assert asm.contacts() == []
+    assert assembly_contacts(asm) == []
     g = blocking_graph(asm, "extended")
     assert g.removable() == []
     # without the interlock (second ring moved away) they separate
@@ -166,7 +170,7 @@ APERTURE = 0.15
 def test_a_cube_leaves_a_one_piece_cage_only_through_its_diagonal_tunnel():
     asm = caged_cube()
     tol = asm.tolerance()
-    assert asm.contacts() == []
+    assert assembly_contacts(asm) == []
     # hand-derived: free along the tunnel's axis, blocked 0.2 rad off it and along the axes
     assert extended_free(asm, ["cube"], DIAGONAL, tol)
     off = DIAGONAL + 0.2 * np.array([1.0, -1.0, 0.0]) / np.sqrt(2.0)

@@ -7,8 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from assemblykit.algebra import se3
-from assemblykit.algebra.subgroups import Kind
+from assemblykit.algebra import Kind, se3
 from assemblykit.errors import FeatureError
 from assemblykit.features import (
     Axis,

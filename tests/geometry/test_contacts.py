@@ -11,7 +11,7 @@ import pytest
 import shapely
 import trimesh
 
-from assemblykit.geometry.contacts import candidate_pairs, find_contacts
+from assemblykit.geometry.contacts import assembly_contacts, candidate_pairs, find_contacts
 from assemblykit.io.compas import load_compas
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance
@@ -144,7 +144,7 @@ def test_touching_pairs_and_areas_agree_with_compas_assembly(name, measured, jac
     path = dataset(f"compas_assembly/{name}")
     asm = load_compas(path)
     assert asm.precision.length == pytest.approx(measured, rel=1e-9)
-    found = {frozenset(c.pair): c.area for c in asm.contacts()}
+    found = {frozenset(c.pair): c.area for c in assembly_contacts(asm)}
     ref = _reference(path)
     assert len(found.keys() & ref.keys()) / len(found.keys() | ref.keys()) >= jaccard
     for pair in found.keys() & ref.keys():
@@ -168,7 +168,7 @@ def test_the_cross_vaults_crown_joints_are_sunk_beyond_its_precision():
     path = dataset("compas_assembly/crossvault_assembly.json")
     asm = load_compas(path)
     ref = _reference(path)
-    found = {frozenset(c.pair): c for c in asm.contacts()}
+    found = {frozenset(c.pair): c for c in assembly_contacts(asm)}
     assert ref.keys() - found.keys() == CROWN
     slivers = found.keys() - ref.keys()
     assert len(slivers) == 8
@@ -180,7 +180,7 @@ def test_the_cross_vaults_crown_joints_are_sunk_beyond_its_precision():
         depth = overlap_volume(asm[a].mesh, asm[b].mesh) / ref[pair]
         assert length < depth < 4.3e-5 * asm.scale
     loose = Tolerance.relative(5e-5)
-    found = {frozenset(c.pair): c.area for c in asm.contacts(loose)}
+    found = {frozenset(c.pair): c.area for c in assembly_contacts(asm, loose)}
     assert found.keys() == ref.keys()
     for pair in ref:
         assert found[pair] == pytest.approx(ref[pair], rel=1e-6)

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.geometry.curved import (
     arc_angles,
     cone_generators,
@@ -46,7 +47,7 @@ def test_an_arc_is_sampled_at_its_ends_and_at_most_a_step_apart() -> None:
 
 def test_the_triangles_of_a_half_cylinder_cover_half_a_turn() -> None:
     asm = rod_in_groove(through=True)
-    (surface,) = [s for s in asm.surfaces("block") if s.kind == "cylinder"]
+    (surface,) = [s for s in assembly_surfaces(asm, "block") if s.kind == "cylinder"]
     mesh = asm.parts["block"].mesh
     triangles = np.asarray(mesh.vertices)[np.asarray(mesh.faces)[surface.faces]]
     axis = np.array([0.0, 1.0, 0.0])
@@ -57,7 +58,7 @@ def test_the_triangles_of_a_half_cylinder_cover_half_a_turn() -> None:
 
 
 def test_a_rod_in_a_half_round_groove_touches_on_half_a_circle_of_normals() -> None:
-    (contact,) = rod_in_groove(through=True).contacts()
+    (contact,) = assembly_contacts(rod_in_groove(through=True))
     (patch,) = contact.curved
     assert patch.inner == "rod"
     # the rod's outward normals where the groove holds it: -x, -z, +x (ends and middle)
@@ -65,7 +66,7 @@ def test_a_rod_in_a_half_round_groove_touches_on_half_a_circle_of_normals() -> N
 
 
 def test_a_shaft_through_a_hole_keeps_the_whole_circle_of_normals() -> None:
-    contact = next(c for c in shaft_in_hole().contacts() if c.curved)
+    contact = next(c for c in assembly_contacts(shaft_in_hole()) if c.curved)
     (patch,) = contact.curved
     normals = patch.normal_cone()
     # four directions across the axis y, pairwise opposite: the whole circle
@@ -85,13 +86,13 @@ def test_cone_generators_are_the_extreme_rays_or_the_six_axes() -> None:
 
 
 def test_a_ball_in_a_closed_socket_is_held_by_every_direction() -> None:
-    contact = next(c for c in ball_in_closed_socket().contacts() if c.curved)
+    contact = next(c for c in assembly_contacts(ball_in_closed_socket()) if c.curved)
     (patch,) = contact.curved
     assert _rows(patch.normal_cone()) == _rows(np.vstack([np.eye(3), -np.eye(3)]))
 
 
 def test_the_ball_joint_cup_is_generated_by_its_rim() -> None:
-    (contact,) = load_assembly(BALL_JOINT / "ball_joint.yaml").contacts()
+    (contact,) = assembly_contacts(load_assembly(BALL_JOINT / "ball_joint.yaml"))
     (patch,) = contact.curved
     normals = patch.normal_cone()
     # the cup is cut at z = -2 on the sphere of radius 10: its rim is the circle of

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from assemblykit.geometry import occlusion
 from assemblykit.geometry.interference import interferes, solid
 from assemblykit.geometry.occlusion import occluded_pairs, shadows, view_frame
 from assemblykit.tolerance import Tolerance
@@ -92,6 +93,23 @@ def test_agrees_with_swept_volumes():
             if i != j and interferes(swept(meshes[i], d, 20.0), meshes[j], TOL.for_mesh())
         }
         assert blocked(meshes, d) == expected, d
+
+
+@pytest.mark.parametrize("count", [0, 1, 8, 10**6])
+def test_looking_at_the_largest_triangles_first_changes_no_answer(count, monkeypatch):
+    # none, a few or all triangles of each mesh in the first pass: the pairs found are
+    # those of the whole meshes, the hook and the wall included
+    hook = mesh_of(cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4])).subdivide()
+    wall = mesh_of(cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1]))
+    meshes = [*pin_in_blind_hole(), hook, wall]
+    allowed = ~np.eye(len(meshes), dtype=bool)
+    rng = np.random.default_rng(3)
+    directions = [UP, DOWN, EAST, *rng.normal(size=(4, 3))]
+    expected = [occluded_pairs(shadows(meshes, d, TOL), allowed, TOL) for d in directions]
+    monkeypatch.setattr(occlusion, "_FIRST_TRIANGLES", count)
+    for d, pairs in zip(directions, expected, strict=True):
+        assert occluded_pairs(shadows(meshes, d, TOL), allowed, TOL) == pairs, d
+    assert any(pairs for pairs in expected)
 
 
 @pytest.mark.parametrize(("scale", "kept"), [(100.0, 0), (1.0, 1)])

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import trimesh
 
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.precision import (
-    Precision,
     combined,
     coordinate_precision,
     decimals,
@@ -17,7 +17,7 @@ from assemblykit.geometry.precision import (
     pose_precision,
     round_up,
 )
-from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.assembly import Assembly, Part, Precision
 
 UNIT_BOX = trimesh.creation.box(extents=[1, 1, 1])
 
@@ -81,10 +81,10 @@ def test_a_tilted_joint_measures_its_mismatch_and_becomes_a_contact():
     assert measured.length == pytest.approx(0.01, rel=1e-12)
     assert "1 block pairs" in measured.source
     asm.precision = measured
-    (contact,) = asm.contacts()
+    (contact,) = assembly_contacts(asm)
     assert contact.pair == ("low", "high")
     assert contact.area == pytest.approx(1.0, rel=1e-9)
-    assert Assembly(asm.parts).contacts() == []
+    assert assembly_contacts(Assembly(asm.parts)) == []
 
 
 @pytest.mark.parametrize("lifted", [0.001, -0.5])

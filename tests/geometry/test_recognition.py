@@ -7,6 +7,7 @@ import pytest
 import trimesh
 
 from assemblykit.features.primitives import Ball, Cone, Hole, Plane, Shaft, Socket
+from assemblykit.geometry.contacts import assembly_surfaces
 from assemblykit.geometry.recognition import recognise, segment
 from assemblykit.tolerance import Tolerance
 from datasets import dataset
@@ -115,7 +116,7 @@ def test_asap_beam_fillets_are_found():
     from assemblykit.io.assembly import load_assembly
 
     beam = load_assembly(dataset("asap_beam_assembly"))
-    surfaces = beam.surfaces("0")
+    surfaces = assembly_surfaces(beam, "0")
     cylinders = [s for s in surfaces if s.kind == "cylinder"]
     spheres = [s for s in surfaces if s.kind == "sphere"]
     # the edges are rounded to 0.0762 (0.03 inch, in centimetres), outward

@@ -12,13 +12,10 @@ from assemblykit.inference.numeric import (
     Constraint,
     ResidueProblem,
     _same_solution,
-    gear_residual,
-    mirror_residual,
     pose_from_twist,
-    signed_angle,
     solve_residue,
-    wrap_angle,
 )
+from assemblykit.model.relations import gear_residual, mirror_residual, signed_angle, wrap_angle
 from assemblykit.tolerance import Tolerance
 
 TOL = Tolerance(scale=10.0)

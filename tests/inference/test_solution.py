@@ -17,6 +17,7 @@ from assemblykit.inference.solution import (
     remedy_words,
     status_of,
 )
+from assemblykit.render import render
 
 
 def shift(x: float) -> np.ndarray:
@@ -120,7 +121,7 @@ def test_trace_only_when_explaining_and_render():
         }
     ]
     console = Console(record=True, width=120)
-    console.print(explained.render())
+    console.print(render(explained))
     text = console.export_text()
     assert "b@s1" in text and "solved" in text and "intersect" in text
 
@@ -135,7 +136,7 @@ def test_freedom_is_said_in_words_and_only_when_there_is_some():
     assert Solution({ball.key: ball}).to_dict()["bodies"]["b@s1"]["freedom"] == ball.freedom
     assert "freedom" not in Solution({"b@s1": instance()}).to_dict()["bodies"]["b@s1"]
     console = Console(width=200, record=True)
-    console.print(Solution({ball.key: ball}).render())
+    console.print(render(Solution({ball.key: ball})))
     assert "b@s1 can turn about (0.5, 1, 1.5): 3 dof" in console.export_text()
 
 

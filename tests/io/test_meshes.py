@@ -11,6 +11,7 @@ import pytest
 import trimesh
 
 from assemblykit.errors import GeometryError, SchemaError
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.interference import interferences, overlap_volume
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.meshes import load_manifest, pose_from_spec, pose_from_state, read_mesh
@@ -41,7 +42,7 @@ def test_folder_applies_config_final_state(tmp_path):
     assert asm["b"].mesh.bounds[0][2] == pytest.approx(0.5)
     assert asm["b"].mesh.volume == pytest.approx(1.0)
     assert (asm.units, asm.units_source) == ("mm", "default")
-    assert [c.pair for c in asm.contacts()] == [("a", "b")]
+    assert [c.pair for c in assembly_contacts(asm)] == [("a", "b")]
 
 
 def test_manifest_poses_units_and_relative_paths(tmp_path):
@@ -62,7 +63,7 @@ def test_manifest_poses_units_and_relative_paths(tmp_path):
         asm["lid"].pose[:3, :3], [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-12
     )
     assert asm["side"].mesh.bounds[0][0] == pytest.approx(0.5)
-    assert {c.pair for c in asm.contacts()} == {("base", "lid"), ("base", "side")}
+    assert {c.pair for c in assembly_contacts(asm)} == {("base", "lid"), ("base", "side")}
 
 
 def test_pose_spec_rejects_non_rigid_matrix():
@@ -134,7 +135,7 @@ def test_contacts_and_blocking_of_a_piece_with_cubes_meeting_along_an_edge(tmp_p
     asm = load_assembly(tmp_path)
     assert asm.parts["piece"].volume == pytest.approx(2.0, abs=1e-12)
     # the lid lies on the first cube: one unit square of contact, normal +z
-    (contact,) = asm.contacts()
+    (contact,) = assembly_contacts(asm)
     assert contact.pair == ("lid", "piece")
     assert sum(p.area for p in contact.planar) == pytest.approx(1.0)
     ndbg = blocking_graph(asm, "extended")
@@ -161,14 +162,19 @@ def test_asap_beam_touches_without_interfering_with_final_state_poses():
     asm = load_assembly(dataset("asap_beam_assembly"))
     assert asm.names == ["0", "1", "2", "3", "6"]
     # translation after Rotation.from_euler('xyz') of the mesh as read: beams on posts
-    assert {c.pair for c in asm.contacts()} == {("0", "2"), ("1", "3"), ("2", "6"), ("3", "6")}
+    assert {c.pair for c in assembly_contacts(asm)} == {
+        ("0", "2"),
+        ("1", "3"),
+        ("2", "6"),
+        ("3", "6"),
+    }
     assert interferences(asm) == []
     # final_state is rounded to 4 decimals (translations) and 6 (angles): a vertex may be
     # misplaced by sqrt(3) (5e-5 + r 5e-7), r up to 7.76 (part 6): 9.3e-5
     assert asm.precision.length == pytest.approx(9.3257e-5, rel=1e-4)
     assert asm.tolerance_summary()["from"] == "measured"
     # settled within that rounding, the parts share at most 1e-6 of a part's volume
-    for (a, b), area in {c.pair: c.area for c in asm.contacts()}.items():
+    for (a, b), area in {c.pair: c.area for c in assembly_contacts(asm)}.items():
         assert overlap_volume(asm[a].mesh, asm[b].mesh) <= 1e-6 * min(asm[a].volume, asm[b].volume)
         # still touching: the same 3.82 of seat and tenon area as the poses as written
         assert area == pytest.approx(3.8233, abs=1e-4)
@@ -187,7 +193,7 @@ def test_asap_beam_as_written_shares_thin_layers():
     assert interferences(asm) == []
     # The poses as written leave layers thinner than their rounding (docs/geometry.md):
     # 2.5e-6 to 4.3e-6 of the smaller part's volume
-    areas = {c.pair: c.area for c in asm.contacts()}
+    areas = {c.pair: c.area for c in assembly_contacts(asm)}
     shares = []
     for (a, b), area in areas.items():
         volume = overlap_volume(asm[a].mesh, asm[b].mesh)

@@ -333,5 +333,6 @@ def test_files_that_cannot_be_read(tmp_path: Path):
         load_task(tmp_path / "list.yaml")
 
 
-def test_load_task_is_the_public_api():
-    assert assemblykit.load_task is load_task
+def test_the_public_load_task_reads_the_same_task():
+    path = EXAMPLES / "peg_in_block.yaml"
+    assert assemblykit.load_task(path) == load_task(path)

@@ -13,6 +13,7 @@ import pytest
 
 from assemblykit.errors import GeometryError
 from assemblykit.features.primitives import Ball, Hole, Shaft, Socket
+from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import LINEAR_DEFLECTION, declared_solids, numbered
 
@@ -71,20 +72,22 @@ def test_solids_become_parts_with_exact_surfaces(step_file):
 
 def test_recognised_features_have_exact_radii_and_axes(step_file):
     asm = load_assembly(step_file)
-    (hole,) = [f for f in asm.features("solid1") if isinstance(f, Hole)]
-    (shaft,) = [f for f in asm.features("solid2") if isinstance(f, Shaft)]
+    (hole,) = [f for s in assembly_surfaces(asm, "solid1") if isinstance(f := s.feature(), Hole)]
+    (shaft,) = [f for s in assembly_surfaces(asm, "solid2") if isinstance(f := s.feature(), Shaft)]
     for feature in (hole, shaft):
         assert feature.radius == 5.0
         assert abs(feature.axis @ [0, 0, 1]) == 1.0
         np.testing.assert_allclose(feature.point[:2], [0, 0], atol=1e-12)
-    (socket,) = [f for f in asm.features("solid3") if isinstance(f, Socket)]
-    (ball,) = [f for f in asm.features("solid4") if isinstance(f, Ball)]
+    (socket,) = [
+        f for s in assembly_surfaces(asm, "solid3") if isinstance(f := s.feature(), Socket)
+    ]
+    (ball,) = [f for s in assembly_surfaces(asm, "solid4") if isinstance(f := s.feature(), Ball)]
     assert socket.radius == 4.0 and ball.radius == 4.0
     np.testing.assert_allclose(ball.point, [60, 0, 0], atol=1e-12)
 
 
 def test_shaft_in_hole_and_ball_in_socket_are_curved_contacts(step_file):
-    contacts = {c.pair: c for c in load_assembly(step_file).contacts()}
+    contacts = {c.pair: c for c in assembly_contacts(load_assembly(step_file))}
     assert set(contacts) == {("solid1", "solid2"), ("solid3", "solid4")}
     (cylinder,) = contacts["solid1", "solid2"].curved
     assert (cylinder.kind, cylinder.inner, cylinder.radius) == ("cylindrical", "solid2", 5.0)

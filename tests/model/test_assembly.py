@@ -1,4 +1,5 @@
-"""The Assembly model: scale, tolerance, cached contacts, subsets and part changes."""
+"""The Assembly model: scale, tolerance, subsets and part changes, and the contacts and
+surfaces the geometry layer keeps in its memo."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import numpy as np
 import pytest
 
 from assemblykit.errors import UnknownNameError
+from assemblykit.geometry.contacts import GeometryMemo, assembly_contacts, assembly_surfaces
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.model.packings import box_mesh as box
 from assemblykit.tolerance import Tolerance, using
@@ -37,28 +39,36 @@ def test_tolerance_uses_mesh_thresholds_scaled_to_the_model(tower):
     assert exact.tolerance().length == pytest.approx(1e-9 * np.sqrt(11))
 
 
-def test_contacts_are_cached_per_tolerance(tower):
-    first = tower.contacts()
+def test_contacts_are_kept_in_the_memo_per_tolerance(tower):
+    assert tower.memo is None
+    first = assembly_contacts(tower)
     assert [c.pair for c in first] == [("a", "b"), ("b", "c")]
-    assert tower.contacts() is first
+    assert assembly_contacts(tower) is first
+    assert isinstance(tower.memo, GeometryMemo) and list(tower.memo.contacts) == [tower.tolerance()]
 
 
 def test_subset_keeps_scale_and_cached_contacts(tower):
-    tower.contacts()
+    assembly_contacts(tower)
     sub = tower.subset(["c", "b"])
     assert sub.names == ["b", "c"]
     assert sub.scale == tower.scale
-    assert [c.pair for c in sub.contacts()] == [("b", "c")]
-    assert [c.pair for c in tower.without_part("b").contacts()] == []
+    assert isinstance(sub.memo, GeometryMemo)
+    ((covered, kept),) = sub.memo.contacts.values()
+    assert covered == {"b", "c"} and [c.pair for c in kept] == [("b", "c")]
+    assert assembly_contacts(sub) is kept
+    assert [c.pair for c in assembly_contacts(tower.without_part("b"))] == []
 
 
 def test_with_part_adds_only_the_new_contacts(tower):
-    tower.contacts()
+    assembly_contacts(tower)
     grown = tower.without_part("c").with_part(Part("c", box([0, 0, 2], [1, 1, 3])))
-    assert sorted(c.pair for c in grown.contacts()) == [("a", "b"), ("b", "c")]
+    assert isinstance(grown.memo, GeometryMemo)
+    ((covered, _),) = grown.memo.contacts.values()
+    assert covered == {"a", "b"}
+    assert sorted(c.pair for c in assembly_contacts(grown)) == [("a", "b"), ("b", "c")]
     outside = tower.with_part(Part("d", box([0, 0, 3], [1, 1, 4])))
     assert outside.scale == pytest.approx(np.sqrt(18))
-    assert [c.pair for c in outside.contacts()] == [("a", "b"), ("b", "c"), ("c", "d")]
+    assert [c.pair for c in assembly_contacts(outside)] == [("a", "b"), ("b", "c"), ("c", "d")]
 
 
 def test_unknown_part_is_named(tower):
@@ -67,7 +77,7 @@ def test_unknown_part_is_named(tower):
 
 
 def test_features_of_a_box_are_its_six_faces(tower):
-    features = tower.features("a")
+    features = [s.feature() for s in assembly_surfaces(tower, "a")]
     assert len(features) == 6
     normals = sorted(tuple(np.round(f.normal, 12)) for f in features)
     assert normals == sorted([(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)])

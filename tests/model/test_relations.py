@@ -96,7 +96,7 @@ def test_every_kind_is_registered():
         "mirror",
     }
     assert all(spec.arity == 2 for spec in RELATIONS.values())
-    cosets = {kind for kind, spec in RELATIONS.items() if spec.coset}
+    cosets = {kind for kind, spec in RELATIONS.items() if spec.is_coset}
     assert cosets == {"against", "coplanar", "fits", "coaxial", "fixed", "parallel", "coincident"}
 
 

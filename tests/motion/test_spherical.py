@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import assemblykit
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.curved import in_region
 from assemblykit.io.assembly import load_assembly
 from assemblykit.motion.freedom import MotionSolver
@@ -44,7 +45,7 @@ def test_orientation_of_the_triangle_does_not_matter_and_flat_ones_cover_nothing
 
 def _region_and_ball(path: Path) -> tuple[np.ndarray, np.ndarray]:
     assembly = load_assembly(path)
-    contact = next(c for c in assembly.contacts() if c.curved)
+    contact = next(c for c in assembly_contacts(assembly) if c.curved)
     patch = contact.curved[0]
     region = patch.points
     assert region is not None

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 from assemblykit.io.burrtools import load_puzzle, solution_count
 from assemblykit.planning.multimove import Move, MultiMovePlan, Separation, plan_voxels
+from assemblykit.render import render
 from cli_runs import run
 from datasets import dataset
 
@@ -123,7 +124,7 @@ def test_a_sealed_cage_is_stuck_and_a_limit_cuts_the_search():
     assert sealed.stuck == ("cage", "key") and sealed.level == ""
     cut = plan_voxels(*cage_and_key(CHANNEL), max_states=2)
     assert cut.cut and cut.root.status == "cut" and cut.first_moves is None
-    assert "search cut at 2 states" in cut.render().title
+    assert "search cut at 2 states" in render(cut).title
     assert cut.to_dict()["cut"] is True
 
 

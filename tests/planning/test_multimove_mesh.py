@@ -19,6 +19,7 @@ from assemblykit.model.packings import guillotine_cells
 from assemblykit.planning.multimove import MultiMovePlan, Separation
 from assemblykit.planning.multimove_mesh import plan_meshes
 from assemblykit.planning.planner import plan
+from assemblykit.render import render
 from assemblykit.tolerance import Tolerance
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float]]
@@ -138,7 +139,7 @@ def test_the_key_goes_through_the_staircase_in_four_moves_of_hand_computed_lengt
             sweep = manifold3d.Manifold.hull_points(np.vstack([key, key + 100 * np.array(d)]))
             assert (sweep ^ base).volume() > 0.1
     console = Console(record=True, width=200)
-    console.print(result.render())
+    console.print(render(result))
     text = console.export_text()
     assert "level 4" in text and "first separation: 4 moves" in text
 

@@ -16,6 +16,7 @@ from scipy.spatial.transform import Rotation
 from assemblykit.cli import main
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.screw import plan_with_screws, screw_removal
+from assemblykit.render import render
 
 # side view (x right, z up), extruded along y over [0, 1]: the base is a floor, a wall on
 # the left, a post on the right carrying a lip over x in [3.4, 5] at z in [3.5, 4], and
@@ -122,7 +123,7 @@ def test_plan_with_turns_takes_the_hook_out_where_translations_stop():
     axis = {name: np.array(value) for name, value in step["axis"].items()}
     assert turn_is_clear(axis["point"], axis["direction"], step["angle"], np.array(step["exit"]))
     console = Console(record=True, width=200)
-    console.print(result.render())
+    console.print(render(result))
     assert "turn 50.0 deg" in console.export_text()
 
 
@@ -231,5 +232,5 @@ def test_plan_with_turns_prints_the_pitch():
     assert not result.stages[0].feasible
     assert result.feasible and [s.pitch for s in result.screws] == [pytest.approx(-2.0)]
     console = Console(record=True, width=200)
-    console.print(result.render())
+    console.print(render(result))
     assert "pitch -2 per rad" in console.export_text()

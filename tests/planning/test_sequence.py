@@ -9,22 +9,21 @@ import numpy as np
 import pytest
 import trimesh
 
+from assemblykit.blocking import tables
+from assemblykit.blocking.directions import DirectionTable, local_table
 from assemblykit.blocking.extended import extended_dbg, extended_free
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
+from assemblykit.blocking.tables import translation_table
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
-from assemblykit.planning import sequence
 from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import (
-    DirectionTable,
     ExtendedDirections,
     Plan,
-    _Search,
+    Search,
     and_or_graph,
-    local_table,
     minimal_interlocked,
     separable,
-    translation_table,
 )
 from datasets import dataset
 
@@ -50,9 +49,9 @@ LOCKED = table("pq", {(0.0, 0.0, 1.0): "pq qp", (1.0, 0.0, 0.0): "pq qp"})
 
 def run(
     tab: DirectionTable, volumes: tuple[float, ...], extended: DirectionTable | None = None
-) -> _Search:
+) -> Search:
     """The greedy search with ``tab`` as Γ_t and ``extended`` (default: the same) as Γ_e."""
-    search = _Search(tab, extended or tab, volumes, lambda *_: None, [], [])
+    search = Search(tab, extended or tab, volumes, lambda *_: None, [], [])
     search.disassemble((1 << len(tab.names)) - 1)
     return search
 
@@ -295,25 +294,6 @@ def test_crossvault_plan_takes_all_184_blocks_apart():
     assert len(result.steps) <= 40
 
 
-def test_free_parts_of_shrinking_sets_match_a_fresh_count():
-    rng = np.random.default_rng(7)
-    names = tuple("abcdefgh")
-    arcs = [
-        [(i, j) for i in range(8) for j in range(8) if i != j and rng.random() < 0.3]
-        for _ in range(20)
-    ]
-    tab = table_from(names, rng.normal(size=(20, 3)), arcs)
-    members = (1 << 8) - 1
-    while members:
-        fresh = table_from(names, tab.directions, arcs)
-        np.testing.assert_array_equal(tab.free_parts(members), fresh.free_parts(members))
-        members &= ~(1 << int(rng.choice([i for i in range(8) if members >> i & 1])))
-
-
-def table_from(names, directions, arcs) -> DirectionTable:
-    return DirectionTable.from_arcs(names, directions, arcs)
-
-
 def test_large_assemblies_take_candidates_from_each_parts_own_arrangement(monkeypatch):
     assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
     tol = assembly.tolerance()
@@ -331,7 +311,7 @@ def test_large_assemblies_take_candidates_from_each_parts_own_arrangement(monkey
     assert set(np.flatnonzero(whole.free_parts(everything).any(axis=0))) == set(
         np.flatnonzero(local.free_parts(everything).any(axis=0))
     )
-    monkeypatch.setattr(sequence, "FULL_ARRANGEMENT_REGIONS", 0)
+    monkeypatch.setattr(tables, "FULL_ARRANGEMENT_REGIONS", 0)
     result = plan(assembly)
     assert result.directions == len(local.directions)
     assert_every_step_free(assembly, result)
@@ -433,52 +413,3 @@ def test_plan_blocking_and_motion_agree_that_the_ball_joint_ball_lifts_out():
     assert reading.can_lift_off and min(r[2] for r in reading.lift_off) > 0.97
     volumes, touching = swept_overlaps(asm, "ball", first.direction, DISTANCES)
     assert np.all(volumes <= touching)
-
-
-def test_free_bits_past_one_byte_count_the_free_movers_of_shrinking_sets():
-    rng = np.random.default_rng(11)
-    names = tuple(f"p{i}" for i in range(19))
-    arcs = [
-        [(i, j) for i in range(19) for j in range(19) if i != j and rng.random() < 0.15]
-        for _ in range(30)
-    ]
-    tab = table_from(names, rng.normal(size=(30, 3)), arcs)
-    members = (1 << 19) - 1
-    while sequence._several(members):
-        movers = members & int(rng.integers(1 << 19))
-        blocked = np.zeros((30, 19), dtype=bool)
-        for k, per_direction in enumerate(arcs):
-            for i, j in per_direction:
-                blocked[k, i] |= bool(members >> j & 1)
-        chosen = np.array([bool(movers >> i & 1) for i in range(19)])
-        expected = ~blocked & chosen
-        bits = tab.free_bits(members, movers)
-        assert [sequence._row_mask(row) for row in bits] == [
-            sum(1 << int(i) for i in np.flatnonzero(row)) for row in expected
-        ]
-        np.testing.assert_array_equal(np.bitwise_count(bits).sum(axis=1), expected.sum(axis=1))
-        members &= ~(1 << int(rng.choice([i for i in range(19) if members >> i & 1])))
-
-
-@pytest.mark.parametrize("sizes", [(1, 1, 1, 1), (0, 1, 3, 2, 1, 3, 1)])
-def test_term_slots_match_the_terms_one_at_a_time(sizes):
-    from assemblykit.blocking.constraints import BlockingTerm
-    from assemblykit.tolerance import Tolerance
-
-    rng = np.random.default_rng(len(sizes))
-    tol = Tolerance()
-    terms = [BlockingTerm("a", "b", rng.normal(size=(m, 3))) for m in sizes]
-    owners = [int(s) for s in rng.integers(0, 3, len(terms))]
-    directions = rng.normal(size=(2500, 3))  # more than one chunk
-    directions[0] = 0.0  # on every circle: blocked by no term with normals
-    expected = np.zeros((len(directions), 3), dtype=bool)
-    for term, s in zip(terms, owners, strict=True):
-        expected[:, s] |= np.all(directions @ term.normals.T > tol.angle, axis=1)
-    found = sequence._term_slots(directions, terms, owners, 3, tol)
-    np.testing.assert_array_equal(found, expected)
-    # one term per slot, given out of slot order
-    single = [BlockingTerm("a", "b", rng.normal(size=(1, 3))) for _ in range(4)]
-    expected = np.column_stack([directions @ t.normals[0] > tol.angle for t in single])
-    order = [2, 0, 3, 1]
-    found = sequence._term_slots(directions, [single[s] for s in order], order, 4, tol)
-    np.testing.assert_array_equal(found, expected)

@@ -1,26 +1,23 @@
 """The algebra of assemblykit (layer 0): SE(3), Hervé's symmetry subgroups, cosets,
 characteristic invariants and transporters (ALGEBRA.md §1-§2, §5)."""
 
-from assemblykit.algebra.cosets import (
-    Chain,
-    Coset,
-    EmptySet,
-    Mismatch,
-    intersect_groups,
-    stabilizer,
-    transporter,
-)
+from assemblykit.algebra.cosets import Chain, Coset, EmptySet, stabilizer, transporter
+from assemblykit.algebra.groups import SymmetryGroup
 from assemblykit.algebra.invariants import (
     DirectionInvariant,
     Invariant,
     LineInvariant,
+    Mismatch,
+    MismatchKind,
     PlaneInvariant,
     PointInvariant,
     congruence_mismatch,
     pair_frame,
     transform_invariant,
 )
-from assemblykit.algebra.subgroups import Kind, Locus, SymmetryGroup
+from assemblykit.algebra.lie import Kind
+from assemblykit.algebra.loci import Locus, LocusKind
+from assemblykit.algebra.meets import intersect_groups
 
 __all__ = [
     "Chain",
@@ -31,7 +28,9 @@ __all__ = [
     "Kind",
     "LineInvariant",
     "Locus",
+    "LocusKind",
     "Mismatch",
+    "MismatchKind",
     "PlaneInvariant",
     "PointInvariant",
     "SymmetryGroup",

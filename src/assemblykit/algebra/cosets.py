@@ -5,15 +5,16 @@ A relation between body 1 and body 2 is the set of relative positions X = L1^-1 
 for lower pairs it is a right coset H . x0 with H in body 1's frame. Intersections
 are cosets of the intersected group or empty; products are cosets only when the two
 groups permute (otherwise a :class:`Chain`). Transporters of characteristic invariants
-(:mod:`assemblykit.algebra.invariants` finds X0 and Stab) are cosets too, and so are the
-components of a group with discrete parts, which is why group intersection
-(:func:`intersect_groups`) lives here.
+(:mod:`assemblykit.algebra.invariants` finds X0 and Stab) are cosets too. Coset
+intersections meet the groups of connected cosets and cyclic lattices directly
+(:mod:`assemblykit.algebra.connected_meets`).
 """
 
 from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
@@ -24,22 +25,24 @@ from assemblykit import formatting as fmt
 from assemblykit.algebra import invariants as inv
 from assemblykit.algebra import se3
 from assemblykit.algebra.caching import cached
-from assemblykit.algebra.invariants import Invariant, LineInvariant, Mismatch
-from assemblykit.algebra.lattices import IntegerPoints, commensurate, integer_points
-from assemblykit.algebra.subgroups import (
-    Kind,
+from assemblykit.algebra.connected_meets import connected_meet, lattice_meet, tr_meet
+from assemblykit.algebra.groups import (
+    IDENTITY_MATRIX,
     SymmetryGroup,
-    _helix_residual,
-    _rank_threshold,
-    _scaled,
-    _Sub,
-    _tr_meet,
     classify_algebra,
-    connected_meet,
-    lattice_meet,
     lattice_parameter,
     one_parameter,
 )
+from assemblykit.algebra.invariants import Invariant, LineInvariant, Mismatch, MismatchKind
+from assemblykit.algebra.lattices import IntegerPoints, commensurate, integer_points
+from assemblykit.algebra.lie import (
+    Kind,
+    RotationPart,
+    helix_residual,
+    rank_threshold,
+    scaled_twists,
+)
+from assemblykit.algebra.subspaces import Subspace
 from assemblykit.errors import GroupError, NumericError
 from assemblykit.tolerance import Tolerance, current
 
@@ -47,8 +50,6 @@ __all__ = [
     "Chain",
     "Coset",
     "EmptySet",
-    "Mismatch",
-    "intersect_groups",
     "stabilizer",
     "transporter",
 ]
@@ -58,22 +59,6 @@ NUMERIC_STARTS = 24
 
 #: Lattice steps tried on each side when intersecting a lattice coset.
 LATTICE_SEARCH = 64
-
-#: The documented mismatch kinds.
-MISMATCH_KINDS = frozenset(
-    {
-        "angle",
-        "distance",
-        "radius",
-        "moment",
-        "handedness",
-        "pitch",
-        "sides",
-        "size",
-        "type",
-        "residual",
-    }
-)
 
 _TRANSLATIONS = frozenset({Kind.FIXED, Kind.PRISMATIC, Kind.TRANSLATION2, Kind.TRANSLATION3})
 _CONTAINS_T3 = frozenset({Kind.TRANSLATION3, Kind.SCHOENFLIES, Kind.FREE})
@@ -294,7 +279,7 @@ def _lattice_coset_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
     lat, other = (p, q) if p.group.lattice else (q, p)
     if len(lat.group.lattice) != 1 or other.group.lattice:
         raise GroupError("intersection of cosets of these lattice groups is not supported")
-    group = intersect_groups(p.group, q.group, tol)
+    group = lattice_meet(p.group, q.group, tol)
     if lat.group.kind is Kind.FIXED:
         found = _cyclic_coset_meet(lat, other, group, tol)
         if found is not None:
@@ -310,7 +295,7 @@ def _lattice_coset_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
             if isinstance(piece, Coset):
                 return Coset(group, piece.rep)
     message = f"no lattice element found within {LATTICE_SEARCH} steps of {tau[:3, 3].tolist()}"
-    return EmptySet(Mismatch("residual", math.inf, message), proven=False)
+    return EmptySet(Mismatch(MismatchKind.RESIDUAL, math.inf, message), proven=False)
 
 
 def _cyclic_coset_meet(
@@ -354,7 +339,7 @@ def _cyclic_coset_meet(
             if found is None:
                 miss = abs(s0 - round(s0)) * abs(along)
                 text = f"the lattice steps of {abs(along):.6g} miss the other set"
-                empty = empty or EmptySet(Mismatch("distance", miss, text))
+                empty = empty or EmptySet(Mismatch(MismatchKind.DISTANCE, miss, text))
                 continue
             points = found
         c = lat.group.element((), 0, (points.start,)) @ base
@@ -366,15 +351,20 @@ def _cyclic_coset_meet(
 
 
 def _connected_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
+    """The intersection of two cosets of connected groups (§2.5): a point tested for
+    membership, the transporter of TR groups, the helical closed form, else the numeric
+    fallback."""
     for point, other in ((p, q), (q, p)):
         if point.dof == 0:
             if other.contains(point.rep, tol):
                 return point
             if not (p.group.is_tr and q.group.is_tr):
-                return EmptySet(Mismatch("residual", 1.0, "the fixed position is not in the set"))
+                return EmptySet(
+                    Mismatch(MismatchKind.RESIDUAL, 1.0, "the fixed position is not in the set")
+                )
     if p.group.is_tr and q.group.is_tr:
         (ta, sa), (tb, sb) = p.transporter_flats, q.transporter_flats
-        return flat_transporter(ta + tb, sa + sb, _tr_meet(p.group, q.group, tol), tol)
+        return flat_transporter(ta + tb, sa + sb, tr_meet(p.group, q.group, tol), tol)
     if p.group.is_tr or q.group.is_tr:
         helical, other = (q, p) if p.group.is_tr else (p, q)
         found = _helical_meet(helical, other, tol)
@@ -415,9 +405,9 @@ def _helical_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet | None
     k, d = found.group, found.rep
     theta, shift = _screw_coordinates(h, d)
     u = h.axis
-    w = _steepest_translation(k._tr_shape[1], u)
+    w = _steepest_translation(k.tr_shape[1], u)
     along = float(w @ u)
-    if k._tr_shape[0] == "line":
+    if k.tr_shape[0] is RotationPart.LINE:
         step = se3.rotation(u, shift / h.pitch - theta, k.origin)
     elif abs(along) > tol.angle:
         step = se3.translation(w * ((h.pitch * theta - shift) / along))
@@ -429,19 +419,19 @@ def _helical_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet | None
         step = se3.translation(u * (h.pitch * (theta + 2.0 * math.pi * turns) - shift))
         c = step @ d @ p.rep
         if p.contains(c, tol) and q.contains(c, tol):
-            return Coset(intersect_groups(p.group, q.group, tol), c)
-        miss = _helix_residual(h.pitch, shift, theta)
+            return Coset(connected_meet(p.group, q.group, tol), c)
+        miss = helix_residual(h.pitch, shift, theta)
         if miss <= tol.length:
             return None
         text = f"the positions miss the screw's phase by {miss:.6g} along its axis"
-        return EmptySet(Mismatch("distance", miss, text))
+        return EmptySet(Mismatch(MismatchKind.DISTANCE, miss, text))
     c = step @ d @ p.rep
     if not (p.contains(c, tol) and q.contains(c, tol)):
         return None
-    return Coset(intersect_groups(p.group, q.group, tol), c)
+    return Coset(connected_meet(p.group, q.group, tol), c)
 
 
-def _steepest_translation(v: _Sub, u: np.ndarray) -> np.ndarray:
+def _steepest_translation(v: Subspace, u: np.ndarray) -> np.ndarray:
     """The unit vector of the subspace ``v`` with the largest component along ``u``
     (zero when ``v`` is trivial)."""
     if v.dim == 0:
@@ -459,37 +449,39 @@ def _residual_vector(d: np.ndarray, scale: float) -> np.ndarray:
     return np.concatenate(((d[:3, :3] * scale).ravel(), d[:3, 3]))
 
 
-def _starts(rng: np.random.Generator, angles: np.ndarray, length: float) -> np.ndarray:
-    x = rng.uniform(-1.0, 1.0, angles.size)
-    return x * np.where(angles, math.pi, length)
+def _multistart(
+    residual: Callable[[np.ndarray], np.ndarray], angles: np.ndarray, length: float
+) -> Iterator[Any]:
+    """The fits of the deterministic multi-start over group parameters (§2.5 "Numeric
+    fallback"): :data:`NUMERIC_STARTS` starts, Levenberg-Marquardt while the 12 residual
+    entries are at least as many as the parameters."""
+    starts = se3.random_starts(angles, length, NUMERIC_STARTS)
+    method = "lm" if angles.size <= 12 else "trf"
+    return se3.multistart_least_squares(residual, starts, method=method)
 
 
 def _numeric_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet:
     """A common point from least squares over both parameterisations, from a deterministic
     multi-start (§2.5 "Numeric fallback"); never claims emptiness."""
-    from scipy.optimize import least_squares  # imported here: only numeric cases need it
-
     a, b = p.group, q.group
-    group = intersect_groups(a, b, tol)
+    group = connected_meet(a, b, tol)
     na = a.dof
     length = max(tol.scale, se3.norm(p.rep[:3, 3]), se3.norm(q.rep[:3, 3]))
-    angles = np.concatenate((a._angle_params(), b._angle_params()))
+    angles = np.concatenate((a.angle_parameters(), b.angle_parameters()))
 
     def residual(x: np.ndarray) -> np.ndarray:
         d = a.element(x[:na]) @ p.rep - b.element(x[na:]) @ q.rep
         return _residual_vector(d, length)
 
-    rng = np.random.default_rng(0)
     best = math.inf
-    for i in range(NUMERIC_STARTS):
-        x0 = np.zeros(angles.size) if i == 0 else _starts(rng, angles, length)
-        sol = least_squares(residual, x0, method="lm" if angles.size <= 12 else "trf")
+    for sol in _multistart(residual, angles, length):
         best = min(best, float(np.max(np.abs(sol.fun))))
         c = a.element(sol.x[:na]) @ p.rep
         if p.contains(c, tol) and q.contains(c, tol):
             return Coset(group, c)
     return EmptySet(
-        Mismatch("residual", best, f"no solution found (best residual {best:.3g})"), proven=False
+        Mismatch(MismatchKind.RESIDUAL, best, f"no solution found (best residual {best:.3g})"),
+        proven=False,
     )
 
 
@@ -505,12 +497,12 @@ def _group_product(a: SymmetryGroup, k: SymmetryGroup, tol: Tolerance) -> Symmet
     if a.lattice or k.lattice:
         return None
     basis = np.hstack((a.algebra, k.algebra))
-    scaled = _scaled(basis, tol)
+    scaled = scaled_twists(basis, tol)
     u, s, _ = np.linalg.svd(scaled, full_matrices=False)
-    q = u[:, : int(np.sum(s > _rank_threshold(tol)))]
+    q = u[:, : int(np.sum(s > rank_threshold(tol)))]
     for i, j in itertools.combinations(range(basis.shape[1]), 2):
-        br = _scaled(_bracket(basis[:, i], basis[:, j])[:, None], tol)
-        if float(np.max(np.abs(br - q @ (q.T @ br)))) > _rank_threshold(tol):
+        br = scaled_twists(_bracket(basis[:, i], basis[:, j])[:, None], tol)
+        if float(np.max(np.abs(br - q @ (q.T @ br)))) > rank_threshold(tol):
             return None
     kinds = frozenset({a.kind, k.kind})
     accepted = (
@@ -578,10 +570,10 @@ class Chain:
             for f in self.factors:
                 cols.append(se3.adjoint(prefix) @ f.group.algebra)
                 prefix = prefix @ f.sample(rng, 1)[0]
-            stacked = _scaled(np.hstack(cols), tol)
+            stacked = scaled_twists(np.hstack(cols), tol)
             if stacked.size:
                 s = np.linalg.svd(stacked, compute_uv=False)
-                best = max(best, int(np.sum(s > _rank_threshold(tol) * max(1.0, s[0]))))
+                best = max(best, int(np.sum(s > rank_threshold(tol) * max(1.0, s[0]))))
         return best
 
     def sample(self, rng: np.random.Generator, n: int = 1) -> list[np.ndarray]:
@@ -597,36 +589,24 @@ class Chain:
     def contains(self, x: np.ndarray, tol: Tolerance | None = None) -> bool:
         """Whether ``x`` is in the product set, by least squares over the factors'
         parameters from a deterministic multi-start."""
-        from scipy.optimize import least_squares
-
         tol = tol or current()
         x = np.asarray(x, dtype=np.float64)
         if any(f.group.lattice for f in self.factors):
             raise GroupError("membership in a chain of lattice cosets is not supported")
-        angles = np.concatenate([f.group._angle_params() for f in self.factors])
+        angles = np.concatenate([f.group.angle_parameters() for f in self.factors])
         length = max(tol.scale, se3.norm(x[:3, 3]))
         length = max([length] + [se3.norm(f.rep[:3, 3]) for f in self.factors])
         comps = itertools.product(*(range(len(f.group.reps)) for f in self.factors))
         for components in comps:
-            rng = np.random.default_rng(0)
 
             def residual(p: np.ndarray, comp: tuple[int, ...] = components) -> np.ndarray:
                 return _residual_vector(self._compose(p, comp) - x, length)
 
-            for i in range(NUMERIC_STARTS):
-                p0 = np.zeros(angles.size) if i == 0 else _starts(rng, angles, length)
-                sol = least_squares(residual, p0, method="lm" if angles.size <= 12 else "trf")
+            for sol in _multistart(residual, angles, length):
                 d = self._compose(sol.x, components) @ se3.inverse(x)
-                if _close_to_identity(d, tol):
+                if se3.poses_equal(d, IDENTITY_MATRIX, tol):
                     return True
         return False
-
-
-def _close_to_identity(d: np.ndarray, tol: Tolerance) -> bool:
-    return (
-        float(np.max(np.abs(d[:3, :3] - np.eye(3)))) <= tol.angle
-        and se3.norm(d[:3, 3]) <= tol.length
-    )
 
 
 # ----------------------------------------------------------------------------- transporters
@@ -690,26 +670,3 @@ def stabilizer(
     result = transporter(invs, invs, tol)
     assert isinstance(result, Coset)
     return result.group
-
-
-def intersect_groups(
-    a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance | None = None
-) -> SymmetryGroup:
-    """G ∩ G' (ALGEBRA.md §2.4): the connected part, the helical residue and the finite
-    parts, these met as cosets of the connected parts (§2.5)."""
-    tol = tol or current()
-    if a.is_connected and b.is_connected:
-        return connected_meet(a, b, tol)
-    if a.lattice or b.lattice:
-        return lattice_meet(a, b, tol)
-    c0 = connected_meet(a.connected_part, b.connected_part, tol)
-    found: list[np.ndarray] = []
-    for x in a.reps:
-        for y in b.reps:
-            met = Coset(a.connected_part, x).intersect(Coset(b.connected_part, y), tol)
-            if isinstance(met, EmptySet):
-                continue
-            found.append(met.rep)
-    if not found:
-        return c0
-    return c0.with_known_discrete(reps=tuple(found), lattice=c0.lattice, tol=tol)

@@ -13,13 +13,17 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.algebra import se3
-from assemblykit.algebra.subgroups import Kind, SymmetryGroup, Vec3, _tr_meet, psd_solve
+from assemblykit.algebra.connected_meets import tr_meet
+from assemblykit.algebra.groups import SymmetryGroup
+from assemblykit.algebra.lie import Kind
+from assemblykit.algebra.subspaces import Vec3, psd_solve
 from assemblykit.errors import FeatureError
 from assemblykit.tolerance import Tolerance, current
 
@@ -28,6 +32,7 @@ __all__ = [
     "Invariant",
     "LineInvariant",
     "Mismatch",
+    "MismatchKind",
     "PlaneInvariant",
     "PointInvariant",
     "characteristic_invariants",
@@ -38,12 +43,28 @@ __all__ = [
 ]
 
 
+class MismatchKind(StrEnum):
+    """What a failed test measured (ALGEBRA.md §2.5 congruence tests, §4 feature
+    parameters, the numeric fallback's residual)."""
+
+    ANGLE = "angle"
+    DISTANCE = "distance"
+    RADIUS = "radius"
+    MOMENT = "moment"
+    HANDEDNESS = "handedness"
+    PITCH = "pitch"
+    SIDES = "sides"
+    SIZE = "size"
+    TYPE = "type"
+    RESIDUAL = "residual"
+
+
 @dataclass(frozen=True)
 class Mismatch:
-    """Why a set is empty: ``kind`` (angle, distance, radius, moment, handedness, pitch,
-    sides, type, residual), its size (radians or model units) and a one-line message."""
+    """Why a set is empty: the :class:`MismatchKind` measured, its size (radians or
+    model units) and a one-line message."""
 
-    kind: str
+    kind: MismatchKind
     value: float
     message: str
 
@@ -161,21 +182,21 @@ def _perp(v: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]
     return v - (v @ u) * u
 
 
-def _pair_measures(a: Invariant, b: Invariant, tol: Tolerance) -> list[tuple[str, float]]:
+def _pair_measures(a: Invariant, b: Invariant, tol: Tolerance) -> list[tuple[MismatchKind, float]]:
     """The congruence measures of one pair (§2.5 table, "congruence test" column)."""
-    out: list[tuple[str, float]] = []
+    out: list[tuple[MismatchKind, float]] = []
     ua, ub = _axis_of(a), _axis_of(b)
     if ua is not None and ub is not None:
-        out.append(("angle", _angle(ua, ub)))
+        out.append((MismatchKind.ANGLE, _angle(ua, ub)))
     if isinstance(b, PointInvariant) and not isinstance(a, PointInvariant):
         a, b = b, a
     if isinstance(a, PointInvariant):
         if isinstance(b, PointInvariant):
-            out.append(("distance", se3.norm(b.point - a.point)))
+            out.append((MismatchKind.DISTANCE, se3.norm(b.point - a.point)))
         elif isinstance(b, LineInvariant):
-            out.append(("distance", se3.norm(_perp(a.point - b.point, b.direction))))
+            out.append((MismatchKind.DISTANCE, se3.norm(_perp(a.point - b.point, b.direction))))
         elif isinstance(b, PlaneInvariant):
-            out.append(("distance", float(b.normal @ (a.point - b.point))))
+            out.append((MismatchKind.DISTANCE, float(b.normal @ (a.point - b.point))))
         return out
     if isinstance(a, PlaneInvariant) and isinstance(b, LineInvariant):
         a, b = b, a
@@ -184,21 +205,21 @@ def _pair_measures(a: Invariant, b: Invariant, tol: Tolerance) -> list[tuple[str
         norm = se3.norm(cross)
         offset = b.point - a.point
         if norm <= tol.angle:
-            out.append(("distance", se3.norm(_perp(offset, a.direction))))
+            out.append((MismatchKind.DISTANCE, se3.norm(_perp(offset, a.direction))))
         else:
             signed = float(cross @ offset) / norm
-            out.append(("distance", abs(signed)))
+            out.append((MismatchKind.DISTANCE, abs(signed)))
             if a.directed and b.directed:
-                out.append(("moment", signed))
+                out.append((MismatchKind.MOMENT, signed))
     elif isinstance(a, LineInvariant) and isinstance(b, PlaneInvariant):
         if abs(float(a.direction @ b.normal)) <= tol.angle:
-            out.append(("distance", float(b.normal @ (a.point - b.point))))
+            out.append((MismatchKind.DISTANCE, float(b.normal @ (a.point - b.point))))
     elif (
         isinstance(a, PlaneInvariant)
         and isinstance(b, PlaneInvariant)
         and se3.norm(se3.cross(a.normal, b.normal)) <= tol.angle
     ):
-        out.append(("distance", float(a.normal @ (b.point - a.point))))
+        out.append((MismatchKind.DISTANCE, float(a.normal @ (b.point - a.point))))
     return out
 
 
@@ -221,11 +242,11 @@ def _elements(invariants: Sequence[Invariant], i: int, j: int) -> str:
     return f"{plural} {rank.index(i) + 1} and {rank.index(j) + 1}"
 
 
-def _describe_mismatch(kind: str, value: float, between: str) -> Mismatch:
+def _describe_mismatch(kind: MismatchKind, value: float, between: str) -> Mismatch:
     where = f"between {between}"
-    if kind == "angle":
+    if kind is MismatchKind.ANGLE:
         text = f"angle mismatch {math.degrees(value):.6g}° {where}"
-    elif kind == "moment":
+    elif kind is MismatchKind.MOMENT:
         text = f"moment (handedness) mismatch {value:.6g} {where}"
     else:
         text = f"{kind} mismatch {value:.6g} {where}"
@@ -235,10 +256,14 @@ def _describe_mismatch(kind: str, value: float, between: str) -> Mismatch:
 def _shape_mismatch(targets: Any, sources: Any) -> Mismatch | None:
     """A "type" mismatch when the tuples differ in length or in invariant types."""
     if len(targets) != len(sources):
-        return Mismatch("type", float(abs(len(targets) - len(sources))), "different counts")
+        return Mismatch(
+            MismatchKind.TYPE, float(abs(len(targets) - len(sources))), "different counts"
+        )
     for i, (t, s) in enumerate(zip(targets, sources, strict=True)):
         if type(t) is not type(s):
-            return Mismatch("type", 1.0, f"invariant {i}: {type(t).__name__} vs {type(s).__name__}")
+            return Mismatch(
+                MismatchKind.TYPE, 1.0, f"invariant {i}: {type(t).__name__} vs {type(s).__name__}"
+            )
     return None
 
 
@@ -257,11 +282,11 @@ def congruence_mismatch(
         mt = _pair_measures(targets[i], targets[j], tol)
         ms = _pair_measures(sources[i], sources[j], tol)
         for (kind, vt), (_, vs) in zip(mt, ms, strict=False):
-            limit = tol.angle if kind == "angle" else tol.length
+            limit = tol.angle if kind is MismatchKind.ANGLE else tol.length
             if abs(vt - vs) > limit:
                 return _describe_mismatch(kind, abs(vt - vs), _elements(targets, i, j))
         if len(mt) != len(ms):
-            return _describe_mismatch("angle", 0.0, _elements(targets, i, j))
+            return _describe_mismatch(MismatchKind.ANGLE, 0.0, _elements(targets, i, j))
     return None
 
 
@@ -413,7 +438,7 @@ def directed_stabilizer(invariants: tuple[Invariant, ...], tol: Tolerance) -> Sy
         return SymmetryGroup.free()
     group = _single_stabilizer(invariants[0])
     for inv in invariants[1:]:
-        group = _tr_meet(group, _single_stabilizer(inv), tol)
+        group = tr_meet(group, _single_stabilizer(inv), tol)
     return group
 
 
@@ -587,7 +612,7 @@ def flat_transport(
         )
         if found is None:
             found = Mismatch(
-                "handedness",
+                MismatchKind.HANDEDNESS,
                 worst,
                 "the invariants are pairwise congruent but not under a proper rigid motion",
             )

@@ -8,7 +8,8 @@ the velocity of the point currently at the origin.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,6 +24,7 @@ __all__ = [
     "apply",
     "apply_direction",
     "as_floats",
+    "axis_basis",
     "cross",
     "exp",
     "frame",
@@ -33,7 +35,10 @@ __all__ = [
     "is_rigid",
     "log",
     "matrix_from_columns",
+    "multistart_least_squares",
     "norm",
+    "poses_equal",
+    "random_starts",
     "random_transform",
     "rot_x",
     "rot_y",
@@ -385,3 +390,65 @@ def random_transform(rng: np.random.Generator, scale: float = 10.0) -> NDArray[n
 
     r = Rotation.random(random_state=rng).as_matrix()
     return _compose(r, rng.uniform(-scale, scale, 3))
+
+
+def axis_basis(
+    axes: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Unit vectors ``u, v`` completing each unit axis ``n`` to the right-handed frame
+    ``(u, v, n)``, for one axis (shape (3,)) or for rows (shape (m, 3)): ``u`` along
+    ``e x n`` for the coordinate axis ``e`` least aligned with ``n`` (the first on ties),
+    ``v = n x u``."""
+    n = np.asarray(axes, dtype=np.float64)
+    u = np.cross(np.eye(3)[np.argmin(np.abs(n), axis=-1)], n)
+    u /= np.linalg.norm(u) if n.ndim == 1 else np.linalg.norm(u, axis=-1, keepdims=True)
+    return u, np.cross(n, u)
+
+
+def poses_equal(
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    tol: Tolerance | None = None,
+    *,
+    numeric: bool = False,
+) -> bool:
+    """Whether two poses are one under the tolerance policy: every rotation entry within
+    the angular tolerance and the translations within the length tolerance. ``numeric``
+    poses come from the numeric solvers, whose precision is that of the mesh tolerances:
+    these or the tolerance in force, whichever is looser."""
+    tol = tol or current()
+    angle, length = tol.angle, tol.length
+    if numeric:
+        angle, length = max(tol.mesh_angle, angle), max(tol.mesh_length, length)
+    return (
+        float(np.max(np.abs(a[:3, :3] - b[:3, :3]))) <= angle
+        and norm(a[:3, 3] - b[:3, 3]) <= length
+    )
+
+
+def random_starts(
+    angles: NDArray[np.bool_], length: float, count: int, seed: int = 0
+) -> Iterator[NDArray[np.float64]]:
+    """The deterministic starts of a multi-start over group parameters (ALGEBRA.md §2.5
+    "Numeric fallback"): zero, then ``count - 1`` seeded uniform draws, angles in
+    [-pi, pi] and lengths in [-``length``, ``length``]."""
+    rng = np.random.default_rng(seed)
+    yield np.zeros(angles.size)
+    for _ in range(count - 1):
+        yield rng.uniform(-1.0, 1.0, angles.size) * np.where(angles, math.pi, length)
+
+
+def multistart_least_squares(
+    residual: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    starts: Iterable[NDArray[np.float64]],
+    **options: Any,
+) -> Iterator[Any]:
+    """``scipy.optimize.least_squares`` of ``residual`` from each start in turn, yielding
+    each fit (its ``x``, ``fun``, ``jac``): a deterministic multi-start (ALGEBRA.md §2.5
+    "Numeric fallback") that the caller ends at the first fit it accepts. ``options`` go
+    to ``least_squares`` unchanged; ``scipy.optimize`` is imported at the first start, so
+    that only numeric cases pay for it."""
+    from scipy.optimize import least_squares
+
+    for x0 in starts:
+        yield least_squares(residual, x0, **options)

@@ -122,6 +122,22 @@ def _links(
     return arr[:, 0], arr[:, 1], arr[:, 2], arr[:, 3]
 
 
+def _whole(
+    dimension: int, normals: NDArray[np.float64], direction: tuple[float, float, float]
+) -> Arrangement:
+    """The arrangement of no circle (Wilson & Latombe 1992): the whole direction circle
+    (``dimension`` 2) or sphere (3) as one region, represented by ``direction``."""
+    return Arrangement(
+        dimension,
+        normals,
+        np.array([direction]),
+        np.array([dimension - 1], np.int8),
+        *_links([]),
+        0,
+        np.zeros(0, np.int8),
+    )
+
+
 def circle_partition(normals: NDArray[np.float64], tol: Tolerance | None = None) -> Arrangement:
     """The partition of S¹ (Wilson & Latombe 1992, 2D case) by the diameters perpendicular to the
     given in-plane circle normals (distinct, z = 0): points and open arcs, in angular
@@ -129,15 +145,7 @@ def circle_partition(normals: NDArray[np.float64], tol: Tolerance | None = None)
     normals = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     c = len(normals)
     if c == 0:
-        return Arrangement(
-            2,
-            normals,
-            np.array([[1.0, 0.0, 0.0]]),
-            np.array([1], np.int8),
-            *_links([]),
-            0,
-            np.zeros(0, np.int8),
-        )
+        return _whole(2, normals, (1.0, 0.0, 0.0))
     z = np.array([0.0, 0.0, 1.0])
     perp = np.cross(z, normals)
     points = np.concatenate([perp, -perp])
@@ -262,15 +270,7 @@ def sphere_arrangement(normals: NDArray[np.float64]) -> Arrangement:
     normals = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     c = len(normals)
     if c == 0:
-        return Arrangement(
-            3,
-            normals,
-            np.array([[0.0, 0.0, 1.0]]),
-            np.array([2], np.int8),
-            *_links([]),
-            0,
-            np.zeros(0, np.int8),
-        )
+        return _whole(3, normals, (0.0, 0.0, 1.0))
     if c == 1:
         e1, _ = _basis(normals)
         return Arrangement(

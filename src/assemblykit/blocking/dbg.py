@@ -15,7 +15,6 @@ from functools import cached_property
 import networkx as nx
 import numpy as np
 from numpy.typing import NDArray
-from rich.table import Table
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,19 +121,3 @@ class Removal:
         if self.tolerance_dependent:
             out["tolerance_dependent"] = True
         return out
-
-
-def removal_table(title: str, kind: str, example: str, removals: list[Removal]) -> Table:
-    """A table of removable subassemblies: parts, how many ``kind`` free them, and the
-    first one as an ``example``."""
-    table = Table(title=title)
-    table.add_column("removable parts")
-    table.add_column(kind)
-    table.add_column(example)
-    for r in removals:
-        table.add_row(
-            ", ".join(sorted(r.parts)),
-            str(len(r.directions)),
-            np.array2string(r.directions[0], precision=3),
-        )
-    return table

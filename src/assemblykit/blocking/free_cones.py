@@ -4,7 +4,7 @@ translations").
 Part ``j`` blocks part ``i`` along ``d`` iff the ray ``{t d, t > 0}`` enters the grown
 obstacle ``P_j ⊕ (−P_i)``; the directions blocked by ``j`` are the projection of that
 obstacle on the sphere, a union of open cones, one per pair of convex pieces (parts
-made of convex bodies, :meth:`assemblykit.blocking.extended._Obstacles.cones_of`) or per
+made of convex bodies, :meth:`assemblykit.blocking.obstacles.Obstacles.cones_of`) or per
 pair of triangles (any other part, :func:`assemblykit.geometry.minkowski.triangle_cones`).
 The free set of a moving set is the complement of the union over its blockers.
 
@@ -24,14 +24,20 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
 from numpy.typing import NDArray
 
+from assemblykit.blocking.cache import BlockingCache
+from assemblykit.blocking.extended import extended_free
+from assemblykit.blocking.obstacles import Obstacles
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
 
 TRIANGLE_PAIRS = 16_000
 """Triangle pairs of one moving part and one obstacle beyond which the exact free set
@@ -212,23 +218,23 @@ def overlay_faces(sets: Sequence[ChartSet], tol: Tolerance, limit: int = 20_000)
 
 
 def blocked_by(
-    assembly: Any, moving: Iterable[str], blocker: str, tol: Tolerance
+    assembly: Assembly, moving: Iterable[str], blocker: str, tol: Tolerance
 ) -> ChartSet | None:
     """The directions along which ``blocker`` blocks some part of ``moving`` (Wilson & Latombe 1992
     §5), or ``None`` when there are more triangle pairs than :data:`TRIANGLE_PAIRS`.
-    Computed once per assembly, moving set, blocker and tolerance."""
-    from assemblykit.blocking.extended import obstacles
-
-    cache = obstacles(assembly)
+    Computed once per assembly, moving set, blocker and tolerance (kept in the
+    assembly's :class:`~assemblykit.blocking.cache.BlockingCache`)."""
+    cache = BlockingCache.of(assembly)
     key = (tuple(sorted(set(moving))), blocker, tol)
     if key not in cache.blocked:
-        cache.blocked[key] = _blocked_by(assembly, cache, key[0], blocker, tol)
-    found: ChartSet | None = cache.blocked[key]
+        cache.blocked[key] = _blocked_by(assembly, cache.obstacles, key[0], blocker, tol)
+    found = cache.blocked[key]
+    assert found is None or isinstance(found, ChartSet)
     return found
 
 
 def _blocked_by(
-    assembly: Any, cache: Any, moving: tuple[str, ...], blocker: str, tol: Tolerance
+    assembly: Assembly, cache: Obstacles, moving: tuple[str, ...], blocker: str, tol: Tolerance
 ) -> ChartSet | None:
     """:func:`blocked_by` computed: the union of the cones of every pair of convex
     pieces, or of front and back triangles of non-convex parts."""
@@ -280,7 +286,7 @@ class ExactFree:
 
 
 def blocked_sets(
-    assembly: Any, moving: Iterable[str], among: Iterable[str], tol: Tolerance
+    assembly: Assembly, moving: Iterable[str], among: Iterable[str], tol: Tolerance
 ) -> dict[str, ChartSet] | None:
     """Per other part of ``among``, the directions along which it blocks ``moving``
     (``None`` when one is too large to compute)."""
@@ -295,7 +301,7 @@ def blocked_sets(
 
 
 def exact_free_directions(
-    assembly: Any,
+    assembly: Assembly,
     moving: Iterable[str],
     tol: Tolerance,
     among: Iterable[str] | None = None,
@@ -303,8 +309,6 @@ def exact_free_directions(
 ) -> ExactFree:
     """Up to ``limit`` directions, one per face of the free set of ``moving`` among the
     parts ``among`` (default: all), each checked exactly (Wilson & Latombe 1992 §5)."""
-    from assemblykit.blocking.extended import extended_free
-
     movers = sorted(set(moving))
     others = list(assembly.names if among is None else among)
     sets = blocked_sets(assembly, movers, others, tol)

@@ -1,50 +1,56 @@
 """The blocking-graph factory (Wilson & Latombe 1992): the blocking terms of an assembly
 for a motion, and its NDBG (or rigid blocking graph) for the whole assembly or a
-sub-assembly, computed once per assembly and tolerance.
+sub-assembly, computed once per assembly and tolerance and kept in the assembly's
+:class:`~assemblykit.blocking.cache.BlockingCache`.
 
 It sits above the graph modules it chooses between: the NDBG built by the crossing rule
-(:mod:`assemblykit.blocking.ndbg`), its sampled variant for non-convex parts and the
-extended-translation terms (:mod:`assemblykit.blocking.extended`), the exact planar terms
-(:mod:`assemblykit.blocking.planar`) and the rigid-motion graph
-(:mod:`assemblykit.blocking.rigid`).
+(:mod:`assemblykit.blocking.ndbg`), the extended-translation terms and exact DBGs
+(:mod:`assemblykit.blocking.extended`, with which :func:`sampled_ndbg` builds the NDBG
+of non-convex parts), the exact planar terms (:mod:`assemblykit.blocking.planar`) and
+the rigid-motion graph (:mod:`assemblykit.blocking.rigid`).
 """
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Iterable
-from typing import Any, Literal, overload
+from typing import TYPE_CHECKING, Literal, overload
 
+import numpy as np
+
+from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.constraints import BlockingTerm, infinitesimal_terms
-from assemblykit.blocking.extended import all_convex, extended_terms, sampled_ndbg
-from assemblykit.blocking.ndbg import AssemblyLike, Motion, NonDirectionalBlockingGraph, build_ndbg
+from assemblykit.blocking.extended import all_convex, extended_arcs, extended_dbg, extended_terms
+from assemblykit.blocking.ndbg import (
+    AssemblyLike,
+    ConstraintTable,
+    Motion,
+    NonDirectionalBlockingGraph,
+    build_ndbg,
+)
+from assemblykit.blocking.obstacles import of_meshes
 from assemblykit.blocking.planar import planar_extended_terms
+from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import UnknownNameError
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.tolerance import Tolerance
 
-_TERMS: weakref.WeakKeyDictionary[Any, dict[tuple[str, Tolerance], list[BlockingTerm]]] = (
-    weakref.WeakKeyDictionary()
-)
-
-
-_GRAPHS: weakref.WeakKeyDictionary[
-    Any, dict[tuple[str, tuple[str, ...], Tolerance], NonDirectionalBlockingGraph]
-] = weakref.WeakKeyDictionary()
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
 
 
 def blocking_terms(assembly: AssemblyLike, motion: str, tol: Tolerance) -> list[BlockingTerm]:
     """The blocking terms of the whole assembly for a motion, computed once per
     assembly and tolerance (subsets filter them)."""
-    cache = _TERMS.setdefault(assembly, {})
+    cache = BlockingCache.of(assembly).terms
     key = (motion, tol)
     if key not in cache:
-        if motion == "extended" and getattr(assembly, "dimension", 3) == 2:
+        if motion == "extended" and isinstance(assembly, PolygonAssembly):
             cache[key] = planar_extended_terms(assembly, tol)
         elif motion == "extended":
-            cache[key] = extended_terms(assembly, tol)
+            cache[key] = extended_terms(of_meshes(assembly), tol)
         else:
-            cache[key] = infinitesimal_terms(assembly.contacts(tol))
+            cache[key] = infinitesimal_terms(assembly_contacts(assembly, tol))
     return cache[key]
 
 
@@ -104,24 +110,23 @@ def blocking_graph(
     tol = assembly.tolerance(tol)
     names = _subset(assembly, parts)
     inside = set(names)
-    contacts = [c for c in assembly.contacts(tol) if c.a in inside and c.b in inside]
+    contacts = [c for c in assembly_contacts(assembly, tol) if c.a in inside and c.b in inside]
     if motion == "rigid":
         return RigidBlockingGraph(names, tuple(contacts), tol)
-    graphs = _GRAPHS.setdefault(assembly, {})
+    graphs = BlockingCache.of(assembly).graphs
     key = (motion, names, tol)
     whole = graphs.get((motion, tuple(assembly.names), tol))
-    if key not in graphs and whole is not None:
+    if key not in graphs and isinstance(whole, NonDirectionalBlockingGraph):
         # a sub-assembly of an assembly already analysed: drop the other parts' slots
         graphs[key] = whole.without_parts(set(whole.parts) - inside)
-    planar = getattr(assembly, "dimension", 3) == 2  # polygons: exact terms, any shape
     if (
         key not in graphs
         and motion == "extended"
-        and not planar
-        and not all_convex(assembly, names)
+        and not isinstance(assembly, PolygonAssembly)  # polygons: exact terms, any shape
+        and not all_convex(of_meshes(assembly), names)
     ):
         local = blocking_graph(assembly, "infinitesimal", names, tol)
-        graphs[key] = sampled_ndbg(assembly, names, local, tol)
+        graphs[key] = sampled_ndbg(of_meshes(assembly), names, local, tol)
     if key not in graphs:
         terms = [
             t
@@ -130,4 +135,44 @@ def blocking_graph(
         ]
         dimension = getattr(assembly, "dimension", 3)
         graphs[key] = build_ndbg(names, motion, terms, len(contacts), tol, dimension)
-    return graphs[key]
+    graph = graphs[key]
+    assert isinstance(graph, NonDirectionalBlockingGraph)
+    return graph
+
+
+def sampled_ndbg(
+    assembly: Assembly, parts: tuple[str, ...], local: NonDirectionalBlockingGraph, tol: Tolerance
+) -> NonDirectionalBlockingGraph:
+    """Γ_e over the regions of the Γ_t graph ``local`` of the same parts, each region's
+    DBG computed exactly at its representative direction; ``dbg(d)`` is exact for any
+    ``d``. Used when some part is not convex: the regions are then regular for Γ_t, not
+    necessarily for Γ_e, so free directions strictly between them may be missed."""
+    index = {name: k for k, name in enumerate(parts)}
+    pairs = [(i, j) for i in range(len(parts)) for j in range(len(parts)) if i != j]
+    moving = np.array([p[0] for p in pairs], dtype=np.int64)
+    blocker = np.array([p[1] for p in pairs], dtype=np.int64)
+    circles = local.arrangement.normals
+    table = ConstraintTable(
+        circles,
+        np.zeros((len(circles), len(pairs))),
+        np.zeros((len(circles), len(pairs))),
+        np.full(len(pairs), np.inf),
+        np.arange(len(pairs), dtype=np.int64),
+        moving,
+        blocker,
+    )
+    column = {pair: s for s, pair in enumerate(pairs)}
+    slots = np.zeros((len(local.arrangement), len(pairs)), dtype=bool)
+    for r, d in enumerate(local.arrangement.directions):
+        for i, j in extended_arcs(assembly, d, parts, parts, tol):
+            slots[r, column[(index[i], index[j])]] = True
+    return NonDirectionalBlockingGraph(
+        parts,
+        "extended",
+        local.arrangement,
+        table,
+        np.packbits(slots, axis=1),
+        local.contacts,
+        tol,
+        lambda d, names: extended_dbg(assembly, d, names, tol),
+    )

@@ -23,7 +23,6 @@ from typing import Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from rich.table import Table
 
 from assemblykit.blocking.arrangement import (
     Arrangement,
@@ -33,8 +32,8 @@ from assemblykit.blocking.arrangement import (
     sphere_arrangement,
 )
 from assemblykit.blocking.constraints import BlockingTerm
-from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal, removal_table
-from assemblykit.geometry.contacts import Contact
+from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
+from assemblykit.blocking.directions import DirectionTable
 from assemblykit.tolerance import Tolerance
 
 Motion = Literal["infinitesimal", "extended", "rigid"]
@@ -43,12 +42,11 @@ _PAD = -2
 
 
 class AssemblyLike(Protocol):
-    """What the blocking graphs need from an assembly (3D or planar)."""
+    """What the blocking graphs need from an assembly (3D or planar); its contacts are
+    :func:`assemblykit.geometry.contacts.assembly_contacts`."""
 
     @property
     def names(self) -> list[str]: ...
-
-    def contacts(self, tol: Tolerance | None = None) -> list[Contact]: ...
 
     def tolerance(self, tol: Tolerance | None = None) -> Tolerance: ...
 
@@ -217,8 +215,8 @@ class NonDirectionalBlockingGraph:
         )
         return DirectionalBlockingGraph(self.parts, direction, arcs)
 
-    def _slots(self, region: int) -> NDArray[np.bool_]:
-        return np.unpackbits(self.packed[region], count=len(self.table.starts)).astype(bool)
+    def _unpacked(self, row: NDArray[np.uint8]) -> NDArray[np.bool_]:
+        return np.unpackbits(row, count=len(self.table.starts)).astype(bool)
 
     def _direction(self, direction: ArrayLike) -> NDArray[np.float64]:
         d = np.asarray(direction, dtype=np.float64).ravel()
@@ -239,7 +237,7 @@ class NonDirectionalBlockingGraph:
         """The DBG of one region as found by the crossing rule."""
         d = self.arrangement.directions[region]
         out = d[:2] if self.arrangement.dimension == 2 else d
-        return self._graph(out, self._slots(region))
+        return self._graph(out, self._unpacked(self.packed[region]))
 
     def regions(self) -> list[Region]:
         """Every regular region with its representative direction and DBG."""
@@ -249,18 +247,42 @@ class NonDirectionalBlockingGraph:
             for r in range(len(dims))
         ]
 
+    def unique_dbgs(self) -> list[tuple[DirectionalBlockingGraph, NDArray[np.int64]]]:
+        """Each distinct DBG of the regions, once, with the regions (increasing) that
+        have it; the DBG's direction is the zero vector (it stands for all of them)."""
+        unique, inverse = np.unique(self.packed, axis=0, return_inverse=True)
+        by_row = np.argsort(inverse.ravel(), kind="stable")
+        cuts = np.cumsum(np.bincount(inverse.ravel(), minlength=len(unique)))[:-1]
+        return [
+            (self._graph(np.zeros(3), self._unpacked(row)), members)
+            for row, members in zip(unique, np.split(by_row, cuts), strict=True)
+        ]
+
+    def direction_table(self, directions: NDArray[np.float64] | None = None) -> DirectionTable:
+        """The DBGs along ``directions``, computed from the terms; by default the DBG of
+        every region (vertices and edges included: free directions are often isolated,
+        e.g. a pin's axis) at its representative direction, read from the crossing
+        rule's slots as they are. Regions with the same DBG are kept apart."""
+        if directions is None:
+            directions = np.asarray(self.arrangement.directions, dtype=np.float64)
+            slots = self._slot_matrix().reshape(len(directions), len(self.table.starts))
+        else:
+            slots = self.table.direct_arcs(directions, self.tol)
+        return DirectionTable(
+            tuple(self.parts),
+            directions,
+            slots,
+            np.asarray(self.table.slot_moving, dtype=np.int64),
+            np.asarray(self.table.slot_blocker, dtype=np.int64),
+        )
+
     def removable(self, max_size: int | None = None) -> list[Removal]:
         """Every locally free subassembly closed under blocking (up to ``max_size``
         parts) with the directions of the regions that free it, faces first.
 
         Regions with the same DBG are analysed once."""
-        unique, inverse = np.unique(self.packed, axis=0, return_inverse=True)
-        by_row = np.argsort(inverse.ravel(), kind="stable")
-        cuts = np.cumsum(np.bincount(inverse.ravel(), minlength=len(unique)))[:-1]
         found: dict[frozenset[str], list[int]] = defaultdict(list)
-        for row, members in zip(unique, np.split(by_row, cuts), strict=True):
-            slots = np.unpackbits(row, count=len(self.table.starts)).astype(bool)
-            graph = self._graph(np.zeros(3), slots)
+        for graph, members in self.unique_dbgs():
             for subset in graph.free_subassemblies():
                 if max_size is None or len(subset) <= max_size:
                     found[subset].extend(members.tolist())
@@ -509,17 +531,6 @@ class NonDirectionalBlockingGraph:
             "regions": self.arrangement.counts,
             "removable": [r.to_dict() for r in self.removable()],
         }
-
-    def render(self) -> Table:
-        """A table of the removable subassemblies and their first direction."""
-        counts = self.arrangement.counts
-        return removal_table(
-            f"{self.motion} NDBG: {len(self.parts)} parts, {self.contacts} contacts, "
-            f"{counts['vertices']} vertices, {counts['edges']} edges, {counts['faces']} faces",
-            "directions",
-            "e.g.",
-            self.removable(),
-        )
 
 
 def build_ndbg(

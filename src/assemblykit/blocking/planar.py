@@ -27,7 +27,7 @@ DBG is constant over each, and ``dbg(d)`` holds for any ``d``.
 from __future__ import annotations
 
 import itertools
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
@@ -37,6 +37,9 @@ from shapely.ops import unary_union
 
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.blocking.polygons import PolygonAssembly
 
 
 def convex_pieces(polygon: NDArray[np.float64], tol: Tolerance) -> list[NDArray[np.float64]]:
@@ -107,7 +110,7 @@ def blocked_normals(
     return np.array([_left(first), -_left(last)])
 
 
-def planar_extended_terms(model: Any, tol: Tolerance) -> list[BlockingTerm]:
+def planar_extended_terms(model: PolygonAssembly, tol: Tolerance) -> list[BlockingTerm]:
     """The Γ_e terms of a polygon assembly (:class:`assemblykit.blocking.polygons.
     PolygonAssembly`): one per pair of convex pieces of every two parts, both ways."""
     pieces = {name: convex_pieces(poly, tol) for name, poly in model.polygons.items()}
@@ -121,6 +124,6 @@ def planar_extended_terms(model: Any, tol: Tolerance) -> list[BlockingTerm]:
     return terms
 
 
-def areas(model: Any) -> dict[str, float]:
+def areas(model: PolygonAssembly) -> dict[str, float]:
     """The area of each polygon (the planar planner keeps the largest part as base)."""
     return {name: float(Polygon(poly).area) for name, poly in model.polygons.items()}

@@ -22,7 +22,7 @@ from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
 from assemblykit.errors import GeometryError, UnknownNameError
-from assemblykit.geometry.contacts import Contact, PlanarPatch
+from assemblykit.geometry.contacts import Contact, PlanarPatch, assembly_contacts
 from assemblykit.tolerance import Tolerance, current
 
 
@@ -68,6 +68,9 @@ class PolygonAssembly:
         return PolygonAssembly(
             {n: self.polygons[n] for n in self.polygons if n in names}, self.source
         )
+
+
+assembly_contacts.register(PolygonAssembly, PolygonAssembly.contacts)
 
 
 def counter_clockwise(

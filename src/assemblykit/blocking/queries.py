@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import networkx as nx
 import numpy as np
@@ -36,8 +37,13 @@ from assemblykit.blocking.ndbg import (
     NonDirectionalBlockingGraph,
     build_ndbg,
 )
+from assemblykit.blocking.obstacles import of_meshes
 from assemblykit.errors import UnknownNameError
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
 
 _AXES = np.concatenate([np.eye(3), -np.eye(3)])
 
@@ -94,7 +100,7 @@ def _extra_directions(
     for name in sorted(subassembly):
         mesh = assembly.parts[name].mesh  # type: ignore[attr-defined]
         candidates.extend([*mesh.principal_inertia_vectors, *-mesh.principal_inertia_vectors])
-    for c in assembly.contacts(tol):
+    for c in assembly_contacts(assembly, tol):
         if (c.a in subassembly) != (c.b in subassembly):
             away = -1.0 if c.a in subassembly else 1.0
             candidates.extend(away * np.asarray(p.normal, dtype=np.float64) for p in c.planar)
@@ -141,12 +147,13 @@ def can_extract(
     if motion == "extended" and len(dims):
         # the highest dimension first (the open free cone when it has one), then the rest
         top = dims == dims[0]
+        meshes = of_meshes(assembly)
         for batch in (directions[top], directions[~top], _extra_directions(assembly, moving, tol)):
-            free = [d for d in batch if extended_free(assembly, moving, d, tol, names)]
+            free = [d for d in batch if extended_free(meshes, moving, d, tol, names)]
             if free:
                 return Removal(chosen, tuple(free))
         # none of the sampled directions: a face of the exact free set (a tunnel)
-        exact = exact_free_directions(assembly, moving, tol)
+        exact = exact_free_directions(meshes, moving, tol)
         if exact.directions:
             return Removal(chosen, exact.directions, exact.tolerance_dependent)
         return None
@@ -184,7 +191,7 @@ class Prerequisite:
     minimal: bool
 
 
-def removal_before(assembly: AssemblyLike, part: str, tol: Tolerance | None = None) -> Prerequisite:
+def removal_before(assembly: Assembly, part: str, tol: Tolerance | None = None) -> Prerequisite:
     """The fewest parts to remove before ``part`` can leave by an extended translation,
     over all directions (Wilson & Latombe 1992 §5): the directions are one per face of the overlay
     of the sets each other part blocks (over a face, the parts blocking ``part`` are
@@ -226,7 +233,7 @@ def removal_before(assembly: AssemblyLike, part: str, tol: Tolerance | None = No
 
 
 def _removable_first(
-    assembly: AssemblyLike, chosen: frozenset[str], names: list[str], tol: Tolerance
+    assembly: Assembly, chosen: frozenset[str], names: list[str], tol: Tolerance
 ) -> bool:
     """Whether the parts of ``chosen`` can be taken out of ``names`` one at a time, each
     along a face of its exact free set among the parts still there (removing parts only
@@ -261,7 +268,7 @@ def parts_to_remove_before(
     if part not in assembly.names:
         raise UnknownNameError(f"no part named {part!r}")
     if motion == "extended":
-        return removal_before(assembly, part, tol).parts
+        return removal_before(of_meshes(assembly), part, tol).parts
     if motion == "rigid":
         graph = blocking_graph(assembly, "rigid", tol=tol)
         best = min(
@@ -272,9 +279,7 @@ def parts_to_remove_before(
         return frozenset(best - {part})
     ndbg = blocking_graph(assembly, motion, tol=tol)
     best_set = frozenset(assembly.names) - {part}
-    for row in np.unique(ndbg.packed, axis=0):
-        slots = np.unpackbits(row, count=len(ndbg.table.starts)).astype(bool)
-        dbg = ndbg._graph(np.zeros(3), slots)
+    for dbg, _ in ndbg.unique_dbgs():
         pushed = frozenset(nx.descendants(dbg.graph, part))
         if len(pushed) < len(best_set):
             best_set = pushed

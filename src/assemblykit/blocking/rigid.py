@@ -35,11 +35,10 @@ from typing import Any
 import networkx as nx
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from rich.table import Table
 from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, QhullError
 
-from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal, removal_table
+from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
 from assemblykit.geometry.contacts import Contact, PlanarPatch
 from assemblykit.tolerance import Tolerance
@@ -301,13 +300,3 @@ class RigidBlockingGraph:
             "arrangement": arr.status,
             "removable": [r.to_dict() for r in self.removable()],
         }
-
-    def render(self) -> Table:
-        """A table of the removable subassemblies with their first twist."""
-        return removal_table(
-            f"rigid NDBG: {len(self.parts)} parts, {len(self.contacts)} contacts, "
-            f"arrangement {self.arrangement.status}",
-            "twists",
-            "e.g. (omega; v)",
-            self.removable(),
-        )

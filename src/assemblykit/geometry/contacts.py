@@ -16,6 +16,15 @@ and cones and concentric spheres of equal size, one convex and one concave, read
 the parts' exact or recognised surfaces; each keeps only the part of the surface of
 revolution both parts cover, as the normals there (:mod:`assemblykit.geometry.curved`).
 
+What is found is kept with the assembly: :func:`assembly_contacts` (contacts per
+tolerance) and :func:`assembly_surfaces` (surfaces per part and tolerance) fill a
+:class:`GeometryMemo`, an explicit object held in the assembly's ``memo`` slot rather than
+a module global keyed by assembly. The model owns the slot and knows only its protocol
+(``model.assembly.Derived``); this layer fills it. So the memo lives and dies with the
+assembly, two assemblies never share one, and a sub-assembly keeps what concerns its own
+parts (:meth:`GeometryMemo.restricted`, called by ``Assembly.subset`` and ``with_part``):
+taking parts away costs nothing, and adding one costs only that part's contacts.
+
 Convention: every normal stored here is the outward normal of part ``a``'s surface, so
 it points from ``a`` into ``b``. Translating ``a`` infinitesimally along ``d`` pushes
 into ``b`` across a planar patch iff ``d . normal > 0`` (Wilson & Latombe 1992, DBG arcs).
@@ -24,14 +33,18 @@ into ``b`` across a planar patch iff ``d . normal > 0`` (Wilson & Latombe 1992, 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any, Literal
+from collections.abc import Iterable, Set
+from dataclasses import dataclass, field, replace
+from functools import singledispatch
+from typing import Any, Literal
 
 import numpy as np
 import shapely
+import trimesh
 from numpy.typing import NDArray
 from rtree import index
 
+from assemblykit.algebra.se3 import axis_basis
 from assemblykit.geometry.curved import (
     ARC_STEP,
     CONE_AZIMUTHS,
@@ -44,11 +57,16 @@ from assemblykit.geometry.curved import (
     revolution_normals,
     sphere_region,
 )
-from assemblykit.geometry.recognition import Segmentation, Surface, faces_on, segment
+from assemblykit.geometry.recognition import (
+    Segmentation,
+    faces_on,
+    recognise_curved,
+    recognise_planes,
+    segment,
+)
+from assemblykit.model.assembly import Assembly
+from assemblykit.model.surfaces import Surface
 from assemblykit.tolerance import Tolerance
-
-if TYPE_CHECKING:
-    from assemblykit.model.assembly import Assembly
 
 CurvedKind = Literal["cylindrical", "conical", "spherical"]
 
@@ -196,14 +214,6 @@ def candidate_pairs(
     return np.unique(pairs, axis=0) if len(pairs) else np.zeros((0, 2), dtype=np.int64)
 
 
-def _frames(normals: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Unit vectors ``u, v`` with ``(u, v, n)`` right-handed, for each row ``n``."""
-    helper = np.eye(3)[np.argmin(np.abs(normals), axis=1)]
-    u = np.cross(helper, normals)
-    u /= np.linalg.norm(u, axis=1)[:, None]
-    return u, np.cross(normals, u)
-
-
 def _boxes_overlap(
     lo_a: NDArray[np.float64],
     hi_a: NDArray[np.float64],
@@ -225,9 +235,10 @@ class PartStack:
     face_start: NDArray[np.int64]
 
 
-def stack_parts(assembly: Assembly) -> PartStack:
-    """The triangles of all parts of ``assembly`` in one :class:`PartStack`."""
-    meshes = [p.mesh for p in assembly.parts.values()]
+def stack_parts(meshes: Iterable[trimesh.Trimesh]) -> PartStack:
+    """The triangles of ``meshes`` (the parts of an assembly, in order) in one
+    :class:`PartStack`."""
+    meshes = list(meshes)
     n_vertices = np.array([len(m.vertices) for m in meshes], dtype=np.int64)
     n_faces = np.array([len(m.faces) for m in meshes], dtype=np.int64)
     vertex_start = np.cumsum(n_vertices) - n_vertices
@@ -339,7 +350,7 @@ def triangle_overlaps(
     faces_b = seg.order[_expand(seg.start[h], size_h)]
     i, j = _cross_join(owner_a, owner_b, len(g))
     owner = owner_a[i]
-    u, v = _frames(seg.normal[g]) if len(g) else (np.zeros((0, 3)), np.zeros((0, 3)))
+    u, v = axis_basis(seg.normal[g]) if len(g) else (np.zeros((0, 3)), np.zeros((0, 3)))
     tri_a = _triangles_2d(stack.vertices[stack.faces[faces_a[i]]], u[owner], v[owner])
     tri_b = _triangles_2d(stack.vertices[stack.faces[faces_b[j]]], u[owner], v[owner])
     width = np.minimum(tri_a.max(axis=1), tri_b.max(axis=1)) - np.maximum(
@@ -569,7 +580,7 @@ def find_contacts(
     names = list(assembly.parts)
     if len(names) < 2:
         return []
-    stack = stack_parts(assembly)
+    stack = stack_parts(p.mesh for p in assembly)
     seg = segment(stack.vertices, stack.faces, tol)
     part_lo = np.array([p.mesh.bounds[0] for p in assembly.parts.values()])
     part_hi = np.array([p.mesh.bounds[1] for p in assembly.parts.values()])
@@ -586,9 +597,7 @@ def find_contacts(
     for k in parts_in_pairs:
         part = assembly.parts[names[k]]
         if part.surfaces or curved_part[k]:
-            curved_surfaces = tuple(
-                s for s in assembly.surfaces(names[k], tol) if s.kind != "plane"
-            )
+            curved_surfaces = assembly_curved_surfaces(assembly, names[k], tol)
             surfaces[int(k)] = curved_surfaces
             start = stack.face_start[k]
             excluded[start : start + len(part.mesh.faces)] = faces_on(
@@ -622,6 +631,103 @@ def find_contacts(
         if planar.get(key) or curved.get(key)
     ]
     return snapped(found, policy)
+
+
+@dataclass(eq=False)
+class GeometryMemo:
+    """What the geometry of an assembly's parts gave, kept in its ``memo`` slot (module
+    docstring): ``contacts`` per tolerance, with the names of the parts they cover,
+    ``surfaces`` per part name and tolerance, and the ``curved`` ones among them (all
+    that contacts ask for: recognised first, without the planes)."""
+
+    contacts: dict[Tolerance, tuple[frozenset[str], list[Contact]]] = field(default_factory=dict)
+    surfaces: dict[tuple[str, Tolerance], tuple[Surface, ...]] = field(default_factory=dict)
+    curved: dict[tuple[str, Tolerance], tuple[Surface, ...]] = field(default_factory=dict)
+
+    def restricted(self, names: Set[str]) -> GeometryMemo:
+        """What still holds for the parts ``names`` alone: the contacts among them and
+        their surfaces."""
+        return GeometryMemo(
+            {
+                key: (covered & names, [c for c in found if c.a in names and c.b in names])
+                for key, (covered, found) in self.contacts.items()
+            },
+            {key: found for key, found in self.surfaces.items() if key[0] in names},
+            {key: found for key, found in self.curved.items() if key[0] in names},
+        )
+
+
+def memo_of(assembly: Assembly) -> GeometryMemo:
+    """The :class:`GeometryMemo` in ``assembly.memo``, an empty one on first use."""
+    if not isinstance(assembly.memo, GeometryMemo):
+        assembly.memo = GeometryMemo()
+    return assembly.memo
+
+
+def assembly_surfaces(
+    assembly: Assembly, name: str, tol: Tolerance | None = None
+) -> tuple[Surface, ...]:
+    """The surfaces of part ``name``: its exact CAD surfaces, else those recognised on
+    its mesh (:func:`~assemblykit.geometry.recognition.recognise`: the curved ones of
+    :func:`assembly_curved_surfaces`, then the planes), once per tolerance."""
+    part = assembly.part(name)
+    if part.surfaces:
+        return part.surfaces
+    key = (name, assembly.tolerance(tol))
+    memo = memo_of(assembly).surfaces
+    if key not in memo:
+        curved = assembly_curved_surfaces(assembly, name, tol)
+        memo[key] = curved + recognise_planes(part.mesh, curved, key[1])
+    return memo[key]
+
+
+def assembly_curved_surfaces(
+    assembly: Assembly, name: str, tol: Tolerance | None = None
+) -> tuple[Surface, ...]:
+    """The surfaces of part ``name`` other than planes: of its exact CAD surfaces, else
+    those recognised on its mesh
+    (:func:`~assemblykit.geometry.recognition.recognise_curved`), once per tolerance."""
+    part = assembly.part(name)
+    if part.surfaces:
+        return tuple(s for s in part.surfaces if s.kind != "plane")
+    key = (name, assembly.tolerance(tol))
+    memo = memo_of(assembly).curved
+    if key not in memo:
+        memo[key] = recognise_curved(part.mesh, key[1])
+    return memo[key]
+
+
+@singledispatch
+def assembly_contacts(assembly: object, tol: Tolerance | None = None) -> list[Contact]:
+    """The contacts between the touching parts of ``assembly``, dispatched on its type:
+    an :class:`~assemblykit.model.assembly.Assembly` (:func:`_mesh_contacts`) or another
+    kind that registers its own (the planar polygons of ``assemblykit.blocking.polygons``)."""
+    raise TypeError(f"no contacts for a {type(assembly).__name__}")
+
+
+@assembly_contacts.register
+def _mesh_contacts(assembly: Assembly, tol: Tolerance | None = None) -> list[Contact]:
+    """The contacts between touching parts, computed once per tolerance
+    (:func:`find_contacts`); for parts the memo does not cover yet (one added by
+    ``Assembly.with_part``) only their own contacts are found and added."""
+    key = assembly.tolerance(tol)
+    memo = memo_of(assembly).contacts
+    covered, found = memo.get(key, (frozenset(), []))
+    missing = [name for name in assembly.parts if name not in covered]
+    if missing:
+        if not covered:
+            found = find_contacts(assembly, tol)
+        else:
+            found, added = list(found), set[str]()
+            for name in missing:
+                found += [
+                    c
+                    for c in find_contacts(assembly, key, only=name)
+                    if c.a not in added and c.b not in added
+                ]
+                added.add(name)
+        memo[key] = (frozenset(assembly.parts), found)
+    return found
 
 
 def _spread(patch: PlanarPatch | CurvedPatch) -> NDArray[np.float64]:
@@ -752,7 +858,7 @@ def _layer_patches(
     patches: list[PlanarPatch], normal: NDArray[np.float64], tol: Tolerance
 ) -> list[PlanarPatch]:
     """The union of coplanar ``patches`` (normal ``normal``) as patches, one per piece."""
-    u, v = (w[0] for w in _frames(normal[None]))
+    u, v = (w[0] for w in axis_basis(normal[None]))
     height = float(np.mean([normal @ p.centroid for p in patches]))
     flat = [shapely.Polygon(np.column_stack([p.polygon @ u, p.polygon @ v])) for p in patches]
     union = _closed(np.array([shapely.union_all(flat)], dtype=object), tol.length)[0]

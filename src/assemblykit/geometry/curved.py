@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, QhullError
 
+from assemblykit.algebra.se3 import axis_basis
 from assemblykit.tolerance import Tolerance
 
 # a cone's normals are sampled every eighth of a turn (module docstring)
@@ -57,11 +58,8 @@ _AXES = np.eye(3)
 def axis_frame(axis: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Unit ``e1, e2`` completing the unit ``axis`` to a right-handed frame; azimuths
     about the axis are measured from ``e1`` towards ``e2``."""
-    a = axis / np.linalg.norm(axis)
-    helper = _AXES[int(np.argmin(np.abs(a)))]
-    e1 = np.cross(a, helper)
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(a, e1)
+    u, v = axis_basis(axis / np.linalg.norm(axis))
+    return -u, -v
 
 
 def _merge(intervals: NDArray[np.float64], gap: float) -> NDArray[np.float64]:

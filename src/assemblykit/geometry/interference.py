@@ -40,7 +40,12 @@ def solid(mesh: trimesh.Trimesh, name: str | None = None) -> manifold3d.Manifold
 
 def overlap_volume(mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh) -> float:
     """Volume of the intersection of two closed meshes, ``vol(A ∩ B)``."""
-    return float((solid(mesh_a) ^ solid(mesh_b)).volume())
+    return shared_volume(solid(mesh_a), solid(mesh_b))
+
+
+def shared_volume(a: manifold3d.Manifold, b: manifold3d.Manifold) -> float:
+    """Volume of the intersection of two solids (:func:`solid`), ``vol(A ∩ B)``."""
+    return float((a ^ b).volume())
 
 
 def interference_threshold(
@@ -83,7 +88,7 @@ def interferences(assembly: Assembly, tol: Tolerance | None = None) -> list[tupl
         for k, part in ((i, a), (j, b)):
             if k not in solids:
                 solids[k] = solid(part.mesh, part.name)
-        volume = float((solids[i] ^ solids[j]).volume())
+        volume = shared_volume(solids[i], solids[j])
         if volume > interference_threshold(a.mesh, b.mesh, tol):
             found.append((a.name, b.name, volume))
     return found

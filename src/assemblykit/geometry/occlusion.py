@@ -14,14 +14,17 @@ some overlap the depth of ``j`` exceeds that of ``i`` by more than the length to
 (faces in contact give 0). The excess is measured across the faces (times the larger
 ``|n . d|`` of the two): coincident faces nearly parallel to ``d`` differ along ``d`` by
 their rounding error divided by that cosine, not by an overlap. The broad phase is
-shapely's STRtree over the triangles' bounding boxes with an affine depth bound, the
-overlaps every pair's triangles clipped by one another at once (Sutherland & Hodgman
-1974, in numpy); overlaps thinner than the length tolerance (shared edges) have no area
-and are left out. Triangles within the angle tolerance of parallel to ``d`` project to
-nothing and are skipped, and so are those whose projection is thinner than the length
-tolerance (a side face tilted by vertex noise): every overlap with them would be too
-thin to count. Meshes that do not bound a volume (open or inconsistently wound) use
-all their triangles on both sides, which is still exact, only slower.
+shapely's STRtree over the triangles' bounding boxes, one per blocking mesh, with an
+affine depth bound, the overlaps every pair's triangles clipped by one another at once
+(Sutherland & Hodgman 1974, in numpy). Any pair of triangles that blocks shows that its
+meshes block, so the largest projected triangles of each mesh are compared first and
+only the pairs of meshes not yet blocking are compared over all triangles. Overlaps
+thinner than the length tolerance (shared edges) have no area and are left out.
+Triangles within the angle tolerance of parallel to ``d`` project to nothing and are
+skipped, and so are those whose projection is thinner than the length tolerance (a side
+face tilted by vertex noise): every overlap with them would be too thin to count.
+Meshes that do not bound a volume (open or inconsistently wound) use all their triangles
+on both sides, which is still exact, only slower.
 """
 
 from __future__ import annotations
@@ -37,6 +40,9 @@ from numpy.typing import ArrayLike, NDArray
 from assemblykit.tolerance import Tolerance, current
 
 _FIRST_CHUNK = 1024
+_FIRST_TRIANGLES = 256
+"""How many of each mesh's largest projected triangles :func:`occluded_pairs` compares
+first (where most blocking pairs show)."""
 
 
 def view_frame(direction: ArrayLike) -> NDArray[np.float64]:
@@ -95,9 +101,10 @@ class Shadows:
 
 def _shadow_width(flat: NDArray[np.float64]) -> NDArray[np.float64]:
     """The smallest altitude of each projected triangle (t x 3 x 2)."""
-    edges = np.roll(flat, -1, axis=1) - flat
+    edges = flat[:, [1, 2, 0]] - flat
     double_area = np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
-    longest = np.linalg.norm(edges, axis=2).max(axis=1)
+    length = np.sqrt(edges[:, :, 0] * edges[:, :, 0] + edges[:, :, 1] * edges[:, :, 1])
+    longest = np.maximum(np.maximum(length[:, 0], length[:, 1]), length[:, 2])
     return double_area / np.where(longest > 0, longest, 1.0)
 
 
@@ -110,12 +117,13 @@ def shadows(
     owner, facing, corners, normals = [], [], [], []
     for k, mesh in enumerate(meshes):
         cos = mesh.face_normals @ frame[2]
-        flat = np.asarray(mesh.triangles, dtype=np.float64) @ frame[:2].T
-        keep = (np.abs(cos) > tol.mesh_angle) & (_shadow_width(flat) > tol.length)
+        # every corner in the view frame once: its first two coordinates on the plane
+        seen = np.asarray(mesh.triangles, dtype=np.float64) @ frame.T
+        keep = (np.abs(cos) > tol.mesh_angle) & (_shadow_width(seen[:, :, :2]) > tol.length)
         owner.append(np.full(int(keep.sum()), k, dtype=np.int64))
         # without a consistent outside every triangle may bound the part on either side
         facing.append(np.sign(cos[keep]).astype(np.int8) * np.int8(mesh.is_volume))
-        corners.append(np.asarray(mesh.triangles[keep], dtype=np.float64) @ frame.T)
+        corners.append(seen[keep])
         normals.append(mesh.face_normals[keep] @ frame.T)
     tri = np.concatenate(corners) if corners else np.zeros((0, 3, 3))
     n = np.concatenate(normals) if normals else np.zeros((0, 3))
@@ -123,14 +131,18 @@ def shadows(
     plane = np.column_stack(
         [-n[:, 0] / n[:, 2], -n[:, 1] / n[:, 2], np.einsum("ij,ij->i", n, tri[:, 0]) / n[:, 2]]
     )
+    # minima and maxima of the three corners pairwise: reductions over an axis of
+    # length 3 cost more than the comparisons
+    lowest = np.minimum(np.minimum(tri[:, 0], tri[:, 1]), tri[:, 2])
+    highest = np.maximum(np.maximum(tri[:, 0], tri[:, 1]), tri[:, 2])
     return Shadows(
         np.concatenate(owner) if owner else np.zeros(0, np.int64),
         np.concatenate(facing) if facing else np.zeros(0, np.int8),
         tri[:, :, :2],
         plane,
-        tri[:, :, 2].min(axis=1),
-        tri[:, :, 2].max(axis=1),
-        np.column_stack([tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)]),
+        lowest[:, 2],
+        highest[:, 2],
+        np.column_stack([lowest[:, :2], highest[:, :2]]),
     )
 
 
@@ -181,35 +193,131 @@ def _following(corner: NDArray[np.bool_]) -> NDArray[np.int64]:
     return np.where(index + 1 < corner.sum(axis=1)[:, None], index + 1, 0)
 
 
+def _box_hits(
+    view: Shadows,
+    backward: NDArray[np.int64],
+    forward: NDArray[np.int64],
+    allowed: NDArray[np.bool_],
+    tol: Tolerance,
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The pairs of a ``backward`` and a ``forward`` triangle of meshes ``(i, j)`` with
+    ``allowed[i, j]`` whose bounding boxes meet and whose depth ranges let the forward
+    one lie deeper by more than the length tolerance (else :meth:`Shadows.bound` rules
+    them out): per blocking mesh, its forward triangles and the backward triangles of the
+    meshes it may block, each kept only where it meets the other side's overall box and
+    depth range, then one STRtree (a mesh's own triangles, overlapping everywhere, are
+    never compared)."""
+    sides: list[tuple[NDArray[np.int64], NDArray[np.int64]]] = []
+    for j in np.flatnonzero(np.any(allowed, axis=0)):
+        front = forward[view.owner[forward] == j]
+        back = backward[allowed[view.owner[backward], j]]
+        if len(front) and len(back):
+            back = back[_meets(view, back, front, tol, behind=True)]
+        if len(back):
+            front = front[_meets(view, front, back, tol, behind=False)]
+        if len(front) and len(back):
+            sides.append((back, front))
+    # the trees only compare bounding boxes: each box's diagonal has the same and is
+    # cheaper to make than the triangle (made once for a triangle on several sides)
+    used = np.unique(
+        np.concatenate([np.zeros(0, dtype=np.int64), *(np.concatenate(s) for s in sides)])
+    )
+    diagonals = np.empty(len(view.owner), dtype=object)
+    diagonals[used] = shapely.linestrings(
+        np.stack([view.box[used, :2], view.box[used, 2:]], axis=1)
+    )
+    backs, fronts = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
+    for back, front in sides:
+        hits = shapely.STRtree(diagonals[front]).query(diagonals[back])
+        backs.append(back[hits[0]])
+        fronts.append(front[hits[1]])
+    return np.concatenate(backs), np.concatenate(fronts)
+
+
+def _meets(
+    view: Shadows,
+    these: NDArray[np.int64],
+    others: NDArray[np.int64],
+    tol: Tolerance,
+    *,
+    behind: bool,
+) -> NDArray[np.bool_]:
+    """Per triangle of ``these``, whether its box meets the box around all of ``others``
+    and whether a forward triangle can lie deeper than a backward one by more than the
+    length tolerance: ``behind``, these are backward (the deepest of ``others`` beyond
+    their lowest depth by more), else forward (their deepest beyond the lowest of
+    ``others`` by more), the differences taken as :meth:`Shadows.bound` takes them."""
+    lo, hi = view.box[others, :2].min(axis=0), view.box[others, 2:].max(axis=0)
+    box = view.box[these]
+    near = np.all((box[:, :2] <= hi) & (box[:, 2:] >= lo), axis=1)
+    if behind:
+        return near & (view.high[others].max() - view.low[these] > tol.length)
+    return near & (view.high[these] - view.low[others].min() > tol.length)
+
+
 def occluded_pairs(
     view: Shadows, allowed: NDArray[np.bool_], tol: Tolerance | None = None
 ) -> set[tuple[int, int]]:
     """The pairs ``(i, j)`` of meshes such that ``j`` blocks the extended translation of
     ``i`` along the view direction, among those with ``allowed[i, j]`` (module
-    docstring). Triangle pairs are examined by decreasing :meth:`Shadows.bound`, and a
-    pair of meshes stops being examined once it blocks."""
+    docstring). First among the largest projected triangles of each mesh
+    (``_FIRST_TRIANGLES``): most blocking pairs have a pair of triangles that shows it
+    there, and only the others are then examined over all their triangles."""
     tol = tol or current()
-    backward = np.flatnonzero((view.facing <= 0) & np.any(allowed, axis=1)[view.owner])
-    forward = np.flatnonzero((view.facing >= 0) & np.any(allowed, axis=0)[view.owner])
+    found = _occluded_among(view, allowed, _largest(view, _FIRST_TRIANGLES), tol)
+    rest = allowed.copy()
+    for i, j in found:
+        rest[i, j] = False
+    return found | _occluded_among(view, rest, np.ones(len(view.owner), dtype=bool), tol)
+
+
+def _largest(view: Shadows, count: int) -> NDArray[np.bool_]:
+    """Per triangle, whether it is among the ``count`` largest projected triangles of
+    its mesh."""
+    edges = view.flat[:, 1:] - view.flat[:, :1]
+    area = np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
+    large = np.zeros(len(area), dtype=bool)
+    for k in np.unique(view.owner):
+        mine = np.flatnonzero(view.owner == k)
+        if len(mine) > count:
+            mine = mine[np.argpartition(-area[mine], count)[:count]]
+        large[mine] = True
+    return large
+
+
+def _occluded_among(
+    view: Shadows, allowed: NDArray[np.bool_], among: NDArray[np.bool_], tol: Tolerance
+) -> set[tuple[int, int]]:
+    """:func:`occluded_pairs` over the triangles ``among`` alone (a subset shows only
+    pairs that block). Triangle pairs are examined by decreasing :meth:`Shadows.bound`
+    within each pair of meshes, the pairs of meshes in turn, and a pair of meshes stops
+    being examined once it blocks."""
+    backward = np.flatnonzero(among & (view.facing <= 0) & np.any(allowed, axis=1)[view.owner])
+    forward = np.flatnonzero(among & (view.facing >= 0) & np.any(allowed, axis=0)[view.owner])
     if not len(backward) or not len(forward):
         return set()
-    # the tree only compares bounding boxes: each box's diagonal has the same and is
-    # cheaper to make than the triangle
-    diagonals = shapely.linestrings(np.stack([view.box[:, :2], view.box[:, 2:]], axis=1))
-    hits = shapely.STRtree(diagonals[forward]).query(diagonals[backward])
-    back, front = backward[hits[0]], forward[hits[1]]
-    keep = allowed[view.owner[back], view.owner[front]]
-    back, front = back[keep], front[keep]
+    back, front = _box_hits(view, backward, forward, allowed, tol)
     bound = view.bound(back, front) * np.maximum(view.cos[front], view.cos[back])
     keep = bound > tol.length
     order = np.argsort(-bound[keep], kind="stable")
     back, front = back[keep][order], front[keep][order]
-    found: set[tuple[int, int]] = set()
     size = len(allowed)
+    # round robin over the pairs of meshes: the k-th deepest candidate of every pair
+    # before the (k + 1)-th of any, so that each blocking pair is met early whatever
+    # the depths of the others
+    pairs = view.owner[back] * size + view.owner[front]
+    by_pair = np.argsort(pairs, kind="stable")
+    ranked = pairs[by_pair]
+    rank = np.empty(len(pairs), dtype=np.int64)
+    rank[by_pair] = np.arange(len(pairs)) - np.searchsorted(ranked, ranked)
+    order = np.argsort(rank, kind="stable")
+    back, front = back[order], front[order]
+    found: set[tuple[int, int]] = set()
     lo, chunk = 0, _FIRST_CHUNK
     while lo < len(back):
         b, f = back[lo : lo + chunk], front[lo : lo + chunk]
-        # growing chunks: blocking pairs are usually found in the first, deepest ones
+        # growing chunks: blocking pairs are usually found in the first, deepest ones of
+        # each pair of meshes
         lo, chunk = lo + chunk, 2 * chunk
         pair = view.owner[b] * size + view.owner[f]
         fresh = ~np.isin(pair, [i * size + j for i, j in found])

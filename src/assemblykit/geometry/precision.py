@@ -1,7 +1,8 @@
 """The input's own precision, measured from the data (extends the policy of tolerance.py).
 
 The tolerance policy fixes how precisely geometry is *compared*; the data fixes how
-precisely it was *given*. A loader measures the second and records it on the
+precisely it was *given*. A loader measures the second (a
+:class:`~assemblykit.model.assembly.Precision`) and records it on the
 :class:`~assemblykit.model.assembly.Assembly`, whose length tolerance is then
 ``max(policy, measured)``: a comparison never asks for more precision than the input has.
 
@@ -28,9 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from decimal import Decimal
-from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
@@ -44,21 +43,10 @@ from assemblykit.geometry.contacts import (
     triangle_overlaps,
 )
 from assemblykit.geometry.recognition import segment
+from assemblykit.model.assembly import Assembly, Precision
 from assemblykit.tolerance import Tolerance
 
-if TYPE_CHECKING:
-    from assemblykit.model.assembly import Assembly
-
 MAX_JOINT_TILT = math.radians(10.0)
-
-
-@dataclass(frozen=True)
-class Precision:
-    """A measured precision of the input: ``length`` in model units, and ``source``,
-    what it was measured from (shown by the ``contacts`` command)."""
-
-    length: float
-    source: str
 
 
 def combined(precisions: Iterable[Precision]) -> Precision | None:
@@ -115,7 +103,7 @@ def joint_mismatch(assembly: Assembly, tol: Tolerance | None = None) -> Precisio
     tol = assembly.policy_tolerance(tol)
     floor = tol.length
     names = list(assembly.parts)
-    stack = stack_parts(assembly)
+    stack = stack_parts(p.mesh for p in assembly)
     seg = segment(stack.vertices, stack.faces, tol)
     part_lo = np.array([p.mesh.bounds[0] for p in assembly.parts.values()])
     part_hi = np.array([p.mesh.bounds[1] for p in assembly.parts.values()])

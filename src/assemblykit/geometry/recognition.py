@@ -50,7 +50,7 @@ Method on meshes (all thresholds from the tolerance policy):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 import trimesh
@@ -59,11 +59,10 @@ from scipy.optimize import least_squares
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from assemblykit.algebra.se3 import line_classes
-from assemblykit.features.primitives import Feature
+from assemblykit.algebra.se3 import axis_basis, line_classes
+from assemblykit.model.surfaces import Surface, SurfaceKind
 from assemblykit.tolerance import Tolerance, current
 
-SurfaceKind = Literal["plane", "cylinder", "cone", "sphere", "torus"]
 SMOOTH_ANGLE = np.radians(30.0)
 MIN_CURVED_FACES = 3
 STRIP_WIDTHS = 2.0
@@ -73,61 +72,6 @@ AXIS_ANGLE = np.radians(1.0)
 """Edge axes within this angle count as one axis when a smooth region is split (step 4):
 the edges of one tessellated cylinder turn about parallel axes, up to the noise of the
 normals of small triangles."""
-
-
-@dataclass(frozen=True, eq=False)
-class Surface:
-    """One surface of a part, in world coordinates.
-
-    ``point``: a point of the plane, the axis foot at the start of the surface
-    (cylinder), the apex (cone), the centre (sphere, torus). ``axis``: the outward normal
-    (plane) or the unit axis (cylinder, cone from apex to opening, torus); ``None`` for
-    spheres. ``convex``: the material is inside (shaft, ball, male cone). ``extent``:
-    the interval ``(s0, s1)`` covered along the axis from ``point``. ``faces``: the
-    triangles of the part's mesh on this surface.
-    """
-
-    kind: SurfaceKind
-    point: NDArray[np.float64]
-    axis: NDArray[np.float64] | None
-    faces: NDArray[np.int64]
-    area: float
-    radius: float = 0.0
-    half_angle: float = 0.0
-    minor_radius: float = 0.0
-    convex: bool = True
-    extent: tuple[float, float] = (0.0, 0.0)
-
-    def feature(self) -> Feature:
-        """The :mod:`assemblykit.features` primitive of this surface (Liu 1997 §2)."""
-        from assemblykit.features.primitives import (
-            Ball,
-            Cone,
-            Hole,
-            Plane,
-            Shaft,
-            Socket,
-            Torus,
-        )
-
-        if self.kind == "sphere":
-            return (Ball if self.convex else Socket)(point=self.point, radius=self.radius)
-        axis = self.axis
-        assert axis is not None
-        if self.kind == "plane":
-            return Plane(point=self.point, normal=axis)
-        if self.kind == "cylinder":
-            cls = Shaft if self.convex else Hole
-            return cls(point=self.point, axis=axis, radius=self.radius, directed=False)
-        if self.kind == "cone":
-            return Cone(point=self.point, axis=axis, half_angle=self.half_angle, male=self.convex)
-        return Torus(
-            point=self.point,
-            axis=axis,
-            major_radius=self.radius,
-            minor_radius=self.minor_radius,
-            male=self.convex,
-        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -307,14 +251,6 @@ def _circle_fit(xy: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
     return centre, float(np.sqrt(max(solution[2] + centre @ centre, 0.0)))
 
 
-def _basis(axis: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Two unit vectors completing ``axis`` to a right-handed frame (rows)."""
-    helper = np.eye(3)[int(np.argmin(np.abs(axis)))]
-    u = np.cross(helper, axis)
-    u /= np.linalg.norm(u)
-    return np.array([u, np.cross(axis, u)])
-
-
 def _fit_cylinder(
     points: NDArray[np.float64],
     normals: NDArray[np.float64],
@@ -326,7 +262,7 @@ def _fit_cylinder(
     if values[0] > tol.angle:
         return None
     axis = vectors[:, 0]
-    plane = _basis(axis)
+    plane = np.array(axis_basis(axis))
     centre2, radius = _circle_fit(points @ plane.T)
     residual = np.abs(np.linalg.norm(points @ plane.T - centre2, axis=1) - radius)
     if residual.max() > tol.length:
@@ -353,7 +289,7 @@ def _fit_cone(
     if values[0] > tol.angle:
         return None
     axis = vectors[:, 0]
-    plane = _basis(axis)
+    plane = np.array(axis_basis(axis))
     xy, heights = points @ plane.T, points @ axis
     centre2, mean_radius = _circle_fit(xy)
 
@@ -444,7 +380,13 @@ def is_convex(
     weighted), away from the axis through ``point`` (or from ``point`` if no axis):
     the material is inside, as in a shaft, a ball or a male cone."""
     corners = vertices[faces]
-    weighted = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    (a0, a1, a2), (b0, b1, b2) = (
+        (corners[:, 1] - corners[:, 0]).T,
+        (corners[:, 2] - corners[:, 0]).T,
+    )
+    # the cross products written out (as np.cross computes them, without its overhead
+    # on the few triangles of a piece)
+    weighted = np.column_stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
     radial = corners.mean(axis=1) - point
     if axis is not None:
         radial -= np.outer(radial @ axis, axis)
@@ -452,8 +394,15 @@ def is_convex(
 
 
 def recognise(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surface, ...]:
-    """The surfaces of ``mesh``: its flat coplanar groups outside recognised curved
-    surfaces as planes, then its cylinders, cones and spheres (module docstring)."""
+    """The surfaces of ``mesh``: its cylinders, cones and spheres, then its flat coplanar
+    groups outside them as planes (module docstring)."""
+    curved = recognise_curved(mesh, tol)
+    return curved + recognise_planes(mesh, curved, tol)
+
+
+def recognise_curved(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surface, ...]:
+    """The cylinders, cones and spheres of ``mesh`` (method steps 1-4 on the strict
+    groups): all that contacts need, the planes being the coplanar groups they match."""
     tol = tol or current()
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
@@ -464,7 +413,18 @@ def recognise(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surf
     unfit = np.isin(seg.region, candidates[~fitted])
     if unfit.any():
         curved += split_surfaces(vertices, faces, seg, tol, unfit)
-    return curved + planes(segment(vertices, faces, tol), faces_on(curved, len(faces)))
+    return curved
+
+
+def recognise_planes(
+    mesh: trimesh.Trimesh, curved: tuple[Surface, ...], tol: Tolerance | None = None
+) -> tuple[Surface, ...]:
+    """The flat coplanar groups of ``mesh`` with no face on its ``curved`` surfaces
+    (:func:`recognise_curved`), as planes."""
+    tol = tol or current()
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    return planes(segment(vertices, faces, tol), faces_on(curved, len(faces)))
 
 
 def curved_surfaces(
@@ -541,11 +501,13 @@ def split_surfaces(
         axis = (turns * np.sign(turns @ turns[0])[:, None]).mean(axis=0)
         axis /= np.linalg.norm(axis)
         points = vertices[np.unique(edges[members])]
-        plane = _basis(axis)
+        plane = np.array(axis_basis(axis))
         centre, radius = _circle_fit(points @ plane.T)
         if np.abs(np.linalg.norm(points @ plane.T - centre, axis=1) - radius).max() > tol.length:
             continue
-        near = np.flatnonzero(np.isin(seg.group, seg.group[adjacency[members]]))
+        near = np.sort(
+            np.concatenate([seg.faces_of(g) for g in np.unique(seg.group[adjacency[members]])])
+        )
         corners = vertices[faces[near]] @ plane.T - centre
         on = np.abs(np.linalg.norm(corners, axis=2) - radius).max(axis=1) <= tol.length
         candidates.append(near[on])
@@ -558,8 +520,14 @@ def split_surfaces(
             claimed[ids] = True
     rest = ~claimed[adjacency[:, 0]] & ~claimed[adjacency[:, 1]]
     label = _components(len(faces), adjacency[rest])
-    for patch in np.unique(label[adjacency[rest, 0]]):
-        ids = np.flatnonzero((label == patch) & inside & ~claimed)
+    # the unclaimed faces inside, sorted by patch (each patch's in ascending order)
+    free = np.flatnonzero(inside & ~claimed)
+    free = free[np.argsort(label[free], kind="stable")]
+    patches = np.unique(label[adjacency[rest, 0]])
+    lo = np.searchsorted(label[free], patches)
+    hi = np.searchsorted(label[free], patches, side="right")
+    for start, stop in zip(lo.tolist(), hi.tolist(), strict=True):
+        ids = free[start:stop]
         if len(ids) < MIN_CURVED_FACES:
             continue
         sphere = _fit_faces(vertices, faces, seg, tol, ids, ("sphere",))

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from assemblykit.algebra import Kind, Locus, se3
-from assemblykit.inference.numeric import signed_angle
+from assemblykit.algebra import Kind, Locus, LocusKind, se3
+from assemblykit.model.relations import signed_angle
 from assemblykit.tolerance import Tolerance
 
 
@@ -182,19 +182,19 @@ def circle_sphere(
 def circle_meets(circle: Circle, locus: Locus, tol: Tolerance) -> list[np.ndarray] | None:
     """Common points of a circle and an orbit (ALGEBRA.md §2.3): a point, circle, line,
     plane or sphere. None for a continuum or a locus without a closed form here."""
-    if locus.kind == "point":
+    if locus.kind == LocusKind.POINT:
         assert locus.point is not None
         return [locus.point] if _on_circle(circle, locus.point, tol) else []
-    if locus.kind == "sphere":
+    if locus.kind == LocusKind.SPHERE:
         assert locus.point is not None
         return circle_sphere(circle, locus.point, locus.radius, tol)
-    if locus.kind == "line":
+    if locus.kind == LocusKind.LINE:
         assert locus.point is not None and locus.direction is not None
         return circle_line(circle, locus.point, locus.direction, tol)
-    if locus.kind == "plane":
+    if locus.kind == LocusKind.PLANE:
         assert locus.point is not None and locus.direction is not None
         return circle_plane(circle, locus.point, locus.direction, tol)
-    if locus.kind == "circle":
+    if locus.kind == LocusKind.CIRCLE:
         assert locus.point is not None and locus.direction is not None
         other = Circle(locus.point, locus.direction, locus.radius)
         met = circle_plane(circle, locus.point, locus.direction, tol)

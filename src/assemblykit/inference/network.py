@@ -6,9 +6,10 @@ situation. Fixed bodies are the world: all their instances are the one node
 ``X = inv(L_source) @ L_target``:
 
 * a spatial relation ``[kind, first, second]`` within a situation links the second
-  body's instance to the first's with ``relation_coset`` (the set of
-  ``inv(L_second) @ L_first``); relations that are not cosets (point_on_plane, distance,
-  gear, rack, mirror, ...) become general constraints (residual functions);
+  body's instance to the first's with the coset of its kind (the set of
+  ``inv(L_second) @ L_first``, :class:`~assemblykit.model.relations.RelationType`);
+  relations that are not cosets (point_on_plane, distance, gear, rack, mirror, ...)
+  become general constraints (residual functions);
 * an action between consecutive situations links the body's two instances
   (Corner et al. 1983 §III B: "f ** p2 = rel(v) ** f ** p1"): ``move b along f by s`` is the fixed
   transform F·Tr(0,0,s)·F⁻¹, ``along f`` without ``by`` the prismatic coset F·T(z)·F⁻¹,
@@ -33,26 +34,12 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from assemblykit.algebra import Coset, EmptySet, Mismatch, SymmetryGroup, se3
+from assemblykit.algebra import Coset, EmptySet, Mismatch, MismatchKind, SymmetryGroup, se3
 from assemblykit.errors import SchemaError
-from assemblykit.inference.numeric import (
-    Constraint,
-    Node,
-    Residual,
-    gear_residual,
-    mirror_residual,
-    rack_residual,
-)
-from assemblykit.model.relations import (
-    AXIAL,
-    COUPLED,
-    LINED,
-    RELATIONS,
-    Relation,
-    relation_coset,
-    relation_residual,
-)
-from assemblykit.model.task import Action, Situation, Task
+from assemblykit.features import Feature
+from assemblykit.inference.numeric import Constraint, Node, Residual
+from assemblykit.model.relations import HeldLine, HeldPoint, Relation, RelationType
+from assemblykit.model.task import Action, ActionKind, Situation, Task
 from assemblykit.tolerance import Tolerance, current
 
 WORLD: Node = ("world", "")
@@ -123,7 +110,7 @@ def _plain_value(value: Any) -> Hashable:
     return value
 
 
-def feature_key(feature: Any) -> Hashable:
+def feature_key(feature: Feature) -> Hashable:
     """The type and geometry of a feature (every field but its name): features with equal
     keys have equal frames, groups and parameters."""
     return (
@@ -147,7 +134,7 @@ def instance_key(node: Node) -> str:
     return "world" if node == WORLD else f"{node[0]}@{node[1]}"
 
 
-def relation_label(relation: Any, situation: str) -> str:
+def relation_label(relation: Relation, situation: str) -> str:
     """A readable name of a relation with its place in the task file when known:
     ``"against block.bottom table.top @s1 (line 14)"``."""
     refs = " ".join(str(r) for r in relation.refs)
@@ -157,7 +144,7 @@ def relation_label(relation: Any, situation: str) -> str:
 
 def _fixed_residual(target: np.ndarray, scale: float) -> Callable[[np.ndarray], np.ndarray]:
     """Residual of ``X == target``: rotation entries (times the length ``scale``, the
-    tolerance's arm, so every entry is a length, as in :func:`relation_residual`) and
+    tolerance's arm, so every entry is a length, as in the relations' residuals) and
     translation."""
 
     def residual(x: np.ndarray) -> np.ndarray:
@@ -201,7 +188,7 @@ def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | No
     if action.where:
         label += f" ({action.where})"
     frame = np.asarray(task.feature(ref, action.where or label).frame(), dtype=np.float64)
-    rotate = action.kind == "turn"
+    rotate = action.kind == ActionKind.TURN
     if action.by is None:
         group = (
             SymmetryGroup.revolute(frame[:3, 3], frame[:3, 2])
@@ -228,7 +215,7 @@ def _carrier(situation: Situation, pair: tuple[str, str], node: Callable[[str], 
     the carrier of a gear pair, the palm of a gripper."""
     related: dict[str, list[Node]] = {pair[0]: [], pair[1]: []}
     for relation in situation.relations:
-        if relation.kind in COUPLED:
+        if relation.type.coupled:
             continue
         ends = [r.body for r in relation.refs]
         for here, there in (ends, ends[::-1]):
@@ -244,32 +231,23 @@ def _carrier(situation: Situation, pair: tuple[str, str], node: Callable[[str], 
 
 
 def _coupled_constraint(
-    task: Task, situation: Situation, relation: Relation, node: Callable[[str], Node], label: str
+    task: Task,
+    situation: Situation,
+    relation: Relation,
+    node: Callable[[str], Node],
+    label: str,
+    law: RelationType,
 ) -> Constraint:
-    """A gear, rack or mirror relation as a general constraint (see :mod:`numeric`)."""
+    """A gear, rack or mirror relation as a general constraint over the world poses of its
+    two bodies and their carrier (:meth:`RelationType.coupling`)."""
     where = relation.where or label
     first, second = (task.feature(r, where) for r in relation.refs)
-    frames = (np.asarray(first.frame(), dtype=float), np.asarray(second.frame(), dtype=float))
     bodies = tuple(node(r.body) for r in relation.refs)
     carrier = _carrier(situation, (relation.refs[0].body, relation.refs[1].body), node)
-    if relation.kind == "gear":
-        ratio = float(relation.options["ratio"])
-        residual = gear_residual(*frames, ratio, current().arm)
-        return Constraint((*bodies, carrier), residual, (label,))
-    if relation.kind == "rack":
-        residual = rack_residual(*frames, float(relation.options["radius"]))
-        return Constraint((*bodies, carrier), residual, (label,))
-    direction = frames[0][:3, 2]
-    if first.type_name != "plane":
-        offset = frames[1][:3, 3] - frames[0][:3, 3]
-        if not np.linalg.norm(offset) > 0:
-            raise SchemaError(
-                "mirror: the two points coincide, so they give no direction",
-                source=task.source,
-                where=where,
-            )
-        direction = offset / np.linalg.norm(offset)
-    residual = mirror_residual(*frames, direction)
+    try:
+        residual = law.coupling(first, second, law.values(relation.options), current())
+    except SchemaError as error:
+        raise SchemaError(error.detail, source=task.source, where=where) from None
     return Constraint((*bodies, carrier), residual, (label,))
 
 
@@ -294,12 +272,6 @@ class PointLocus:
         return len(self.rows)
 
 
-def line_normals(direction: np.ndarray) -> np.ndarray:
-    """Two orthonormal normals of a line of unit ``direction``."""
-    basis = np.linalg.svd(direction.reshape(1, 3))[2]
-    return basis[1:]
-
-
 @dataclass(frozen=True)
 class LineOnPlane:
     """A line of one instance lying parallel to a plane of another, at a signed distance
@@ -317,29 +289,13 @@ class LineOnPlane:
     normal: np.ndarray
 
 
-def _geometry(
-    kind: str, options: dict[str, Any], first: tuple[Node, Any], second: tuple[Node, Any]
-) -> PointLocus | LineOnPlane | None:
-    """The closed-form geometry of a higher pair: the locus of a ``point_on_plane``,
-    ``point_on_line`` or point-plane ``distance`` relation, or the line and plane of a
-    line-plane ``distance`` (either order; a distance offsets the plane along its
-    normal); None for the other kinds and feature pairs."""
-    if kind not in ("point_on_plane", "point_on_line", "distance"):
-        return None
-    types = (first[1].type_name, second[1].type_name)
-    if kind == "distance" and ("plane" not in types or types[0] == types[1]):
-        return None
-    on_second = types[1] in AXIAL if kind == "point_on_line" else types[1] == "plane"
-    (node, feature), (locus_node, locus) = (first, second) if on_second else (second, first)
-    frame = np.asarray(locus.frame(), dtype=np.float64)
-    own = np.asarray(feature.frame(), dtype=np.float64)
-    axis = frame[:3, 2]
-    if kind == "point_on_line":
-        return PointLocus(node, own[:3, 3], locus_node, frame[:3, 3], line_normals(axis))
-    origin = frame[:3, 3] + float(options.get("distance", 0.0)) * axis
-    if feature.type_name in LINED:
-        return LineOnPlane(node, own[:3, 3], own[:3, 2], locus_node, origin, axis)
-    return PointLocus(node, own[:3, 3], locus_node, origin, axis.reshape(1, 3))
+def _placed(held: HeldPoint | HeldLine, first: Node, second: Node) -> PointLocus | LineOnPlane:
+    """The geometry of a higher pair between the instances of its first and second
+    features' bodies."""
+    node, locus_node = (first, second) if held.on_first else (second, first)
+    if isinstance(held, HeldLine):
+        return LineOnPlane(node, held.point, held.direction, locus_node, held.origin, held.normal)
+    return PointLocus(node, held.point, locus_node, held.origin, held.rows)
 
 
 def meet_loci(
@@ -404,7 +360,7 @@ def _fold_point_loci(
         source, target = head.locus_node, head.point_node
         make = partial(_group_residual, tuple(group), source)
         if isinstance(met, float):
-            miss = Mismatch("distance", met, "the point's loci are parallel and apart")
+            miss = Mismatch(MismatchKind.DISTANCE, met, "the point's loci are parallel and apart")
             links.append(Link(source, target, EmptySet(miss), labels, make))
             continue
         origin, rows = met
@@ -439,7 +395,7 @@ def _group_residual(
     return residual
 
 
-def _memo_key(feature: Any, memo: MutableMapping[Hashable, Any]) -> Hashable:
+def _memo_key(feature: Feature, memo: MutableMapping[Hashable, Any]) -> Hashable:
     """:func:`feature_key`, computed once per feature object of the task being built."""
     found = memo.get(id(feature))
     if found is None:
@@ -456,24 +412,26 @@ def _relation_part(
 ) -> Link | Constraint:
     """The link (coset relations) or constraint (all others) of one spatial relation.
 
-    ``cosets`` caches the cosets of identical feature pairs (a stack of equal parts asks
-    for the same coset once) and the keys of the task's features (by object id: the task
-    holds them while the network is built)."""
+    ``cosets`` caches the cosets of identical feature pairs with their option values (a
+    stack of equal parts asks for the same coset once) and the keys of the task's
+    features (by object id: the task holds them while the network is built)."""
     label = relation_label(relation, situation.name)
-    if relation.kind in COUPLED:
-        return _coupled_constraint(task, situation, relation, node, label)
+    law = relation.type
+    if law.coupled:
+        return _coupled_constraint(task, situation, relation, node, label, law)
     where = relation.where or label
     first_ref, second_ref = relation.refs[0], relation.refs[1]
     first, second = task.feature(first_ref, where), task.feature(second_ref, where)
     options = dict(relation.options or {})
     source, target = node(second_ref.body), node(first_ref.body)
-    if not RELATIONS[relation.kind].coset:
-        residual = relation_residual(relation.kind, first, second, options)
+    if not law.is_coset:
+        values = law.values(options)
+        held = law.geometry(first, second, values)
         return Constraint(
             (source, target),
-            _between(residual),
+            _between(law.residual(first, second, values, current())),
             (label,),
-            _geometry(relation.kind, options, (target, first), (source, second)),
+            None if held is None else _placed(held, target, source),
         )
     key = (
         relation.kind,
@@ -481,10 +439,12 @@ def _relation_part(
         _memo_key(second, cosets),
         tuple(sorted((k, _plain_value(v)) for k, v in options.items())),
     )
-    value = cosets.get(key)
-    if value is None:
-        value = cosets[key] = relation_coset(relation.kind, first, second, options)
-    make = partial(relation_residual, relation.kind, first, second, options, current())
+    found = cosets.get(key)
+    if found is None:
+        values = law.values(options)
+        found = cosets[key] = (law.coset(first, second, values, current()), values)
+    value, values = found
+    make = partial(law.residual, first, second, values, current())
     return Link(source, target, value, (label,), make, key)
 
 

@@ -42,7 +42,16 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from assemblykit.algebra import Coset, EmptySet, Locus, SymmetryGroup, intersect_groups, se3
+from assemblykit.algebra import (
+    Coset,
+    EmptySet,
+    Kind,
+    Locus,
+    LocusKind,
+    SymmetryGroup,
+    intersect_groups,
+    se3,
+)
 from assemblykit.inference.loops import (
     Circle,
     LoopPoses,
@@ -61,25 +70,27 @@ from assemblykit.inference.network import (
     PointLocus,
     build_network,
     instance_key,
-    line_normals,
     meet_loci,
     point_coset,
 )
 from assemblykit.inference.numeric import (
     Constraint,
     ResidueProblem,
-    signed_angle,
     solve_residue,
 )
 from assemblykit.inference.solution import (
+    MECHANISM,
     BodyInstanceResult,
     BranchCut,
     Conflict,
+    Mechanism,
     Solution,
     TraceStep,
     freedom_words,
     remedy_words,
 )
+from assemblykit.model.relations import line_normals, signed_angle
+from assemblykit.model.task import Task
 from assemblykit.tolerance import Tolerance, current, using
 
 CYCLE_LENGTH = 4  # Corner et al. 1983 §III F: "we restrict the size of the cycles ... to four"
@@ -545,7 +556,7 @@ def _progress(before: Any, after: Any) -> bool:
 
 def _axis(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
     """Axis point and unit direction of a revolute coset (world of its source)."""
-    if _kind_name(value) != "revolute" or _components(value) != 1:
+    if _kind_name(value) != Kind.REVOLUTE or _components(value) != 1:
         return None
     return value.group.origin, value.group.axis
 
@@ -585,7 +596,7 @@ def revolute_loop(
     if meets is None:
         return None
     if not meets:
-        far = Locus("circle", point=c3, direction=u3, radius=float(np.linalg.norm(q1 - c3)))
+        far = Locus(LocusKind.CIRCLE, point=c3, direction=u3, radius=float(np.linalg.norm(q1 - c3)))
         return [], circle_gap(Circle(c1, u1, float(np.linalg.norm(q0 - c1))), far)
     answers = []
     for point in meets:
@@ -617,7 +628,7 @@ def _motion(value: Any) -> tuple[str, Mapping[str, Any]]:
     invariants = dict(value.group.invariants)
     if "axis" in invariants:
         invariants["direction"] = invariants.pop("axis")
-    if _kind_name(value) == "spherical":
+    if _kind_name(value) == Kind.SPHERICAL:
         invariants["center"] = invariants.pop("point")
     return _kind_name(value), invariants
 
@@ -736,7 +747,7 @@ def _solve_component(
         tree_like and not constrained and all(isinstance(v, Coset) for v in sets.values())
     ) or reducer.conflicts:
         # a tree of cosets needs no residue; an inconsistent network is not solved further
-        out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
+        out = {WORLD: _Instance(np.eye(4), 0, Kind.FIXED)}
         for node in component - {WORLD}:
             value = sets.get(node)
             if isinstance(value, Coset):
@@ -745,7 +756,7 @@ def _solve_component(
                     poses[node], value.dof, motion, _components(value), (), invariants
                 )
             else:
-                out[node] = _Instance(poses.get(node, np.eye(4)), 0, "mechanism")
+                out[node] = _Instance(poses.get(node, np.eye(4)), 0, MECHANISM)
         return out, []
     closed = _higher_pairs(network, reducer, component, tol)
     if closed is not None:
@@ -772,7 +783,7 @@ def _higher_pairs(
         if not closed or WORLD not in reps or len(reps) != 2:
             return None
         own[next(iter(reps - {WORLD}))].append(constraint)
-    out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
+    out = {WORLD: _Instance(np.eye(4), 0, Kind.FIXED)}
     conflicts: list[Conflict] = []
     for node in sorted(nodes):
         edge = reducer.edges.get(frozenset((WORLD, node)))
@@ -794,6 +805,27 @@ def _higher_pairs(
         out[node], miss = found
         conflicts.extend(miss)
     return out, conflicts
+
+
+def _trace_held(
+    reducer: Reducer,
+    node: Node,
+    labels: tuple[str, ...],
+    before: int,
+    after: int,
+    detail: str,
+) -> None:
+    """Record in the trace a higher pair of ``node`` solved from the world in closed form
+    (ALGEBRA.md §3): dof ``before`` and ``after``."""
+    reducer.trace.append(
+        TraceStep(
+            "higher-pair",
+            f"world -> {instance_key(node)} [{'; '.join(labels)}]",
+            before,
+            after,
+            detail,
+        )
+    )
 
 
 def _held(
@@ -853,7 +885,6 @@ def _point_in_locus(
     origin = se3.apply(locus_x, geometry.origin)
     rows = geometry.rows @ locus_x[:3, :3].T
     base = _EYE
-    name = instance_key(node)
     if value is not None:
         if _components(value) != 1:
             return None
@@ -864,24 +895,23 @@ def _point_in_locus(
             met = Coset(met.group, met.rep @ base)
             motion, invariants = _motion(met)
             found = _Instance(met.rep, met.dof, motion, 1, (), invariants)
-            reducer.trace.append(
-                TraceStep(
-                    "higher-pair",
-                    f"world -> {name} [{'; '.join(labels)}]",
-                    value.dof,
-                    met.dof,
-                    f"the {subject}'s locus meets its orbit under the joint: {motion}",
-                )
+            _trace_held(
+                reducer,
+                node,
+                labels,
+                value.dof,
+                met.dof,
+                f"the {subject}'s locus meets its orbit under the joint: {motion}",
             )
             return found, []
-        if met is None and value.group.kind == "planar":
+        if met is None and value.group.kind == Kind.PLANAR:
             met = meet_loci(origin, rows, [(value.group.axis, reached)], tol)
         if met is None:
             return None
         if isinstance(met, float):
             message = _PARALLEL_MISS.format(subject)
             miss = Conflict.measured(labels, "distance", met, message, tol)
-            return _Instance(base, 0, "mechanism", 0), [miss]
+            return _Instance(base, 0, MECHANISM, 0), [miss]
         origin, rows = met
     elif len(rows) == 3:
         return None
@@ -894,21 +924,20 @@ def _point_in_locus(
     elif value is not None:
         m = value.group.axis
         invariants = {"normal": m, "direction": np.cross(rows[0], rows[1]) + 0.0, "point": target}
-        found = _Instance(pose, 2, "mechanism", 1, (), invariants, "planar-point-on-line")
+        found = _Instance(pose, 2, MECHANISM, 1, (), invariants, Mechanism.PLANAR_POINT_ON_LINE)
     elif len(rows) == 1:
         invariants = {"normal": rows[0], "point": target}
-        found = _Instance(pose, 5, "mechanism", 1, (), invariants, "point-in-plane")
+        found = _Instance(pose, 5, MECHANISM, 1, (), invariants, Mechanism.POINT_IN_PLANE)
     else:
         invariants = {"direction": np.cross(rows[0], rows[1]) + 0.0, "point": target}
-        found = _Instance(pose, 4, "mechanism", 1, (), invariants, "point-on-line")
-    reducer.trace.append(
-        TraceStep(
-            "higher-pair",
-            f"world -> {name} [{'; '.join(labels)}]",
-            6 if value is None else value.dof,
-            found.dof,
-            f"the {subject}'s loci meet in {_LOCI[len(rows)]}",
-        )
+        found = _Instance(pose, 4, MECHANISM, 1, (), invariants, Mechanism.POINT_ON_LINE)
+    _trace_held(
+        reducer,
+        node,
+        labels,
+        6 if value is None else value.dof,
+        found.dof,
+        f"the {subject}'s loci meet in {_LOCI[len(rows)]}",
     )
     return found, []
 
@@ -977,16 +1006,8 @@ def _line_on_plane(
         return None
     pose, placed, flat = laid
     invariants = {"normal": normal, "direction": flat, "point": placed}
-    found = _Instance(pose, 4, "mechanism", 1, (), invariants, "line-on-plane")
-    reducer.trace.append(
-        TraceStep(
-            "higher-pair",
-            f"world -> {instance_key(node)} [{'; '.join(labels)}]",
-            6,
-            4,
-            "a line parallel to a plane at its distance",
-        )
-    )
+    found = _Instance(pose, 4, MECHANISM, 1, (), invariants, Mechanism.LINE_ON_PLANE)
+    _trace_held(reducer, node, labels, 6, 4, "a line parallel to a plane at its distance")
     return found, []
 
 
@@ -1034,7 +1055,7 @@ def _line_with_coset(
             " should lie parallel to",
             tol,
         )
-        return _Instance(base, 0, "mechanism", 0), [miss]
+        return _Instance(base, 0, MECHANISM, 0), [miss]
     held = PointLocus(
         geometry.line_node,
         geometry.point,
@@ -1045,11 +1066,11 @@ def _line_with_coset(
     found = _point_in_locus(
         reducer, node, replace(constraint, geometry=held), value, labels, tol, "line point"
     )
-    if found is None or found[0].mechanism != "planar-point-on-line":
+    if found is None or found[0].mechanism != Mechanism.PLANAR_POINT_ON_LINE:
         return found
     instance, _ = found
     invariants = {"point": instance.invariants["point"], "direction": along, "normal": normal}
-    return replace(instance, invariants=invariants, mechanism="roll-and-slide"), []
+    return replace(instance, invariants=invariants, mechanism=Mechanism.ROLL_AND_SLIDE), []
 
 
 def _line_and_point(
@@ -1093,7 +1114,7 @@ def _line_and_point(
             f"the point turns about the line at {reach:.6g} from it, and its plane is"
             f" {abs(height):.6g} from the line's"
         )
-        return _Instance(pose, 0, "mechanism", 0), [
+        return _Instance(pose, 0, MECHANISM, 0), [
             Conflict.measured(labels, "distance", gap, message, tol)
         ]
     if reach <= tol.length:
@@ -1105,14 +1126,13 @@ def _line_and_point(
     met = Coset(SymmetryGroup.planar(normal), rotation_about(placed, flat, roll) @ pose)
     motion, invariants = _motion(met)
     count = 1 if reach * math.sin(spread) <= tol.length else 2
-    reducer.trace.append(
-        TraceStep(
-            "higher-pair",
-            f"world -> {instance_key(node)} [{'; '.join(labels)}]",
-            6,
-            3,
-            f"a line and a point on parallel planes: {count} roll(s) about the line, {motion}",
-        )
+    _trace_held(
+        reducer,
+        node,
+        labels,
+        6,
+        3,
+        f"a line and a point on parallel planes: {count} roll(s) about the line, {motion}",
     )
     return _Instance(met.rep, 3, motion, count, (), invariants), []
 
@@ -1141,7 +1161,7 @@ def _coset_meets_locus(
     is then h's slide along the group's translations, which its rotations keep; the
     kernel is the whole group when those slides keep N·y, else the group met with S(q)
     (a cylinder crossing the locus: the revolute about its axis)."""
-    helical = {"helical", "pseudo-planar"}
+    helical = {Kind.HELICAL, Kind.PSEUDO_PLANAR}
     keeping = SymmetryGroup.schoenflies(rows[0]) if len(rows) == 1 else SymmetryGroup.translation3()
     kept = keeping.includes(group, tol)
     if len(rows) == 3 or not (kept or _fixes(group, reached, tol)):
@@ -1164,17 +1184,17 @@ def _coset_meets_locus(
         step = shifts.T @ solved
     miss = float(np.linalg.norm(rows @ step - need))
     if miss > tol.length:
-        return None if str(group.kind) in helical else miss
+        return None if group.kind in helical else miss
     return Coset(intersect_groups(group, kernel_of, tol), se3.translation(step))
 
 
 def _fixes(group: SymmetryGroup, point: np.ndarray, tol: Tolerance) -> bool:
     """Whether every rotation of a connected ``group`` fixes ``point``: a revolute or
     cylindrical group whose axis passes through it, a spherical group centred on it."""
-    kind = str(group.kind)
-    if kind == "spherical":
+    kind = group.kind
+    if kind == Kind.SPHERICAL:
         return bool(np.linalg.norm(point - group.origin) <= tol.length)
-    if kind not in ("revolute", "cylindrical"):
+    if kind not in (Kind.REVOLUTE, Kind.CYLINDRICAL):
         return False
     offset = point - group.origin
     return bool(np.linalg.norm(offset - (offset @ group.axis) * group.axis) <= tol.length)
@@ -1182,12 +1202,12 @@ def _fixes(group: SymmetryGroup, point: np.ndarray, tol: Tolerance) -> bool:
 
 def _translations(group: SymmetryGroup) -> np.ndarray:
     """Orthonormal rows spanning a translation group (fixed, prismatic, T2 or T3)."""
-    kind = str(group.kind)
-    if kind == "prismatic":
+    kind = group.kind
+    if kind == Kind.PRISMATIC:
         return group.axis.reshape(1, 3)
-    if kind == "translation2":
+    if kind == Kind.TRANSLATION2:
         return line_normals(group.axis)
-    return np.eye(3) if kind == "translation3" else np.zeros((0, 3))
+    return np.eye(3) if kind == Kind.TRANSLATION3 else np.zeros((0, 3))
 
 
 _LOCI = {1: "a plane", 2: "a line", 3: "a point"}
@@ -1231,7 +1251,7 @@ def _numeric_component(
             f"{len(result.solutions)} solution(s), best residual {result.best_residual:.3g}",
         )
     )
-    out = {WORLD: _Instance(np.eye(4), 0, "fixed")}
+    out = {WORLD: _Instance(np.eye(4), 0, Kind.FIXED)}
     if not result.found:
         labels = tuple(dict.fromkeys(lb for c in constraints for lb in c.labels))
         conflict = Conflict.measured(
@@ -1243,13 +1263,13 @@ def _numeric_component(
             tol,
         )
         for n in unknowns:
-            out[n] = _Instance(np.asarray(problem.start[n]), 0, "mechanism", 0)
+            out[n] = _Instance(np.asarray(problem.start[n]), 0, MECHANISM, 0)
         return out, [conflict]
     first = result.solutions[0]
     isolated = first.total_dof == 0
     for n in unknowns:
         dof = first.dof[n]
-        motion = "fixed" if dof == 0 else "mechanism"
+        motion = Kind.FIXED if dof == 0 else MECHANISM
         invariants: Mapping[str, Any] = {}
         link = reducer.edges.get(frozenset((WORLD, n)))
         options = [link.oriented(WORLD) if link else None, (candidates or {}).get(n)]
@@ -1306,15 +1326,6 @@ def _said(key: str, instance: _Instance) -> str:
     return f"{key} {text}; {remedy}"
 
 
-def _same_pose(a: np.ndarray, b: np.ndarray, tol: Tolerance) -> bool:
-    """Whether two branches' poses are one: within the numeric solvers' precision (the
-    mesh tolerances) or the tolerance in force when looser."""
-    return bool(
-        np.abs(a[:3, :3] - b[:3, :3]).max() <= max(tol.mesh_angle, tol.angle)
-        and np.abs(a[:3, 3] - b[:3, 3]).max() <= max(tol.mesh_length, tol.length)
-    )
-
-
 def _combine(
     network: Network, reports: list[tuple[dict[Node, _Instance], list[Conflict]]], tol: Tolerance
 ) -> tuple[dict[str, BodyInstanceResult], list[Conflict]]:
@@ -1326,7 +1337,7 @@ def _combine(
             node = network.node(body, situation)
             if node == WORLD:
                 bodies[f"{body}@{situation}"] = BodyInstanceResult(
-                    body, situation, np.eye(4), 0, "fixed"
+                    body, situation, np.eye(4), 0, Kind.FIXED
                 )
                 continue
             first = consistent[0][0][node]
@@ -1334,7 +1345,7 @@ def _combine(
             for report, _ in consistent:
                 item = report[node]
                 for pose in (item.pose, *item.alternatives):
-                    if not any(_same_pose(pose, p, tol) for p in poses):
+                    if not any(se3.poses_equal(pose, p, tol, numeric=True) for p in poses):
                         poses.append(pose)
             count = first.solutions
             if count is not None and first.dof == 0:
@@ -1404,7 +1415,7 @@ _EXTENTS = ("radius", "size", "major_radius", "minor_radius")
 origin is a model of size 10, not 0)."""
 
 
-def model_scale(task: Any) -> float:
+def model_scale(task: Task) -> float:
     """Bounding-box diagonal of all feature origins, each grown by its feature's radius or
     size (the length scale of the tolerances)."""
     low, high = [], []
@@ -1421,7 +1432,7 @@ def model_scale(task: Any) -> float:
 
 
 def solve_task(
-    task: Any,
+    task: Task,
     tol: Tolerance | None = None,
     explain: bool = False,
     max_branches: int | None = None,
@@ -1438,7 +1449,7 @@ def solve_task(
     return replace(solution, units=task.units)
 
 
-def solve_numeric_only(task: Any, tol: Tolerance | None = None, starts: int = 8) -> Solution:
+def solve_numeric_only(task: Task, tol: Tolerance | None = None, starts: int = 8) -> Solution:
     """The whole network solved by the residue solver alone, without reduction (the
     "equation solving" system Corner et al. 1983 §III G compares against; used for benchmarks)."""
     tol = tol or current().with_scale(model_scale(task))

@@ -12,32 +12,45 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Any
 
 import numpy as np
-from rich.console import Group
-from rich.table import Table
-from rich.text import Text
 
+from assemblykit.algebra import Kind
 from assemblykit.tolerance import Tolerance
 
-STATUSES = ("solved", "ambiguous", "underconstrained", "inconsistent")
 
-MOTIONS = (
-    "fixed",
-    "revolute",
-    "prismatic",
-    "helical",
-    "cylindrical",
-    "planar",
-    "spherical",
-    "translation2",
-    "translation3",
-    "pseudo-planar",
-    "schoenflies",
-    "free",
-    "mechanism",
-)
+class Status(StrEnum):
+    """The answer for the whole task (DESIGN.md §5.3; :func:`status_of`)."""
+
+    SOLVED = "solved"
+    AMBIGUOUS = "ambiguous"
+    UNDERCONSTRAINED = "underconstrained"
+    INCONSISTENT = "inconsistent"
+
+
+STATUSES: tuple[Status, ...] = tuple(Status)
+
+
+class Mechanism(StrEnum):
+    """The freedoms of higher pairs that are no Hervé family (the ``mechanism`` of a
+    :class:`BodyInstanceResult`, said in words by :data:`MECHANISMS`)."""
+
+    POINT_IN_PLANE = "point-in-plane"
+    POINT_ON_LINE = "point-on-line"
+    PLANAR_POINT_ON_LINE = "planar-point-on-line"
+    LINE_ON_PLANE = "line-on-plane"
+    ROLL_AND_SLIDE = "roll-and-slide"
+
+
+MECHANISM = "mechanism"
+"""The motion of an instance whose freedom is no Hervé family (a higher pair, a closed
+loop, a coupled relation, a residue solved numerically)."""
+
+MOTIONS: tuple[str, ...] = (*Kind, MECHANISM)
+"""Every motion of a body instance: Hervé's families (:class:`~assemblykit.algebra.Kind`)
+and :data:`MECHANISM`."""
 
 INVARIANT_KEYS = ("point", "direction", "normal", "center", "pitch")
 
@@ -112,17 +125,17 @@ def point_text(point: Any) -> str:
     return fmt.vector(np.asarray(point, dtype=np.float64))
 
 
-MECHANISMS = {
-    "point-in-plane": "can slide its point {point} in the plane normal to {normal} and turn"
-    " about it",
-    "point-on-line": "can slide its point {point} along {direction} and turn about it",
-    "planar-point-on-line": "can slide its point {point} along {direction} and turn about"
-    " {normal} through it",
-    "line-on-plane": "keeps its line through {point} along {direction} parallel to the plane"
-    " normal to {normal}: it can slide in the plane and turn about the normal and about the"
-    " line",
-    "roll-and-slide": "can turn about its line through {point} along {direction} and slide"
-    " that line sideways, keeping it parallel to the plane normal to {normal}",
+MECHANISMS: dict[str, str] = {
+    Mechanism.POINT_IN_PLANE: "can slide its point {point} in the plane normal to {normal}"
+    " and turn about it",
+    Mechanism.POINT_ON_LINE: "can slide its point {point} along {direction} and turn about it",
+    Mechanism.PLANAR_POINT_ON_LINE: "can slide its point {point} along {direction} and turn"
+    " about {normal} through it",
+    Mechanism.LINE_ON_PLANE: "keeps its line through {point} along {direction} parallel to"
+    " the plane normal to {normal}: it can slide in the plane and turn about the normal and"
+    " about the line",
+    Mechanism.ROLL_AND_SLIDE: "can turn about its line through {point} along {direction} and"
+    " slide that line sideways, keeping it parallel to the plane normal to {normal}",
 }
 """The freedoms of higher pairs that are no Hervé family, in words (the ``mechanism``
 names of :class:`BodyInstanceResult`; the placeholders are their invariants)."""
@@ -133,7 +146,7 @@ def freedom_words(motion: str, dof: int, invariants: Mapping[str, Any], mechanis
     1.5): 3 dof"``; empty for a fixed instance. A named ``mechanism`` says its freedom
     (:data:`MECHANISMS`); one that the reduction does not name (a closed loop, a coupled
     joint, a relation that is no coset) says its dof."""
-    inv = {k: _invariant_text(k, v) for k, v in invariants.items() if k != "pitch"}
+    inv = {k: invariant_text(k, v) for k, v in invariants.items() if k != "pitch"}
     if dof and mechanism in MECHANISMS:
         return f"{MECHANISMS[mechanism].format(**inv)}: {dof} dof"
     phrases = {
@@ -196,7 +209,7 @@ def remedy_words(motion: str, mechanism: str, invariants: Mapping[str, Any]) -> 
     about that axis) and a stop off that axis would remove it"``. A mechanism without a
     name (a closed loop, a coupled joint, a relation that is no coset, solved
     numerically) loses at most one dof to each stop on it or on a body it moves with."""
-    inv = {k: _invariant_text(k, v) for k, v in invariants.items() if k != "pitch"}
+    inv = {k: invariant_text(k, v) for k, v in invariants.items() if k != "pitch"}
     phrase = _REMEDIES.get(mechanism or motion, "")
     try:
         phrase = phrase.format(**inv)
@@ -302,7 +315,7 @@ def direction_text(direction: Any) -> str:
     return fmt.direction(np.asarray(direction, dtype=np.float64))
 
 
-def _invariant_text(key: str, value: Any) -> str:
+def invariant_text(key: str, value: Any) -> str:
     """An invariant for people: directions and normals as ``+Z`` where they are axes,
     points as ``(x, y, z)``, the pitch as a number (tiny values shown as 0)."""
     from assemblykit import formatting as fmt
@@ -318,19 +331,19 @@ def status_of(
     bodies: Mapping[str, BodyInstanceResult],
     conflicts: tuple[Conflict, ...],
     cut: BranchCut | None = None,
-) -> str:
+) -> Status:
     """Inconsistent if anything conflicts; ambiguous if some instance has finitely many
     poses (or alternatives were left unexplored); underconstrained if some instance keeps
     freedom (dof > 0 or a lattice)."""
     if conflicts:
-        return "inconsistent"
+        return Status.INCONSISTENT
     if cut is not None or any(
         b.solutions is not None and b.solutions > 1 and b.dof == 0 for b in bodies.values()
     ):
-        return "ambiguous"
+        return Status.AMBIGUOUS
     if any(b.dof > 0 or b.solutions is None for b in bodies.values()):
-        return "underconstrained"
-    return "solved"
+        return Status.UNDERCONSTRAINED
+    return Status.SOLVED
 
 
 @dataclass(frozen=True)
@@ -346,7 +359,7 @@ class Solution:
     units: str | None = None
 
     @property
-    def status(self) -> str:
+    def status(self) -> Status:
         """``solved``, ``ambiguous``, ``underconstrained`` or ``inconsistent``."""
         return status_of(self.bodies, self.conflicts, self.cut)
 
@@ -404,47 +417,3 @@ class Solution:
         if self.explain:
             out["trace"] = [step.to_dict() for step in self.trace]
         return out
-
-    def render(self) -> Group:
-        """A rich table of instances, then conflicts and (when explaining) the trace."""
-        from assemblykit import formatting as fmt
-
-        table = Table(title=f"RAPT inference: {self.status}")
-        for column in ("instance", "dof", "motion", "solutions"):
-            table.add_column(column)
-        table.add_column(fmt.header("position", self.units))
-        table.add_column("invariants")
-        for key, b in self.bodies.items():
-            table.add_row(
-                key,
-                str(b.dof),
-                b.mechanism or b.motion,
-                "infinite" if b.solutions is None else str(b.solutions),
-                fmt.vector(np.asarray(b.pose)[:3, 3]),
-                ", ".join(
-                    f"{k} {_invariant_text(k, v)}"
-                    for k, v in b.invariants.items()
-                    if k in INVARIANT_KEYS
-                ),
-            )
-        parts: list[Any] = [table]
-        if self.cut is not None:
-            parts.append(Text(self.cut.message))
-        parts.extend(Text(b.freedom) for b in self.bodies.values() if b.freedom)
-        for c in self.conflicts:
-            parts.append(Text(f"conflict ({c.kind} {c.value:.6g}): {', '.join(c.relations)}"))
-            parts.append(Text(f"  {c.message}"))
-            if c.advice is not None:
-                parts.append(Text(f"  {c.advice}"))
-        if self.explain:
-            # one line per step whatever the width: the trace is read by people and programs
-            for step in self.trace:
-                parts.append(
-                    Text(
-                        f"{step.rule}: {step.link} dof {step.dof_before} -> {step.dof_after}"
-                        + (f" ({step.detail})" if step.detail else ""),
-                        no_wrap=True,
-                        overflow="ignore",
-                    )
-                )
-        return Group(*parts)

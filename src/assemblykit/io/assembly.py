@@ -13,18 +13,17 @@
 
 from __future__ import annotations
 
-from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from assemblykit.errors import GeometryError, InputError
-from assemblykit.geometry.contacts import Contact
+from assemblykit.geometry.contacts import Contact, assembly_contacts, assembly_surfaces
 from assemblykit.geometry.precision import coordinate_precision
-from assemblykit.geometry.recognition import Surface
 from assemblykit.io.documents import read_json, read_text
 from assemblykit.io.meshes import MESH_SUFFIXES, load_manifest, load_mesh_folder, read_mesh
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.surfaces import Surface
 from assemblykit.tolerance import Tolerance
 
 
@@ -137,39 +136,6 @@ class ContactReport:
         summary["interferences"] = [{"a": a, "b": b, "volume": v} for a, b, v in self.interferences]
         return summary
 
-    def render(self) -> Any:
-        """A rich rendering: one table of parts, one of contacts, then interferences."""
-        from rich.console import Group
-        from rich.table import Table
-
-        asm = self.assembly
-        parts = Table(title=f"{asm.source}: {len(asm)} parts ({asm.units}, {asm.units_source})")
-        for column in ("part", "triangles", "volume", "features"):
-            parts.add_column(column)
-        for name, part in asm.parts.items():
-            kinds = Counter(s.feature().type_name for s in self.surfaces[name])
-            listing = ", ".join(f"{n} {k}" for k, n in sorted(kinds.items()))
-            parts.add_row(name, str(len(part.mesh.faces)), f"{part.volume:.6g}", listing)
-        contacts = Table(title=f"{len(self.contacts)} contacts")
-        for column in ("a", "b", "planar area", "normals", "curved"):
-            contacts.add_column(column)
-        for c in self.contacts:
-            normals = "; ".join(
-                "(" + ", ".join(f"{x:.3g}" for x in p.normal) + ")" for p in c.planar
-            )
-            curved = ", ".join(f"{p.kind} r={p.radius:.6g} inner={p.inner}" for p in c.curved)
-            contacts.add_row(c.a, c.b, f"{c.area:.6g}", normals, curved)
-        clashes = (
-            "\n".join(f"interference {a} / {b}: volume {v:.6g}" for a, b, v in self.interferences)
-            or "no interferences"
-        )
-        used = asm.tolerance_summary(self.policy)
-        measured = f"{used['measured_from'] or 'nothing measured'}: {used['measured'] or 0:.2g}"
-        why = f"input ({measured})" if used["from"] == "measured" else f"policy ({measured})"
-
-        tolerance = f"length tolerance {used['length']:.3g} {asm.units} from the {why}"
-        return Group(tolerance, parts, contacts, clashes)
-
 
 def contact_report(assembly: Assembly, tol: Tolerance | None = None) -> ContactReport:
     """Contacts, surface features and interferences of ``assembly``."""
@@ -177,8 +143,8 @@ def contact_report(assembly: Assembly, tol: Tolerance | None = None) -> ContactR
 
     return ContactReport(
         assembly,
-        assembly.contacts(tol),
-        {name: assembly.surfaces(name, tol) for name in assembly.parts},
+        assembly_contacts(assembly, tol),
+        {name: assembly_surfaces(assembly, name, tol) for name in assembly.parts},
         interferences(assembly, tol),
         tol,
     )

@@ -21,8 +21,8 @@ import numpy as np
 import trimesh
 
 from assemblykit import formatting as fmt
-from assemblykit.io.outputs import atomic_output
 from assemblykit.io.report import json_number, jsonable
+from assemblykit.outputs import atomic_output
 from assemblykit.viz.explode import explosion
 
 if TYPE_CHECKING:

@@ -42,16 +42,11 @@ from scipy.spatial.transform import Rotation
 
 from assemblykit.errors import GeometryError, SchemaError
 from assemblykit.geometry.contacts import candidate_pairs
-from assemblykit.geometry.precision import (
-    Precision,
-    combined,
-    coordinate_precision,
-    pose_precision,
-)
+from assemblykit.geometry.precision import combined, coordinate_precision, pose_precision
 from assemblykit.geometry.settling import settle as settle_parts
 from assemblykit.geometry.solids import placed
 from assemblykit.io.documents import read_json, read_text, read_yaml
-from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.assembly import Assembly, Part, Precision
 from assemblykit.tolerance import Tolerance, current
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".glb")

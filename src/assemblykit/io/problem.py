@@ -35,7 +35,6 @@ from pydantic import (
     BeforeValidator,
     ConfigDict,
     Field,
-    ValidationError,
     model_validator,
 )
 
@@ -45,7 +44,7 @@ from assemblykit.features import Feature, feature_from_dict, parse_angle
 from assemblykit.geometry.solids import Box, Cylinder, Primitive, generated_mesh
 from assemblykit.io.documents import read_json, read_text, read_yaml
 from assemblykit.io.meshes import read_mesh
-from assemblykit.io.spec import UNITS, Name, schema_error, with_source
+from assemblykit.io.spec import UNITS, Name, validated, with_source
 from assemblykit.mating.problem import (
     Goal,
     MatingBody,
@@ -171,14 +170,13 @@ def parse_problem(
 ) -> MatingProblem:
     """Build a :class:`MatingProblem` from the file's mapping; the tolerance is scaled to
     the bounding-box diagonal of the feature points and meshes (DESIGN.md §4)."""
-    if not isinstance(data, Mapping):
-        raise SchemaError(
-            "a mating problem must hold a mapping with bodies and goals", source=source
-        )
-    try:
-        model = ProblemModel.model_validate(data)
-    except ValidationError as error:
-        raise schema_error(error, source, lambda place: place) from None
+    model = validated(
+        ProblemModel,
+        data,
+        "a mating problem must hold a mapping with bodies and goals",
+        source,
+        lambda place: place,
+    )
     try:
         features = {
             name: {

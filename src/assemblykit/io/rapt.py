@@ -28,7 +28,7 @@ from lark.exceptions import (
 
 from assemblykit.errors import SchemaError, TaskSyntaxError
 from assemblykit.io.spec import parse_task, task_to_dict
-from assemblykit.model.task import Task
+from assemblykit.model.task import ActionKind, Task
 
 GRAMMAR = Path(__file__).with_name("rapt.lark")
 
@@ -255,7 +255,7 @@ class _Builder(Transformer[Token, tuple[dict[str, Any], dict[str, str]]]):
             if isinstance(item, tuple):
                 options["by"] = item[1]
             else:
-                options["along" if kind == "move" else "about"] = item
+                options["along" if kind == ActionKind.MOVE else "about"] = item
         return "actions", [str(kind), str(body), *([options] if options else [])], meta
 
     @v_args(meta=True)

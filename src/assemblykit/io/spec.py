@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import MISSING, fields
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, StringConstraints, ValidationError
 
@@ -21,7 +21,7 @@ from assemblykit.errors import InputError, SchemaError
 from assemblykit.features.primitives import FEATURE_TYPES, Feature, feature_from_dict, parse_angle
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
-from assemblykit.model.task import Action, Situation, Task
+from assemblykit.model.task import ACTION_KINDS, Action, ActionKind, Situation, Task
 
 NAME_PATTERN = r"^[A-Za-z_][A-Za-z0-9_]*$"
 """Body, feature and situation names: identifiers, so that ``body.feature`` and the
@@ -31,6 +31,7 @@ UNITS = ("mm", "cm", "m", "um", "in", "ft")
 
 Name = Annotated[str, StringConstraints(pattern=NAME_PATTERN)]
 Locate = Callable[[str], str]
+M = TypeVar("M", bound=BaseModel)
 
 
 class _Model(BaseModel):
@@ -70,14 +71,13 @@ def parse_task(
     entry is located by its longest listed prefix, or shown as it is.
     """
     locate = _locator(places or {})
-    if not isinstance(data, Mapping):
-        raise SchemaError(
-            "a task file must hold a mapping with bodies and situations", source=source
-        )
-    try:
-        model = TaskModel.model_validate(data)
-    except ValidationError as error:
-        raise schema_error(error, source, locate) from None
+    model = validated(
+        TaskModel,
+        data,
+        "a task file must hold a mapping with bodies and situations",
+        source,
+        locate,
+    )
     try:
         bodies = {
             name: Body(
@@ -130,7 +130,9 @@ def _action(items: list[Any], where: str) -> Action:
     ``[turn, body, {about: b.f, by: 90 deg}]`` (``by`` in model units or radians)."""
     if not (2 <= len(items) <= 3 and all(isinstance(item, str) for item in items[:2])):
         raise SchemaError(f"expected [move|turn, body, {{options}}], got {items!r}", where=where)
-    kind, body = items[0], items[1]
+    # an unknown kind is kept as written, for Task.validate to name it
+    kind = ActionKind(items[0]) if items[0] in ACTION_KINDS else items[0]
+    body = items[1]
     options = items[2] if len(items) == 3 else {}
     if not isinstance(options, Mapping):
         raise SchemaError(f"action options must be a mapping, got {options!r}", where=where)
@@ -149,7 +151,7 @@ def _action(items: list[Any], where: str) -> Action:
 def _amount(kind: str, value: Any, where: str) -> float | None:
     if value is None:
         return None
-    if kind == "turn":
+    if kind == ActionKind.TURN:
         return parse_angle(value, f"{where}.by")
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         raise SchemaError(f"'by' must be a finite length, got {value!r}", where=f"{where}.by")
@@ -199,10 +201,10 @@ def feature_to_dict(feature: Feature) -> dict[str, Any]:
 def _action_to_list(action: Action) -> list[Any]:
     options: dict[str, Any] = {}
     if action.ref is not None:
-        options["along" if action.kind == "move" else "about"] = str(action.ref)
+        options["along" if action.kind == ActionKind.MOVE else "about"] = str(action.ref)
     if action.by is not None:
         options["by"] = action.by
-    return [action.kind, action.body, *([options] if options else [])]
+    return [str(action.kind), action.body, *([options] if options else [])]
 
 
 def _locator(places: Mapping[str, str]) -> Locate:
@@ -225,7 +227,19 @@ def _path(loc: tuple[int | str, ...]) -> str:
     return text
 
 
-def schema_error(error: ValidationError, source: str | None, locate: Locate) -> SchemaError:
+def validated(model: type[M], data: Any, message: str, source: str | None, locate: Locate) -> M:
+    """``data`` read by the schema ``model``; :class:`SchemaError` with ``message`` when
+    it is no mapping, or naming the first field in error (:func:`_schema_error`, places
+    shown through ``locate``)."""
+    if not isinstance(data, Mapping):
+        raise SchemaError(message, source=source)
+    try:
+        return model.model_validate(data)
+    except ValidationError as error:
+        raise _schema_error(error, source, locate) from None
+
+
+def _schema_error(error: ValidationError, source: str | None, locate: Locate) -> SchemaError:
     """The first pydantic error as one line naming the field path."""
     first = error.errors()[0]
     loc = tuple(first["loc"])

@@ -52,8 +52,9 @@ import trimesh
 from numpy.typing import NDArray
 
 from assemblykit.errors import GeometryError, MissingExtraError
-from assemblykit.geometry.recognition import Surface, is_convex
+from assemblykit.geometry.recognition import is_convex
 from assemblykit.model.assembly import Assembly, Part, Skipped
+from assemblykit.model.surfaces import Surface
 from assemblykit.tolerance import Tolerance
 
 LINEAR_DEFLECTION = 1e-3

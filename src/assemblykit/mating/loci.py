@@ -23,7 +23,6 @@ import math
 from collections.abc import Callable, Mapping
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from assemblykit.algebra import Coset, Kind, Locus, SymmetryGroup, se3
 from assemblykit.tolerance import Tolerance
@@ -147,14 +146,6 @@ def _pose_residual(x: np.ndarray, y: np.ndarray, scale: float) -> np.ndarray:
     return np.concatenate([(x[:3, :3] - y[:3, :3]).ravel(), (x[:3, 3] - y[:3, 3]) / scale])
 
 
-def _close(x: np.ndarray, y: np.ndarray, tol: Tolerance) -> bool:
-    """Whether two poses agree within the angle and length tolerances."""
-    return bool(
-        np.max(np.abs(x[:3, :3] - y[:3, :3])) <= tol.angle
-        and se3.norm(x[:3, 3] - y[:3, 3]) <= tol.length
-    )
-
-
 def _starts(dof: int) -> list[np.ndarray]:
     """The deterministic grid of starting parameters, truncated to :data:`MAX_STARTS`."""
     grid = itertools.product(START_VALUES, repeat=dof)
@@ -197,21 +188,21 @@ def numeric_closure(
         return _pose_residual(se3.inverse(lu) @ lv, x, tol.scale)
 
     found: list[tuple[np.ndarray, np.ndarray]] = []
-    for start in _starts(sum(dofs)):
-        fit = least_squares(
-            residual,
-            start,
-            method="lm",
-            xtol=SOLVER_PRECISION,
-            ftol=SOLVER_PRECISION,
-            gtol=SOLVER_PRECISION,
-        )
+    fits = se3.multistart_least_squares(
+        residual,
+        _starts(sum(dofs)),
+        method="lm",
+        xtol=SOLVER_PRECISION,
+        ftol=SOLVER_PRECISION,
+        gtol=SOLVER_PRECISION,
+    )
+    for fit in fits:
         lu, lv, x = members(fit.x)
-        if not _close(se3.inverse(lu) @ lv, x, tol):
+        if not se3.poses_equal(se3.inverse(lu) @ lv, x, tol):
             continue
         if not _isolated(residual, fit.x, tol):
             return None
-        if not any(_close(lu, u, tol) and _close(lv, v, tol) for u, v in found):
+        if not any(se3.poses_equal(lu, u, tol) and se3.poses_equal(lv, v, tol) for u, v in found):
             found.append((lu, lv))
     branches = []
     for lu, lv in found:

@@ -27,14 +27,12 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import constraint
 import numpy as np
-from rich.console import Group
-from rich.text import Text
 
 from assemblykit import formatting as fmt
 from assemblykit.algebra import Coset, EmptySet, Kind, SymmetryGroup
@@ -61,6 +59,9 @@ from assemblykit.mating.laws import (
 from assemblykit.mating.loci import World, loci_branches, numeric_closure
 from assemblykit.mating.problem import MatingProblem
 from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    import trimesh
 
 LAWS = (
     "candidates",
@@ -205,30 +206,6 @@ class MatingResult:
             "emptied": None if self.emptied is None else self.emptied.to_dict(),
             "rejections": [r.to_dict() for r in self.rejections],
         }
-
-    def render(self) -> Group:
-        """Liu & Popplestone's (1990) Or/And form, then the pruning statistics."""
-        lines = [Text(self.or_and())]
-        if self.emptied is not None:
-            lines.append(
-                Text(f"goal {self.emptied.goal}: domain emptied by the {self.emptied.law} law")
-            )
-            if self.emptied.reason:
-                lines.append(Text(f"  {self.emptied.reason}"))
-        for rejection in self.rejections:
-            lines.append(Text(f"rejected: {rejection.reason}"))
-        lines.append(Text(f"{self.count} configurations ({len(self.configurations)} found)"))
-        for config in self.configurations:
-            for name, motion in config.motions.items():
-                spans = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in motion.intervals)
-                lines.append(Text(f"  {name}: {motion.kind} {motion.parameter} {spans}"))
-        header = " -> ".join(LAWS)
-        lines.append(Text(f"domain sizes ({header}):"))
-        lines.extend(
-            Text(f"  goal {g}: {' -> '.join(map(str, s))}") for g, s in self.statistics.items()
-        )
-        lines.append(Text(f"candidate pairs deleted by path consistency: {self.pairs_removed}"))
-        return Group(*lines)
 
     def or_and(self) -> str:
         """``** [Or [And [fit [b1 comp1] [b4 comp13]] ...] ...]`` (Liu & Popplestone 1990
@@ -697,14 +674,18 @@ def _ranges(
 
 
 def interfering_meshes(
-    mesh_a: Any, pose_a: np.ndarray, mesh_b: Any, pose_b: np.ndarray, tol: Tolerance
+    mesh_a: trimesh.Trimesh,
+    pose_a: np.ndarray,
+    mesh_b: trimesh.Trimesh,
+    pose_b: np.ndarray,
+    tol: Tolerance,
 ) -> bool:
     """Whether two meshes at world poses share more than a touching volume."""
     return interfering_solids(placed(mesh_a, pose_a), placed(mesh_b, pose_b), tol.for_mesh())
 
 
 def _free_intervals(
-    free: Any, span: tuple[float, float], angle: bool
+    free: Callable[[float], bool], span: tuple[float, float], angle: bool
 ) -> tuple[tuple[float, float], ...]:
     """The free intervals of a sampled parameter, ends refined by bisection."""
     samples = np.linspace(span[0], span[1], SWEEP_SAMPLES + 1)
@@ -725,7 +706,7 @@ def _free_intervals(
     return tuple(intervals)
 
 
-def _edge(free: Any, blocked: float, clear: float) -> float:
+def _edge(free: Callable[[float], bool], blocked: float, clear: float) -> float:
     """The boundary between a blocked and a free parameter value, by bisection."""
     for _ in range(BISECTION_STEPS):
         middle = 0.5 * (blocked + clear)

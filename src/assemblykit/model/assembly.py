@@ -2,32 +2,47 @@
 
 A :class:`Part` is a triangle mesh already placed in the world, the pose that placed it,
 and, for CAD input, the exact surfaces of its faces. An :class:`Assembly` is an ordered
-set of parts with their units and the file they came from; it computes (and caches) the
-contacts between its parts (Liu 1997 and Wilson & Latombe 1992 start from "the
-specification of the contact surfaces between parts") and the surface features
-recognised on each part.
-
-The geometry is computed by :mod:`assemblykit.geometry` (same layer); those modules are
-imported inside the methods because they themselves take an :class:`Assembly`.
+set of parts with their units, the file they came from and the tolerance its geometry
+is compared with. Both are plain data: the contacts between parts (Liu 1997 and Wilson &
+Latombe 1992 start from "the specification of the contact surfaces between parts") and
+the surfaces recognised on each part are computed by :mod:`assemblykit.geometry`, a
+layer above, which keeps them in the assembly's :attr:`Assembly.memo` slot
+(:class:`Derived`), so that they live as long as the assembly and a sub-assembly keeps
+those of its parts.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping, Set
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol, Self
 
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
 from assemblykit.errors import UnknownNameError
+from assemblykit.model.surfaces import Surface
 from assemblykit.tolerance import Tolerance, current
 
-if TYPE_CHECKING:
-    from assemblykit.geometry.contacts import Contact
-    from assemblykit.geometry.precision import Precision
-    from assemblykit.geometry.recognition import Surface
+
+@dataclass(frozen=True)
+class Precision:
+    """A measured precision of the input: ``length`` in model units, and ``source``,
+    what it was measured from (shown by the ``contacts`` command); measured by
+    :mod:`assemblykit.geometry.precision`."""
+
+    length: float
+    source: str
+
+
+class Derived(Protocol):
+    """What a higher layer computed from the parts of an assembly and keeps with it
+    (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts, surfaces)."""
+
+    def restricted(self, names: Set[str]) -> Derived:
+        """What of it still holds for the parts ``names`` alone (the same parts)."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -78,6 +93,8 @@ class Assembly:
     ``skipped`` lists what the loader could not read (:class:`Skipped`) and ``warnings``
     what the reader reported while reading. ``groups`` names sets of parts the input
     keeps together (a STEP file's subassemblies), each listing its parts in order.
+    ``memo`` is the slot where the geometry layer keeps what it computed from the parts
+    (:class:`Derived`; ``None`` until it is asked).
     """
 
     def __init__(
@@ -111,8 +128,7 @@ class Assembly:
         self.precision = precision
         self.skipped = tuple(skipped)
         self.warnings = tuple(warnings)
-        self._contacts: dict[Tolerance, list[Contact]] = {}
-        self._surfaces: dict[tuple[str, Tolerance], tuple[Surface, ...]] = {}
+        self.memo: Derived | None = None
 
     def __len__(self) -> int:
         return len(self.parts)
@@ -216,81 +232,58 @@ class Assembly:
             "measured_from": None if self.precision is None else self.precision.source,
         }
 
-    def contacts(self, tol: Tolerance | None = None) -> list[Contact]:
-        """The contacts between touching parts, computed once per tolerance
-        (:func:`assemblykit.geometry.contacts.find_contacts`)."""
-        from assemblykit.geometry.contacts import find_contacts
-
-        key = self.tolerance(tol)
-        if key not in self._contacts:
-            self._contacts[key] = find_contacts(self, tol)
-        return self._contacts[key]
-
-    def surfaces(self, name: str, tol: Tolerance | None = None) -> tuple[Surface, ...]:
-        """The surfaces of part ``name``: its exact CAD surfaces, else those recognised on
-        its mesh (:func:`~assemblykit.geometry.recognition.recognise`)."""
-        from assemblykit.geometry.recognition import recognise
-
-        part = self.part(name)
-        if part.surfaces:
-            return part.surfaces
-        key = (name, self.tolerance(tol))
-        if key not in self._surfaces:
-            self._surfaces[key] = recognise(part.mesh, key[1])
-        return self._surfaces[key]
-
-    def features(self, name: str, tol: Tolerance | None = None) -> list[Any]:
-        """The surface features of part ``name`` as :mod:`assemblykit.features` objects."""
-        return [s.feature() for s in self.surfaces(name, tol)]
-
-    def _derived(self, parts: Iterable[Part], scale: float | None) -> Assembly:
-        return Assembly(
-            parts,
-            units=self.units,
-            units_source=self.units_source,
-            source=self.source,
-            exact=self.exact,
+    @classmethod
+    def like(
+        cls, other: Assembly, parts: Iterable[Part] | None = None, scale: float | None = None
+    ) -> Self:
+        """An assembly of ``parts`` (default: those of ``other``) with everything else
+        taken from ``other``: units, source, policy, precision, what was skipped, the
+        warnings and groups; ``scale`` as given (``None``: measured from the parts)."""
+        return cls(
+            other.parts.values() if parts is None else parts,
+            units=other.units,
+            units_source=other.units_source,
+            source=other.source,
+            exact=other.exact,
             scale=scale,
-            policy=self.policy,
-            precision=self.precision,
-            skipped=self.skipped,
-            warnings=self.warnings,
-            groups=self.groups,
+            policy=other.policy,
+            precision=other.precision,
+            skipped=other.skipped,
+            warnings=other.warnings,
+            groups=other.groups,
         )
 
-    def subset(self, names: Iterable[str]) -> Assembly:
+    def _kept(self, parts: Iterable[Part], scale: float | None) -> Self:
+        """This assembly with just ``parts``; the memo keeps what concerns the parts it
+        shares with this one."""
+        derived = type(self).like(self, parts, scale)
+        if self.memo is not None:
+            derived.memo = self.memo.restricted(
+                {n for n, p in derived.parts.items() if self.parts.get(n) is p}
+            )
+        return derived
+
+    def subset(self, names: Iterable[str]) -> Self:
         """The sub-assembly of the named parts (in this assembly's order), with this
-        assembly's scale; cached contacts among them are kept."""
+        assembly's scale; contacts already computed among them are kept."""
         wanted = set(names)
         for name in wanted:
             self.part(name)
-        sub = self._derived((p for n, p in self.parts.items() if n in wanted), self.scale)
-        for key, found in self._contacts.items():
-            sub._contacts[key] = [c for c in found if c.a in wanted and c.b in wanted]
-        sub._surfaces = {k: v for k, v in self._surfaces.items() if k[0] in wanted}
-        return sub
+        return self._kept((p for n, p in self.parts.items() if n in wanted), self.scale)
 
-    def without_part(self, name: str) -> Assembly:
-        """This assembly without part ``name`` (same scale, cached contacts kept)."""
+    def without_part(self, name: str) -> Self:
+        """This assembly without part ``name`` (same scale, computed contacts kept)."""
         self.part(name)
         return self.subset(n for n in self.parts if n != name)
 
-    def with_part(self, part: Part) -> Assembly:
+    def with_part(self, part: Part) -> Self:
         """This assembly with ``part`` added (or replaced). The scale is kept unless the
-        new part lies outside the current bounds; cached contacts are kept when the
-        scale is, and only the new part's contacts are then computed."""
-        from assemblykit.geometry.contacts import find_contacts
-
+        new part lies outside the current bounds; contacts already computed among the
+        other parts are kept, so that only the new part's are then computed."""
         lo, hi = self.bounds
         inside = bool(np.all(part.mesh.bounds[0] >= lo) and np.all(part.mesh.bounds[1] <= hi))
         others = [p for n, p in self.parts.items() if n != part.name]
-        grown = self._derived([*others, part], self.scale if inside and self.parts else None)
-        grown._surfaces = {k: v for k, v in self._surfaces.items() if k[0] != part.name}
-        if inside:
-            for key, found in self._contacts.items():
-                kept = [c for c in found if part.name not in (c.a, c.b)]
-                grown._contacts[key] = kept + find_contacts(grown, key, only=part.name)
-        return grown
+        return self._kept([*others, part], self.scale if inside and self.parts else None)
 
     def to_dict(self) -> dict[str, Any]:
         """Summary: source, units, scale and per-part triangle count, volume, bounds,

@@ -15,18 +15,25 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal
+from enum import StrEnum
+from typing import Any
 
 from assemblykit.errors import FeatureError, SchemaError, UnknownNameError
+from assemblykit.features import Feature
+from assemblykit.features.primitives import Vector
 from assemblykit.model.body import Body
-from assemblykit.model.relations import RELATIONS, FeatureRef, Relation, check_relation
+from assemblykit.model.relations import FeatureRef, Relation, check_relation, relation_type
 from assemblykit.tolerance import Tolerance, current
 
-if TYPE_CHECKING:
-    from assemblykit.inference import Solution
 
-ActionKind = Literal["move", "turn"]
-ACTION_KINDS: tuple[ActionKind, ...] = ("move", "turn")
+class ActionKind(StrEnum):
+    """How a body moved from the previous situation (Corner et al. 1983 §II)."""
+
+    MOVE = "move"
+    TURN = "turn"
+
+
+ACTION_KINDS: tuple[ActionKind, ...] = tuple(ActionKind)
 
 
 @dataclass(frozen=True)
@@ -50,7 +57,7 @@ class Action:
     @property
     def ref(self) -> FeatureRef | None:
         """The feature the action is relative to (``along`` or ``about``)."""
-        return self.along if self.kind == "move" else self.about
+        return self.along if self.kind == ActionKind.MOVE else self.about
 
 
 @dataclass(frozen=True)
@@ -188,16 +195,6 @@ class Task:
                 self._check_action(action, where)
         return self
 
-    def solve(
-        self, tol: Tolerance | None = None, explain: bool = False, max_branches: int | None = None
-    ) -> Solution:
-        """Poses of every body in every situation by network reduction (Corner et al. 1983 §III);
-        at most ``max_branches`` finite alternatives are followed (default
-        ``inference.reduction.MAX_BRANCHES``; ``Solution.cut`` says when more were left)."""
-        from assemblykit.inference import solve_task
-
-        return solve_task(self, tol=tol, explain=explain, max_branches=max_branches)
-
     def _body(self, name: str, where: str) -> Body:
         """The body called ``name``; :class:`UnknownNameError` naming ``where`` if none."""
         body = self.bodies.get(name)
@@ -209,7 +206,7 @@ class Task:
             )
         return body
 
-    def feature(self, ref: FeatureRef, where: str) -> Any:
+    def feature(self, ref: FeatureRef, where: str) -> Feature:
         """The feature ``ref`` names; :class:`UnknownNameError` naming ``where`` if none."""
         body = self._body(ref.body, where)
         found = body.features.get(ref.feature)
@@ -223,14 +220,11 @@ class Task:
         return found
 
     def _check_relation(self, relation: Relation, where: str) -> None:
-        if relation.kind not in RELATIONS:
-            raise SchemaError(
-                f"unknown relation {relation.kind!r} (expected one of {', '.join(RELATIONS)})",
-                source=self.source,
-                where=where,
-            )
+        try:
+            arity = relation_type(relation.kind).arity
+        except SchemaError as error:
+            raise SchemaError(error.detail, source=self.source, where=where) from None
         features = tuple(self.feature(ref, where) for ref in relation.refs)
-        arity = RELATIONS[relation.kind].arity
         if len(features) != arity:
             raise SchemaError(
                 f"{relation.kind} relates {arity} features, got {len(features)}",
@@ -263,18 +257,18 @@ class Task:
             raise SchemaError(
                 f"the fixed body {action.body!r} cannot move", source=self.source, where=where
             )
-        wrong = action.about if action.kind == "move" else action.along
+        wrong = action.about if action.kind == ActionKind.MOVE else action.along
         if wrong is not None:
-            key = "about" if action.kind == "move" else "along"
+            key = "about" if action.kind == ActionKind.MOVE else "along"
             raise SchemaError(
                 f"'{action.kind}' does not take '{key}'", source=self.source, where=where
             )
         ref = action.ref
         if ref is None:
-            if action.kind == "turn" or action.by is not None:
+            if action.kind == ActionKind.TURN or action.by is not None:
                 raise SchemaError(
                     f"'{action.kind}' needs a feature "
-                    + ("to turn about" if action.kind == "turn" else "to move along"),
+                    + ("to turn about" if action.kind == ActionKind.TURN else "to move along"),
                     source=self.source,
                     where=where,
                 )
@@ -289,14 +283,14 @@ class Task:
             )
         if axis_of(feature) is None:
             raise FeatureError(
-                f"cannot {action.kind} {'along' if action.kind == 'move' else 'about'} "
+                f"cannot {action.kind} {'along' if action.kind == ActionKind.MOVE else 'about'} "
                 f"{ref.body}.{ref.feature}: a {feature.type_name} has no axis",
                 source=self.source,
                 where=where,
             )
 
 
-def axis_of(feature: Any) -> Any:
+def axis_of(feature: Feature) -> Vector | None:
     """The axis (or plane normal) an action may move along or turn about, or ``None``.
 
     Balls, sockets, points and frames have no single axis (a frame has three).

@@ -26,10 +26,9 @@ from typing import Any
 import networkx as nx
 import numpy as np
 from numpy.typing import NDArray
-from rich.console import Group
-from rich.table import Table
 from scipy.linalg import null_space
 
+from assemblykit.algebra import Kind
 from assemblykit.model.assembly import Assembly
 from assemblykit.motion.freedom import Motion, MotionReport, motion
 from assemblykit.tolerance import Tolerance
@@ -85,7 +84,7 @@ class GearTrain:
 
 def revolute_of(assembly: Assembly, moved: Motion) -> Revolute | None:
     """The revolute joint of a single part whose motion is a revolute, else ``None``."""
-    if moved.kind != "revolute" or len(moved.parts) != 1:
+    if moved.kind != Kind.REVOLUTE or len(moved.parts) != 1:
         return None
     axis = moved.to_dict()["axis"]
     point = np.asarray(axis["point"], dtype=np.float64)
@@ -162,19 +161,6 @@ class Articulation:
     def to_dict(self) -> dict[str, Any]:
         """The motion report's ``parts`` and the ``gear_trains``."""
         return {**self.report.to_dict(), "gear_trains": [t.to_dict() for t in self.trains]}
-
-    def render(self) -> Group:
-        """The motion table followed by one table of gear ratios per train."""
-        tables: list[Table] = [self.report.render()]
-        for number, train in enumerate(self.trains, start=1):
-            table = Table(title=f"Gear train {number}: {train.dof} dof")
-            table.add_column("gear")
-            table.add_column(f"speed / speed of {train.gears[0]}")
-            for gear in train.gears:
-                ratio = train.ratios.get(gear)
-                table.add_row(gear, "locked" if ratio is None else f"{ratio:.6g}")
-            tables.append(table)
-        return Group(*tables)
 
 
 def articulation(

@@ -29,13 +29,12 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from rich.table import Table
 
-from assemblykit.algebra import SymmetryGroup, intersect_groups, se3
+from assemblykit.algebra import Kind, SymmetryGroup, intersect_groups, se3
 from assemblykit.errors import UnknownNameError
 from assemblykit.features import compound_group
 from assemblykit.features.primitives import Ball, Cone, Feature, Hole, Plane, Shaft, Socket
-from assemblykit.geometry.contacts import Contact, CurvedPatch
+from assemblykit.geometry.contacts import Contact, CurvedPatch, assembly_contacts
 from assemblykit.model.assembly import Assembly
 from assemblykit.motion.unilateral import UnilateralReading, unilateral_readings
 from assemblykit.tolerance import Tolerance
@@ -226,7 +225,7 @@ class Motion(GroupMotion):
     def separates(self) -> bool:
         """Whether the bilateral motion carries the set arbitrarily far away: its group
         is continuous and not only rotations about a line or a point."""
-        return self.kind not in ("fixed", "revolute", "spherical") and self.dof > 0
+        return self.kind not in (Kind.FIXED, Kind.REVOLUTE, Kind.SPHERICAL) and self.dof > 0
 
     def to_dict(self) -> dict[str, Any]:
         """``dof``, ``motion``, ``components``, the invariants (``axis`` {point,
@@ -279,7 +278,7 @@ class MotionSolver:
     def __init__(self, assembly: Assembly, tol: Tolerance | None = None) -> None:
         self.assembly = assembly
         self.tol = assembly.tolerance(tol)
-        self.contacts = assembly.contacts(tol)
+        self.contacts = assembly_contacts(assembly, tol)
         self._groups: dict[tuple[Any, ...], tuple[SymmetryGroup, Vector]] = {}
         self._by_part: dict[str, list[Contact]] = {}
         for contact in self.contacts:
@@ -399,29 +398,6 @@ class MotionReport:
     def to_dict(self) -> dict[str, Any]:
         """``parts`` keyed by part name (subassemblies by ``a+b``), DESIGN.md §5.3."""
         return {"source": self.source, "parts": {k: m.to_dict() for k, m in self.motions.items()}}
-
-    def render(self) -> Table:
-        """A table: moving set, motion with its invariants, dof, components and the
-        unilateral reading."""
-        from assemblykit import formatting as fmt
-
-        table = Table(title=f"Motion of each part{f' of {self.source}' if self.source else ''}")
-        for column in ("part", "motion", "dof", "components", "unilateral"):
-            table.add_column(column)
-        for key, moved in self.motions.items():
-            data = motion_summary(moved.group)
-            reading = moved.unilateral
-            if reading.lift_off:
-                rays = ", ".join(fmt.direction(r) for r in reading.lift_off)
-                unilateral = f"lifts off along {rays}"
-            elif reading.can_lift_off:
-                unilateral = "lifts off by turning"
-            else:
-                unilateral = "keeps every contact" if reading.free else "held"
-            table.add_row(
-                key, data["description"], str(data["dof"]), str(data["components"]), unilateral
-            )
-        return table
 
 
 def motion(

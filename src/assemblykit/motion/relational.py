@@ -32,12 +32,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from rich.table import Table
 
 from assemblykit.algebra import Coset, SymmetryGroup, intersect_groups
 from assemblykit.inference import Solution
-from assemblykit.inference.reduction import model_scale
-from assemblykit.model.relations import RELATIONS, Relation, relation_coset
+from assemblykit.inference.reduction import model_scale, solve_task
+from assemblykit.model.relations import Relation
 from assemblykit.model.task import Task
 from assemblykit.motion.freedom import GroupMotion, motion_summary
 from assemblykit.tolerance import Tolerance, current
@@ -100,25 +99,6 @@ class TaskMotionReport:
             "parts": {k: m.to_dict() for k, m in self.motions.items()},
         }
 
-    def render(self) -> Table:
-        """A table: body instance, motion with its invariants, dof, components, the
-        bodies it meets and the ignored relations."""
-        title = f"Motion of each body{f' of {self.source}' if self.source else ''}"
-        table = Table(title=f"{title} (inference: {self.status})")
-        for column in ("body", "motion", "dof", "components", "touching", "ignored"):
-            table.add_column(column)
-        for key, moved in self.motions.items():
-            data = motion_summary(moved.group)
-            table.add_row(
-                key,
-                data["description"],
-                str(data["dof"]),
-                str(data["components"]),
-                ", ".join(moved.touching),
-                "; ".join(moved.ignored),
-            )
-        return table
-
 
 def placed_group(
     task: Task, relation: Relation, poses: Mapping[str, np.ndarray], tol: Tolerance
@@ -126,10 +106,10 @@ def placed_group(
     """The world motions of either body that keep ``relation`` with the other body held:
     its coset's group conjugated by the second body's pose (module docstring); or the
     reason it constrains no subgroup."""
-    if not RELATIONS[relation.kind].coset:
+    if not relation.type.is_coset:
         return "not a subgroup of motions"
     first, second = (task.feature(ref, relation.where or str(ref)) for ref in relation.refs)
-    coset = relation_coset(relation.kind, first, second, relation.options, tol)
+    coset = relation.type.coset(first, second, relation.values, tol)
     if not isinstance(coset, Coset):
         return f"cannot hold: {coset.mismatch.message}"
     return coset.group.conjugate(poses[relation.refs[1].body])
@@ -195,7 +175,7 @@ def task_motion(task: Task, tol: Tolerance | None = None) -> TaskMotionReport:
     rest, from the relations it takes part in (module docstring); lengths in the
     tolerance are scaled to the task's size."""
     working = (tol or current()).with_scale(model_scale(task))
-    solution = task.solve(working)
+    solution = solve_task(task, working)
     motions = [
         m
         for name, relations in standing_relations(task).items()

@@ -16,6 +16,7 @@ from collections.abc import Iterable
 
 import networkx as nx
 
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.model.assembly import Assembly
 from assemblykit.motion.freedom import Motion, MotionSolver
 from assemblykit.tolerance import Tolerance
@@ -25,7 +26,7 @@ def contact_graph(assembly: Assembly, tol: Tolerance | None = None) -> nx.Graph[
     """Parts as nodes (assembly order), an edge between every two parts in contact."""
     graph: nx.Graph[str] = nx.Graph()
     graph.add_nodes_from(assembly.names)
-    graph.add_edges_from(c.pair for c in assembly.contacts(tol))
+    graph.add_edges_from(c.pair for c in assembly_contacts(assembly, tol))
     return graph
 
 

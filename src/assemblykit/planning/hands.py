@@ -33,24 +33,20 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
+from assemblykit.blocking.directions import DirectionTable, bits, mask_of, several
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
-from assemblykit.planning.sequence import (
-    DirectionTable,
-    Hands,
-    HandsMove,
-    _bits,
-    _mask,
-    _Search,
-    _several,
-    direction_table,
-)
+from assemblykit.blocking.polygons import PolygonAssembly
+from assemblykit.planning.sequence import Hands, HandsMove, Search
 from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.model.assembly import Assembly
 
 MAX_HANDS = 4
 """The most hands the planner tries by default."""
@@ -59,9 +55,9 @@ HANDS_MAX_PARTS = 8
 """The largest set split into groups (the partitions grow as k^n / k!)."""
 
 
-def _sizes(assembly: Any) -> dict[str, float]:
+def _sizes(assembly: Assembly | PolygonAssembly) -> dict[str, float]:
     """Volumes of the parts (areas for polygons): the largest stays fixed."""
-    if getattr(assembly, "dimension", 3) == 2:
+    if isinstance(assembly, PolygonAssembly):
         from assemblykit.blocking.planar import areas
 
         return areas(assembly)
@@ -103,14 +99,14 @@ class _HandsSearch:
 
     def free(self, group: int, others: int, k: int) -> bool:
         """Whether ``group`` leaves ``others`` along candidate direction ``k``."""
-        return all(self.masks[k][i] & others == 0 for i in _bits(group))
+        return all(self.masks[k][i] & others == 0 for i in bits(group))
 
     def free_along(self, group: int, others: int, direction: NDArray[np.float64]) -> bool:
         """Whether ``group`` leaves ``others`` along any ``direction`` (exact)."""
         names = self.table.names
         dbg = self.ndbg.dbg(direction)
-        inside = {names[i] for i in _bits(group)}
-        outside = {names[j] for j in _bits(others)}
+        inside = {names[i] for i in bits(group)}
+        outside = {names[j] for j in bits(others)}
         return not any(i in inside and j in outside for i, j in dbg.arcs)
 
     def ratios(self, d_g: NDArray[np.float64], d_h: NDArray[np.float64]) -> list[float]:
@@ -180,13 +176,13 @@ class _HandsSearch:
     def split(self, members: int) -> HandsMove | None:
         """The first operation with the fewest hands (3 to ``max_hands``) that splits
         ``members``, the group of its largest part fixed."""
-        parts = sorted(_bits(members), key=lambda i: (-self.sizes[i], i))
+        parts = sorted(bits(members), key=lambda i: (-self.sizes[i], i))
         if len(parts) > HANDS_MAX_PARTS:
             return None
         names = self.table.names
         for k in range(3, self.max_hands + 1):
             for split in partitions(parts, k):
-                groups = tuple(_mask(g) for g in split)
+                groups = tuple(mask_of(g) for g in split)
                 velocities = self.velocities(groups)
                 if velocities is not None:
                     labels = tuple(tuple(names[i] for i in sorted(g)) for g in split)
@@ -196,9 +192,9 @@ class _HandsSearch:
     def take_apart(self, members: int) -> tuple[int | None, list[HandsMove]]:
         """Hands needed for ``members`` and the operations with more than two, taking
         it apart with two hands wherever the planner's search can."""
-        if not _several(members):
+        if not several(members):
             return 1, []
-        search = _Search(self.table, self.table, self.sizes, lambda *_: None, [], [])
+        search = Search(self.table, self.table, self.sizes, lambda *_: None, [], [])
         search.disassemble(members)
         needed = 2
         moves: list[HandsMove] = []
@@ -210,7 +206,7 @@ class _HandsSearch:
             moves.append(move)
             needed = max(needed, move.hands)
             for group in move.groups:
-                inner, more = self.take_apart(_mask(index[n] for n in group))
+                inner, more = self.take_apart(mask_of(index[n] for n in group))
                 moves.extend(more)
                 if inner is None:
                     return None, moves
@@ -219,7 +215,7 @@ class _HandsSearch:
 
 
 def hands_needed(
-    assembly: Any,
+    assembly: Assembly | PolygonAssembly,
     parts: Sequence[str] | None = None,
     max_hands: int = MAX_HANDS,
     tol: Tolerance | None = None,
@@ -231,8 +227,8 @@ def hands_needed(
     names = tuple(assembly.names if parts is None else parts)
     ndbg = blocking_graph(assembly, "extended", parts=names, tol=tol)
     assert isinstance(ndbg, NonDirectionalBlockingGraph)
-    table = direction_table(ndbg)
+    table = ndbg.direction_table()
     sizes = _sizes(assembly)
     search = _HandsSearch(ndbg, table, tuple(sizes[n] for n in table.names), max_hands, tol)
-    needed, moves = search.take_apart(_mask(range(len(table.names))))
+    needed, moves = search.take_apart(mask_of(range(len(table.names))))
     return Hands(needed, max_hands, tuple(moves))

@@ -37,7 +37,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from rich.table import Table
 
 MAX_STATES = 250_000
 """Default limit of states visited per separation: Pelikan's 98-move first separation
@@ -210,36 +209,6 @@ class MultiMovePlan:
             "max_states": self.max_states,
             "separations": None if self.root is None else self.root.to_dict(),
         }
-
-    def render(self) -> Table:
-        """A rich table: one row per move, grouped by separation."""
-        verdict = "feasible" if self.feasible else "infeasible"
-        if self.cut:
-            verdict += f", search cut at {self.max_states} states"
-        title = f"Multi-move disassembly ({verdict}), level {self.level or '-'}"
-        table = Table(title=title)
-        for column in ("separation", "move", "parts", "direction", "distance"):
-            table.add_column(column)
-
-        def rows(node: Separation | None, label: str) -> None:
-            if node is None:
-                return
-            if node.status != "separated":
-                table.add_row(label, "-", ", ".join(node.parts), node.status, "-")
-                return
-            for number, move in enumerate(node.moves, start=1):
-                distance = "inf" if move.distance is None else f"{move.distance:.6g}"
-                table.add_row(label, str(number), ", ".join(move.parts), move.label, distance)
-            rows(node.removed, f"{label}.r")
-            rows(node.left, f"{label}.l")
-
-        rows(self.root, "1")
-        first = "-" if self.first_moves is None else str(self.first_moves)
-        caption = f"first separation: {first} moves"
-        if self.reference_level is not None:
-            caption += f" (stored level {self.reference_level})"
-        table.caption = caption
-        return table
 
 
 class _Tables:

@@ -9,7 +9,7 @@ any shape the same breadth-first search runs on these states and moves:
 * a *state* is the translation of every part relative to the first; two states whose
   translations agree to the length tolerance are one;
 * *directions* are the monotone planner's candidates, the regions of Γ_t's arrangement
-  (:func:`assemblykit.planning.sequence.translation_table`), with the contact normals,
+  (:func:`assemblykit.blocking.tables.translation_table`), with the contact normals,
   all both ways;
 * *distances* come from the Minkowski sums: every part is cut into convex pieces
   (:func:`assemblykit.geometry.minkowski.convex_pieces`); piece ``p`` of a moving part
@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
 from assemblykit.errors import GeometryError
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.minkowski import convex_pieces
 from assemblykit.planning.multimove import (
     MAX_STATES,
@@ -62,10 +63,10 @@ def candidate_directions(assembly: Assembly, tol: Tolerance) -> NDArray[np.float
     """Unit directions (rows) to move along: the regions of Γ_t's arrangement and the
     contact normals (of planar patches; axes of curved ones), each both ways, one per
     direction within the angle tolerance; those along an axis first."""
-    from assemblykit.planning.sequence import translation_table
+    from assemblykit.blocking.tables import translation_table
 
     rows = [np.asarray(translation_table(assembly, tol).directions, dtype=np.float64)]
-    for contact in assembly.contacts(tol):
+    for contact in assembly_contacts(assembly, tol):
         rows += [np.asarray(p.normal, dtype=np.float64)[None] for p in contact.planar]
         rows += [np.asarray(c.axis)[None] for c in contact.curved if c.axis is not None]
     found = np.vstack(rows)

@@ -14,18 +14,20 @@ from __future__ import annotations
 import itertools
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.optimize import linprog
 
-from assemblykit.blocking.arrangement import circle_partition, snap_normals
-from assemblykit.blocking.graphs import blocking_graph
-from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
+from assemblykit.blocking.directions import DirectionTable, mask_of
 from assemblykit.blocking.rigid import RIGID_MAX_SIZE, RigidBlockingGraph, wrenches
-from assemblykit.planning.sequence import DirectionTable, Progress, _mask, _Search
+from assemblykit.blocking.tables import planar_direction_tables
+from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.planning.sequence import Progress, Search
 from assemblykit.tolerance import Tolerance
+
+if TYPE_CHECKING:
+    from assemblykit.blocking.polygons import PolygonAssembly
 
 # twists (omega; v) of the plane z = 0: a turn about z and a translation in the plane
 _PLANAR_TWIST_BOUNDS = [(0.0, 0.0), (0.0, 0.0), (-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0), (0.0, 0.0)]
@@ -41,7 +43,7 @@ class PlanarExtended(DirectionTable):
         """The DBGs among ``members`` (default: all parts) along the directions
         ``indices``, as a table."""
         chosen = sorted(set(indices))
-        among = _mask(range(len(self.names))) if members is None else members
+        among = mask_of(range(len(self.names))) if members is None else members
         arcs = [list(self.graph(k, among).edges) for k in chosen]
         return DirectionTable.from_arcs(self.names, self.directions[chosen], arcs)
 
@@ -51,57 +53,33 @@ class PlanarExtended(DirectionTable):
         return set(range(len(self.directions)))
 
 
-_Table = TypeVar("_Table", bound=DirectionTable)
-
-
-def _slots_table(
-    cls: type[_Table],
-    ndbg: NonDirectionalBlockingGraph,
-    directions: NDArray[np.float64],
-    tol: Tolerance,
-) -> _Table:
-    """``ndbg``'s DBGs at ``directions``, computed directly from its terms."""
-    return cls(
-        tuple(ndbg.parts),
-        directions,
-        ndbg.table.direct_arcs(directions, tol),
-        np.asarray(ndbg.table.slot_moving, dtype=np.int64),
-        np.asarray(ndbg.table.slot_blocker, dtype=np.int64),
-    )
-
-
 def planar_tables(
-    model: Any, tol: Tolerance
+    model: PolygonAssembly, tol: Tolerance
 ) -> tuple[DirectionTable, PlanarExtended, tuple[float, ...]]:
     """Γ_t and Γ_e of a polygon assembly along the regions of their common arrangement
-    of S¹ (module docstring), and the parts' areas (the largest stays as the base)."""
+    of S¹ (module docstring, :func:`~assemblykit.blocking.tables.planar_direction_tables`),
+    and the parts' areas (the largest stays as the base)."""
     from assemblykit.blocking.planar import areas
 
-    local = blocking_graph(model, "infinitesimal", tol=tol)
-    grown = blocking_graph(model, "extended", tol=tol)
-    assert isinstance(local, NonDirectionalBlockingGraph)
-    assert isinstance(grown, NonDirectionalBlockingGraph)
-    normals = np.vstack([local.table.normals, grown.table.normals])
-    circles = snap_normals(normals, tol)[0] if len(normals) else normals.reshape(0, 3)
-    directions = circle_partition(circles, tol).directions
+    local, exact = planar_direction_tables(model, tol)
     area = areas(model)
     return (
-        _slots_table(DirectionTable, local, directions, tol),
-        _slots_table(PlanarExtended, grown, directions, tol),
+        local,
+        PlanarExtended(exact.names, exact.directions, exact.slots, exact.moving, exact.blocker),
         tuple(area[name] for name in model.names),
     )
 
 
-def planar_search(model: Any, tol: Tolerance, report: Progress) -> _Search:
+def planar_search(model: PolygonAssembly, tol: Tolerance, report: Progress) -> Search:
     """The planner's search over a polygon assembly, run: Γ_t bounds and Γ_e accepts
     along every region of the common arrangement (:func:`planar_tables`)."""
     translations, extended, volumes = planar_tables(model, tol)
-    search = _Search(translations, extended, volumes, report, [], [])
-    search.disassemble(_mask(range(len(translations.names))))
+    search = Search(translations, extended, volumes, report, [], [])
+    search.disassemble(mask_of(range(len(translations.names))))
     return search
 
 
-def planar_rigid_may_free(model: Any, parts: Iterable[str], tol: Tolerance) -> bool:
+def planar_rigid_may_free(model: PolygonAssembly, parts: Iterable[str], tol: Tolerance) -> bool:
     """Whether some infinitesimal rigid motion of the plane (a turn about z and a
     translation in z = 0) moves a proper part of ``parts`` away from the others without
     penetration, breaking some contact (Γ_g in 2D, seed 004: "the 2D case is just
@@ -110,7 +88,7 @@ def planar_rigid_may_free(model: Any, parts: Iterable[str], tol: Tolerance) -> b
     with the out-of-plane twist components held at zero."""
     names = tuple(parts)
     inside = set(names)
-    contacts = tuple(c for c in model.contacts(tol) if c.a in inside and c.b in inside)
+    contacts = tuple(c for c in assembly_contacts(model, tol) if c.a in inside and c.b in inside)
     graph = RigidBlockingGraph(names, contacts, tol)
     for size in range(1, min(RIGID_MAX_SIZE, len(names) - 1) + 1):
         for chosen in itertools.combinations(names, size):

@@ -12,29 +12,27 @@ from collections.abc import Iterable, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
+from assemblykit.blocking.directions import DirectionTable, bits, mask_of
 from assemblykit.blocking.graphs import blocking_graph
+from assemblykit.blocking.polygons import PolygonAssembly
+from assemblykit.blocking.tables import translation_slots, translation_table
 from assemblykit.errors import InputError
 from assemblykit.planning.hands import hands_needed
 from assemblykit.planning.planar import planar_rigid_may_free, planar_search
 from assemblykit.planning.sequence import (
-    DirectionTable,
     ExtendedDirections,
     Hands,
     Interlock,
     Plan,
     Progress,
-    _base,
-    _bits,
-    _mask,
-    _Search,
+    Search,
     and_or_graph,
+    base_part,
     distinct_directions,
     exact_candidates,
     minimal_interlocked,
     one_set,
     separable,
-    translation_slots,
-    translation_table,
 )
 from assemblykit.planning.stability import Gravity, GravityReport, StateJudge, equilibrium_model
 from assemblykit.tolerance import Tolerance
@@ -43,18 +41,20 @@ if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
 
 
-def rigid_may_free(assembly: Assembly, parts: Iterable[str], tol: Tolerance | None = None) -> bool:
+def rigid_may_free(
+    assembly: Assembly | PolygonAssembly, parts: Iterable[str], tol: Tolerance | None = None
+) -> bool:
     """Whether some DBG of Γ_g (infinitesimal rigid motions) of the sub-assembly
     ``parts`` frees a proper part of it: the necessary condition of seed 004 ("a
     necessary condition for a subassembly S to be directly removable")."""
-    if getattr(assembly, "dimension", 3) == 2:
+    if isinstance(assembly, PolygonAssembly):
         # polygons move in their plane: lifting off it would free every part
         return planar_rigid_may_free(assembly, parts, assembly.tolerance(tol))
     return bool(blocking_graph(assembly, motion="rigid", parts=parts, tol=tol).removable())
 
 
 def plan(
-    assembly: Assembly,
+    assembly: Assembly | PolygonAssembly,
     tol: Tolerance | None = None,
     max_and_or_parts: int = 8,
     progress: Progress | None = None,
@@ -84,7 +84,7 @@ def plan(
     names = tuple(assembly.names)
     report: Progress = progress or (lambda stage, done, total: None)
     report("blocking graph (infinitesimal translations)", 0, len(names))
-    if getattr(assembly, "dimension", 3) == 2:
+    if isinstance(assembly, PolygonAssembly):
         if gravity is not None or one_at_a_time:
             raise InputError("--gravity and --one-at-a-time need 3D parts, not 2D polygons")
 
@@ -93,7 +93,7 @@ def plan(
     translations = translation_table(assembly, tol)
     extended = ExtendedDirections(assembly, translations.directions, tol)
     volumes = tuple(assembly.parts[name].volume for name in names)
-    search = _Search(
+    search = Search(
         translations,
         extended,
         volumes,
@@ -105,14 +105,14 @@ def plan(
         (one_set,) if one_at_a_time else (),
     )
     if gravity is None:
-        search.disassemble(_mask(range(len(names))))
+        search.disassemble(mask_of(range(len(names))))
         return finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
     return _plan_under_gravity(assembly, search, gravity, tol, max_and_or_parts, max_hands)
 
 
 def _plan_under_gravity(
     assembly: Assembly,
-    search: _Search,
+    search: Search,
     gravity: Gravity,
     tol: Tolerance,
     max_and_or_parts: int,
@@ -136,20 +136,20 @@ def _plan_under_gravity(
         v + total if name in fixed else v
         for name, v in zip(model.names, search.volumes, strict=True)
     )
-    everything = _mask(range(len(model.names)))
+    everything = mask_of(range(len(model.names)))
     judge = StateJudge(
         model,
         gravity.holds,
         search.translations.vector,
-        lambda members: _base(members, search.volumes),
-        _base(everything, search.volumes),
+        lambda members: base_part(members, search.volumes),
+        base_part(everything, search.volumes),
     )
     search.narrowers = (judge.stable, judge.fewest_falling)
     search.judge = judge.judge
     if gravity.fixed is not None:
         # declared fixed parts (a fixture) never move; the default ones only rest on the
         # ground, and are taken off it last
-        search.ground = _mask(k for k, name in enumerate(model.names) if name in fixed)
+        search.ground = mask_of(k for k, name in enumerate(model.names) if name in fixed)
     search.disassemble(everything)
     result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
     whole = model.check()
@@ -168,8 +168,8 @@ def _plan_under_gravity(
 
 
 def finish_plan(
-    assembly: Any,
-    search: _Search,
+    assembly: Assembly | PolygonAssembly,
+    search: Search,
     tol: Tolerance,
     max_and_or_parts: int,
     max_hands: int,
@@ -203,7 +203,7 @@ def finish_plan(
         report("hands", 0, len(search.locked))
         # each stopped set on its own: its groups never need the parts already removed
         found = [
-            hands_needed(assembly, [names[i] for i in _bits(members)], max_hands, tol)
+            hands_needed(assembly, [names[i] for i in bits(members)], max_hands, tol)
             for members in search.locked
         ]
         needed = [h.needed for h in found]
@@ -219,24 +219,26 @@ def finish_plan(
 
 
 def _interlock(
-    assembly: Assembly,
+    assembly: Assembly | PolygonAssembly,
     names: Sequence[str],
     members: int,
     locked: int,
     translations: DirectionTable,
     tol: Tolerance,
 ) -> Interlock:
-    parts = tuple(names[i] for i in _bits(members))
+    parts = tuple(names[i] for i in bits(members))
     return Interlock(
         parts=parts,
         translation_locked=not separable(translations, members),
         rigid_may_free=rigid_may_free(assembly, parts, tol),
-        held=tuple(names[i] for i in _bits(locked & ~members)),
+        held=tuple(names[i] for i in bits(locked & ~members)),
     )
 
 
 def separable_by_translations(
-    assembly: Any, parts: Iterable[str] | None = None, tol: Tolerance | None = None
+    assembly: Assembly | PolygonAssembly,
+    parts: Iterable[str] | None = None,
+    tol: Tolerance | None = None,
 ) -> bool:
     """Whether the assembly comes completely apart with extended translations, one
     subassembly moving at a time (seed 004, conclusion). Removing parts only removes

@@ -40,10 +40,10 @@ import manifold3d
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
-from rich.table import Table
 
 from assemblykit.algebra import se3
 from assemblykit.blocking.rigid import RigidBlockingGraph
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.interference import interference_threshold, solid
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.planner import plan
@@ -182,7 +182,7 @@ def screw_removal(
     if not moving or not rest:
         return None
     tol = assembly.tolerance(tol)
-    graph = RigidBlockingGraph(tuple(assembly.names), tuple(assembly.contacts(tol)), tol)
+    graph = RigidBlockingGraph(tuple(assembly.names), tuple(assembly_contacts(assembly, tol)), tol)
     points, normals = graph.constraints(moving)
     if len(points) == 0:
         return None
@@ -236,40 +236,6 @@ class ScrewPlan:
             "screws": [s.to_dict() for s in self.screws],
             "moves": "rigid",
         }
-
-    def render(self) -> Table:
-        """One row per step, turns with their axis and angle."""
-        verdict = "feasible" if self.feasible else "infeasible"
-        table = Table(title=f"Disassembly plan with turns ({verdict})")
-        for column in ("step", "move", "motion", "axis (point; direction)", "then along"):
-            table.add_column(column)
-        number = 0
-        for k, stage in enumerate(self.stages):
-            for step in stage.steps:
-                number += 1
-                direction = ", ".join(f"{x:.3g}" for x in step.direction)
-                table.add_row(str(number), ", ".join(step.parts), step.motion, "-", direction)
-            if k < len(self.screws):
-                turn = self.screws[k]
-                number += 1
-                axis = (
-                    "("
-                    + ", ".join(f"{x:.3g}" for x in turn.point)
-                    + "; "
-                    + ", ".join(f"{x:.3g}" for x in turn.axis)
-                    + ")"
-                )
-                table.add_row(
-                    str(number),
-                    ", ".join(turn.parts),
-                    f"turn {math.degrees(turn.angle):.1f} deg"
-                    + (f", pitch {turn.pitch:.4g} per rad" if turn.pitch else ""),
-                    axis,
-                    ", ".join(f"{x:.3g}" for x in turn.exit),
-                )
-        if not self.feasible:
-            table.caption = "stuck: " + ", ".join(self.stages[-1].stuck)
-        return table
 
 
 def plan_with_screws(assembly: Assembly, tol: Tolerance | None = None) -> ScrewPlan:

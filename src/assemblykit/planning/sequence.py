@@ -37,18 +37,24 @@ every two-handed partition accepted by Γ_e is built too, and its plans are coun
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cache
 from typing import TYPE_CHECKING, Any, Literal
 
 import networkx as nx
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
-from rich.console import Group
-from rich.table import Table
+from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
-from assemblykit.blocking.constraints import BlockingTerm
+from assemblykit.blocking.directions import (
+    DirectionTable,
+    bits,
+    count_bits,
+    mask_of,
+    row_mask,
+    several,
+    union_of,
+)
 from assemblykit.blocking.extended import extended_arcs
 from assemblykit.tolerance import Tolerance
 
@@ -61,142 +67,7 @@ Narrow = Callable[[int, int, list[int]], list[int]]
 """``narrow(members, k, sets)``: the free sets (bit masks) of direction ``k`` to move."""
 LOOK_AHEAD = 12
 """Candidate directions still examined after the first removal Γ_e accepts."""
-
-FULL_ARRANGEMENT_REGIONS = 250_000
-"""The largest arrangement of Γ_t whose regions all become candidate directions."""
 MotionKind = Literal["translation", "rigid"]
-
-
-@dataclass(frozen=True, eq=False)
-class DirectionTable:
-    """DBGs of one NDBG along a list of directions, over a fixed list of parts.
-
-    ``directions[k]`` is the k-th direction (a region's representative). The
-    possible arcs are *slots*, sorted by moving part: slot ``s`` is the arc
-    ``moving[s] → blocker[s]`` ("``blocker[s]`` blocks ``moving[s]``"), present along
-    direction ``k`` when ``slots[k, s]``. Sets of parts are bit masks over ``names``.
-    """
-
-    names: tuple[str, ...]
-    directions: NDArray[np.float64]
-    slots: NDArray[np.bool_]
-    moving: NDArray[np.int64]
-    blocker: NDArray[np.int64]
-    _last: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
-
-    @classmethod
-    def from_arcs(
-        cls,
-        names: Sequence[str],
-        directions: ArrayLike,
-        arcs: Sequence[Iterable[tuple[int, int]]],
-    ) -> DirectionTable:
-        """A table from the arcs ``(i, j)`` ("j blocks i") of each direction."""
-        pairs = sorted({arc for per_direction in arcs for arc in per_direction})
-        column = {pair: s for s, pair in enumerate(pairs)}
-        slots = np.zeros((len(arcs), len(pairs)), dtype=bool)
-        for k, per_direction in enumerate(arcs):
-            slots[k, [column[arc] for arc in per_direction]] = True
-        ends = np.array(pairs, dtype=np.int64).reshape(-1, 2)
-        return cls(tuple(names), np.asarray(directions, dtype=np.float64), slots, *ends.T)
-
-    def vector(self, members: int) -> NDArray[np.bool_]:
-        """The set ``members`` as a boolean vector over ``names``."""
-        return np.array([bool(members >> i & 1) for i in range(len(self.names))], dtype=bool)
-
-    def _active(self, members: int) -> NDArray[np.int64]:
-        inside = self.vector(members)
-        return np.flatnonzero(inside[self.moving] & inside[self.blocker])
-
-    def free_parts(self, members: int) -> NDArray[np.bool_]:
-        """``free[k, i]``: part i of ``members`` has no blocker in ``members`` along k."""
-        bits = self.free_bits(members, members)
-        return np.unpackbits(bits, axis=1, count=len(self.names), bitorder="little").astype(bool)
-
-    def free_bits(self, members: int, movers: int) -> NDArray[np.uint8]:
-        """Per direction, the parts of ``movers`` with no blocker in ``members``, packed
-        (bit ``i`` of row ``k`` read little-endian, as :func:`_row_mask` does).
-
-        The search asks this of shrinking sets: when ``members`` is a subset of the set
-        asked last, only the parts that had a blocker among the parts since removed are
-        recomputed."""
-        inside = self.vector(members)
-        last = self._last.get("blocked")
-        if last is not None and last[0] & members == members:
-            removed = self.vector(last[0] & ~members)
-            blocked = last[1]
-            for i in np.unique(self.moving[removed[self.blocker]]):
-                if inside[i]:
-                    column = self._blocked_part(int(i), inside).astype(np.uint8)
-                    byte, bit = divmod(int(i), 8)
-                    blocked[:, byte] &= np.uint8(~(1 << bit) & 0xFF)
-                    blocked[:, byte] |= column << np.uint8(bit)
-        else:
-            unpacked = np.zeros((len(self.directions), len(self.names)), dtype=bool)
-            columns = self._active(members)
-            if len(columns):
-                owners = self.moving[columns]
-                starts = np.flatnonzero(np.r_[True, owners[1:] != owners[:-1]])
-                # every slot is active in the first call: no copy of the table then
-                active = (
-                    self.slots if len(columns) == self.slots.shape[1] else self.slots[:, columns]
-                )
-                # maximum over 0/1 bytes is logical or, and much faster along rows
-                unpacked[:, owners[starts]] = np.maximum.reduceat(
-                    active.view(np.uint8), starts, axis=1
-                ).view(bool)
-            blocked = np.packbits(unpacked, axis=1, bitorder="little")
-        self._last["blocked"] = (members, blocked)
-        chosen = np.packbits(self.vector(movers & members), bitorder="little")
-        return ~blocked & chosen
-
-    def _blocked_part(self, i: int, inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
-        """Per direction, whether part ``i`` has a blocker among ``inside``."""
-        lo, hi = np.searchsorted(self.moving, [i, i + 1])
-        columns = np.arange(lo, hi)[inside[self.blocker[lo:hi]]]
-        return np.asarray(self.slots[:, columns].any(axis=1))
-
-    def graph(self, k: int, members: int) -> nx.DiGraph:
-        """The DBG of direction ``k`` induced on ``members``: arc i→j when j blocks i."""
-        columns = self._active(members)
-        columns = columns[self.slots[k, columns]]
-        graph: nx.DiGraph[int] = nx.DiGraph()
-        graph.add_nodes_from(_bits(members))
-        graph.add_edges_from(
-            zip(self.moving[columns].tolist(), self.blocker[columns].tolist(), strict=True)
-        )
-        return graph
-
-    def incomplete(self, members: int) -> list[int]:
-        """The directions along which some part of ``members`` does not block another:
-        the only ones that may separate any subset of ``members`` (Γ_e blocks at least
-        where Γ_t does)."""
-        columns = self._active(members)
-        size = _count(members)
-        arcs = self.slots[:, columns].sum(axis=1)
-        return [int(k) for k in np.flatnonzero(arcs < size * (size - 1))]
-
-    def blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
-        """Per part of ``movers``, the mask of its blockers in ``among`` along ``k``."""
-        masks = self.masks(k)
-        return {i: masks[i] & among & ~(1 << i) for i in _bits(movers)}
-
-    def appended(self, directions: NDArray[np.float64], slots: NDArray[np.bool_]) -> DirectionTable:
-        """The table with more directions (rows of ``slots`` over the same slots)."""
-        return DirectionTable(
-            self.names,
-            np.vstack([self.directions, directions]),
-            np.vstack([self.slots, slots]),
-            self.moving,
-            self.blocker,
-        )
-
-    def masks(self, k: int) -> tuple[int, ...]:
-        """Per part, the bit mask of its blockers along direction ``k``."""
-        masks = [0] * len(self.names)
-        for s in np.flatnonzero(self.slots[k]):
-            masks[self.moving[s]] |= 1 << int(self.blocker[s])
-        return tuple(masks)
 
 
 class ExtendedDirections:
@@ -217,13 +88,13 @@ class ExtendedDirections:
     def blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
         """Per part of ``movers``, the mask of its blockers in ``among`` along ``k``;
         only the pairs not tested before are computed, in one call."""
-        untested = [i for i in _bits(movers) if among & ~self._tested.get((k, i), 1 << i)]
+        untested = [i for i in bits(movers) if among & ~self._tested.get((k, i), 1 << i)]
         if untested:
             arcs = extended_arcs(
                 self.assembly,
                 self.directions[k],
                 [self.names[i] for i in untested],
-                [self.names[j] for j in _bits(among)],
+                [self.names[j] for j in bits(among)],
                 self.tol,
             )
             for i in untested:
@@ -231,21 +102,21 @@ class ExtendedDirections:
             for a, b in arcs:
                 key = (k, self.index[a])
                 self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
-        return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in _bits(movers)}
+        return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
 
     def arcs(self, k: int, members: int | None = None) -> list[tuple[int, int]]:
         """The arcs ``(i, j)``, "j blocks i", of the DBG along direction ``k`` among
         ``members`` (default: all parts)."""
-        among = _mask(range(len(self.names))) if members is None else members
-        return [(i, j) for i, mask in self.blockers(k, among, among).items() for j in _bits(mask)]
+        among = mask_of(range(len(self.names))) if members is None else members
+        return [(i, j) for i, mask in self.blockers(k, among, among).items() for j in bits(mask)]
 
     def graph(self, k: int, members: int) -> nx.DiGraph:
         """The Γ_e DBG along direction ``k`` induced on ``members`` (blocking is
         pairwise, so the arcs found for one subassembly serve every other)."""
         graph: nx.DiGraph[int] = nx.DiGraph()
-        graph.add_nodes_from(_bits(members))
+        graph.add_nodes_from(bits(members))
         graph.add_edges_from(
-            (i, j) for i, mask in self.blockers(k, members, members).items() for j in _bits(mask)
+            (i, j) for i, mask in self.blockers(k, members, members).items() for j in bits(mask)
         )
         return graph
 
@@ -425,24 +296,6 @@ class Hands:
             return f"more than {self.max_hands} hands"
         return f"{self.needed} hand" + ("s" if self.needed > 1 else "")
 
-    def render(self) -> Table:
-        """A rich table of the operations with more than two hands."""
-        table = Table(title=f"Hands: {self.summary()}")
-        for column in ("operation", "group", "parts", "direction", "speed"):
-            table.add_column(column)
-        for number, move in enumerate(self.moves, start=1):
-            for g, (group, direction, speed) in enumerate(
-                zip(move.groups, move.directions, move.speeds, strict=True)
-            ):
-                table.add_row(
-                    str(number) if g == 0 else "",
-                    "fixed" if g == 0 else str(g),
-                    ", ".join(group),
-                    "-" if g == 0 else format_direction(direction),
-                    "-" if g == 0 else f"{speed:.3g}",
-                )
-        return table
-
 
 @dataclass(frozen=True, eq=False)
 class Plan:
@@ -547,68 +400,6 @@ class Plan:
         headers = ("step", "move", "direction", "motion", "away from")
         return fmt.html_summary(repr(self), headers, rows)
 
-    def render(self) -> Group:
-        """Rich tables of the disassembly steps (and the interlocked sets when
-        infeasible) and of the assembly order."""
-        return Group(self._disassembly_table(), self._assembly_table())
-
-    def _assembly_table(self) -> Table:
-        table = Table(title="Assembly order")
-        for column in ("step", "insert", "direction", "held"):
-            table.add_column(column)
-        for number, step in enumerate(self.assembly_steps, start=1):
-            table.add_row(
-                str(number),
-                ", ".join(step.parts),
-                format_direction(step.direction),
-                fmt.name_list(step.held),
-            )
-        return table
-
-    def _disassembly_table(self) -> Table:
-        title = "feasible" if self.feasible else "infeasible"
-        if self.and_or is not None:
-            title += f", {self.and_or.plans} plan(s) in the AND/OR graph"
-        if self.gravity is not None:
-            title += ", " + self.gravity.summary()
-        table = Table(title=f"Disassembly plan ({title})")
-        columns = ["step", "move", "direction", "motion", "away from"]
-        if self.gravity is not None:
-            columns += ["held", "would fall", "friction needed"]
-        for column in columns:
-            table.add_column(column)
-        for number, step in enumerate(self.steps, start=1):
-            cells = [
-                str(number),
-                ", ".join(step.parts),
-                format_direction(step.direction),
-                step.motion,
-                fmt.name_list(step.rest),
-            ]
-            if step.stability is not None:
-                cells += step.stability.cells()
-            table.add_row(*cells)
-        for lock in self.interlocked:
-            freed = "rigid motion may free" if lock.rigid_may_free else "locked"
-            table.add_row("-", ", ".join(lock.parts), "-", f"interlocked ({freed})", "-")
-            if lock.held:
-                table.add_row("-", ", ".join(lock.held), "-", "held by the interlock", "-")
-        if self.hands is not None and self.hands.moves:
-            # the groups of the operations two hands cannot do, one row per group
-            for move in self.hands.moves:
-                for group, direction in zip(move.groups[1:], move.directions[1:], strict=True):
-                    table.add_row(
-                        f"{move.hands} hands",
-                        ", ".join(group),
-                        format_direction(direction),
-                        "translation, together",
-                        fmt.name_list(move.groups[0]),
-                    )
-            table.caption = f"needs {self.hands.summary()}"
-        elif self.hands is not None and self.hands.needed is None:
-            table.caption = f"needs {self.hands.summary()}"
-        return table
-
 
 @dataclass(frozen=True, eq=False)
 class AssemblyStep:
@@ -634,70 +425,6 @@ class AssemblyStep:
         }
 
 
-def format_direction(direction: Sequence[float] | NDArray[np.float64]) -> str:
-    """A direction for tables: ``+Z`` along an axis, else ``(x, y, z)`` (the shared
-    formatter, :func:`assemblykit.formatting.direction`)."""
-    return fmt.direction(np.asarray(direction, dtype=np.float64))
-
-
-def _bits(mask: int) -> Iterable[int]:
-    index = 0
-    while mask:
-        if mask & 1:
-            yield index
-        mask >>= 1
-        index += 1
-
-
-def _mask(indices: Iterable[int]) -> int:
-    total = 0
-    for i in indices:
-        total |= 1 << int(i)  # numpy integers would overflow past 63 parts
-    return total
-
-
-def _union(masks: Iterable[int]) -> int:
-    total = 0
-    for mask in masks:
-        total |= mask
-    return total
-
-
-def _row_mask(row: NDArray[np.uint8]) -> int:
-    """The bit mask held by one row of little-endian packed bits (``np.packbits(...,
-    bitorder="little")``)."""
-    return int.from_bytes(row.tobytes(), "little")
-
-
-def _count(mask: int) -> int:
-    return bin(mask).count("1")
-
-
-def _several(mask: int) -> bool:
-    return (mask & (mask - 1)) != 0
-
-
-def direction_table(ndbg: Any) -> DirectionTable:
-    """The DBG of every region of ``ndbg`` (Γ_t or Γ_e of :mod:`assemblykit.blocking.ndbg`)
-    with the region's representative direction.
-
-    Every region counts, vertices and edges included (free directions of extended
-    translations are often isolated, e.g. a pin's axis), and regions with the same DBG
-    are kept apart: Γ_e may free a set along one of them and not another. The NDBG's
-    bit-packed slots are read as they are; expanding every region into a graph would
-    cost more than planning on large assemblies.
-    """
-    count = len(ndbg.table.starts)
-    slots = np.unpackbits(ndbg.packed, axis=1, count=count).astype(bool)
-    return DirectionTable(
-        tuple(ndbg.parts),
-        np.asarray(ndbg.arrangement.directions, dtype=np.float64),
-        slots.reshape(len(slots), count),
-        np.asarray(ndbg.table.slot_moving, dtype=np.int64),
-        np.asarray(ndbg.table.slot_blocker, dtype=np.int64),
-    )
-
-
 def distinct_directions(table: DirectionTable) -> list[int]:
     """One direction per distinct DBG of ``table``: the one closest to a coordinate axis."""
     _, inverse = np.unique(table.slots, axis=0, return_inverse=True)
@@ -709,7 +436,7 @@ def distinct_directions(table: DirectionTable) -> list[int]:
 def separable(table: DirectionTable, members: int) -> bool:
     """True when some direction of ``table`` frees a proper, non-empty part of ``members``
     (a DBG that is not strongly connected, seed 004)."""
-    if not _several(members):
+    if not several(members):
         return False
     if table.free_parts(members).any():
         return True
@@ -723,22 +450,22 @@ def _sinks(source: DirectionTable | ExtendedDirections, k: int, members: int) ->
     components of its DBG, as bit masks (seed 004, "Directional Blocking Graph")."""
     condensed = nx.condensation(source.graph(k, members))
     return [
-        _mask(condensed.nodes[c]["members"])
+        mask_of(condensed.nodes[c]["members"])
         for c in condensed.nodes
         if condensed.out_degree(c) == 0
     ]
 
 
-def _base(members: int, volumes: Sequence[float]) -> int:
+def base_part(members: int, volumes: Sequence[float]) -> int:
     """The heaviest part of ``members``: it stays, everything else leaves it."""
-    return max(_bits(members), key=lambda i: (volumes[i], -i))
+    return max(bits(members), key=lambda i: (volumes[i], -i))
 
 
 def _removal(sinks: list[int], members: int, volumes: Sequence[float]) -> list[int]:
-    """The free sets to move: all but the one holding the base (:func:`_base`). Keeping
+    """The free sets to move: all but the one holding the base (:func:`base_part`). Keeping
     the base still is no loss: the other side of a partition along ``d`` is free along
     ``-d``, which is also a candidate (the arrangement is symmetric)."""
-    base = 1 << _base(members, volumes)
+    base = 1 << base_part(members, volumes)
     return [s for s in sinks if not s & base]
 
 
@@ -748,7 +475,7 @@ def _group_bounds(
     """Per candidate direction, how many parts the free sets of Γ_t (sink components,
     the base's excluded) take out of ``members``: a bound for those of Γ_e."""
     bounds = {
-        k: _count(_union(_removal(_sinks(translations, k, members), members, volumes)))
+        k: count_bits(union_of(_removal(_sinks(translations, k, members), members, volumes)))
         for k in range(len(translations.directions))
     }
     return {k: v for k, v in bounds.items() if v}
@@ -770,14 +497,14 @@ def _choose_removal(
     k, sets)``, when given, picks among the free sets of direction ``k`` those to move
     (one at a time, or only removals that leave stable states).
     """
-    free = translations.free_bits(members, members & ~(1 << _base(members, volumes)))
+    free = translations.free_bits(members, members & ~(1 << base_part(members, volumes)))
     counts = np.bitwise_count(free).sum(axis=1, dtype=np.int64)
 
     def chosen(k: int, sets: list[int]) -> list[int]:
         return sets if narrow is None or not sets else narrow(members, k, sets)
 
     def singles(k: int) -> list[int]:
-        held = extended.blockers(k, _row_mask(free[k]), members)
+        held = extended.blockers(k, row_mask(free[k]), members)
         return chosen(k, [1 << i for i, mask in held.items() if not mask])
 
     def groups(k: int) -> list[int]:
@@ -829,13 +556,19 @@ def _best_direction(
                 break
             patience -= 1
         sinks = removal(k)
-        if sinks and (best is None or rank(k, _count(_union(sinks))) > best[0]):
-            best = (rank(k, _count(_union(sinks))), k, sinks)
+        if sinks and (best is None or rank(k, count_bits(union_of(sinks))) > best[0]):
+            best = (rank(k, count_bits(union_of(sinks))), k, sinks)
     return None if best is None else (best[1], best[2])
 
 
 @dataclass
-class _Search:
+class Search:
+    """The greedy disassembly search (module docstring): Γ_t along the candidate
+    directions (``translations``) bounds and orders them, Γ_e (``extended``) accepts the
+    removals; ``steps`` and the sets left interlocked (``locked``, bit masks) grow as
+    :meth:`disassemble` runs. ``exact`` and ``add_translations`` supply more candidate
+    directions where the sampled ones separate nothing."""
+
     translations: DirectionTable
     extended: DirectionTable | ExtendedDirections
     volumes: tuple[float, ...]
@@ -886,28 +619,28 @@ class _Search:
         pending = [members]
         while pending:
             current = pending.pop()
-            while _several(current) and current & ~self.ground:
+            while several(current) and current & ~self.ground:
                 choice = self._choose(current, previous)
                 if choice is None:
                     self.locked.append(current)
                     break
                 k, sinks = choice
-                moved = _union(sinks)
+                moved = union_of(sinks)
                 self._record(k, moved, current)
                 previous = k
-                pending.extend(s for s in sinks if _several(s))
+                pending.extend(s for s in sinks if several(s))
                 current &= ~moved
 
     def _record(self, k: int, moved: int, members: int) -> None:
         names = self.translations.names
         rest = members & ~moved
         held = self.extended.blockers(k, rest, moved) | self.extended.blockers(k, moved, moved)
-        arcs = sorted((i, j) for i, mask in held.items() for j in _bits(mask))
+        arcs = sorted((i, j) for i, mask in held.items() for j in bits(mask))
         self.steps.append(
             Step(
-                parts=tuple(names[i] for i in _bits(moved)),
+                parts=tuple(names[i] for i in bits(moved)),
                 direction=self.translations.directions[k],
-                rest=tuple(names[i] for i in _bits(rest)),
+                rest=tuple(names[i] for i in bits(rest)),
                 blocking=tuple((names[i], names[j]) for i, j in arcs),
                 stability=None if self.judge is None else self.judge(members, moved),
             )
@@ -918,15 +651,15 @@ class _Search:
 def one_set(members: int, k: int, sets: list[int]) -> list[int]:
     """The narrower of one-at-a-time planning: the free set with the fewest parts (the
     lowest-numbered of those)."""
-    return [min(sets, key=lambda mask: (_count(mask), mask & -mask))]
+    return [min(sets, key=lambda mask: (count_bits(mask), mask & -mask))]
 
 
 def minimal_interlocked(table: DirectionTable, members: int) -> int:
     """A minimal subset of ``members`` that no direction of ``table`` separates: parts are
     dropped one at a time while the rest stays interlocked."""
-    for i in list(_bits(members)):
+    for i in list(bits(members)):
         smaller = members & ~(1 << i)
-        if _several(smaller) and not separable(table, smaller):
+        if several(smaller) and not separable(table, smaller):
             return minimal_interlocked(table, smaller)
     return members
 
@@ -942,17 +675,17 @@ def and_or_graph(table: DirectionTable) -> AndOrGraph:
     graph: nx.DiGraph[AndOrNode] = nx.DiGraph()
 
     def label(mask: int) -> frozenset[str]:
-        return frozenset(names[i] for i in _bits(mask))
+        return frozenset(names[i] for i in bits(mask))
 
     def free(part: int, members: int) -> bool:
         # part is free along k when none of its blockers inside members lies outside it
         outside = members & ~part
-        return any(all((blockers[i] & outside) == 0 for i in _bits(part)) for blockers in masks)
+        return any(all((blockers[i] & outside) == 0 for i in bits(part)) for blockers in masks)
 
     @cache
     def count(members: int) -> int:
         graph.add_node(label(members), kind="or")
-        if not _several(members):
+        if not several(members):
             return 1
         total = 0
         lowest = members & -members
@@ -973,55 +706,8 @@ def and_or_graph(table: DirectionTable) -> AndOrGraph:
             sub = (sub - 1) & rest
         return total
 
-    plans = count(_mask(range(len(names))))
+    plans = count(mask_of(range(len(names))))
     return AndOrGraph(graph, plans)
-
-
-def translation_table(assembly: Assembly, tol: Tolerance) -> DirectionTable:
-    """Γ_t along the candidate directions of the planner: the regions of the whole
-    arrangement when it is small enough (about ``3 c²`` regions for ``c`` circles, at
-    most ``FULL_ARRANGEMENT_REGIONS``), else those of each part's own arrangement
-    (:func:`local_table`)."""
-    from assemblykit.blocking.arrangement import snap_normals
-    from assemblykit.blocking.graphs import blocking_graph, blocking_terms
-
-    terms = blocking_terms(assembly, "infinitesimal", tol)
-    rows = [t.normals for t in terms]
-    circles = len(snap_normals(np.vstack(rows), tol)[0]) if rows else 0
-    if 3 * circles**2 <= FULL_ARRANGEMENT_REGIONS:
-        return direction_table(blocking_graph(assembly, motion="infinitesimal", tol=tol))
-    return local_table(tuple(assembly.names), terms, tol)
-
-
-def local_table(
-    names: tuple[str, ...], terms: Sequence[BlockingTerm], tol: Tolerance
-) -> DirectionTable:
-    """Γ_t along the regions of each part's own arrangement (the great circles of the
-    terms that block it; seed 004's arrangement, one part at a time).
-
-    A part's blockers are constant over each region of its own arrangement, so every
-    way Γ_t lets a single part leave any subassembly is among these directions; groups
-    that must leave together may be free along others. On the 527-block dome: 49,926
-    directions instead of 2.2 million regions."""
-    from assemblykit.blocking.arrangement import snap_normals, sphere_arrangement
-
-    index = {name: i for i, name in enumerate(names)}
-    own: dict[str, list[NDArray[np.float64]]] = {}
-    for term in terms:
-        own.setdefault(term.moving, []).append(term.normals)
-    directions = np.vstack(
-        [
-            sphere_arrangement(snap_normals(np.vstack(rows), tol)[0]).directions
-            for rows in own.values()
-        ]
-        or [np.array([[0.0, 0.0, 1.0]])]
-    )
-    pairs = sorted({(index[t.moving], index[t.blocker]) for t in terms})
-    column = {pair: s for s, pair in enumerate(pairs)}
-    owners = [column[(index[t.moving], index[t.blocker])] for t in terms]
-    slots = _term_slots(directions, terms, owners, len(pairs), tol)
-    ends = np.array(pairs, dtype=np.int64).reshape(-1, 2)
-    return DirectionTable(names, directions, slots, *ends.T)
 
 
 EXACT_GROUP_PARTS = 12
@@ -1040,7 +726,7 @@ def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDAr
     names = tuple(assembly.names)
 
     def directions(members: int) -> NDArray[np.float64]:
-        among = [names[i] for i in _bits(members)]
+        among = [names[i] for i in bits(members)]
         found: list[NDArray[np.float64]] = []
         for name in among:
             found.extend(exact_free_directions(assembly, [name], tol, among, limit=2).directions)
@@ -1057,82 +743,3 @@ def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDAr
         return overlay_faces(sets, tol).directions
 
     return directions
-
-
-def translation_slots(
-    assembly: Assembly, table: DirectionTable, tol: Tolerance
-) -> Callable[[NDArray[np.float64]], NDArray[np.bool_]]:
-    """Γ_t along new directions over the slots of ``table``: a slot blocks when one of its
-    infinitesimal terms holds strictly (beyond the angle tolerance, as the arrangement's
-    snapping has it)."""
-    from assemblykit.blocking.graphs import blocking_terms
-
-    index = {name: i for i, name in enumerate(table.names)}
-    column = {
-        (int(i), int(j)): s
-        for s, (i, j) in enumerate(zip(table.moving, table.blocker, strict=True))
-    }
-    kept = [
-        (term, column[pair])
-        for term in blocking_terms(assembly, "infinitesimal", tol)
-        if (pair := (index[term.moving], index[term.blocker])) in column
-    ]
-
-    def slots(directions: NDArray[np.float64]) -> NDArray[np.bool_]:
-        return _term_slots(
-            directions, [t for t, _ in kept], [s for _, s in kept], len(table.moving), tol
-        )
-
-    return slots
-
-
-TERM_CHUNK = 256
-"""Directions whose inner products with every term normal :func:`_term_slots` holds at
-once (a few MB on the dome: the chunk stays in cache)."""
-
-
-def _term_slots(
-    directions: NDArray[np.float64],
-    terms: Sequence[BlockingTerm],
-    owners: Sequence[int],
-    count: int,
-    tol: Tolerance,
-) -> NDArray[np.bool_]:
-    """``slots[k, s]``: some term of slot ``s`` (``owners[t]`` is term ``t``'s slot) holds
-    strictly along direction ``k``, every normal ``n`` of it with ``n . d > tol.angle``: a
-    direction on a circle (edge, vertex) is on neither side, within the angle tolerance,
-    as the arrangement's snapping has it. All terms at once, a chunk of directions at a
-    time."""
-    # column-major: the search gathers the slots of one moving part over every direction
-    slots = np.zeros((len(directions), count), dtype=bool, order="F")
-    sizes = np.array([len(np.atleast_2d(t.normals)) for t in terms], dtype=np.int64)
-    always = np.array(owners, dtype=np.int64)[sizes == 0]
-    slots[:, always] = True  # a term without normals holds everywhere
-    used = [t for t, size in zip(terms, sizes.tolist(), strict=True) if size]
-    if not used:
-        return slots
-    normals = np.vstack([np.atleast_2d(t.normals) for t in used]).T.copy()
-    firsts = np.r_[0, np.cumsum(sizes[sizes > 0])[:-1]]
-    slot_of = np.array(owners, dtype=np.int64)[sizes > 0]
-    order = np.argsort(slot_of, kind="stable")
-    ordered = slot_of[order]
-    starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]])
-    single = bool((sizes[sizes > 0] == 1).all())
-    # one normal per term and one term per slot (COMPAS vaults): no reduction, the
-    # normals put in slot order
-    direct = single and np.array_equal(ordered, np.arange(count))
-    if direct:
-        normals = normals[:, order]
-    for lo in range(0, len(directions), TERM_CHUNK):
-        chunk = directions[lo : lo + TERM_CHUNK]
-        inner = chunk[:, :1] * normals[0] + chunk[:, 1:2] * normals[1] + chunk[:, 2:] * normals[2]
-        if direct:
-            slots[lo : lo + TERM_CHUNK] |= inner > tol.angle
-            continue
-        ahead = (inner > tol.angle).view(np.uint8)
-        # minimum and maximum over 0/1 bytes: "all normals" per term, "any term" per slot
-        held = ahead if single else np.minimum.reduceat(ahead, firsts, axis=1)
-        slots[lo : lo + TERM_CHUNK, ordered[starts]] |= np.maximum.reduceat(
-            held[:, order], starts, axis=1
-        ).view(bool)
-    return slots

@@ -47,6 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linprog
 
 from assemblykit.errors import InputError, NumericError
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -184,7 +185,7 @@ def contact_points(
     ``a`` into ``b``; curved: from the inner part outward), and tangent frames."""
     index = {name: i for i, name in enumerate(assembly.names)}
     points, normals, first, second = [], [], [], []
-    for contact in assembly.contacts(tol):
+    for contact in assembly_contacts(assembly, tol):
         a, b = index[contact.a], index[contact.b]
         for patch in contact.planar:
             count = len(patch.polygon)

@@ -19,10 +19,10 @@ from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
 from assemblykit.algebra import se3
-from assemblykit.io.outputs import atomic_output
 from assemblykit.model.assembly import Assembly
 from assemblykit.motion.articulation import Articulation
 from assemblykit.motion.freedom import Motion, MotionReport
+from assemblykit.outputs import atomic_output
 from assemblykit.tolerance import Tolerance
 from assemblykit.viz.viewer import ReportTable, part_colors
 

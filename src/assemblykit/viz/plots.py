@@ -18,7 +18,7 @@ import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from assemblykit import formatting as fmt
-from assemblykit.io.outputs import atomic_output
+from assemblykit.outputs import atomic_output
 
 if TYPE_CHECKING:
     from matplotlib.cm import ScalarMappable

@@ -34,7 +34,7 @@ from plotly.colors import hex_to_rgb, qualitative
 
 from assemblykit import formatting as fmt
 from assemblykit.algebra import se3
-from assemblykit.io.outputs import atomic_output
+from assemblykit.outputs import atomic_output
 from assemblykit.viz.explode import Explosion, explosion
 
 if TYPE_CHECKING:

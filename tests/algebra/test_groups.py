@@ -1,5 +1,6 @@
 """Hervé subgroups, membership, intersection, discrete parts and orbits
-(src/assemblykit/algebra/subgroups.py; ALGEBRA.md §2.1-§2.4, W14, W16, W21)."""
+(src/assemblykit/algebra/lie.py, groups.py, loci.py, subspaces.py, connected_meets.py,
+meets.py; ALGEBRA.md §2.1-§2.4, W14, W16, W21)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from assemblykit.algebra import Kind, Locus, SymmetryGroup, intersect_groups, se3
-from assemblykit.algebra.subgroups import classify_algebra, connected_meet, psd_solve
+from assemblykit.algebra.connected_meets import connected_meet
+from assemblykit.algebra.groups import classify_algebra
+from assemblykit.algebra.subspaces import psd_solve
 from assemblykit.errors import GroupError
 from assemblykit.tolerance import Tolerance
 
@@ -253,7 +256,7 @@ def test_discrete_screw_lattice_meets_in_closed_form():
 
 
 def test_one_parameter_groups_through_lattice_generators():
-    from assemblykit.algebra.subgroups import lattice_parameter, one_parameter
+    from assemblykit.algebra.groups import lattice_parameter, one_parameter
 
     t = one_parameter(tr(0, 0, 1.5))
     assert t is not None and t.kind is Kind.PRISMATIC
@@ -405,10 +408,10 @@ def test_intersection_members_lie_in_both_and_conjugation_commutes(seed):
 def test_closed_form_tr_meet_agrees_with_the_lie_algebra_route(seed):
     rng = np.random.default_rng(seed)
     a, b = _tr_group(rng), _tr_group(rng)
-    from assemblykit.algebra.subgroups import _null_space, _scaled
+    from assemblykit.algebra.lie import null_space, scaled_twists
 
     tol = Tolerance()
-    null = _null_space(_scaled(np.hstack((a.algebra, -b.algebra)), tol), tol)
+    null = null_space(scaled_twists(np.hstack((a.algebra, -b.algebra)), tol), tol)
     via_algebra = classify_algebra(a.algebra @ null[: a.dof], tol)
     assert connected_meet(a, b, tol).equals(via_algebra)
 
@@ -470,17 +473,28 @@ def test_a_helix_has_no_closed_form_distance():
         Locus("helix", point=np.zeros(3), direction=np.array([0.0, 0.0, 1.0])).distance(np.zeros(3))
 
 
-
-def test_the_method_intersect_is_the_group_meet():
-    """``SymmetryGroup.intersect`` (the public method) is :func:`intersect_groups`, for
-    connected groups and for finite ones (the turns of a square about z meet those of a
-    hexagon in the half turns: C4 ∩ C6 = C2, 2 components)."""
+def test_intersect_groups_meets_connected_and_finite_groups():
+    """:func:`intersect_groups` for connected groups and for finite ones (the turns of a
+    square about z meet those of a hexagon in the half turns: C4 ∩ C6 = C2, 2
+    components), the same either way round."""
     cylinder = SymmetryGroup.cylindrical((0, 0, 0), (0, 0, 1))
     plane = SymmetryGroup.planar((0, 0, 1))
-    assert cylinder.intersect(plane).equals(intersect_groups(cylinder, plane))
-    assert cylinder.intersect(plane).kind is Kind.REVOLUTE
+    assert intersect_groups(cylinder, plane).kind is Kind.REVOLUTE
+    assert intersect_groups(cylinder, plane).equals(intersect_groups(plane, cylinder))
     square = SymmetryGroup.cyclic((0, 0, 0), (0, 0, 1), 4)
     hexagon = SymmetryGroup.cyclic((0, 0, 0), (0, 0, 1), 6)
-    met = square.intersect(hexagon)
-    assert met.equals(intersect_groups(square, hexagon))
+    met = intersect_groups(square, hexagon)
+    assert met.equals(intersect_groups(hexagon, square))
     assert (met.dof, met.n_components) == (0, 2)
+
+
+def test_orbit_kinds_are_locus_kinds_equal_to_their_strings():
+    from assemblykit.algebra import LocusKind
+
+    circle = SymmetryGroup.revolute(ORIGIN, Z).orbit((1.0, 0.0, 0.0))
+    assert circle.kind is LocusKind.CIRCLE and circle.kind == "circle"
+    assert SymmetryGroup.free().orbit(ORIGIN).kind is LocusKind.SPACE
+    union = SymmetryGroup.cyclic(ORIGIN, Z, 2).orbit((1.0, 0.0, 0.0))
+    assert union.kind is LocusKind.UNION and len(union.members) == 2
+    # a locus given by its kind's string keeps working
+    assert Locus("sphere", point=np.zeros(3), radius=1.0).contains((0.0, 1.0, 0.0))

@@ -6,7 +6,7 @@ import os
 import stat
 from pathlib import Path
 
-from assemblykit.io.outputs import atomic_output
+from assemblykit.outputs import atomic_output
 
 
 def _mode(path: Path) -> int:

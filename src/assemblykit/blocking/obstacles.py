@@ -1,0 +1,115 @@
+"""The obstacles of extended translations (Wilson & Latombe 1992, "Extended translations"):
+per part its convex bodies and bounding sphere, per ordered pair of parts the open cones
+of directions along which one blocks the other (one per pair of convex bodies, the
+grown obstacle ``Q ⊕ (−P)`` of :mod:`assemblykit.geometry.minkowski`) and the
+translation that backs one out of the other when they share a volume the interference
+policy counts as touching (:func:`assemblykit.geometry.interference.interference_threshold`,
+:func:`assemblykit.geometry.settling.settle`).
+
+:mod:`assemblykit.blocking.extended` decides blocking with them and
+:mod:`assemblykit.blocking.free_cones` builds exact blocked sets from them.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import manifold3d
+import numpy as np
+from numpy.typing import NDArray
+
+from assemblykit.geometry.interference import interference_threshold, shared_volume, solid
+from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
+from assemblykit.geometry.settling import settle
+from assemblykit.model.assembly import Assembly
+from assemblykit.tolerance import Tolerance
+
+
+def of_meshes(assembly: object) -> Assembly:
+    """``assembly``, which must be an :class:`~assemblykit.model.assembly.Assembly`: the
+    obstacles of extended translations in 3D are built from the parts' meshes (polygon
+    assemblies have exact planar terms, :mod:`assemblykit.blocking.planar`)."""
+    assert isinstance(assembly, Assembly)
+    return assembly
+
+
+class Obstacles:
+    """Convex bodies, solids, bounding spheres and pairwise cones and back-outs of one
+    assembly's parts, each computed when first asked for and kept (one per assembly, in
+    its :class:`~assemblykit.blocking.cache.BlockingCache`)."""
+
+    def __init__(self, assembly: Assembly) -> None:
+        self.assembly = assembly
+        self.pieces: dict[str, list[NDArray[np.float64]] | None] = {}
+        self.cones: dict[tuple[str, str, Tolerance], list[NDArray[np.float64]]] = {}
+        self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
+        self.solids: dict[str, manifold3d.Manifold] = {}
+        names = list(assembly.names)
+        self.names = names
+        bounds = np.array([assembly.parts[n].mesh.bounds for n in names]).reshape(-1, 2, 3)
+        self.centers = bounds.mean(axis=1)
+        self.radii = np.linalg.norm(bounds[:, 1] - bounds[:, 0], axis=1) / 2
+
+    def of(self, name: str) -> list[NDArray[np.float64]] | None:
+        """The convex bodies of a part, ``None`` when one of them is not convex."""
+        if name not in self.pieces:
+            self.pieces[name] = convex_bodies(
+                self.assembly.parts[name].mesh, self.assembly.tolerance()
+            )
+        return self.pieces[name]
+
+    def convex(self, name: str) -> bool:
+        """Whether the part is a union of convex bodies (cones are exact for it)."""
+        return self.of(name) is not None
+
+    def solid(self, name: str) -> manifold3d.Manifold:
+        """The manifold3d solid of a part's mesh, made once."""
+        if name not in self.solids:
+            self.solids[name] = solid(self.assembly.parts[name].mesh)
+        return self.solids[name]
+
+    def backout(self, moving: str, blocker: str, tol: Tolerance) -> NDArray[np.float64]:
+        """The translation that backs ``moving`` out of ``blocker`` before blocking is
+        decided: their separation when they share a volume counted as touching (module
+        docstring) and it is longer than the length tolerance the tests allow anyway,
+        else zero."""
+        key = (moving, blocker, tol)
+        if key not in self.backouts:
+            flipped = (blocker, moving, tol)
+            if flipped in self.backouts:
+                self.backouts[key] = -self.backouts[flipped]
+            else:
+                a, b = self.assembly.parts[moving].mesh, self.assembly.parts[blocker].mesh
+                shift = np.zeros(3)
+                volume = shared_volume(self.solid(moving), self.solid(blocker))
+                if 0 < volume <= interference_threshold(a, b, tol):
+                    shifts = settle([a, b], [(0, 1)]).shifts
+                    if np.linalg.norm(shifts[0] - shifts[1]) > tol.length:
+                        shift = shifts[0] - shifts[1]
+                self.backouts[key] = shift
+        return self.backouts[key]
+
+    def cones_of(self, moving: str, blocker: str, tol: Tolerance) -> list[NDArray[np.float64]]:
+        """The cones along which ``blocker`` blocks ``moving``, both unions of convex
+        bodies (:meth:`convex`; other parts go to the projection test, which backs them
+        out). An empty cone (they overlap) is recomputed with ``moving`` backed out of
+        ``blocker`` (:meth:`backout`)."""
+        key = (moving, blocker, tol)
+        if key not in self.cones:
+            flipped = (blocker, moving, tol)
+            if flipped in self.cones:
+                self.cones[key] = [-c for c in self.cones[flipped]]
+            else:
+                self.cones[key] = self._cones(moving, blocker, tol, np.zeros(3))
+                if any(len(c) == 0 for c in self.cones[key]):
+                    shift = self.backout(moving, blocker, tol)
+                    if shift.any():
+                        self.cones[key] = self._cones(moving, blocker, tol, shift)
+        return self.cones[key]
+
+    def _cones(
+        self, moving: str, blocker: str, tol: Tolerance, shift: NDArray[np.float64]
+    ) -> list[NDArray[np.float64]]:
+        pieces, obstacles = self.of(moving), self.of(blocker)
+        assert pieces is not None and obstacles is not None
+        return [blocking_cone(q, p + shift, tol) for p, q in itertools.product(pieces, obstacles)]

@@ -1,0 +1,516 @@
+"""The readable form of every result: the rich tables and lines of text the commands print
+without ``--json``.
+
+The algorithms return data (``to_dict()`` gives the JSON of DESIGN.md §5.3); :func:`render`
+turns any of their results into a rich renderable, dispatched on the result's type
+(:func:`functools.singledispatch`). The renderers of a package's results are registered
+the first time one of its results is rendered, so that printing a solution does not
+import the planners.
+
+>>> from pathlib import Path
+>>> import assemblykit
+>>> from rich.console import Console
+>>> examples = Path(assemblykit.__file__).parent / "examples"
+>>> task = assemblykit.load_task(examples / "tasks" / "peg_in_block.rapt")
+>>> console = Console(width=100, color_system=None)
+>>> with console.capture() as captured:
+...     console.print(render(task.solve()))
+>>> print(captured.get().splitlines()[0].strip())
+RAPT inference: underconstrained
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections import Counter
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+import numpy as np
+from rich.console import Group, RenderableType
+from rich.table import Table
+from rich.text import Text
+
+from assemblykit import formatting as fmt
+
+if TYPE_CHECKING:
+    from assemblykit.batch import BatchSummary
+    from assemblykit.blocking.dbg import Removal
+    from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
+    from assemblykit.blocking.rigid import RigidBlockingGraph
+    from assemblykit.demo import DemoResult
+    from assemblykit.inference.solution import Solution
+    from assemblykit.io.assembly import ContactReport
+    from assemblykit.mating.search import MatingResult
+    from assemblykit.motion.articulation import Articulation
+    from assemblykit.motion.freedom import MotionReport
+    from assemblykit.motion.relational import TaskMotionReport
+    from assemblykit.planning.multimove import MultiMovePlan, Separation
+    from assemblykit.planning.screw import ScrewPlan
+    from assemblykit.planning.sequence import Hands, Plan
+
+
+@functools.singledispatch
+def render(result: object) -> RenderableType:
+    """``result`` as rich tables and text (module docstring); a :class:`TypeError` for
+    an object that is no result of assemblykit."""
+    kind = type(result)
+    register = _REGISTRARS.get(".".join(kind.__module__.split(".")[:2]))
+    if register is not None:
+        register()
+        renderer = render.dispatch(kind)
+        if renderer is not render.registry[object]:
+            return renderer(result)
+    raise TypeError(f"no rendering of {kind.__name__}")
+
+
+def _solution(result: Solution) -> Group:
+    """RAPT inference (Corner et al. 1983): a table of the body instances, then the
+    freedoms, the conflicts and (when explaining) the trace."""
+    from assemblykit.inference.solution import INVARIANT_KEYS, invariant_text
+
+    table = Table(title=f"RAPT inference: {result.status}")
+    for column in ("instance", "dof", "motion", "solutions"):
+        table.add_column(column)
+    table.add_column(fmt.header("position", result.units))
+    table.add_column("invariants")
+    for key, b in result.bodies.items():
+        table.add_row(
+            key,
+            str(b.dof),
+            b.mechanism or b.motion,
+            "infinite" if b.solutions is None else str(b.solutions),
+            fmt.vector(np.asarray(b.pose)[:3, 3]),
+            ", ".join(
+                f"{k} {invariant_text(k, v)}"
+                for k, v in b.invariants.items()
+                if k in INVARIANT_KEYS
+            ),
+        )
+    parts: list[RenderableType] = [table]
+    if result.cut is not None:
+        parts.append(Text(result.cut.message))
+    parts.extend(Text(b.freedom) for b in result.bodies.values() if b.freedom)
+    for c in result.conflicts:
+        parts.append(Text(f"conflict ({c.kind} {c.value:.6g}): {', '.join(c.relations)}"))
+        parts.append(Text(f"  {c.message}"))
+        if c.advice is not None:
+            parts.append(Text(f"  {c.advice}"))
+    if result.explain:
+        # one line per step whatever the width: the trace is read by people and programs
+        for step in result.trace:
+            parts.append(
+                Text(
+                    f"{step.rule}: {step.link} dof {step.dof_before} -> {step.dof_after}"
+                    + (f" ({step.detail})" if step.detail else ""),
+                    no_wrap=True,
+                    overflow="ignore",
+                )
+            )
+    return Group(*parts)
+
+
+def _motion_report(result: MotionReport) -> Table:
+    """Liu 1997 eq. (2): per moving set, the motion with its invariants, dof, components
+    and the unilateral reading."""
+    from assemblykit.motion.freedom import motion_summary
+
+    table = Table(title=f"Motion of each part{f' of {result.source}' if result.source else ''}")
+    for column in ("part", "motion", "dof", "components", "unilateral"):
+        table.add_column(column)
+    for key, moved in result.motions.items():
+        data = motion_summary(moved.group)
+        reading = moved.unilateral
+        if reading.lift_off:
+            rays = ", ".join(fmt.direction(r) for r in reading.lift_off)
+            unilateral = f"lifts off along {rays}"
+        elif reading.can_lift_off:
+            unilateral = "lifts off by turning"
+        else:
+            unilateral = "keeps every contact" if reading.free else "held"
+        table.add_row(
+            key, data["description"], str(data["dof"]), str(data["components"]), unilateral
+        )
+    return table
+
+
+def _articulation(result: Articulation) -> Group:
+    """The motion table followed by one table of gear ratios per train (Liu 1997 Fig. 9)."""
+    tables: list[RenderableType] = [render(result.report)]
+    for number, train in enumerate(result.trains, start=1):
+        table = Table(title=f"Gear train {number}: {train.dof} dof")
+        table.add_column("gear")
+        table.add_column(f"speed / speed of {train.gears[0]}")
+        for gear in train.gears:
+            ratio = train.ratios.get(gear)
+            table.add_row(gear, "locked" if ratio is None else f"{ratio:.6g}")
+        tables.append(table)
+    return Group(*tables)
+
+
+def _task_motion(result: TaskMotionReport) -> Table:
+    """Per body instance of a task: the motion its relations leave (Liu 1997 eq. (2)) with
+    its invariants, dof, components, the bodies it meets and the ignored relations."""
+    from assemblykit.motion.freedom import motion_summary
+
+    title = f"Motion of each body{f' of {result.source}' if result.source else ''}"
+    table = Table(title=f"{title} (inference: {result.status})")
+    for column in ("body", "motion", "dof", "components", "touching", "ignored"):
+        table.add_column(column)
+    for key, moved in result.motions.items():
+        data = motion_summary(moved.group)
+        table.add_row(
+            key,
+            data["description"],
+            str(data["dof"]),
+            str(data["components"]),
+            ", ".join(moved.touching),
+            "; ".join(moved.ignored),
+        )
+    return table
+
+
+def _mating(result: MatingResult) -> Group:
+    """Liu & Popplestone's (1990) Or/And form, then the ranges of motion and the pruning
+    statistics of each law."""
+    from assemblykit.mating.search import LAWS
+
+    lines = [Text(result.or_and())]
+    if result.emptied is not None:
+        lines.append(
+            Text(f"goal {result.emptied.goal}: domain emptied by the {result.emptied.law} law")
+        )
+        if result.emptied.reason:
+            lines.append(Text(f"  {result.emptied.reason}"))
+    for rejection in result.rejections:
+        lines.append(Text(f"rejected: {rejection.reason}"))
+    lines.append(Text(f"{result.count} configurations ({len(result.configurations)} found)"))
+    for config in result.configurations:
+        for name, motion in config.motions.items():
+            spans = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in motion.intervals)
+            lines.append(Text(f"  {name}: {motion.kind} {motion.parameter} {spans}"))
+    header = " -> ".join(LAWS)
+    lines.append(Text(f"domain sizes ({header}):"))
+    lines.extend(
+        Text(f"  goal {g}: {' -> '.join(map(str, s))}") for g, s in result.statistics.items()
+    )
+    lines.append(Text(f"candidate pairs deleted by path consistency: {result.pairs_removed}"))
+    return Group(*lines)
+
+
+def _removals(title: str, kind: str, example: str, removals: list[Removal]) -> Table:
+    """The removable subassemblies (Wilson & Latombe 1992): parts, how many ``kind`` free
+    them, and the first one as an ``example``."""
+    table = Table(title=title)
+    table.add_column("removable parts")
+    table.add_column(kind)
+    table.add_column(example)
+    for r in removals:
+        table.add_row(
+            ", ".join(sorted(r.parts)),
+            str(len(r.directions)),
+            np.array2string(r.directions[0], precision=3),
+        )
+    return table
+
+
+def _ndbg(result: NonDirectionalBlockingGraph) -> Table:
+    """The NDBG's removable subassemblies with their first direction (Wilson & Latombe
+    1992)."""
+    counts = result.arrangement.counts
+    return _removals(
+        f"{result.motion} NDBG: {len(result.parts)} parts, {result.contacts} contacts, "
+        f"{counts['vertices']} vertices, {counts['edges']} edges, {counts['faces']} faces",
+        "directions",
+        "e.g.",
+        result.removable(),
+    )
+
+
+def _rigid(result: RigidBlockingGraph) -> Table:
+    """The subassemblies some rigid twist frees, with their first twist (Wilson & Latombe
+    1992)."""
+    return _removals(
+        f"rigid NDBG: {len(result.parts)} parts, {len(result.contacts)} contacts, "
+        f"arrangement {result.arrangement.status}",
+        "twists",
+        "e.g. (omega; v)",
+        result.removable(),
+    )
+
+
+def _plan(result: Plan) -> Group:
+    """The disassembly steps (and the interlocked sets when infeasible) and the assembly
+    order (Wilson & Latombe 1992)."""
+    return Group(_disassembly_table(result), _assembly_table(result))
+
+
+def _assembly_table(plan: Plan) -> Table:
+    table = Table(title="Assembly order")
+    for column in ("step", "insert", "direction", "held"):
+        table.add_column(column)
+    for number, step in enumerate(plan.assembly_steps, start=1):
+        table.add_row(
+            str(number),
+            ", ".join(step.parts),
+            fmt.direction(step.direction),
+            fmt.name_list(step.held),
+        )
+    return table
+
+
+def _disassembly_table(plan: Plan) -> Table:
+    title = "feasible" if plan.feasible else "infeasible"
+    if plan.and_or is not None:
+        title += f", {plan.and_or.plans} plan(s) in the AND/OR graph"
+    if plan.gravity is not None:
+        title += ", " + plan.gravity.summary()
+    table = Table(title=f"Disassembly plan ({title})")
+    columns = ["step", "move", "direction", "motion", "away from"]
+    if plan.gravity is not None:
+        columns += ["held", "would fall", "friction needed"]
+    for column in columns:
+        table.add_column(column)
+    for number, step in enumerate(plan.steps, start=1):
+        cells = [
+            str(number),
+            ", ".join(step.parts),
+            fmt.direction(step.direction),
+            step.motion,
+            fmt.name_list(step.rest),
+        ]
+        if step.stability is not None:
+            cells += step.stability.cells()
+        table.add_row(*cells)
+    for lock in plan.interlocked:
+        freed = "rigid motion may free" if lock.rigid_may_free else "locked"
+        table.add_row("-", ", ".join(lock.parts), "-", f"interlocked ({freed})", "-")
+        if lock.held:
+            table.add_row("-", ", ".join(lock.held), "-", "held by the interlock", "-")
+    if plan.hands is not None and plan.hands.moves:
+        # the groups of the operations two hands cannot do, one row per group
+        for move in plan.hands.moves:
+            for group, direction in zip(move.groups[1:], move.directions[1:], strict=True):
+                table.add_row(
+                    f"{move.hands} hands",
+                    ", ".join(group),
+                    fmt.direction(direction),
+                    "translation, together",
+                    fmt.name_list(move.groups[0]),
+                )
+        table.caption = f"needs {plan.hands.summary()}"
+    elif plan.hands is not None and plan.hands.needed is None:
+        table.caption = f"needs {plan.hands.summary()}"
+    return table
+
+
+def _hands(result: Hands) -> Table:
+    """The operations with more than two hands (Wilson & Latombe 1992): per group its
+    parts, direction and speed, the first group held fixed."""
+    table = Table(title=f"Hands: {result.summary()}")
+    for column in ("operation", "group", "parts", "direction", "speed"):
+        table.add_column(column)
+    for number, move in enumerate(result.moves, start=1):
+        for g, (group, direction, speed) in enumerate(
+            zip(move.groups, move.directions, move.speeds, strict=True)
+        ):
+            table.add_row(
+                str(number) if g == 0 else "",
+                "fixed" if g == 0 else str(g),
+                ", ".join(group),
+                "-" if g == 0 else fmt.direction(direction),
+                "-" if g == 0 else f"{speed:.3g}",
+            )
+    return table
+
+
+def _multi_move(result: MultiMovePlan) -> Table:
+    """A multi-move plan: one row per move, grouped by separation (``1``, then ``1.r``
+    for the removed side and ``1.l`` for the side left)."""
+    verdict = "feasible" if result.feasible else "infeasible"
+    if result.cut:
+        verdict += f", search cut at {result.max_states} states"
+    table = Table(title=f"Multi-move disassembly ({verdict}), level {result.level or '-'}")
+    for column in ("separation", "move", "parts", "direction", "distance"):
+        table.add_column(column)
+
+    def rows(node: Separation | None, label: str) -> None:
+        if node is None:
+            return
+        if node.status != "separated":
+            table.add_row(label, "-", ", ".join(node.parts), node.status, "-")
+            return
+        for number, move in enumerate(node.moves, start=1):
+            distance = "inf" if move.distance is None else f"{move.distance:.6g}"
+            table.add_row(label, str(number), ", ".join(move.parts), move.label, distance)
+        rows(node.removed, f"{label}.r")
+        rows(node.left, f"{label}.l")
+
+    rows(result.root, "1")
+    first = "-" if result.first_moves is None else str(result.first_moves)
+    caption = f"first separation: {first} moves"
+    if result.reference_level is not None:
+        caption += f" (stored level {result.reference_level})"
+    table.caption = caption
+    return table
+
+
+def _screw(result: ScrewPlan) -> Table:
+    """A plan with turns: one row per step, turns with their axis and angle."""
+    verdict = "feasible" if result.feasible else "infeasible"
+    table = Table(title=f"Disassembly plan with turns ({verdict})")
+    for column in ("step", "move", "motion", "axis (point; direction)", "then along"):
+        table.add_column(column)
+    number = 0
+    for k, stage in enumerate(result.stages):
+        for step in stage.steps:
+            number += 1
+            direction = ", ".join(f"{x:.3g}" for x in step.direction)
+            table.add_row(str(number), ", ".join(step.parts), step.motion, "-", direction)
+        if k < len(result.screws):
+            turn = result.screws[k]
+            number += 1
+            axis = (
+                "("
+                + ", ".join(f"{x:.3g}" for x in turn.point)
+                + "; "
+                + ", ".join(f"{x:.3g}" for x in turn.axis)
+                + ")"
+            )
+            table.add_row(
+                str(number),
+                ", ".join(turn.parts),
+                f"turn {math.degrees(turn.angle):.1f} deg"
+                + (f", pitch {turn.pitch:.4g} per rad" if turn.pitch else ""),
+                axis,
+                ", ".join(f"{x:.3g}" for x in turn.exit),
+            )
+    if not result.feasible:
+        table.caption = "stuck: " + ", ".join(result.stages[-1].stuck)
+    return table
+
+
+def _contacts(result: ContactReport) -> Group:
+    """The tolerance used, a table of parts, one of contacts, then the interferences."""
+    asm = result.assembly
+    parts = Table(title=f"{asm.source}: {len(asm)} parts ({asm.units}, {asm.units_source})")
+    for column in ("part", "triangles", "volume", "features"):
+        parts.add_column(column)
+    for name, part in asm.parts.items():
+        kinds = Counter(s.feature().type_name for s in result.surfaces[name])
+        listing = ", ".join(f"{n} {k}" for k, n in sorted(kinds.items()))
+        parts.add_row(name, str(len(part.mesh.faces)), f"{part.volume:.6g}", listing)
+    contacts = Table(title=f"{len(result.contacts)} contacts")
+    for column in ("a", "b", "planar area", "normals", "curved"):
+        contacts.add_column(column)
+    for c in result.contacts:
+        normals = "; ".join("(" + ", ".join(f"{x:.3g}" for x in p.normal) + ")" for p in c.planar)
+        curved = ", ".join(f"{p.kind} r={p.radius:.6g} inner={p.inner}" for p in c.curved)
+        contacts.add_row(c.a, c.b, f"{c.area:.6g}", normals, curved)
+    clashes = (
+        "\n".join(f"interference {a} / {b}: volume {v:.6g}" for a, b, v in result.interferences)
+        or "no interferences"
+    )
+    used = asm.tolerance_summary(result.policy)
+    measured = f"{used['measured_from'] or 'nothing measured'}: {used['measured'] or 0:.2g}"
+    why = f"input ({measured})" if used["from"] == "measured" else f"policy ({measured})"
+    tolerance = f"length tolerance {used['length']:.3g} {asm.units} from the {why}"
+    return Group(tolerance, parts, contacts, clashes)
+
+
+def _batch(result: BatchSummary) -> Group:
+    """A one-row table of the counts, then one line per failed input."""
+    data = result.to_dict()
+    keys = ("total", "skipped", "ok", "error", "timeout", "missing")
+    table = Table(title=f"batch -> {result.out}")
+    for key in keys:
+        table.add_column(key)
+    table.add_row(*(str(data[key]) for key in keys))
+    lines = [
+        Text(f"{f.status}: {f.input}: {f.error}", no_wrap=True, overflow="ignore")
+        for f in result.failed
+    ]
+    return Group(table, *lines)
+
+
+def _demo(result: DemoResult) -> Text:
+    """One line saying what was found and where the report is."""
+    verdict = "feasible" if result.plan.feasible else "infeasible"
+    return Text(
+        f"Gearbox ({len(result.plan.parts)} parts): {verdict} plan in "
+        f"{len(result.plan.steps)} steps.\nReport written to {result.report}"
+    )
+
+
+def _register_inference() -> None:
+    from assemblykit.inference.solution import Solution
+
+    render.register(Solution, _solution)
+
+
+def _register_motion() -> None:
+    from assemblykit.motion.articulation import Articulation
+    from assemblykit.motion.freedom import MotionReport
+    from assemblykit.motion.relational import TaskMotionReport
+
+    render.register(MotionReport, _motion_report)
+    render.register(Articulation, _articulation)
+    render.register(TaskMotionReport, _task_motion)
+
+
+def _register_mating() -> None:
+    from assemblykit.mating.search import MatingResult
+
+    render.register(MatingResult, _mating)
+
+
+def _register_blocking() -> None:
+    from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
+    from assemblykit.blocking.rigid import RigidBlockingGraph
+
+    render.register(NonDirectionalBlockingGraph, _ndbg)
+    render.register(RigidBlockingGraph, _rigid)
+
+
+def _register_planning() -> None:
+    from assemblykit.planning.multimove import MultiMovePlan
+    from assemblykit.planning.screw import ScrewPlan
+    from assemblykit.planning.sequence import Hands, Plan
+
+    render.register(Plan, _plan)
+    render.register(Hands, _hands)
+    render.register(MultiMovePlan, _multi_move)
+    render.register(ScrewPlan, _screw)
+
+
+def _register_io() -> None:
+    from assemblykit.io.assembly import ContactReport
+
+    render.register(ContactReport, _contacts)
+
+
+def _register_batch() -> None:
+    from assemblykit.batch import BatchSummary
+
+    render.register(BatchSummary, _batch)
+
+
+def _register_demo() -> None:
+    from assemblykit.demo import DemoResult
+
+    render.register(DemoResult, _demo)
+
+
+_REGISTRARS: dict[str, Callable[[], None]] = {
+    "assemblykit.inference": _register_inference,
+    "assemblykit.motion": _register_motion,
+    "assemblykit.mating": _register_mating,
+    "assemblykit.blocking": _register_blocking,
+    "assemblykit.planning": _register_planning,
+    "assemblykit.io": _register_io,
+    "assemblykit.batch": _register_batch,
+    "assemblykit.demo": _register_demo,
+}
+"""The package of a result's module -> the function registering the renderers of that
+package's results."""

@@ -1,0 +1,76 @@
+"""Tests of direction tables and set bit masks (:mod:`assemblykit.blocking.directions`)
+on random tables and blocking terms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from assemblykit.blocking.constraints import BlockingTerm
+from assemblykit.blocking.directions import DirectionTable, row_mask, several, term_slots
+from assemblykit.tolerance import Tolerance
+
+
+def table_from(names, directions, arcs) -> DirectionTable:
+    return DirectionTable.from_arcs(names, directions, arcs)
+
+
+def test_free_parts_of_shrinking_sets_match_a_fresh_count():
+    rng = np.random.default_rng(7)
+    names = tuple("abcdefgh")
+    arcs = [
+        [(i, j) for i in range(8) for j in range(8) if i != j and rng.random() < 0.3]
+        for _ in range(20)
+    ]
+    tab = table_from(names, rng.normal(size=(20, 3)), arcs)
+    members = (1 << 8) - 1
+    while members:
+        fresh = table_from(names, tab.directions, arcs)
+        np.testing.assert_array_equal(tab.free_parts(members), fresh.free_parts(members))
+        members &= ~(1 << int(rng.choice([i for i in range(8) if members >> i & 1])))
+
+
+def test_free_bits_past_one_byte_count_the_free_movers_of_shrinking_sets():
+    rng = np.random.default_rng(11)
+    names = tuple(f"p{i}" for i in range(19))
+    arcs = [
+        [(i, j) for i in range(19) for j in range(19) if i != j and rng.random() < 0.15]
+        for _ in range(30)
+    ]
+    tab = table_from(names, rng.normal(size=(30, 3)), arcs)
+    members = (1 << 19) - 1
+    while several(members):
+        movers = members & int(rng.integers(1 << 19))
+        blocked = np.zeros((30, 19), dtype=bool)
+        for k, per_direction in enumerate(arcs):
+            for i, j in per_direction:
+                blocked[k, i] |= bool(members >> j & 1)
+        chosen = np.array([bool(movers >> i & 1) for i in range(19)])
+        expected = ~blocked & chosen
+        bits = tab.free_bits(members, movers)
+        assert [row_mask(row) for row in bits] == [
+            sum(1 << int(i) for i in np.flatnonzero(row)) for row in expected
+        ]
+        np.testing.assert_array_equal(np.bitwise_count(bits).sum(axis=1), expected.sum(axis=1))
+        members &= ~(1 << int(rng.choice([i for i in range(19) if members >> i & 1])))
+
+
+@pytest.mark.parametrize("sizes", [(1, 1, 1, 1), (0, 1, 3, 2, 1, 3, 1)])
+def test_term_slots_match_the_terms_one_at_a_time(sizes):
+    rng = np.random.default_rng(len(sizes))
+    tol = Tolerance()
+    terms = [BlockingTerm("a", "b", rng.normal(size=(m, 3))) for m in sizes]
+    owners = [int(s) for s in rng.integers(0, 3, len(terms))]
+    directions = rng.normal(size=(2500, 3))  # more than one chunk
+    directions[0] = 0.0  # on every circle: blocked by no term with normals
+    expected = np.zeros((len(directions), 3), dtype=bool)
+    for term, s in zip(terms, owners, strict=True):
+        expected[:, s] |= np.all(directions @ term.normals.T > tol.angle, axis=1)
+    found = term_slots(directions, terms, owners, 3, tol)
+    np.testing.assert_array_equal(found, expected)
+    # one term per slot, given out of slot order
+    single = [BlockingTerm("a", "b", rng.normal(size=(1, 3))) for _ in range(4)]
+    expected = np.column_stack([directions @ t.normals[0] > tol.angle for t in single])
+    order = [2, 0, 3, 1]
+    found = term_slots(directions, [single[s] for s in order], order, 4, tol)
+    np.testing.assert_array_equal(found, expected)
