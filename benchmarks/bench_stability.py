@@ -6,15 +6,17 @@ Run ``python benchmarks/bench_stability.py [--crossvault-plan]``. Figures (wall 
 run each, loading and contacts excluded unless said; the machine is named first):
 
 * equilibrium of the whole arch, dome and cross vault: assembling the sparse equations,
-  then the equilibrium program (HiGHS, interior point), and the slack program when the
-  assembly does not stand; the cross vault also at the tolerance that makes its crown
-  joints contacts (``CROWN_JOINTS``), where it stands;
+  then the equilibrium program (Clarabel, interior point, in Farkas form over the
+  generators at the polygons' corners), and the slack program (HiGHS, interior point,
+  every generator) when the assembly does not stand; the cross vault also at the
+  tolerance that makes its crown joints contacts (``CROWN_JOINTS``), where it stands;
 * one state of the cross vault that stands and one that does not, the programs each
   candidate step of a plan runs (a plan of the vault runs about three per step);
 * plans with gravity: the ASAP beam (also without gravity) and the COMPAS arch with three
   holds, each followed by the time of the stability work alone: assembling the
   equations and checking every state of the plan once; the cross vault with three holds
-  only with ``--crossvault-plan`` (it takes minutes).
+  only with ``--crossvault-plan`` (it takes an hour or more: a slack program of 2 to 5 s
+  for each candidate step that leaves parts falling, about 15 per step).
 
 The dome is skipped unless ``$ASSEMBLYKIT_DATA`` holds
 ``compas_assembly/dome_assembly.json``.
@@ -28,13 +30,14 @@ import sys
 import time
 from pathlib import Path
 
+import clarabel
 import numpy as np
 import scipy
 
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io.assembly import load_assembly
 from assemblykit.planning.planner import plan
-from assemblykit.planning.stability import Gravity, equilibrium_model
+from assemblykit.planning.stability import CONE_SIDES, Gravity, equilibrium_model
 from assemblykit.tolerance import Tolerance
 from datasets import dataset
 
@@ -47,7 +50,8 @@ def machine() -> str:
     """CPU, cores, Python and library versions."""
     return (
         f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-        f"Python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}"
+        f"Python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}, "
+        f"clarabel {clarabel.__version__}"
     )
 
 
@@ -64,8 +68,10 @@ def whole(name: str, path: Path | None, tol: Tolerance | None = None) -> bool | 
     found = model.check()
     solved = time.perf_counter() - start - built
     columns = model.normal_part.shape[1]
+    corners = int(model.corners.sum()) * CONE_SIDES
     print(
-        f"{name:<24} {len(assembly.names):>4} parts {columns:>7} generators  "
+        f"{name:<24} {len(assembly.names):>4} parts {columns:>7} generators "
+        f"({corners:>6} at corners)  "
         f"equations {built:7.3f} s  program {solved:8.3f} s  "
         f"{'stands' if found.stands else f'{len(found.would_fall)} parts would fall'}"
     )
@@ -139,7 +145,7 @@ def main() -> None:
     if full:
         planned("crossvault, 3 holds", vault, Gravity(holds=3), CROWN_JOINTS)
     else:
-        print("crossvault, 3 holds       skipped: minutes; run with --crossvault-plan")
+        print("crossvault, 3 holds       skipped: an hour or more; run with --crossvault-plan")
 
 
 if __name__ == "__main__":

@@ -160,7 +160,9 @@ def _plan_under_gravity(
             settings=gravity,
             fixed=model.fixed,
             whole=whole,
-            friction_needed=model.friction_needed(present, present & judge.fixed),
+            friction_needed=model.friction_needed(
+                present, present & judge.fixed, model.mask(whole.would_fall)
+            ),
             stable=whole.stands
             and all(step.stability is None or step.stability.stands for step in search.steps),
         ),

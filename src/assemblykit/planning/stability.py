@@ -25,13 +25,19 @@ who judged the states by rigid-body simulation instead.
 
 A set of parts stands when non-negative generator weights balance every free part's
 weight (six equations per part). A first program asks whether the equations alone have
-a solution; when they have none, a second one minimises the absolute residuals (slacks)
-of those equations, each scaled by the part's weight and the model's size: it is always
-feasible, and the parts left with a residual beyond the tolerance are those that cannot
-be in equilibrium (they would fall). Both are solved by HiGHS's interior point method
-within :data:`LP_TIME_LIMIT`. Loads are homogeneous in rigid-block equilibrium (scaling
-gravity scales every force), so the margin reported is the least friction coefficient
-with which the state stands, found by bisection.
+a solution, on the corners of the contact polygons only: a vertex on the straight
+segment between its two neighbours adds nothing (every force it could carry is a
+combination of the same force at its neighbours, the contact's normal and friction
+directions being the same at all its vertices), so the answer is the same with a
+quarter fewer columns on the dome. It is solved in its Farkas form by Clarabel
+(:func:`solvable`). When they have none, a second one, on every point, minimises the
+absolute residuals (slacks) of those equations, each scaled by the part's weight and
+the model's size: it is always feasible, and the parts left with a residual beyond the
+tolerance are those that cannot be in equilibrium (they would fall). It is solved by
+HiGHS's interior point method within :data:`LP_TIME_LIMIT`. Loads are homogeneous in
+rigid-block equilibrium (scaling gravity scales every force), so the margin reported is
+the least friction coefficient with which the state stands, found by bisection on the
+first program.
 """
 
 from __future__ import annotations
@@ -48,7 +54,7 @@ from scipy.optimize import linprog
 
 from assemblykit.errors import InputError, NumericError
 from assemblykit.geometry.contacts import assembly_contacts
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import MIN_REL_LENGTH, Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
@@ -68,11 +74,12 @@ it are the solver's rounding, not a fall."""
 
 LP_TIME_LIMIT = 120.0
 """Seconds one equilibrium program may take before :class:`NumericError` (a bound; the
-largest program measured, the 527-block dome's, takes 20 to 45 s on two shared cores:
-benchmarks/bench_stability.py). Both programs are solved by HiGHS's interior
-point method: the nearly balanced states of a vault make the dual simplex method
-degenerate (minutes of pivots on the cross vault where the interior point method needs
-about 50 iterations)."""
+largest programs measured, the 527-block dome's first and the 184-block cross vault's
+slack program, take 0.5 to 1.2 s and 2 to 5 s on two shared cores:
+benchmarks/bench_stability.py). The slack program is solved by HiGHS's interior point
+method: the nearly balanced states of a vault make the dual simplex method degenerate
+(minutes of pivots on the cross vault where the interior point method needs about 50
+iterations)."""
 
 DOWN = (0.0, 0.0, -1.0)
 
@@ -167,7 +174,9 @@ def lowest_parts(assembly: Assembly, direction: ArrayLike, tol: Tolerance) -> tu
 class ContactPoints:
     """The force points of an assembly's contacts: ``points`` (P x 3) where part
     ``first[p]`` pushes part ``second[p]`` along unit ``normals[p]``, and the contact
-    plane's tangents ``u`` (downhill when gravity is not along the normal) and ``v``."""
+    plane's tangents ``u`` (downhill when gravity is not along the normal) and ``v``;
+    ``corners`` marks the points that are not on a straight stretch of their polygon's
+    boundary (:func:`_corners`; every curved sample point is one)."""
 
     points: NDArray[np.float64]
     normals: NDArray[np.float64]
@@ -175,6 +184,7 @@ class ContactPoints:
     second: NDArray[np.int64]
     u: NDArray[np.float64]
     v: NDArray[np.float64]
+    corners: NDArray[np.bool_]
 
 
 def contact_points(
@@ -182,17 +192,22 @@ def contact_points(
 ) -> ContactPoints:
     """Polygon vertices of the planar contacts and sample points of the curved ones, with
     normals from the pushing part into the pushed one (contacts.py's convention: from
-    ``a`` into ``b``; curved: from the inner part outward), and tangent frames."""
+    ``a`` into ``b``; curved: from the inner part outward), tangent frames and corners."""
     index = {name: i for i, name in enumerate(assembly.names)}
-    points, normals, first, second = [], [], [], []
+    resolution = MIN_REL_LENGTH * assembly.scale
+    points, normals, first, second, planar = [], [], [], [], []
+    polygons: list[NDArray[np.float64]] = []
     for contact in assembly_contacts(assembly, tol):
         a, b = index[contact.a], index[contact.b]
         for patch in contact.planar:
-            count = len(patch.polygon)
-            points.append(np.asarray(patch.polygon, dtype=np.float64))
+            polygon = np.asarray(patch.polygon, dtype=np.float64)
+            count = len(polygon)
+            points.append(polygon)
             normals.append(np.tile(patch.normal, (count, 1)))
             first.append(np.full(count, a))
             second.append(np.full(count, b))
+            planar.append(np.ones(count, dtype=bool))
+            polygons.append(polygon)
         for curved in contact.curved:
             at, outward = curved.samples()
             inner = index[curved.inner]
@@ -200,13 +215,17 @@ def contact_points(
             normals.append(outward)
             first.append(np.full(len(at), inner))
             second.append(np.full(len(at), b if inner == a else a))
+            planar.append(np.zeros(len(at), dtype=bool))
     if not points:
         empty = np.zeros((0, 3))
         none = np.zeros(0, dtype=np.int64)
-        return ContactPoints(empty, empty, none, none, empty, empty)
+        return ContactPoints(empty, empty, none, none, empty, empty, np.zeros(0, dtype=bool))
     n = np.vstack(normals)
     n = n / np.linalg.norm(n, axis=1, keepdims=True)
     u, v = _tangents(n, np.asarray(direction, dtype=np.float64), assembly.tolerance(tol))
+    on_polygon = np.concatenate(planar)
+    corners = np.ones(len(on_polygon), dtype=bool)
+    corners[on_polygon] = _corners(polygons, resolution)
     return ContactPoints(
         np.vstack(points),
         n,
@@ -214,7 +233,34 @@ def contact_points(
         np.concatenate(second).astype(np.int64),
         u,
         v,
+        corners,
     )
+
+
+def _corners(polygons: Sequence[NDArray[np.float64]], resolution: float) -> NDArray[np.bool_]:
+    """Which vertices of closed polygons (each in boundary order; their vertices one after
+    the other) are corners: not strictly between their two neighbours on the segment
+    joining them, within ``resolution`` (float64's: a vertex there is collinear up to
+    rounding). The forces of a vertex that is no corner are combinations of the same
+    forces at its neighbours: ``p = t a + (1 - t) b`` moves a force ``f`` to ``t f`` at
+    ``a`` and ``(1 - t) f`` at ``b`` with the same resultant and moment."""
+    sizes = np.array([len(p) for p in polygons], dtype=np.int64)
+    if not sizes.sum():
+        return np.zeros(0, dtype=bool)
+    polygon = np.vstack(polygons)
+    size = np.repeat(sizes, sizes)
+    start = np.repeat(np.cumsum(sizes) - sizes, sizes)
+    local = np.arange(len(polygon)) - start
+    before = polygon[start + (local - 1) % size]
+    after = polygon[start + (local + 1) % size]
+    chord = after - before
+    length = np.linalg.norm(chord, axis=1)
+    offset = polygon - before
+    with np.errstate(divide="ignore", invalid="ignore"):
+        distance = np.linalg.norm(np.cross(offset, chord), axis=1) / length
+        along = np.sum(offset * chord, axis=1) / length**2
+    between = (length > resolution) & (distance <= resolution) & (along > 0) & (along < 1)
+    return ~between | (size < 3)
 
 
 def _tangents(
@@ -232,6 +278,49 @@ def _tangents(
     return u, np.cross(normals, u)
 
 
+def solvable(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> bool:
+    """Whether ``matrix @ x = rhs`` has a solution ``x >= 0``. By Farkas' lemma it has
+    none exactly when some ``y`` has ``matrix.T @ y >= 0`` and ``rhs @ y < 0``, so the
+    program "minimise ``rhs @ y`` subject to ``matrix.T @ y >= 0``" has the optimum 0
+    when there is a solution and is unbounded otherwise. It is solved by Clarabel's
+    interior point method (Goulart and Chen 2024, "Clarabel: an interior-point solver
+    for conic programs with quadratic objectives": a sparse direct factorisation per
+    iteration; 0.6 s on the 527-block dome where HiGHS's interior point method
+    needs 25 s), which proves unboundedness by a certificate; its unknowns are the
+    equations (6 per part), not the generators. Should it stop short of either answer
+    (iterations, numerical trouble, :data:`LP_TIME_LIMIT`), HiGHS's interior point
+    method decides, within :data:`LP_FEASIBILITY`."""
+    import clarabel
+
+    rows, columns = matrix.shape
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.time_limit = LP_TIME_LIMIT
+    found = clarabel.DefaultSolver(
+        sp.csc_matrix((rows, rows)),
+        np.asarray(rhs, dtype=np.float64),
+        sp.csc_matrix(-matrix.T),
+        np.zeros(columns),
+        [clarabel.NonnegativeConeT(columns)],
+        settings,
+    ).solve()
+    if found.status == clarabel.SolverStatus.Solved:
+        return True
+    if found.status == clarabel.SolverStatus.DualInfeasible:
+        return False
+    result = linprog(
+        np.zeros(columns),
+        A_eq=matrix,
+        b_eq=rhs,
+        bounds=(0, None),
+        method="highs-ipm",
+        options={"primal_feasibility_tolerance": LP_FEASIBILITY, "time_limit": LP_TIME_LIMIT},
+    )
+    if result.status not in (0, 2):
+        raise NumericError(f"equilibrium program failed: {result.message}")
+    return bool(result.status == 0)
+
+
 @dataclass(frozen=True, eq=False)
 class EquilibriumModel:
     """The equilibrium equations of every part of an assembly, assembled once.
@@ -241,7 +330,8 @@ class EquilibriumModel:
     6 rows per part: force, then moment about ``origin`` divided by ``scale``, each row
     divided by the part's weight), and the opposite on the pushing part. ``load`` holds
     the scaled weights. A state (a subset of the parts, some of them fixed) keeps the
-    rows of its free parts and the columns of the points between its parts.
+    rows of its free parts and the columns of the points between its parts (of the
+    ``corners`` among them in the first program).
     """
 
     names: tuple[str, ...]
@@ -249,6 +339,7 @@ class EquilibriumModel:
     tangent_part: sp.csr_matrix
     load: NDArray[np.float64]
     point_parts: NDArray[np.int64]
+    corners: NDArray[np.bool_]
     heights: NDArray[np.float64]
     fixed: tuple[str, ...]
     friction: float
@@ -267,6 +358,40 @@ class EquilibriumModel:
             out[[self._index[n] for n in names]] = True
         return out
 
+    def _rows(self, free: NDArray[np.bool_]) -> NDArray[np.int64]:
+        """The equations (rows) of the ``free`` parts."""
+        return (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
+
+    def _touching(self, present: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """The force points between two parts of ``present``."""
+        return present[self.point_parts[:, 0]] & present[self.point_parts[:, 1]]
+
+    def _matrix(
+        self, rows: NDArray[np.int64], selected: NDArray[np.bool_], mu: float
+    ) -> sp.csc_matrix:
+        """The equations ``rows`` over the generators of the ``selected`` points."""
+        columns = (CONE_SIDES * np.flatnonzero(selected)[:, None] + np.arange(CONE_SIDES)).ravel()
+        part = self.normal_part[rows][:, columns] + mu * self.tangent_part[rows][:, columns]
+        return sp.csc_matrix(part)
+
+    def stands(
+        self,
+        present: NDArray[np.bool_],
+        fixed: NDArray[np.bool_],
+        friction: float | None = None,
+    ) -> bool:
+        """Whether the equations of ``present`` alone have a solution with ``fixed``
+        immobile: the first program, on the corners (:func:`solvable`)."""
+        free = present & ~fixed
+        if not free.any():
+            return True
+        points = self._touching(present)
+        if not points.any():
+            return False
+        rows = self._rows(free)
+        mu = self.friction if friction is None else friction
+        return solvable(self._matrix(rows, points & self.corners, mu), -self.load[rows])
+
     def residuals(
         self,
         present: NDArray[np.bool_],
@@ -275,48 +400,47 @@ class EquilibriumModel:
     ) -> NDArray[np.float64]:
         """Per part, the largest scaled residual of its six equations at the optimum of
         the slack program (0 for fixed and absent parts). A state that stands is told by
-        the equations alone first: that program is smaller, and its answer is all zeros."""
-        mu = self.friction if friction is None else friction
-        free = present & ~fixed
+        the equations alone first, on the corners (:meth:`stands`): that program is
+        smaller, and its answer is all zeros. The slack program keeps every point: its
+        optimum is not unique on a state that falls, and which parts it leaves falling
+        depends on the program's columns and its solver (HiGHS's interior point method
+        with crossover, whose vertex optimum the plans report)."""
+        if self.stands(present, fixed, friction):
+            return np.zeros(len(self.names))
+        return self.slack(present, fixed, friction)
+
+    def slack(
+        self,
+        present: NDArray[np.bool_],
+        fixed: NDArray[np.bool_],
+        friction: float | None = None,
+    ) -> NDArray[np.float64]:
+        """The slack program of :meth:`residuals` alone, for a state known not to stand:
+        per part, the largest scaled residual of its equations at its optimum."""
         out = np.zeros(len(self.names))
-        if not free.any():
-            return out
-        rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
-        points = present[self.point_parts].all(axis=1)
-        columns = (CONE_SIDES * np.flatnonzero(points)[:, None] + np.arange(CONE_SIDES)).ravel()
-        if not len(columns):
+        free = present & ~fixed
+        rows = self._rows(free)
+        points = self._touching(present)
+        if not points.any():
             # nothing touches: every free part keeps its whole weight as residual
             out[free] = np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
             return out
-        matrix = self.normal_part[rows][:, columns] + mu * self.tangent_part[rows][:, columns]
-        options = {"primal_feasibility_tolerance": LP_FEASIBILITY, "time_limit": LP_TIME_LIMIT}
-        found = linprog(
-            np.zeros(len(columns)),
-            A_eq=matrix.tocsc(),
-            b_eq=-self.load[rows],
-            bounds=(0, None),
-            method="highs-ipm",
-            options=options,
-        )
-        if found.status not in (0, 2):
-            raise NumericError(f"equilibrium program failed: {found.message}")
-        if found.status == 0:
-            return out
         size = len(rows)
         eye = sp.identity(size, format="csr")
-        system = sp.hstack([matrix, eye, -eye], format="csc")
-        cost = np.r_[np.zeros(len(columns)), np.ones(2 * size)]
+        every = self._matrix(rows, points, self.friction if friction is None else friction)
+        system = sp.hstack([every, eye, -eye], format="csc")
+        cost = np.r_[np.zeros(every.shape[1]), np.ones(2 * size)]
         result = linprog(
             cost,
             A_eq=system,
             b_eq=-self.load[rows],
             bounds=(0, None),
             method="highs-ipm",
-            options=options,
+            options={"primal_feasibility_tolerance": LP_FEASIBILITY, "time_limit": LP_TIME_LIMIT},
         )
         if result.status != 0:
             raise NumericError(f"equilibrium slack program failed: {result.message}")
-        slack = result.x[len(columns) :]
+        slack = result.x[every.shape[1] :]
         residual = np.abs(slack[:size] - slack[size:]).reshape(-1, 6).max(axis=1)
         out[free] = residual
         return out
@@ -353,15 +477,15 @@ class EquilibriumModel:
         ``falls``: :meth:`falling` at ``friction``, when already known."""
         if (self.falling(present, fixed) if falls is None else falls).any():
             return None
-        if not self.falling(present, fixed, 0.0).any():
+        if self.stands(present, fixed, 0.0):
             return 0.0
         low, high = 0.0, self.friction
         for _ in range(FRICTION_STEPS):
             middle = (low + high) / 2
-            if self.falling(present, fixed, middle).any():
-                low = middle
-            else:
+            if self.stands(present, fixed, middle):
                 high = middle
+            else:
+                low = middle
         return high
 
 
@@ -426,6 +550,7 @@ def equilibrium_model(
         tangent_part=matrix(tangent_force),
         load=load.ravel(),
         point_parts=ends,
+        corners=found.corners,
         heights=centres @ down,
         fixed=tuple(fixed) if fixed is not None else lowest_parts(assembly, down, tol),
         friction=float(friction),
@@ -551,25 +676,44 @@ class StateJudge:
         self.base = base
         self.ground_base = ground_base
         self.fixed = model.mask(model.fixed)
+        self._stands: dict[tuple[bytes, bytes], bool] = {}
         self._falling: dict[tuple[bytes, bytes], NDArray[np.bool_]] = {}
         self._assessed: dict[tuple[int, int], _Assessment] = {}
 
+    def stands(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> bool:
+        """:meth:`EquilibriumModel.stands`, once per state."""
+        key = (present.tobytes(), fixed.tobytes())
+        if key not in self._stands:
+            self._stands[key] = self.model.stands(present, fixed)
+        return self._stands[key]
+
     def falling(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> NDArray[np.bool_]:
-        """:meth:`EquilibriumModel.falling`, once per state."""
+        """:meth:`EquilibriumModel.falling`, once per state: the slack program only when
+        :meth:`stands` says it does not."""
         key = (present.tobytes(), fixed.tobytes())
         if key not in self._falling:
-            self._falling[key] = self.model.falling(present, fixed)
+            self._falling[key] = (
+                np.zeros_like(present)
+                if self.stands(present, fixed)
+                else self.model.slack(present, fixed) > self.model.threshold
+            )
         return self._falling[key]
 
     def _hold(
         self, present: NDArray[np.bool_], fixed: NDArray[np.bool_], budget: int
     ) -> tuple[NDArray[np.bool_], NDArray[np.bool_], bool]:
+        """Hold the highest falling part of ``present`` while ``budget`` allows: the
+        holds, the parts falling without them and whether the state then stands (once
+        the last hold is taken, which parts still fall no longer matters: the first
+        program alone tells)."""
         falls = self.falling(present, fixed)
         held = np.zeros_like(present)
         now = falls
         while now.any() and int(held.sum()) < budget:
             top = min(np.flatnonzero(now), key=lambda i: (self.model.heights[i], i))
             held[top] = True
+            if int(held.sum()) == budget:
+                return held, falls, self.stands(present, fixed | held)
             now = self.falling(present, fixed | held)
         return held, falls, not now.any()
 

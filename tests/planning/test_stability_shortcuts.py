@@ -1,0 +1,164 @@
+"""Force points on a straight stretch of a contact polygon's boundary are left out of
+the first equilibrium program (whether the equations alone have a solution): the answers
+must be those of the programs with every vertex, and vertices off the stretch must
+stay."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning import stability
+from assemblykit.planning.stability import (
+    CONE_SIDES,
+    EquilibriumModel,
+    contact_points,
+    equilibrium_model,
+)
+
+MU = 0.5
+
+
+def box(extents: tuple[float, ...], low: tuple[float, ...]) -> trimesh.Trimesh:
+    """An axis-aligned box with its lowest corner at ``low``."""
+    mesh = trimesh.creation.box(extents=extents)
+    mesh.apply_translation(np.asarray(low) + np.asarray(extents) / 2)
+    return mesh
+
+
+def stack(overhang: float) -> Assembly:
+    """Three unit cubes stacked; the top one shifted by ``overhang`` along x."""
+    return Assembly(
+        [
+            Part("bottom", box((1, 1, 1), (0, 0, 0))),
+            Part("middle", box((1, 1, 1), (0, 0, 1))),
+            Part("top", box((1, 1, 1), (overhang, 0, 2))),
+        ]
+    )
+
+
+def corbels() -> Assembly:
+    """A ground slab, two pillars, two corbels reaching inwards and a keystone between
+    them: it stands with friction 0.354 or more, and falls without the keystone."""
+    return Assembly(
+        [
+            Part("ground", box((6, 1, 1), (-3, 0, -1))),
+            Part("pillar_l", box((1, 1, 1), (-2, 0, 0))),
+            Part("pillar_r", box((1, 1, 1), (1, 0, 0))),
+            Part("corbel_l", box((1.4, 1, 1), (-1.6, 0, 1))),
+            Part("corbel_r", box((1.4, 1, 1), (0.2, 0, 1))),
+            Part("keystone", box((0.4, 1, 1), (-0.2, 0, 1))),
+        ]
+    )
+
+
+def with_midpoints(monkeypatch: pytest.MonkeyPatch, bulge: float) -> None:
+    """Give every contact polygon a vertex in the middle of each side, moved outwards
+    (across the side, in the contact plane) by ``bulge``."""
+    original = stability.assembly_contacts
+
+    def patched(assembly, tol=None):
+        found = []
+        for contact in original(assembly, tol):
+            planar = []
+            for patch in contact.planar:
+                polygon = np.asarray(patch.polygon, dtype=np.float64)
+                middle = (polygon + np.roll(polygon, -1, axis=0)) / 2
+                outward = middle - polygon.mean(axis=0)
+                outward -= (outward @ patch.normal)[:, None] * patch.normal
+                middle += bulge * outward / np.linalg.norm(outward, axis=1, keepdims=True)
+                ring = np.stack([polygon, middle], axis=1).reshape(-1, 3)
+                planar.append(dataclasses.replace(patch, polygon=ring))
+            found.append(dataclasses.replace(contact, planar=tuple(planar)))
+        return found
+
+    monkeypatch.setattr(stability, "assembly_contacts", patched)
+
+
+def answers(model: EquilibriumModel, states: list[set[str]]) -> list[tuple]:
+    """Per state: the parts that would fall and the least friction it needs."""
+    out = []
+    for parts in states:
+        present = model.mask(parts)
+        fixed = present & model.mask(model.fixed)
+        found = model.check(parts)
+        out.append((found.would_fall, model.friction_needed(present, fixed)))
+    return out
+
+
+CASES = [
+    (stack(0.4), [{"bottom", "middle", "top"}]),
+    (stack(0.6), [{"bottom", "middle", "top"}, {"bottom", "middle"}]),
+    (
+        corbels(),
+        [
+            {"ground", "pillar_l", "pillar_r", "corbel_l", "corbel_r", "keystone"},
+            {"ground", "pillar_l", "pillar_r", "corbel_l", "corbel_r"},
+            {"ground", "pillar_l", "corbel_l"},
+        ],
+    ),
+]
+
+
+@pytest.mark.parametrize(("assembly", "states"), CASES)
+def test_vertices_between_their_neighbours_are_left_out_with_the_same_answers(
+    monkeypatch, assembly, states
+):
+    plain = contact_points(assembly, [0, 0, -1])
+    expected = answers(equilibrium_model(assembly, friction=MU), states)
+    assert plain.corners.all()
+    with monkeypatch.context() as patch:
+        with_midpoints(patch, 0.0)
+        # the midpoints are on the sides: no corners, the same answers
+        found = contact_points(assembly, [0, 0, -1])
+        assert len(found.points) == 2 * len(plain.points)
+        assert np.array_equal(found.points[found.corners], plain.points)
+        model = equilibrium_model(assembly, friction=MU)
+        assert model.normal_part.shape[1] == len(found.points) * CONE_SIDES
+        assert answers(model, states) == expected
+        # and the programs with every midpoint agree
+        patch.setattr(
+            stability,
+            "_corners",
+            lambda polygons, resolution: np.ones(sum(map(len, polygons)), dtype=bool),
+        )
+        full = equilibrium_model(assembly, friction=MU)
+        assert full.corners.all() and not model.corners.all()
+        assert answers(full, states) == expected
+
+
+def test_a_vertex_off_the_segment_is_kept():
+    square = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0]], dtype=np.float64)
+    sides = (square + np.roll(square, -1, axis=0)) / 2
+    ring = np.stack([square, sides], axis=1).reshape(-1, 3)
+    assert stability._corners([ring], 1e-15).tolist() == [True, False] * 4
+    # a vertex bent outwards beyond the resolution is a corner
+    bent = ring.copy()
+    bent[1, 1] -= 1e-9
+    assert stability._corners([bent], 1e-15).sum() == 5
+    # the tip of a spike going back along its side (both neighbours at one point) is a
+    # corner; the vertex before it lies between its neighbours, the tip included
+    spike = np.array([[0, 0, 0], [2, 0, 0], [3, 0, 0], [2, 0, 0], [2, 2, 0]], dtype=np.float64)
+    assert stability._corners([spike], 1e-15).tolist() == [True, False, True, True, True]
+    # polygons one after the other: each closes on itself; two points are both corners
+    together = [square[:2], ring, spike, np.zeros((0, 3))]
+    assert stability._corners(together, 1e-15).tolist() == (
+        [True, True] + [True, False] * 4 + [True, False, True, True, True]
+    )
+    assert stability._corners([], 1e-15).tolist() == []
+
+
+def test_points_off_the_sides_are_kept_and_change_what_stands(monkeypatch):
+    # the top block overhangs 0.55: its centre at x = 1.05 is beyond the middle block
+    # (x <= 1); a contact polygon bulged 0.1 outwards across each side reaches x = 1.1,
+    # so those points are kept and the top stands on them
+    assembly = stack(0.55)
+    assert equilibrium_model(assembly).check().would_fall == ("top",)
+    with_midpoints(monkeypatch, 0.1)
+    found = contact_points(assembly, [0, 0, -1])
+    assert len(found.points) == 16 and found.corners.all()
+    assert equilibrium_model(assembly).check().stands

@@ -1,0 +1,154 @@
+"""The first equilibrium program (whether a state's equations alone have a solution) is
+solved by Clarabel (:func:`assemblykit.planning.stability.solvable`): on states of the
+COMPAS arch, stacked and corbelled blocks, a block on a slope and the cross vault, at
+several friction coefficients, its verdict must be that of HiGHS's interior point method
+(scipy's ``linprog``), the solver it replaced."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.optimize import linprog
+
+from assemblykit.io.assembly import load_assembly
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning import stability
+from assemblykit.planning.stability import (
+    CONE_SIDES,
+    LP_FEASIBILITY,
+    EquilibriumModel,
+    equilibrium_model,
+)
+from assemblykit.tolerance import Tolerance
+from datasets import dataset
+
+FRICTIONS = (0.0, 0.1, 0.3, 0.5)
+
+
+def box(extents: tuple[float, ...], low: tuple[float, ...]) -> trimesh.Trimesh:
+    """An axis-aligned box with its lowest corner at ``low``."""
+    mesh = trimesh.creation.box(extents=extents)
+    mesh.apply_translation(np.asarray(low) + np.asarray(extents) / 2)
+    return mesh
+
+
+def stack(overhang: float) -> Assembly:
+    """Three unit cubes stacked; the top one shifted by ``overhang`` along x."""
+    return Assembly(
+        [
+            Part("bottom", box((1, 1, 1), (0, 0, 0))),
+            Part("middle", box((1, 1, 1), (0, 0, 1))),
+            Part("top", box((1, 1, 1), (overhang, 0, 2))),
+        ]
+    )
+
+
+def corbels() -> Assembly:
+    """A ground slab, two pillars, two corbels reaching inwards and a keystone between
+    them (it stands with friction 0.354 or more)."""
+    return Assembly(
+        [
+            Part("ground", box((6, 1, 1), (-3, 0, -1))),
+            Part("pillar_l", box((1, 1, 1), (-2, 0, 0))),
+            Part("pillar_r", box((1, 1, 1), (1, 0, 0))),
+            Part("corbel_l", box((1.4, 1, 1), (-1.6, 0, 1))),
+            Part("corbel_r", box((1.4, 1, 1), (0.2, 0, 1))),
+            Part("keystone", box((0.4, 1, 1), (-0.2, 0, 1))),
+        ]
+    )
+
+
+def block_on_slope(degrees: float) -> Assembly:
+    """A unit cube resting on the top face of a slab tilted by ``degrees`` about y."""
+    turn = trimesh.transformations.rotation_matrix(math.radians(degrees), [0, 1, 0])
+    slab = trimesh.creation.box(extents=(4.0, 4.0, 1.0))
+    slab.apply_transform(turn)
+    cube = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+    cube.apply_transform(turn)
+    cube.apply_translation(turn[:3, :3] @ [0.0, 0.0, 1.0])
+    return Assembly([Part("slope", slab), Part("block", cube)])
+
+
+def highs_stands(
+    model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray, friction: float
+) -> bool:
+    """The first program written out from the model's public arrays and solved by
+    HiGHS's interior point method."""
+    free = present & ~fixed
+    if not free.any():
+        return True
+    rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
+    points = present[model.point_parts[:, 0]] & present[model.point_parts[:, 1]]
+    selected = np.flatnonzero(points & model.corners)
+    if not len(selected):
+        return False
+    columns = (CONE_SIDES * selected[:, None] + np.arange(CONE_SIDES)).ravel()
+    matrix = model.normal_part[rows][:, columns] + friction * model.tangent_part[rows][:, columns]
+    found = linprog(
+        np.zeros(len(columns)),
+        A_eq=matrix.tocsc(),
+        b_eq=-model.load[rows],
+        bounds=(0, None),
+        method="highs-ipm",
+        options={"primal_feasibility_tolerance": LP_FEASIBILITY},
+    )
+    assert found.status in (0, 2), found.message
+    return bool(found.status == 0)
+
+
+def verdicts(
+    model: EquilibriumModel, states: list[set[str] | None], frictions: tuple[float, ...]
+) -> tuple[list[bool], list[bool]]:
+    """Per state and friction: Clarabel's verdict (HiGHS, its fallback, never asked)
+    and HiGHS's."""
+    ours, reference = [], []
+    for parts in states:
+        present = model.mask(parts)
+        fixed = present & model.mask(model.fixed)
+        for friction in frictions:
+            with pytest.MonkeyPatch.context() as patch:
+                patch.setattr(stability, "linprog", None)
+                ours.append(model.stands(present, fixed, friction))
+            reference.append(highs_stands(model, present, fixed, friction))
+    return ours, reference
+
+
+def without_each(assembly: Assembly) -> list[set[str] | None]:
+    """The whole assembly, and without each of its parts in turn."""
+    return [None, *(set(assembly.names) - {name} for name in assembly.names)]
+
+
+@pytest.mark.parametrize(
+    "assembly",
+    [stack(0.4), stack(0.45), stack(0.55), stack(0.6), corbels(), block_on_slope(25.0)],
+    ids=["stack 0.4", "stack 0.45", "stack 0.55", "stack 0.6", "corbels", "slope 25"],
+)
+def test_blocks_computed_by_hand_get_highs_verdicts(assembly):
+    model = equilibrium_model(assembly)
+    ours, reference = verdicts(model, without_each(assembly), (*FRICTIONS, 0.35, 0.36, 0.47))
+    assert ours == reference
+    assert any(ours) and not all(ours)
+
+
+def test_the_arch_gets_highs_verdicts_without_each_block():
+    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    model = equilibrium_model(assembly)
+    ours, reference = verdicts(model, without_each(assembly), FRICTIONS)
+    assert ours == reference
+    assert any(ours) and not all(ours)
+
+
+@pytest.mark.slow
+def test_the_cross_vault_gets_highs_verdicts():
+    # at the tolerance that makes its crown joints contacts (it stands), and without its
+    # highest block or one of its crown blocks; at the default tolerance (it falls)
+    path = dataset("compas_assembly/crossvault_assembly.json")
+    for tol, removed in ((Tolerance.relative(5e-5), ("4", "9")), (None, ())):
+        assembly = load_assembly(path)
+        model = equilibrium_model(assembly, tol=tol)
+        states = [None, *(set(assembly.names) - {name} for name in removed)]
+        ours, reference = verdicts(model, states, (0.5,))
+        assert ours == reference
