@@ -39,10 +39,12 @@ def run(script: str, root: Path, args: Sequence[str]) -> list[str]:
         check=False,
         cwd=root,
     )
+    lines = [line for line in done.stdout.splitlines() if line.strip()]
     if done.returncode != 0:
+        # what the script printed before it failed still compares
         tail = (done.stderr.strip().splitlines() or ["no output"])[-1]
-        return [f"FAILED ({done.returncode}): {tail}"]
-    return [line for line in done.stdout.splitlines() if line.strip()]
+        lines.append(f"FAILED ({done.returncode}): {tail}")
+    return lines
 
 
 def figures(runs: list[list[str]]) -> dict[str, list[list[float]]]:
