@@ -400,8 +400,13 @@ def axis_basis(
     ``e x n`` for the coordinate axis ``e`` least aligned with ``n`` (the first on ties),
     ``v = n x u``."""
     n = np.asarray(axes, dtype=np.float64)
-    u = np.cross(np.eye(3)[np.argmin(np.abs(n), axis=-1)], n)
-    u /= np.linalg.norm(u) if n.ndim == 1 else np.linalg.norm(u, axis=-1, keepdims=True)
+    least = np.eye(3)[np.argmin(np.abs(n), axis=-1)]
+    if n.ndim == 1:
+        u = cross(least, n)
+        u /= np.linalg.norm(u)
+        return u, cross(n, u)
+    u = np.cross(least, n)
+    u /= np.linalg.norm(u, axis=-1, keepdims=True)
     return u, np.cross(n, u)
 
 
