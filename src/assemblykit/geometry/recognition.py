@@ -44,7 +44,9 @@ Method on meshes (all thresholds from the tolerance policy):
    vertices all lie on it and is fitted again by step 3; larger ones first, a triangle
    goes to one surface at most. The rest, joined by the remaining smooth edges, is
    fitted with a sphere (the rounded corners). Pieces of one sphere or one cylinder are
-   fitted again as one surface.
+   fitted again as one surface. The candidate circles and the spheres of the pieces are
+   tested all at once, by the normal equations of the least squares on vertices centred
+   per piece; the surfaces that remain are fitted by step 3.
 """
 
 from __future__ import annotations
@@ -68,6 +70,8 @@ MIN_CURVED_FACES = 3
 STRIP_WIDTHS = 2.0
 """A group joined to a rounded edge counts as one of its strips when it is at most this
 many times as wide across the axis as the median group of its set (step 4)."""
+CIRCLE_EDGES = 3
+"""Smooth edges of one axis (rulings of a cylinder) that determine its circle (step 4)."""
 AXIS_ANGLE = np.radians(1.0)
 """Edge axes within this angle count as one axis when a smooth region is split (step 4):
 the edges of one tessellated cylinder turn about parallel axes, up to the noise of the
@@ -198,21 +202,33 @@ def _group_planes(
     and the largest distance of its vertices from its plane (flat when within the length
     tolerance, method step 1)."""
     n_groups = int(group.max()) + 1 if len(group) else 0
-    weighted = np.zeros((n_groups, 3))
-    np.add.at(weighted, group, normals * areas[:, None])
+    weighted = _group_sums(group, normals * areas[:, None], n_groups)
     area = np.bincount(group, weights=areas, minlength=n_groups)
-    moment = np.zeros((n_groups, 3))
-    np.add.at(moment, group, corners.mean(axis=1) * areas[:, None])
+    first, second, third = corners.transpose(1, 0, 2)
+    moment = _group_sums(group, (first + second + third) / 3 * areas[:, None], n_groups)
     point = moment / np.where(area > 0, area, 1.0)[:, None]
     normal = _group_normals(corners - point[group][:, None], group, areas, weighted)
     order = np.argsort(group, kind="stable")
     start = np.searchsorted(group[order], np.arange(n_groups + 1))
     heads = start[:-1]
-    lo = np.minimum.reduceat(corners.min(axis=1)[order], heads) if n_groups else np.zeros((0, 3))
-    hi = np.maximum.reduceat(corners.max(axis=1)[order], heads) if n_groups else np.zeros((0, 3))
+    low = np.minimum(np.minimum(first, second), third)[order]
+    high = np.maximum(np.maximum(first, second), third)[order]
+    lo = np.minimum.reduceat(low, heads) if n_groups else np.zeros((0, 3))
+    hi = np.maximum.reduceat(high, heads) if n_groups else np.zeros((0, 3))
     offsets = np.abs(np.einsum("fkj,fj->fk", corners - point[group][:, None], normal[group]))
     deviation = np.maximum.reduceat(offsets.max(axis=1)[order], heads) if n_groups else area
     return normal, point, area, lo, hi, order, start, deviation
+
+
+def _group_sums(
+    group: NDArray[np.int64], values: NDArray[np.float64], n_groups: int
+) -> NDArray[np.float64]:
+    """Per group, the sum of the rows of ``values`` (n x k) of its members, added in
+    row order."""
+    sums = np.empty((n_groups, values.shape[1]))
+    for k, column in enumerate(values.T):
+        sums[:, k] = np.bincount(group, weights=column, minlength=n_groups)
+    return sums
 
 
 def plane_deviation(points: NDArray[np.float64]) -> float:
@@ -232,8 +248,8 @@ def _group_normals(
     (``centred`` on the group's point, weighted by their triangle's area), turned along
     the area-weighted triangle normal ``weighted``: it rests on the whole extent of the
     face, not on the tilts of its triangles. Groups of zero area keep ``weighted``."""
-    scatter = np.zeros((len(weighted), 3, 3))
-    np.add.at(scatter, group, np.einsum("fki,fkj,f->fij", centred, centred, areas))
+    products = np.einsum("fki,fkj,f->fij", centred, centred, areas).reshape(-1, 9)
+    scatter = _group_sums(group, products, len(weighted)).reshape(-1, 3, 3)
     _, vectors = np.linalg.eigh(scatter)
     normal = (
         vectors[:, :, 0]
@@ -340,6 +356,20 @@ def fit_surface(
     """The first of ``kinds`` (cylinder, cone, sphere) through the triangles ``faces``
     (numbered ``ids`` in their mesh) by method step 3, or ``None`` when none fits within
     the tolerance."""
+    found = _fit_params(vertices, faces, normals, areas, tol, kinds)
+    return None if found is None else _surface(vertices, faces, areas, ids, found)
+
+
+def _fit_params(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    normals: NDArray[np.float64],
+    areas: NDArray[np.float64],
+    tol: Tolerance,
+    kinds: tuple[SurfaceKind, ...],
+) -> dict[str, Any] | None:
+    """The parameters of :func:`fit_surface` (kind, point, axis, radius, ...), before its
+    convexity is measured."""
     used = np.unique(faces)
     points = vertices[used]
     # points within the tolerance of one plane are a plane, whatever else fits them
@@ -348,9 +378,19 @@ def fit_surface(
     for fit in (FITS[kind] for kind in kinds):
         found = fit(points, normals, areas, tol)
         if found is not None:
-            break
-    else:
-        return None
+            return found
+    return None
+
+
+def _surface(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    areas: NDArray[np.float64],
+    ids: NDArray[np.int64],
+    found: dict[str, Any],
+) -> Surface:
+    """The surface of the fitted parameters ``found`` through the triangles ``faces``
+    (numbered ``ids`` in their mesh, of ``areas``), convex or not by :func:`is_convex`."""
     convex = is_convex(vertices, faces, found["point"], found["axis"])
     return Surface(faces=ids, area=float(areas.sum()), convex=convex, **found)
 
@@ -368,6 +408,31 @@ def _fit_faces(
 ) -> Surface | None:
     """:func:`fit_surface` on the triangles ``ids`` of a segmented mesh."""
     return fit_surface(vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, ids, kinds)
+
+
+@dataclass(frozen=True, eq=False)
+class Piece:
+    """The triangles ``ids`` of a segmented mesh (numbered in the mesh) on one surface of
+    parameters ``found``: fitted by :func:`_fit_params` when ``exact``, else by
+    :func:`_sphere_fits` (close enough to compare pieces, fitted again when kept)."""
+
+    ids: NDArray[np.int64]
+    found: dict[str, Any]
+    exact: bool = True
+
+
+def _fit_piece(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    seg: Segmentation,
+    tol: Tolerance,
+    ids: NDArray[np.int64],
+    kind: SurfaceKind,
+) -> Piece | None:
+    """The triangles ``ids`` of a segmented mesh with the parameters of the surface of
+    ``kind`` through them (:func:`_fit_params`), or ``None`` when it does not fit."""
+    found = _fit_params(vertices, faces[ids], seg.normals[ids], seg.areas[ids], tol, (kind,))
+    return None if found is None else Piece(ids, found)
 
 
 def is_convex(
@@ -492,31 +557,14 @@ def split_surfaces(
     adjacency, edges, axes, pairs = adjacency[kept], edges[kept], axes[kept], pairs[kept]
     label = _components(len(nodes), pairs)[pairs[:, 0]]
     claimed = np.zeros(len(faces), dtype=bool)
-    found: list[Surface] = []
-    candidates: list[NDArray[np.int64]] = []
-    for members in _classes(label):
-        if len(members) < MIN_CURVED_FACES - 1:
-            continue
-        turns = axes[members]
-        axis = (turns * np.sign(turns @ turns[0])[:, None]).mean(axis=0)
-        axis /= np.linalg.norm(axis)
-        points = vertices[np.unique(edges[members])]
-        plane = np.array(axis_basis(axis))
-        centre, radius = _circle_fit(points @ plane.T)
-        if np.abs(np.linalg.norm(points @ plane.T - centre, axis=1) - radius).max() > tol.length:
-            continue
-        near = np.sort(
-            np.concatenate([seg.faces_of(g) for g in np.unique(seg.group[adjacency[members]])])
-        )
-        corners = vertices[faces[near]] @ plane.T - centre
-        on = np.abs(np.linalg.norm(corners, axis=2) - radius).max(axis=1) <= tol.length
-        candidates.append(near[on])
+    found: list[Piece] = []
+    candidates = _strip_candidates(vertices, faces, seg, tol, adjacency, edges, axes, label)
     for ids in sorted(candidates, key=lambda ids: -float(seg.areas[ids].sum())):
         if len(ids) < MIN_CURVED_FACES or claimed[ids].any():
             continue
-        surface = _fit_faces(vertices, faces, seg, tol, ids, ("cylinder",))
-        if surface is not None:
-            found.append(surface)
+        piece = _fit_piece(vertices, faces, seg, tol, ids, "cylinder")
+        if piece is not None:
+            found.append(piece)
             claimed[ids] = True
     rest = ~claimed[adjacency[:, 0]] & ~claimed[adjacency[:, 1]]
     label = _components(len(faces), adjacency[rest])
@@ -526,14 +574,156 @@ def split_surfaces(
     patches = np.unique(label[adjacency[rest, 0]])
     lo = np.searchsorted(label[free], patches)
     hi = np.searchsorted(label[free], patches, side="right")
-    for start, stop in zip(lo.tolist(), hi.tolist(), strict=True):
-        ids = free[start:stop]
-        if len(ids) < MIN_CURVED_FACES:
-            continue
-        sphere = _fit_faces(vertices, faces, seg, tol, ids, ("sphere",))
-        if sphere is not None:
-            found.append(sphere)
+    large = hi - lo >= MIN_CURVED_FACES
+    lo, hi = lo[large], hi[large]
+    centres, radii, fits = _sphere_fits(vertices, faces[free], lo, hi, tol)
+    for k in np.flatnonzero(fits).tolist():
+        sphere = {"kind": "sphere", "point": centres[k], "axis": None, "radius": radii[k]}
+        found.append(Piece(free[lo[k] : hi[k]], sphere, exact=False))
     return _merged(vertices, faces, seg, tol, found)
+
+
+def _strip_candidates(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    seg: Segmentation,
+    tol: Tolerance,
+    adjacency: NDArray[np.int64],
+    edges: NDArray[np.int64],
+    axes: NDArray[np.float64],
+    label: NDArray[np.int64],
+) -> list[NDArray[np.int64]]:
+    """Per set of smooth edges of one ``label`` (the faces ``adjacency``, their shared
+    ``edges`` and unit ``axes``) in label order, the faces of their coplanar groups on
+    the cylinder through the edges' vertices, when these lie on one (method step 4).
+
+    The circles of sets of at least three edges (three rulings determine a circle) are
+    fitted all at once, by the normal equations of the least squares on the vertices
+    centred per set; those of two edges, or whose normal equations are ill-conditioned,
+    one by one (:func:`_strip_candidate`)."""
+    if not len(label):
+        return []
+    _, first, cls, size = np.unique(
+        label, return_index=True, return_inverse=True, return_counts=True
+    )
+    cls = cls.ravel()
+    # each set's axis: the mean of its edges' axes turned along its first one's
+    signs = np.sign(np.einsum("ij,ij->i", axes, axes[first[cls]]))[:, None]
+    turns = np.stack([np.bincount(cls, weights=w) for w in (axes * signs).T], axis=1)
+    axis: NDArray[np.float64] = turns / np.linalg.norm(turns, axis=1)[:, None]
+    u, v = axis_basis(axis)
+    pc, used = np.divmod(np.unique(cls[:, None] * len(vertices) + edges), len(vertices))
+    xy = np.column_stack([np.einsum("ij,ij->i", vertices[used], b[pc]) for b in (u, v)])
+    count = np.bincount(pc, minlength=len(size))
+    heads = np.concatenate([[0], np.cumsum(count)[:-1]])
+    mean = np.add.reduceat(xy, heads) / count[:, None]
+    centred = xy - mean[pc]
+    system = np.column_stack([2 * centred, np.ones(len(centred))])
+    gram = np.add.reduceat(np.einsum("pi,pj->pij", system, system), heads)
+    moment = np.add.reduceat(system * (centred**2).sum(axis=1)[:, None], heads)
+    # normal equations keep half the digits of a system with this conditioning
+    singular = np.linalg.svd(gram, compute_uv=False)
+    determined = (size >= CIRCLE_EDGES) & (
+        singular[:, -1] > np.sqrt(np.finfo(np.float64).eps) * singular[:, 0]
+    )
+    gram = np.where(determined[:, None, None], gram, np.eye(3))
+    solution = np.linalg.solve(gram, moment[:, :, None])[:, :, 0]
+    centre = mean + solution[:, :2]
+    radius = np.sqrt(np.maximum(solution[:, 2] + (solution[:, :2] ** 2).sum(axis=1), 0.0))
+    miss = np.abs(np.linalg.norm(xy - centre[pc], axis=1) - radius[pc])
+    fits = determined & (np.maximum.reduceat(miss, heads) <= tol.length)
+    # the faces of the coplanar groups of each fitting set's edges, ascending per set
+    sides = np.concatenate([adjacency[:, 0], adjacency[:, 1]])
+    keep = np.tile(fits[cls], 2)
+    gc, gg = np.divmod(
+        np.unique(np.tile(cls, 2)[keep] * len(seg.flat) + seg.group[sides[keep]]), len(seg.flat)
+    )
+    sizes = seg.start[gg + 1] - seg.start[gg]
+    rows = np.arange(sizes.sum()) + np.repeat(seg.start[gg] - np.cumsum(sizes) + sizes, sizes)
+    fc, near = np.divmod(np.sort(np.repeat(gc, sizes) * len(faces) + seg.order[rows]), len(faces))
+    corners = vertices[faces[near]]
+    planar = np.stack([np.einsum("ikj,ij->ik", corners, b[fc]) for b in (u, v)], axis=2)
+    off = np.abs(np.linalg.norm(planar - centre[fc][:, None], axis=2) - radius[fc][:, None])
+    on = off.max(axis=1) <= tol.length
+    found = np.split(near[on], np.searchsorted(fc[on], np.arange(1, len(size))))
+    candidates: list[NDArray[np.int64]] = []
+    for k, members in enumerate(_classes(label)):
+        if fits[k]:
+            candidates.append(found[k])
+        elif not determined[k] and size[k] >= MIN_CURVED_FACES - 1:
+            strip = _strip_candidate(vertices, faces, seg, tol, adjacency, edges, axes, members)
+            if strip is not None:
+                candidates.append(strip)
+    return candidates
+
+
+def _strip_candidate(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    seg: Segmentation,
+    tol: Tolerance,
+    adjacency: NDArray[np.int64],
+    edges: NDArray[np.int64],
+    axes: NDArray[np.float64],
+    members: NDArray[np.int64],
+) -> NDArray[np.int64] | None:
+    """:func:`_strip_candidates` for the one set of edges ``members``, by the least
+    squares circle (:func:`_circle_fit`): ``None`` when their vertices lie on none."""
+    turns = axes[members]
+    axis = (turns * np.sign(turns @ turns[0])[:, None]).mean(axis=0)
+    axis /= np.linalg.norm(axis)
+    points = vertices[np.unique(edges[members])]
+    plane = np.array(axis_basis(axis))
+    centre, radius = _circle_fit(points @ plane.T)
+    if np.abs(np.linalg.norm(points @ plane.T - centre, axis=1) - radius).max() > tol.length:
+        return None
+    near = np.sort(
+        np.concatenate([seg.faces_of(g) for g in np.unique(seg.group[adjacency[members]])])
+    )
+    corners = vertices[faces[near]] @ plane.T - centre
+    on = np.abs(np.linalg.norm(corners, axis=2) - radius).max(axis=1) <= tol.length
+    return near[on]
+
+
+def _sphere_fits(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    lo: NDArray[np.int64],
+    hi: NDArray[np.int64],
+    tol: Tolerance,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+    """Centre, radius and whether it fits (method step 3, as :func:`fit_surface`), of the
+    sphere through each piece of triangles ``faces[lo[k]:hi[k]]``, all pieces at once:
+    the vertices of each are centred on their mean and the plane and sphere fitted by
+    the normal equations of the least squares, solved on the stack of pieces."""
+    if not len(lo):
+        return np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool)
+    sizes = hi - lo
+    piece = np.repeat(np.arange(len(lo)), 3 * sizes)
+    rows = np.arange(sizes.sum()) + np.repeat(lo - np.cumsum(sizes) + sizes, sizes)
+    keys = np.unique(piece * len(vertices) + faces[rows].ravel())
+    piece, used = np.divmod(keys, len(vertices))
+    count = np.bincount(piece, minlength=len(lo))
+    heads = np.concatenate([[0], np.cumsum(count)[:-1]])
+
+    def sums(values: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.add.reduceat(values, heads, axis=0)
+
+    mean = sums(vertices[used]) / count[:, None]
+    centred = vertices[used] - mean[piece]
+    # the plane: the smallest eigenvector of the scatter of the centred vertices
+    normal = np.linalg.eigh(sums(np.einsum("pi,pj->pij", centred, centred)))[1][:, :, 0]
+    off_plane = np.maximum.reduceat(np.abs(np.einsum("pi,pi->p", centred, normal[piece])), heads)
+    solid = (count >= 4) & (off_plane > tol.length)
+    # the sphere |q|² = 2 c·q + k: a piece off every plane has regular normal equations
+    system = np.column_stack([2 * centred, np.ones(len(centred))])
+    gram = np.where(solid[:, None, None], sums(np.einsum("pi,pj->pij", system, system)), np.eye(4))
+    moment = sums(system * (centred**2).sum(axis=1)[:, None])
+    solution = np.linalg.solve(gram, moment[:, :, None])[:, :, 0]
+    centre = solution[:, :3]
+    radius = np.sqrt(np.maximum(solution[:, 3] + (centre**2).sum(axis=1), 0.0))
+    miss = np.abs(np.linalg.norm(centred - centre[piece], axis=1) - radius[piece])
+    return mean + centre, radius, solid & (np.maximum.reduceat(miss, heads) <= tol.length)
 
 
 def _merged(
@@ -541,40 +731,50 @@ def _merged(
     faces: NDArray[np.int64],
     seg: Segmentation,
     tol: Tolerance,
-    surfaces: list[Surface],
+    pieces: list[Piece],
 ) -> tuple[Surface, ...]:
-    """``surfaces`` with the pieces of one sphere (same centre and radius) or one
-    cylinder (same axis line and radius) fitted again as one surface: each joins the
-    first earlier one it lies on whose union with it still fits."""
-    merged: list[Surface] = []
-    kinds = np.empty(len(surfaces), dtype=object)
-    radii = np.empty(len(surfaces))
-    points = np.empty((len(surfaces), 3))
-    axes = np.zeros((len(surfaces), 3))
+    """The surfaces of ``pieces`` with the pieces of one sphere (same centre and radius)
+    or one cylinder (same axis line and radius) fitted again as one surface: each joins
+    the first earlier one it lies on whose union with it still fits. Only the surfaces
+    that remain are measured for convexity, and fitted by :func:`_fit_params` if they
+    were not."""
+    merged: list[Piece] = []
+    kinds = np.empty(len(pieces), dtype=object)
+    radii = np.empty(len(pieces))
+    points = np.empty((len(pieces), 3))
+    axes = np.zeros((len(pieces), 3))
 
-    def keep(k: int, surface: Surface) -> None:
-        kinds[k], radii[k], points[k] = surface.kind, surface.radius, surface.point
-        if surface.axis is not None:
-            axes[k] = surface.axis
+    def keep(k: int, found: dict[str, Any]) -> None:
+        kinds[k], radii[k], points[k] = found["kind"], found.get("radius", 0.0), found["point"]
+        if found["axis"] is not None:
+            axes[k] = found["axis"]
 
-    for surface in surfaces:
+    for piece in pieces:
         n = len(merged)
-        same = _same_surfaces(surface, kinds[:n], radii[:n], points[:n], axes[:n], tol)
+        same = _same_surfaces(piece.found, kinds[:n], radii[:n], points[:n], axes[:n], tol)
         for k in np.flatnonzero(same).tolist():
-            ids = np.concatenate([merged[k].faces, surface.faces])
-            union = _fit_faces(vertices, faces, seg, tol, ids, (surface.kind,))
+            ids = np.concatenate([merged[k].ids, piece.ids])
+            union = _fit_piece(vertices, faces, seg, tol, ids, piece.found["kind"])
             if union is not None:
                 merged[k] = union
-                keep(k, union)
+                keep(k, union.found)
                 break
         else:
-            merged.append(surface)
-            keep(n, surface)
-    return tuple(merged)
+            merged.append(piece)
+            keep(n, piece.found)
+    exact = [
+        m if m.exact else _fit_piece(vertices, faces, seg, tol, m.ids, m.found["kind"])
+        for m in merged
+    ]
+    return tuple(
+        _surface(vertices, faces[m.ids], seg.areas[m.ids], m.ids, m.found)
+        for m in exact
+        if m is not None
+    )
 
 
 def _same_surfaces(
-    a: Surface,
+    a: dict[str, Any],
     kinds: NDArray[np.object_],
     radii: NDArray[np.float64],
     points: NDArray[np.float64],
@@ -582,16 +782,26 @@ def _same_surfaces(
     tol: Tolerance,
 ) -> NDArray[np.bool_]:
     """Per surface given by its kind, radius, point and axis (rows), whether it and the
-    sphere or cylinder ``a`` lie on one sphere, or one cylinder, within the tolerance."""
-    if a.kind not in ("sphere", "cylinder"):
+    sphere or cylinder of parameters ``a`` (:func:`_fit_params`) lie on one sphere, or
+    one cylinder, within the tolerance."""
+    if a["kind"] not in ("sphere", "cylinder"):
         return np.zeros(len(kinds), dtype=bool)
-    same = (kinds == a.kind) & (np.abs(a.radius - radii) <= tol.length)
-    offset = points - a.point
-    if a.kind == "sphere":
+    same = (kinds == a["kind"]) & (np.abs(a["radius"] - radii) <= tol.length)
+    offset = points - a["point"]
+    if a["kind"] == "sphere":
         return same & (np.linalg.norm(offset, axis=1) <= tol.length)
-    assert a.axis is not None
-    parallel = np.linalg.norm(np.cross(a.axis, axes), axis=1) <= tol.angle
-    return same & parallel & (np.linalg.norm(np.cross(offset, a.axis), axis=1) <= tol.length)
+    return (
+        same
+        & (_cross_norms(a["axis"], axes) <= tol.angle)
+        & (_cross_norms(a["axis"], offset) <= tol.length)
+    )
+
+
+def _cross_norms(u: NDArray[np.float64], rows: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``|u × r|`` per row ``r`` of ``rows``, the cross products written out (as np.cross
+    computes them, without its overhead on a few rows)."""
+    (a, b, c), (x, y, z) = u, rows.T
+    return np.sqrt((b * z - c * y) ** 2 + (c * x - a * z) ** 2 + (a * y - b * x) ** 2)
 
 
 def _classes(label: NDArray[np.int64]) -> list[NDArray[np.int64]]:
