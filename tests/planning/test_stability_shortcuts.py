@@ -9,9 +9,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-import trimesh
+from stability_blocks import corbels, overhanging_stack
 
-from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning import stability
 from assemblykit.planning.stability import (
     CONE_SIDES,
@@ -21,39 +20,6 @@ from assemblykit.planning.stability import (
 )
 
 MU = 0.5
-
-
-def box(extents: tuple[float, ...], low: tuple[float, ...]) -> trimesh.Trimesh:
-    """An axis-aligned box with its lowest corner at ``low``."""
-    mesh = trimesh.creation.box(extents=extents)
-    mesh.apply_translation(np.asarray(low) + np.asarray(extents) / 2)
-    return mesh
-
-
-def stack(overhang: float) -> Assembly:
-    """Three unit cubes stacked; the top one shifted by ``overhang`` along x."""
-    return Assembly(
-        [
-            Part("bottom", box((1, 1, 1), (0, 0, 0))),
-            Part("middle", box((1, 1, 1), (0, 0, 1))),
-            Part("top", box((1, 1, 1), (overhang, 0, 2))),
-        ]
-    )
-
-
-def corbels() -> Assembly:
-    """A ground slab, two pillars, two corbels reaching inwards and a keystone between
-    them: it stands with friction 0.354 or more, and falls without the keystone."""
-    return Assembly(
-        [
-            Part("ground", box((6, 1, 1), (-3, 0, -1))),
-            Part("pillar_l", box((1, 1, 1), (-2, 0, 0))),
-            Part("pillar_r", box((1, 1, 1), (1, 0, 0))),
-            Part("corbel_l", box((1.4, 1, 1), (-1.6, 0, 1))),
-            Part("corbel_r", box((1.4, 1, 1), (0.2, 0, 1))),
-            Part("keystone", box((0.4, 1, 1), (-0.2, 0, 1))),
-        ]
-    )
 
 
 def with_midpoints(monkeypatch: pytest.MonkeyPatch, bulge: float) -> None:
@@ -91,10 +57,10 @@ def answers(model: EquilibriumModel, states: list[set[str]]) -> list[tuple]:
 
 
 CASES = [
-    (stack(0.4), [{"bottom", "middle", "top"}]),
-    (stack(0.6), [{"bottom", "middle", "top"}, {"bottom", "middle"}]),
+    (overhanging_stack(0.4), [{"bottom", "middle", "top"}]),
+    (overhanging_stack(0.6), [{"bottom", "middle", "top"}, {"bottom", "middle"}]),
     (
-        corbels(),
+        corbels(keystone=True),
         [
             {"ground", "pillar_l", "pillar_r", "corbel_l", "corbel_r", "keystone"},
             {"ground", "pillar_l", "pillar_r", "corbel_l", "corbel_r"},
@@ -156,7 +122,7 @@ def test_points_off_the_sides_are_kept_and_change_what_stands(monkeypatch):
     # the top block overhangs 0.55: its centre at x = 1.05 is beyond the middle block
     # (x <= 1); a contact polygon bulged 0.1 outwards across each side reaches x = 1.1,
     # so those points are kept and the top stands on them
-    assembly = stack(0.55)
+    assembly = overhanging_stack(0.55)
     assert equilibrium_model(assembly).check().would_fall == ("top",)
     with_midpoints(monkeypatch, 0.1)
     found = contact_points(assembly, [0, 0, -1])

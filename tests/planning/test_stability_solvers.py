@@ -6,15 +6,13 @@ several friction coefficients, its verdict must be that of HiGHS's interior poin
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
-import trimesh
 from scipy.optimize import linprog
+from stability_blocks import block_on_slope, corbels, overhanging_stack
 
 from assemblykit.io.assembly import load_assembly
-from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.assembly import Assembly
 from assemblykit.planning import stability
 from assemblykit.planning.stability import (
     CONE_SIDES,
@@ -26,50 +24,6 @@ from assemblykit.tolerance import Tolerance
 from datasets import dataset
 
 FRICTIONS = (0.0, 0.1, 0.3, 0.5)
-
-
-def box(extents: tuple[float, ...], low: tuple[float, ...]) -> trimesh.Trimesh:
-    """An axis-aligned box with its lowest corner at ``low``."""
-    mesh = trimesh.creation.box(extents=extents)
-    mesh.apply_translation(np.asarray(low) + np.asarray(extents) / 2)
-    return mesh
-
-
-def stack(overhang: float) -> Assembly:
-    """Three unit cubes stacked; the top one shifted by ``overhang`` along x."""
-    return Assembly(
-        [
-            Part("bottom", box((1, 1, 1), (0, 0, 0))),
-            Part("middle", box((1, 1, 1), (0, 0, 1))),
-            Part("top", box((1, 1, 1), (overhang, 0, 2))),
-        ]
-    )
-
-
-def corbels() -> Assembly:
-    """A ground slab, two pillars, two corbels reaching inwards and a keystone between
-    them (it stands with friction 0.354 or more)."""
-    return Assembly(
-        [
-            Part("ground", box((6, 1, 1), (-3, 0, -1))),
-            Part("pillar_l", box((1, 1, 1), (-2, 0, 0))),
-            Part("pillar_r", box((1, 1, 1), (1, 0, 0))),
-            Part("corbel_l", box((1.4, 1, 1), (-1.6, 0, 1))),
-            Part("corbel_r", box((1.4, 1, 1), (0.2, 0, 1))),
-            Part("keystone", box((0.4, 1, 1), (-0.2, 0, 1))),
-        ]
-    )
-
-
-def block_on_slope(degrees: float) -> Assembly:
-    """A unit cube resting on the top face of a slab tilted by ``degrees`` about y."""
-    turn = trimesh.transformations.rotation_matrix(math.radians(degrees), [0, 1, 0])
-    slab = trimesh.creation.box(extents=(4.0, 4.0, 1.0))
-    slab.apply_transform(turn)
-    cube = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
-    cube.apply_transform(turn)
-    cube.apply_translation(turn[:3, :3] @ [0.0, 0.0, 1.0])
-    return Assembly([Part("slope", slab), Part("block", cube)])
 
 
 def highs_stands(
@@ -123,7 +77,14 @@ def without_each(assembly: Assembly) -> list[set[str] | None]:
 
 @pytest.mark.parametrize(
     "assembly",
-    [stack(0.4), stack(0.45), stack(0.55), stack(0.6), corbels(), block_on_slope(25.0)],
+    [
+        overhanging_stack(0.4),
+        overhanging_stack(0.45),
+        overhanging_stack(0.55),
+        overhanging_stack(0.6),
+        corbels(keystone=True),
+        block_on_slope(25.0),
+    ],
     ids=["stack 0.4", "stack 0.45", "stack 0.55", "stack 0.6", "corbels", "slope 25"],
 )
 def test_blocks_computed_by_hand_get_highs_verdicts(assembly):
