@@ -9,7 +9,6 @@ import dataclasses
 
 import numpy as np
 import pytest
-from stability_blocks import corbels, overhanging_stack
 
 from assemblykit.planning import stability
 from assemblykit.planning.stability import (
@@ -18,6 +17,7 @@ from assemblykit.planning.stability import (
     contact_points,
     equilibrium_model,
 )
+from stability_blocks import corbels, overhanging_stack
 
 MU = 0.5
 

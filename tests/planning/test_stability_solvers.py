@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.optimize import linprog
-from stability_blocks import block_on_slope, corbels, overhanging_stack
 
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly
@@ -22,6 +21,7 @@ from assemblykit.planning.stability import (
 )
 from assemblykit.tolerance import Tolerance
 from datasets import dataset
+from stability_blocks import block_on_slope, corbels, overhanging_stack
 
 FRICTIONS = (0.0, 0.1, 0.3, 0.5)
 
