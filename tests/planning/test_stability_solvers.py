@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from scipy.optimize import linprog
 
 from assemblykit.io.assembly import load_assembly
@@ -113,3 +114,47 @@ def test_the_cross_vault_gets_highs_verdicts():
         states = [None, *(set(assembly.names) - {name} for name in removed)]
         ours, reference = verdicts(model, states, (0.5,))
         assert ours == reference
+
+
+def test_the_least_residual_balance_names_every_equation_some_optimum_leaves_unbalanced():
+    # minimise |1 - x| + |-1 - x| over x >= 0: the optimum 2 is reached by every x in
+    # [0, 1]; the vertex x = 1 leaves only the second equation unbalanced, x = 0 both,
+    # and the interior point (0 < x < 1) both: the set every optimum's support lies in
+    residual = stability.least_residuals(sp.csc_matrix([[1.0], [1.0]]), np.array([1.0, -1.0]))
+    assert np.abs(residual).sum() == pytest.approx(2.0, abs=1e-7)
+    assert np.all(np.abs(residual) > 1e-3)
+    assert residual[0] > 0 > residual[1]
+    # a unique optimum: x = 1 balances both
+    unique = stability.least_residuals(sp.csc_matrix([[1.0], [2.0]]), np.array([1.0, 2.0]))
+    assert np.abs(unique).max() < LP_FEASIBILITY
+
+
+def test_local_verdicts_are_those_of_the_whole_program_on_a_vault_taken_down():
+    """The cross vault taken down from its highest block, one block at a time: at each
+    state and two friction coefficients, also with its highest block held, the verdict
+    found from the last balance (a balance kept, or a Farkas certificate on a few parts)
+    is the whole program's, and both shortcuts decide some of the states."""
+    tol = Tolerance.relative(5e-5)
+    assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
+    model = equilibrium_model(assembly, tol=tol)
+    decided: list[bool | None] = []
+    original = EquilibriumModel._local_verdict
+
+    def recorded(self, *args):
+        decided.append(original(self, *args))
+        return decided[-1]
+
+    order = sorted(assembly.names, key=lambda n: -float(model.heights[model.mask([n])][0]))
+    ours, whole = [], []
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(EquilibriumModel, "_local_verdict", recorded)
+        for removed in range(12):
+            present = model.mask(order[removed:])
+            fixed = present & model.mask(model.fixed)
+            for friction in (0.5, 0.3):
+                for held in (fixed, fixed | model.mask(order[removed : removed + 1])):
+                    ours.append(model.stands(present, held, friction))
+                    whole.append(model.stands(present, held, friction, local=False))
+    assert ours == whole
+    assert any(ours) and not all(ours)
+    assert True in decided and False in decided

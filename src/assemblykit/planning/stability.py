@@ -30,11 +30,17 @@ segment between its two neighbours adds nothing (every force it could carry is a
 combination of the same force at its neighbours, the contact's normal and friction
 directions being the same at all its vertices), so the answer is the same with a
 quarter fewer columns on the dome. It is solved in its Farkas form by Clarabel
-(:func:`solvable`). When they have none, a second one, on every point, minimises the
+(:func:`balance`). When they have none, a second one, also on the corners, minimises the
 absolute residuals (slacks) of those equations, each scaled by the part's weight and
 the model's size: it is always feasible, and the parts left with a residual beyond the
-tolerance are those that cannot be in equilibrium (they would fall). It is solved by
-HiGHS's interior point method within :data:`LP_TIME_LIMIT`. Loads are homogeneous in
+tolerance are those that cannot be in equilibrium (they would fall). Its optimum is
+not unique on a state that falls; the parts named are those left unbalanced by *some*
+least-residual balance, the support of the interior of its optimal face, to which
+Clarabel's interior point method converges (:func:`least_residuals`), so the set does
+not depend on a solver's pivots. A plan asks about states that differ by a block or a
+hold from one already decided: the balance last found at each friction coefficient
+answers many of them from a few parts' equations (:meth:`EquilibriumModel.stands`).
+Loads are homogeneous in
 rigid-block equilibrium (scaling gravity scales every force), so the margin reported is
 the least friction coefficient with which the state stands, found by bisection on the
 first program.
@@ -70,16 +76,18 @@ FRICTION_STEPS = 5
 
 LP_FEASIBILITY = 1e-7
 """HiGHS's primal feasibility tolerance (its default, passed explicitly): residuals below
-it are the solver's rounding, not a fall."""
+it are the solver's rounding, not a fall. A part that a known balance leaves with
+residuals below it is balanced (:meth:`EquilibriumModel.stands`)."""
 
 LP_TIME_LIMIT = 120.0
 """Seconds one equilibrium program may take before :class:`NumericError` (a bound; the
 largest programs measured, the 527-block dome's first and the 184-block cross vault's
-slack program, take 0.5 to 1.2 s and 2 to 5 s on two shared cores:
-benchmarks/bench_stability.py). The slack program is solved by HiGHS's interior point
-method: the nearly balanced states of a vault make the dual simplex method degenerate
-(minutes of pivots on the cross vault where the interior point method needs about 50
-iterations)."""
+slack program, take 0.5 to 1.2 s and 0.2 to 0.3 s on two shared cores:
+benchmarks/bench_stability.py)."""
+
+LOCAL_HOPS = 3
+"""How many contacts :meth:`EquilibriumModel.stands` grows the region of unbalanced
+parts by, one at a time, before it leaves the verdict to the whole program."""
 
 DOWN = (0.0, 0.0, -1.0)
 
@@ -278,18 +286,19 @@ def _tangents(
     return u, np.cross(normals, u)
 
 
-def solvable(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> bool:
-    """Whether ``matrix @ x = rhs`` has a solution ``x >= 0``. By Farkas' lemma it has
-    none exactly when some ``y`` has ``matrix.T @ y >= 0`` and ``rhs @ y < 0``, so the
-    program "minimise ``rhs @ y`` subject to ``matrix.T @ y >= 0``" has the optimum 0
-    when there is a solution and is unbounded otherwise. It is solved by Clarabel's
-    interior point method (Goulart and Chen 2024, "Clarabel: an interior-point solver
-    for conic programs with quadratic objectives": a sparse direct factorisation per
-    iteration; 0.6 s on the 527-block dome where HiGHS's interior point method
-    needs 25 s), which proves unboundedness by a certificate; its unknowns are the
-    equations (6 per part), not the generators. Should it stop short of either answer
-    (iterations, numerical trouble, :data:`LP_TIME_LIMIT`), HiGHS's interior point
-    method decides, within :data:`LP_FEASIBILITY`."""
+def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """A solution ``x >= 0`` of ``matrix @ x = rhs``, or ``None`` when there is none. By
+    Farkas' lemma there is none exactly when some ``y`` has ``matrix.T @ y >= 0`` and
+    ``rhs @ y < 0``, so the program "minimise ``rhs @ y`` subject to ``matrix.T @ y >=
+    0``" has the optimum 0 when there is a solution and is unbounded otherwise; its
+    multipliers are then a solution. It is solved by Clarabel's interior point method
+    (Goulart and Chen 2024, "Clarabel: an interior-point solver for conic programs with
+    quadratic objectives": a sparse direct factorisation per iteration; 0.6 s on the
+    527-block dome where HiGHS's interior point method needs 25 s), which proves
+    unboundedness by a certificate; its unknowns are the equations (6 per part), not the
+    generators. Should it stop short of either answer (iterations, numerical trouble,
+    :data:`LP_TIME_LIMIT`), HiGHS's interior point method decides, within
+    :data:`LP_FEASIBILITY`."""
     import clarabel
 
     rows, columns = matrix.shape
@@ -305,9 +314,9 @@ def solvable(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> bool:
         settings,
     ).solve()
     if found.status == clarabel.SolverStatus.Solved:
-        return True
+        return np.maximum(np.asarray(found.z), 0.0)
     if found.status == clarabel.SolverStatus.DualInfeasible:
-        return False
+        return None
     result = linprog(
         np.zeros(columns),
         A_eq=matrix,
@@ -318,7 +327,44 @@ def solvable(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> bool:
     )
     if result.status not in (0, 2):
         raise NumericError(f"equilibrium program failed: {result.message}")
-    return bool(result.status == 0)
+    return np.asarray(result.x) if result.status == 0 else None
+
+
+def solvable(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> bool:
+    """Whether ``matrix @ x = rhs`` has a solution ``x >= 0`` (:func:`balance`)."""
+    return balance(matrix, rhs) is not None
+
+
+def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The residual ``rhs - matrix @ x`` of the least-residual balance: the program
+    "minimise ``|r|_1`` with ``matrix @ x + r = rhs``, ``x >= 0``", at the point of its
+    optimal face that an interior point method converges to (the central path's limit,
+    in the relative interior of that face). Its support is therefore the same at every
+    such point: the equations left unbalanced by *some* least-residual balance, a set
+    defined by the program alone, where a vertex optimum names a subset that depends on
+    the solver's pivots. Solved by Clarabel in dual form ("maximise ``rhs @ y`` with
+    ``matrix.T @ y <= 0`` and ``-1 <= y <= 1``", the unknowns being the equations), whose
+    multipliers are ``x`` and the two signs of ``r``. Should it stop short of an optimum,
+    :class:`NumericError`."""
+    import clarabel
+
+    rows, columns = matrix.shape
+    eye = sp.identity(rows, format="csc")
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.time_limit = LP_TIME_LIMIT
+    found = clarabel.DefaultSolver(
+        sp.csc_matrix((rows, rows)),
+        -np.asarray(rhs, dtype=np.float64),
+        sp.vstack([matrix.T, eye, -eye], format="csc"),
+        np.r_[np.zeros(columns), np.ones(2 * rows)],
+        [clarabel.NonnegativeConeT(columns + 2 * rows)],
+        settings,
+    ).solve()
+    if found.status not in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
+        raise NumericError(f"equilibrium slack program failed: {found.status}")
+    multipliers = np.asarray(found.z)
+    return multipliers[columns : columns + rows] - multipliers[columns + rows :]
 
 
 @dataclass(frozen=True, eq=False)
@@ -345,6 +391,9 @@ class EquilibriumModel:
     friction: float
     threshold: float
     _index: dict[str, int] = field(default_factory=dict, repr=False)
+    _balances: dict[float, NDArray[np.float64]] = field(default_factory=dict, repr=False)
+    """Per friction coefficient, the generator weights of the last balance found
+    (:meth:`stands`)."""
 
     def __post_init__(self) -> None:
         self._index.update({name: i for i, name in enumerate(self.names)})
@@ -366,11 +415,15 @@ class EquilibriumModel:
         """The force points between two parts of ``present``."""
         return present[self.point_parts[:, 0]] & present[self.point_parts[:, 1]]
 
+    def _columns(self, selected: NDArray[np.bool_]) -> NDArray[np.int64]:
+        """The generator columns of the ``selected`` points."""
+        return (CONE_SIDES * np.flatnonzero(selected)[:, None] + np.arange(CONE_SIDES)).ravel()
+
     def _matrix(
         self, rows: NDArray[np.int64], selected: NDArray[np.bool_], mu: float
     ) -> sp.csc_matrix:
         """The equations ``rows`` over the generators of the ``selected`` points."""
-        columns = (CONE_SIDES * np.flatnonzero(selected)[:, None] + np.arange(CONE_SIDES)).ravel()
+        columns = self._columns(selected)
         part = self.normal_part[rows][:, columns] + mu * self.tangent_part[rows][:, columns]
         return sp.csc_matrix(part)
 
@@ -379,18 +432,69 @@ class EquilibriumModel:
         present: NDArray[np.bool_],
         fixed: NDArray[np.bool_],
         friction: float | None = None,
+        local: bool = True,
     ) -> bool:
         """Whether the equations of ``present`` alone have a solution with ``fixed``
-        immobile: the first program, on the corners (:func:`solvable`)."""
+        immobile: the first program, on the corners (:func:`balance`). With ``local``,
+        the balance last found at this friction decides first where it can
+        (:meth:`_local_verdict`); its verdicts are the whole program's."""
         free = present & ~fixed
         if not free.any():
             return True
         points = self._touching(present)
         if not points.any():
             return False
-        rows = self._rows(free)
         mu = self.friction if friction is None else friction
-        return solvable(self._matrix(rows, points & self.corners, mu), -self.load[rows])
+        if local and mu in self._balances:
+            verdict = self._local_verdict(present, free, points & self.corners, mu)
+            if verdict is not None:
+                return verdict
+        rows = self._rows(free)
+        selected = points & self.corners
+        found = balance(self._matrix(rows, selected, mu), -self.load[rows])
+        if found is None:
+            return False
+        forces = np.zeros(self.normal_part.shape[1])
+        forces[self._columns(selected)] = found
+        self._balances[mu] = forces
+        return True
+
+    def _local_verdict(
+        self,
+        present: NDArray[np.bool_],
+        free: NDArray[np.bool_],
+        selected: NDArray[np.bool_],
+        mu: float,
+    ) -> bool | None:
+        """The verdict of :meth:`stands` where the balance last found at ``mu`` decides
+        it (``None`` where it does not): *stands* when that balance, without the forces
+        on parts absent from this state, still balances every free part; *falls* when
+        the parts it leaves unbalanced, grown by contacts (:data:`LOCAL_HOPS`), cannot
+        balance even with every part around them immobile (pushing on them however it
+        must): a Farkas certificate on their equations alone is one for the whole state.
+        Removing a block leaves its neighbours to be proved, a dozen parts, where the
+        whole program has all of them; a region holding more than half the free parts
+        is left to the whole program."""
+        forces = self._balances[mu] * np.repeat(selected, CONE_SIDES)
+        wrench = self.normal_part @ forces + mu * (self.tangent_part @ forces)
+        error = np.abs(-self.load - wrench).reshape(-1, 6).max(axis=1)
+        region = free & (error > LP_FEASIBILITY)
+        if not region.any():
+            self._balances[mu] = forces
+            return True
+        ends = self.point_parts
+        for _ in range(LOCAL_HOPS):
+            near = np.zeros_like(region)
+            near[ends[selected & region[ends[:, 0]], 1]] = True
+            near[ends[selected & region[ends[:, 1]], 0]] = True
+            region |= near & free
+            if 2 * int(region.sum()) > int(free.sum()):
+                return None
+            rows = self._rows(region)
+            touching = selected & (region[ends[:, 0]] | region[ends[:, 1]])
+            if balance(self._matrix(rows, touching, mu), -self.load[rows]) is None:
+                return False
+        return None
 
     def residuals(
         self,
@@ -401,10 +505,8 @@ class EquilibriumModel:
         """Per part, the largest scaled residual of its six equations at the optimum of
         the slack program (0 for fixed and absent parts). A state that stands is told by
         the equations alone first, on the corners (:meth:`stands`): that program is
-        smaller, and its answer is all zeros. The slack program keeps every point: its
-        optimum is not unique on a state that falls, and which parts it leaves falling
-        depends on the program's columns and its solver (HiGHS's interior point method
-        with crossover, whose vertex optimum the plans report)."""
+        smaller, and its answer is all zeros. The slack program is on the corners too
+        (:func:`least_residuals`: the residuals of the interior of its optimal face)."""
         if self.stands(present, fixed, friction):
             return np.zeros(len(self.names))
         return self.slack(present, fixed, friction)
@@ -425,24 +527,10 @@ class EquilibriumModel:
             # nothing touches: every free part keeps its whole weight as residual
             out[free] = np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
             return out
-        size = len(rows)
-        eye = sp.identity(size, format="csr")
-        every = self._matrix(rows, points, self.friction if friction is None else friction)
-        system = sp.hstack([every, eye, -eye], format="csc")
-        cost = np.r_[np.zeros(every.shape[1]), np.ones(2 * size)]
-        result = linprog(
-            cost,
-            A_eq=system,
-            b_eq=-self.load[rows],
-            bounds=(0, None),
-            method="highs-ipm",
-            options={"primal_feasibility_tolerance": LP_FEASIBILITY, "time_limit": LP_TIME_LIMIT},
-        )
-        if result.status != 0:
-            raise NumericError(f"equilibrium slack program failed: {result.message}")
-        slack = result.x[every.shape[1] :]
-        residual = np.abs(slack[:size] - slack[size:]).reshape(-1, 6).max(axis=1)
-        out[free] = residual
+        # the corners span the same wrenches as every point, so the same residuals
+        mu = self.friction if friction is None else friction
+        corners = self._matrix(rows, points & self.corners, mu)
+        out[free] = np.abs(least_residuals(corners, -self.load[rows])).reshape(-1, 6).max(axis=1)
         return out
 
     def falling(
