@@ -24,26 +24,25 @@ who judged the states by rigid-body simulation instead.
 * fixed parts (ground, fixture) and held parts take any wrench.
 
 A set of parts stands when non-negative generator weights balance every free part's
-weight (six equations per part). A first program asks whether the equations alone have
-a solution, on the corners of the contact polygons only: a vertex on the straight
-segment between its two neighbours adds nothing (every force it could carry is a
-combination of the same force at its neighbours, the contact's normal and friction
-directions being the same at all its vertices), so the answer is the same with a
-quarter fewer columns on the dome. It is solved in its Farkas form by Clarabel
-(:func:`balance`). When they have none, a second one, also on the corners, minimises the
-absolute residuals (slacks) of those equations, each scaled by the part's weight and
-the model's size: it is always feasible, and the parts left with a residual beyond the
-tolerance are those that cannot be in equilibrium (they would fall). Its optimum is
-not unique on a state that falls; the parts named are those left unbalanced by *some*
-least-residual balance, the support of the interior of its optimal face, to which
-Clarabel's interior point method converges (:func:`least_residuals`), so the set does
-not depend on a solver's pivots. A plan asks about states that differ by a block or a
-hold from one already decided: the balance last found at each friction coefficient
+weight (six equations per part). A first program asks whether the equations alone have a
+solution, on the corners of the contact polygons only: a vertex on the straight segment
+between its two neighbours adds nothing (every force it could carry is a combination of
+the same force at its neighbours, the contact's normal and friction directions being the
+same at all its vertices), so the answer is the same with a quarter fewer columns on the
+dome; a vertex repeated counts once (:func:`_corners`). It is solved in its Farkas form
+by Clarabel (:func:`balance`). When they have none, a second one, also on the corners,
+minimises the absolute residuals (slacks) of those equations, each scaled by the part's
+weight and the model's size: it is always feasible, and the parts left with a residual
+beyond the tolerance are those that cannot be in equilibrium (they would fall). Its
+optimum is not unique on a state that falls; the parts named are those left unbalanced
+by *some* least-residual balance, the support of the interior of its optimal face, to
+which Clarabel's interior point method converges (:func:`least_residuals`), so the set
+does not depend on a solver's pivots. A plan asks about states that differ by a block or
+a hold from one already decided: the balance last found at each friction coefficient
 answers many of them from a few parts' equations (:meth:`EquilibriumModel.stands`).
-Loads are homogeneous in
-rigid-block equilibrium (scaling gravity scales every force), so the margin reported is
-the least friction coefficient with which the state stands, found by bisection on the
-first program.
+Loads are homogeneous in rigid-block equilibrium (scaling gravity scales every force),
+so the margin reported is the least friction coefficient with which the state stands,
+found by bisection on the first program.
 """
 
 from __future__ import annotations
@@ -247,28 +246,43 @@ def contact_points(
 
 def _corners(polygons: Sequence[NDArray[np.float64]], resolution: float) -> NDArray[np.bool_]:
     """Which vertices of closed polygons (each in boundary order; their vertices one after
-    the other) are corners: not strictly between their two neighbours on the segment
-    joining them, within ``resolution`` (float64's: a vertex there is collinear up to
-    rounding). The forces of a vertex that is no corner are combinations of the same
-    forces at its neighbours: ``p = t a + (1 - t) b`` moves a force ``f`` to ``t f`` at
-    ``a`` and ``(1 - t) f`` at ``b`` with the same resultant and moment."""
+    the other) are corners. A vertex within ``resolution`` (float64's) of the one before
+    it in its ring is that vertex again, and no corner (one per ring stays); of the
+    others, those strictly between their two neighbours on the segment joining them are
+    no corners either. The forces of a vertex that is no corner are combinations of the
+    same forces at corners: ``p = t a + (1 - t) b`` moves a force ``f`` to ``t f`` at
+    ``a`` and ``(1 - t) f`` at ``b`` with the same resultant and moment, and a run of
+    vertices on one line ends at two corners, where the ring turns. Repeats go first:
+    two copies of a corner, each between the other and its far neighbour, would
+    otherwise both be dropped and the corner lost."""
     sizes = np.array([len(p) for p in polygons], dtype=np.int64)
     if not sizes.sum():
         return np.zeros(0, dtype=bool)
     polygon = np.vstack(polygons)
-    size = np.repeat(sizes, sizes)
+    ring = np.repeat(np.arange(len(sizes)), sizes)
     start = np.repeat(np.cumsum(sizes) - sizes, sizes)
     local = np.arange(len(polygon)) - start
-    before = polygon[start + (local - 1) % size]
-    after = polygon[start + (local + 1) % size]
+    previous = polygon[start + (local - 1) % sizes[ring]]
+    kept = np.linalg.norm(polygon - previous, axis=1) > resolution
+    # a ring that is one point repeated keeps its first vertex
+    kept |= (local == 0) & (np.bincount(ring, weights=kept, minlength=len(sizes)) == 0)[ring]
+    points, owner = polygon[kept], ring[kept]
+    count = np.bincount(owner, minlength=len(sizes))
+    first = np.cumsum(count) - count
+    size = count[owner]
+    order = np.arange(len(points)) - first[owner]
+    before = points[first[owner] + (order - 1) % size]
+    after = points[first[owner] + (order + 1) % size]
     chord = after - before
     length = np.linalg.norm(chord, axis=1)
-    offset = polygon - before
+    offset = points - before
     with np.errstate(divide="ignore", invalid="ignore"):
         distance = np.linalg.norm(np.cross(offset, chord), axis=1) / length
         along = np.sum(offset * chord, axis=1) / length**2
     between = (length > resolution) & (distance <= resolution) & (along > 0) & (along < 1)
-    return ~between | (size < 3)
+    out = np.zeros(len(polygon), dtype=bool)
+    out[kept] = ~between | (size < 3)
+    return out
 
 
 def _tangents(
