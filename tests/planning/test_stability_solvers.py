@@ -2,7 +2,9 @@
 solved by Clarabel (:func:`assemblykit.planning.stability.solvable`): on states of the
 COMPAS arch, stacked and corbelled blocks, a block on a slope and the cross vault, at
 several friction coefficients, its verdict must be that of HiGHS's interior point method
-(scipy's ``linprog``), the solver it replaced."""
+(scipy's ``linprog``), the solver it replaced, on every vertex of the contact polygons
+where the model keeps only the corners. The slack program and the verdicts a model
+draws from the last balance it found are checked here too."""
 
 from __future__ import annotations
 
@@ -30,14 +32,15 @@ FRICTIONS = (0.0, 0.1, 0.3, 0.5)
 def highs_stands(
     model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray, friction: float
 ) -> bool:
-    """The first program written out from the model's public arrays and solved by
-    HiGHS's interior point method."""
+    """The first program written out from the model's public arrays, on every vertex
+    (not only the corners the model keeps), and solved by HiGHS's interior point
+    method."""
     free = present & ~fixed
     if not free.any():
         return True
     rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
     points = present[model.point_parts[:, 0]] & present[model.point_parts[:, 1]]
-    selected = np.flatnonzero(points & model.corners)
+    selected = np.flatnonzero(points)
     if not len(selected):
         return False
     columns = (CONE_SIDES * selected[:, None] + np.arange(CONE_SIDES)).ravel()

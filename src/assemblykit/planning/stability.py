@@ -404,8 +404,10 @@ class EquilibriumModel:
     fixed: tuple[str, ...]
     friction: float
     threshold: float
-    _index: dict[str, int] = field(default_factory=dict, repr=False)
-    _balances: dict[float, NDArray[np.float64]] = field(default_factory=dict, repr=False)
+    _index: dict[str, int] = field(default_factory=dict, repr=False, init=False)
+    _balances: dict[float, NDArray[np.float64]] = field(
+        default_factory=dict, repr=False, init=False
+    )
     """Per friction coefficient, the generator weights of the last balance found
     (:meth:`stands`)."""
 
