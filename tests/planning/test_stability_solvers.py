@@ -8,6 +8,7 @@ draws from the last balance it found are checked here too."""
 
 from __future__ import annotations
 
+import clarabel
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -161,3 +162,28 @@ def test_local_verdicts_are_those_of_the_whole_program_on_a_vault_taken_down():
     assert ours == whole
     assert any(ours) and not all(ours)
     assert True in decided and False in decided
+
+
+def test_the_slack_program_falls_back_to_highs_when_clarabel_stops_short(monkeypatch):
+    matrix, rhs = sp.csc_matrix([[1.0], [2.0]]), np.array([1.0, 1.0])
+    interior = stability.least_residuals(matrix, rhs)
+    settings = clarabel.DefaultSettings
+
+    def one_iteration():
+        found = settings()
+        found.max_iter = 1
+        return found
+
+    calls = []
+
+    def recorded(*args, **kwargs):
+        calls.append(kwargs["method"])
+        return linprog(*args, **kwargs)
+
+    monkeypatch.setattr(clarabel, "DefaultSettings", one_iteration)
+    monkeypatch.setattr(stability, "linprog", recorded)
+    vertex = stability.least_residuals(matrix, rhs)
+    assert calls == ["highs-ipm"]
+    # by hand: |1 - x| + |1 - 2x| is least, 0.5, at x = 0.5: residuals (0.5, 0)
+    np.testing.assert_allclose(vertex, [0.5, 0.0], atol=1e-7)
+    np.testing.assert_allclose(interior, vertex, atol=1e-7)

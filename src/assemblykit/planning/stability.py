@@ -359,7 +359,8 @@ def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[
     the solver's pivots. Solved by Clarabel in dual form ("maximise ``rhs @ y`` with
     ``matrix.T @ y <= 0`` and ``-1 <= y <= 1``", the unknowns being the equations), whose
     multipliers are ``x`` and the two signs of ``r``. Should it stop short of an optimum,
-    :class:`NumericError`."""
+    HiGHS's interior point method with crossover answers (a vertex of that face), and
+    :class:`NumericError` if it fails too."""
     import clarabel
 
     rows, columns = matrix.shape
@@ -375,10 +376,20 @@ def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[
         [clarabel.NonnegativeConeT(columns + 2 * rows)],
         settings,
     ).solve()
-    if found.status not in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
-        raise NumericError(f"equilibrium slack program failed: {found.status}")
-    multipliers = np.asarray(found.z)
-    return multipliers[columns : columns + rows] - multipliers[columns + rows :]
+    if found.status in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
+        multipliers = np.asarray(found.z)
+        return multipliers[columns : columns + rows] - multipliers[columns + rows :]
+    result = linprog(
+        np.r_[np.zeros(columns), np.ones(2 * rows)],
+        A_eq=sp.hstack([matrix, eye, -eye], format="csc"),
+        b_eq=rhs,
+        bounds=(0, None),
+        method="highs-ipm",
+        options={"primal_feasibility_tolerance": LP_FEASIBILITY, "time_limit": LP_TIME_LIMIT},
+    )
+    if result.status != 0:
+        raise NumericError(f"equilibrium slack program failed: {result.message}")
+    return np.asarray(result.x[columns : columns + rows] - result.x[columns + rows :])
 
 
 @dataclass(frozen=True, eq=False)
