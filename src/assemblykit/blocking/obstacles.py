@@ -83,7 +83,8 @@ class Obstacles:
                 shift = np.zeros(3)
                 volume = shared_volume(self.solid(moving), self.solid(blocker))
                 if 0 < volume <= interference_threshold(a, b, tol):
-                    shifts = settle([a, b], [(0, 1)]).shifts
+                    pair = [self.solid(moving), self.solid(blocker)]
+                    shifts = settle([a, b], [(0, 1)], pair).shifts
                     if np.linalg.norm(shifts[0] - shifts[1]) > tol.length:
                         shift = shifts[0] - shifts[1]
                 self.backouts[key] = shift

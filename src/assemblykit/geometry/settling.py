@@ -76,11 +76,17 @@ def overlap_gradient(
     return volume, area_normals[owner == a_id].sum(axis=0)
 
 
-def settle(meshes: Sequence[trimesh.Trimesh], pairs: Sequence[tuple[int, int]]) -> Settlement:
+def settle(
+    meshes: Sequence[trimesh.Trimesh],
+    pairs: Sequence[tuple[int, int]],
+    solids: Sequence[manifold3d.Manifold] | None = None,
+) -> Settlement:
     """The least-norm translations of ``meshes`` after which the ``pairs`` (indices into
     ``meshes``) no longer share volume, as far as Gauss–Newton on the shared volumes
-    gets (module docstring). Pairs that share none stay out of the system."""
-    solids = [solid(mesh).as_original() for mesh in meshes]
+    gets (module docstring). Pairs that share none stay out of the system. ``solids``:
+    the meshes' manifold3d solids when already made."""
+    made = [solid(mesh) for mesh in meshes] if solids is None else solids
+    solids = [each.as_original() for each in made]
     ids = [s.original_id() for s in solids]
 
     def measure(x: NDArray[np.float64]) -> list[tuple[float, NDArray[np.float64]]]:
