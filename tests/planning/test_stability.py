@@ -19,6 +19,7 @@ from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import (
     CONE_SIDES,
     FRICTION_STEPS,
+    EquilibriumModel,
     Gravity,
     contact_points,
     equilibrium,
@@ -278,3 +279,26 @@ def test_the_cross_vault_stands_once_its_crown_joints_are_contacts():
     assert model.check().stands
     crown = {"5", "6", "7", "8", "9", "10", "11", "12", "13", "14"}
     assert model.fixed and not crown & set(model.fixed)
+
+
+def test_candidates_judged_without_holds_ask_no_slack_program(monkeypatch):
+    """With one hold (the grip alone) no hold is chosen, so the slack program runs only
+    to name the parts that would fall: at steps that do not stand, and to compare the
+    candidates of a step where none stands. Planning the arch on its fixed springers
+    runs it 62 times (every candidate that fell used to run it: 432 times), and the
+    plan is the same: its states re-checked, its falling steps named."""
+    calls = []
+    slack = EquilibriumModel.slack
+
+    def counted(self, *args, **kwargs):
+        calls.append(args)
+        return slack(self, *args, **kwargs)
+
+    monkeypatch.setattr(EquilibriumModel, "slack", counted)
+    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    data = plan(assembly, gravity=Gravity(fixed=("0", "29")), max_and_or_parts=0).to_dict()
+    assert data["feasible"] and not data["gravity"]["stable"]
+    falling = [step for step in data["steps"] if not step["stands"]]
+    assert falling and all(step["would_fall"] for step in falling)
+    assert all(not step["would_fall"] for step in data["steps"] if step["stands"])
+    assert len(falling) <= len(calls) <= 100

@@ -50,6 +50,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -759,10 +760,19 @@ class GravityReport:
 
 @dataclass(frozen=True)
 class _Assessment:
+    """A candidate step judged: its holds, its verdict, its two states (what remains and
+    what is taken, each with its immobile parts) and, asked for only when needed (a
+    slack program each), the parts that would fall without the holds."""
+
     held: NDArray[np.bool_]
-    falls: NDArray[np.bool_]
     stands: bool
     states: tuple[tuple[NDArray[np.bool_], NDArray[np.bool_]], ...]
+    falling: Callable[[], NDArray[np.bool_]]
+
+    @cached_property
+    def falls(self) -> NDArray[np.bool_]:
+        """The parts that would fall without the holds."""
+        return self.falling()
 
 
 class StateJudge:
@@ -816,21 +826,22 @@ class StateJudge:
 
     def _hold(
         self, present: NDArray[np.bool_], fixed: NDArray[np.bool_], budget: int
-    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_], bool]:
+    ) -> tuple[NDArray[np.bool_], bool]:
         """Hold the highest falling part of ``present`` while ``budget`` allows: the
-        holds, the parts falling without them and whether the state then stands (once
-        the last hold is taken, which parts still fall no longer matters: the first
-        program alone tells)."""
-        falls = self.falling(present, fixed)
+        holds and whether the state then stands (once the last hold is taken, or when
+        none may be, which parts still fall no longer matters: the first program alone
+        tells)."""
         held = np.zeros_like(present)
-        now = falls
+        if budget <= 0:
+            return held, self.stands(present, fixed)
+        now = self.falling(present, fixed)
         while now.any() and int(held.sum()) < budget:
             top = min(np.flatnonzero(now), key=lambda i: (self.model.heights[i], i))
             held[top] = True
             if int(held.sum()) == budget:
-                return held, falls, self.stands(present, fixed | held)
+                return held, self.stands(present, fixed | held)
             now = self.falling(present, fixed | held)
-        return held, falls, not now.any()
+        return held, not now.any()
 
     def _one(self, index: int) -> NDArray[np.bool_]:
         out = np.zeros(len(self.model.names), dtype=bool)
@@ -849,19 +860,22 @@ class StateJudge:
         grip = self._one(self.base(moved))
         base_held = rest & ground if not grounded else np.zeros_like(rest)
         budget = self.holds - 1 - int(base_held.sum())
-        held_rest, falls_rest, rest_ok = self._hold(rest, rest & ground, budget)
-        held_moved, falls_moved = np.zeros_like(rest), np.zeros_like(rest)
-        moved_ok = True
-        if int(taken.sum()) > 1:
-            held_moved, falls_moved, moved_ok = self._hold(
-                taken, grip, budget - int(held_rest.sum())
-            )
+        several = int(taken.sum()) > 1
+        held_rest, rest_ok = self._hold(rest, rest & ground, budget)
+        held_moved, moved_ok = np.zeros_like(rest), True
+        if several:
+            held_moved, moved_ok = self._hold(taken, grip, budget - int(held_rest.sum()))
         held = grip | base_held | held_rest | held_moved
+
+        def falling() -> NDArray[np.bool_]:
+            falls = self.falling(rest, rest & ground)
+            return falls | self.falling(taken, grip) if several else falls
+
         found = _Assessment(
             held=held,
-            falls=falls_rest | falls_moved,
             stands=rest_ok and moved_ok and int(held.sum()) <= self.holds,
             states=((rest, (rest & ground) | held_rest), (taken, grip | held_moved)),
+            falling=falling,
         )
         self._assessed[key] = found
         return found
