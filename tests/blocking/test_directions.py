@@ -3,6 +3,7 @@ on random tables and blocking terms."""
 
 from __future__ import annotations
 
+import networkx as nx
 import numpy as np
 import pytest
 
@@ -74,3 +75,31 @@ def test_term_slots_match_the_terms_one_at_a_time(sizes):
     order = [2, 0, 3, 1]
     found = term_slots(directions, [single[s] for s in order], order, 4, tol)
     np.testing.assert_array_equal(found, expected)
+
+
+def test_free_set_sizes_count_the_sink_components_but_the_kept_ones():
+    """Against networkx's condensation of each direction's DBG, on random tables with
+    repeated DBGs, on shrinking sets, and with no arc at all."""
+    rng = np.random.default_rng(3)
+    names = tuple(f"p{i}" for i in range(12))
+    shapes = [
+        [(i, j) for i in range(12) for j in range(12) if i != j and rng.random() < p]
+        for p in (0.0, 0.05, 0.1, 0.2, 0.4)
+    ]
+    arcs = [shapes[int(rng.integers(len(shapes)))] for _ in range(40)]
+    tab = table_from(names, rng.normal(size=(40, 3)), arcs)
+    members = (1 << 12) - 1
+    while members:
+        keep = int(rng.choice([i for i in range(12) if members >> i & 1]))
+        expected = []
+        for k in range(40):
+            condensed = nx.condensation(tab.graph(k, members))
+            sinks = [
+                condensed.nodes[c]["members"]
+                for c in condensed.nodes
+                if condensed.out_degree(c) == 0 and keep not in condensed.nodes[c]["members"]
+            ]
+            expected.append(sum(len(s) for s in sinks))
+        assert tab.free_set_sizes(members, keep).tolist() == expected
+        members &= ~(1 << keep)
+    assert table_from(names, np.eye(3), [[], [], []]).free_set_sizes(0b111, 0).tolist() == [2] * 3

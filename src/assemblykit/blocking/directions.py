@@ -19,6 +19,8 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from assemblykit.blocking.arrangement import snap_normals, sphere_arrangement
 from assemblykit.blocking.constraints import BlockingTerm
@@ -126,6 +128,35 @@ class DirectionTable:
             zip(self.moving[columns].tolist(), self.blocker[columns].tolist(), strict=True)
         )
         return graph
+
+    def free_set_sizes(self, members: int, keep: int) -> NDArray[np.int64]:
+        """Per direction, how many parts of ``members`` its free sets take away: the
+        parts of the sink strong components of its DBG induced on ``members`` (seed 004,
+        "Directional Blocking Graph"), but for the component holding part ``keep``.
+        Directions with the same DBG share one computation; strong components by
+        scipy's ``connected_components``."""
+        inside = self.vector(members)
+        nodes = np.flatnonzero(inside)
+        index = np.full(len(self.names), -1, dtype=np.int64)
+        index[nodes] = np.arange(len(nodes))
+        columns = self._active(members)
+        moving, blocker = index[self.moving[columns]], index[self.blocker[columns]]
+        patterns, which = np.unique(
+            np.packbits(self.slots[:, columns], axis=1), axis=0, return_inverse=True
+        )
+        out = np.zeros(len(self.directions), dtype=np.int64)
+        for row, pattern in enumerate(patterns):
+            arcs = np.unpackbits(pattern, count=len(columns)).astype(bool)
+            tails, heads = moving[arcs], blocker[arcs]
+            graph = coo_matrix(
+                (np.ones(len(tails)), (tails, heads)), shape=(len(nodes), len(nodes))
+            )
+            count, label = connected_components(graph, directed=True, connection="strong")
+            sink = np.ones(count, dtype=bool)
+            sink[label[tails][label[tails] != label[heads]]] = False
+            sink[label[index[keep]]] = False
+            out[np.ravel(which) == row] = np.count_nonzero(sink[label])
+        return out
 
     def incomplete(self, members: int) -> list[int]:
         """The directions along which some part of ``members`` does not block another:

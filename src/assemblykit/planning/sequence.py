@@ -473,12 +473,10 @@ def _group_bounds(
     translations: DirectionTable, members: int, volumes: Sequence[float]
 ) -> dict[int, int]:
     """Per candidate direction, how many parts the free sets of Γ_t (sink components,
-    the base's excluded) take out of ``members``: a bound for those of Γ_e."""
-    bounds = {
-        k: count_bits(union_of(_removal(_sinks(translations, k, members), members, volumes)))
-        for k in range(len(translations.directions))
-    }
-    return {k: v for k, v in bounds.items() if v}
+    the base's excluded: :func:`_removal`) take out of ``members``: a bound for those of
+    Γ_e."""
+    sizes = translations.free_set_sizes(members, base_part(members, volumes))
+    return {int(k): int(sizes[k]) for k in np.flatnonzero(sizes)}
 
 
 def _choose_removal(
