@@ -78,8 +78,9 @@ def test_term_slots_match_the_terms_one_at_a_time(sizes):
 
 
 def test_free_set_sizes_count_the_sink_components_but_the_kept_ones():
-    """Against networkx's condensation of each direction's DBG, on random tables with
-    repeated DBGs, on shrinking sets, and with no arc at all."""
+    """Against networkx's condensation of each direction's DBG (and its strong
+    connectivity for ``separating``), on random tables with repeated DBGs, on shrinking
+    sets, and with no arc at all."""
     rng = np.random.default_rng(3)
     names = tuple(f"p{i}" for i in range(12))
     shapes = [
@@ -101,5 +102,8 @@ def test_free_set_sizes_count_the_sink_components_but_the_kept_ones():
             ]
             expected.append(sum(len(s) for s in sinks))
         assert tab.free_set_sizes(members, keep).tolist() == expected
+        assert tab.separating(members).tolist() == [
+            not nx.is_strongly_connected(tab.graph(k, members)) for k in range(40)
+        ]
         members &= ~(1 << keep)
     assert table_from(names, np.eye(3), [[], [], []]).free_set_sizes(0b111, 0).tolist() == [2] * 3

@@ -13,7 +13,7 @@ directions. Sets of parts are Python integers, bit ``i`` for the ``i``-th part
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 
 import networkx as nx
@@ -129,12 +129,12 @@ class DirectionTable:
         )
         return graph
 
-    def free_set_sizes(self, members: int, keep: int) -> NDArray[np.int64]:
-        """Per direction, how many parts of ``members`` its free sets take away: the
-        parts of the sink strong components of its DBG induced on ``members`` (seed 004,
-        "Directional Blocking Graph"), but for the component holding part ``keep``.
-        Directions with the same DBG share one computation; strong components by
-        scipy's ``connected_components``."""
+    def _components(
+        self, members: int
+    ) -> Iterator[tuple[NDArray[np.bool_], NDArray[np.int64], NDArray[np.bool_]]]:
+        """Per distinct DBG induced on ``members``: the directions that have it, each
+        member's strong component (labels over ``members`` in bit order, by scipy's
+        ``connected_components``) and which components are sinks (no arc leaves them)."""
         inside = self.vector(members)
         nodes = np.flatnonzero(inside)
         index = np.full(len(self.names), -1, dtype=np.int64)
@@ -144,7 +144,7 @@ class DirectionTable:
         patterns, which = np.unique(
             np.packbits(self.slots[:, columns], axis=1), axis=0, return_inverse=True
         )
-        out = np.zeros(len(self.directions), dtype=np.int64)
+        which = np.ravel(which)
         for row, pattern in enumerate(patterns):
             arcs = np.unpackbits(pattern, count=len(columns)).astype(bool)
             tails, heads = moving[arcs], blocker[arcs]
@@ -154,8 +154,26 @@ class DirectionTable:
             count, label = connected_components(graph, directed=True, connection="strong")
             sink = np.ones(count, dtype=bool)
             sink[label[tails][label[tails] != label[heads]]] = False
-            sink[label[index[keep]]] = False
-            out[np.ravel(which) == row] = np.count_nonzero(sink[label])
+            yield which == row, label, sink
+
+    def free_set_sizes(self, members: int, keep: int) -> NDArray[np.int64]:
+        """Per direction, how many parts of ``members`` its free sets take away: the
+        parts of the sink strong components of its DBG induced on ``members`` (seed 004,
+        "Directional Blocking Graph"), but for the component holding part ``keep``.
+        Directions with the same DBG share one computation."""
+        place = count_bits(members & ((1 << keep) - 1))
+        out = np.zeros(len(self.directions), dtype=np.int64)
+        for directions, label, sink in self._components(members):
+            sink[label[place]] = False
+            out[directions] = np.count_nonzero(sink[label])
+        return out
+
+    def separating(self, members: int) -> NDArray[np.bool_]:
+        """Per direction, whether its DBG induced on ``members`` is not strongly
+        connected: some proper, non-empty part of ``members`` is free along it."""
+        out = np.zeros(len(self.directions), dtype=bool)
+        for directions, label, _ in self._components(members):
+            out[directions] = label.max(initial=0) > 0
         return out
 
     def incomplete(self, members: int) -> list[int]:

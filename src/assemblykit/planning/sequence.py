@@ -440,9 +440,7 @@ def separable(table: DirectionTable, members: int) -> bool:
         return False
     if table.free_parts(members).any():
         return True
-    return not all(
-        nx.is_strongly_connected(table.graph(k, members)) for k in range(len(table.directions))
-    )
+    return bool(table.separating(members).any())
 
 
 def _sinks(source: DirectionTable | ExtendedDirections, k: int, members: int) -> list[int]:
