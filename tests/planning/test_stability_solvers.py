@@ -1,5 +1,5 @@
 """The first equilibrium program (whether a state's equations alone have a solution) is
-solved by Clarabel (:func:`assemblykit.planning.stability.solvable`): on states of the
+solved by Clarabel (:func:`assemblykit.planning.stability.balance`): on states of the
 COMPAS arch, stacked and corbelled blocks, a block on a slope and the cross vault, at
 several friction coefficients, its verdict must be that of HiGHS's interior point method
 (scipy's ``linprog``), the solver it replaced, on every vertex of the contact polygons

@@ -345,11 +345,6 @@ def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float
     return np.asarray(result.x) if result.status == 0 else None
 
 
-def solvable(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> bool:
-    """Whether ``matrix @ x = rhs`` has a solution ``x >= 0`` (:func:`balance`)."""
-    return balance(matrix, rhs) is not None
-
-
 def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
     """The residual ``rhs - matrix @ x`` of the least-residual balance: the program
     "minimise ``|r|_1`` with ``matrix @ x + r = rhs``, ``x >= 0``", at the point of its
@@ -473,12 +468,12 @@ class EquilibriumModel:
         if not points.any():
             return False
         mu = self.friction if friction is None else friction
+        selected = points & self.corners
         if local and mu in self._balances:
-            verdict = self._local_verdict(present, free, points & self.corners, mu)
+            verdict = self._local_verdict(present, free, selected, mu)
             if verdict is not None:
                 return verdict
         rows = self._rows(free)
-        selected = points & self.corners
         found = balance(self._matrix(rows, selected, mu), -self.load[rows])
         if found is None:
             return False
