@@ -17,10 +17,13 @@ from scipy.optimize import linprog
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning import stability
+from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import (
     CONE_SIDES,
+    FRICTION_STEPS,
     LP_FEASIBILITY,
     EquilibriumModel,
+    Gravity,
     equilibrium_model,
 )
 from assemblykit.tolerance import Tolerance
@@ -187,3 +190,71 @@ def test_the_slack_program_falls_back_to_highs_when_clarabel_stops_short(monkeyp
     # by hand: |1 - x| + |1 - 2x| is least, 0.5, at x = 0.5: residuals (0.5, 0)
     np.testing.assert_allclose(vertex, [0.5, 0.0], atol=1e-7)
     np.testing.assert_allclose(interior, vertex, atol=1e-7)
+
+
+def bisected(model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray) -> float | None:
+    """The least friction coefficient by plain bisection, each state solved whole."""
+    if not model.stands(present, fixed, local=False):
+        return None
+    if model.stands(present, fixed, 0.0, local=False):
+        return 0.0
+    low, high = 0.0, model.friction
+    for _ in range(FRICTION_STEPS):
+        middle = (low + high) / 2
+        if model.stands(present, fixed, middle, local=False):
+            high = middle
+        else:
+            low = middle
+    return high
+
+
+def counting_programs(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """Count the first programs solved from now on (one entry each)."""
+    calls: list[int] = []
+    original = stability.balance
+
+    def counted(matrix, rhs):
+        calls.append(matrix.shape[0])
+        return original(matrix, rhs)
+
+    monkeypatch.setattr(stability, "balance", counted)
+    return calls
+
+
+def test_the_least_friction_searched_from_the_last_answer_is_the_bisections(monkeypatch):
+    # the states the arch's plan with three holds leaves standing, one after the other:
+    # the search that starts from the last answer finds what bisection finds, with
+    # fewer programs
+    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    result = plan(assembly, gravity=Gravity(holds=3))
+    ours, reference = equilibrium_model(assembly), equilibrium_model(assembly)
+    states = []
+    for step in result.steps:
+        present = ours.mask(step.rest)
+        states.append((present, present & (ours.mask(ours.fixed) | ours.mask(step.stability.held))))
+    expected = [bisected(reference, present, fixed) for present, fixed in states]
+    calls = counting_programs(monkeypatch)
+    found = [ours.friction_needed(present, fixed) for present, fixed in states]
+    assert found == expected
+    assert len(set(found)) > 4 and None not in found
+    assert len(calls) < sum(2 + FRICTION_STEPS for _ in states) / 2
+
+
+def test_a_balance_serves_larger_frictions_and_a_certificate_smaller_ones(monkeypatch):
+    tol = Tolerance.relative(5e-5)
+    assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
+    model = equilibrium_model(assembly, tol=tol)
+    present = model.mask(None)
+    fixed = present & model.mask(model.fixed)
+    calls = counting_programs(monkeypatch)
+    assert model.stands(present, fixed, 0.45)
+    assert model.stands(present, fixed, 0.5) and model.stands(present, fixed, 0.9)
+    assert len(calls) == 1
+    assert not model.stands(present, fixed, 0.3)
+    assert not model.stands(present, fixed, 0.2) and not model.stands(present, fixed, 0.0)
+    assert len(calls) == 2
+    # holding the highest block spoils the certificate: the state is solved again
+    held = fixed | model.mask([model.names[int(np.argmin(model.heights))]])
+    verdict = model.stands(present, held, 0.3)
+    assert len(calls) > 2
+    assert verdict == model.stands(present, held, 0.3, local=False)

@@ -37,12 +37,13 @@ beyond the tolerance are those that cannot be in equilibrium (they would fall). 
 optimum is not unique on a state that falls; the parts named are those left unbalanced
 by *some* least-residual balance, the support of the interior of its optimal face, to
 which Clarabel's interior point method converges (:func:`least_residuals`), so the set
-does not depend on a solver's pivots. A plan asks about states that differ by a block or
-a hold from one already decided: the balance last found at each friction coefficient
-answers many of them from a few parts' equations (:meth:`EquilibriumModel.stands`).
-Loads are homogeneous in rigid-block equilibrium (scaling gravity scales every force),
-so the margin reported is the least friction coefficient with which the state stands,
-found by bisection on the first program.
+does not depend on a solver's pivots. A plan asks about states that differ by a block,
+a hold or the friction coefficient from one already decided: the balances and Farkas
+certificates found before answer many of them with no program, or from a few parts'
+equations (:meth:`EquilibriumModel.stands`). Loads are homogeneous in rigid-block
+equilibrium (scaling gravity scales every force), so the margin reported is the least
+friction coefficient with which the state stands, to a resolution of ``mu / 32``
+(:meth:`EquilibriumModel.friction_needed`).
 """
 
 from __future__ import annotations
@@ -88,6 +89,17 @@ benchmarks/bench_stability.py)."""
 LOCAL_HOPS = 3
 """How many contacts :meth:`EquilibriumModel.stands` grows the region of unbalanced
 parts by, one at a time, before it leaves the verdict to the whole program."""
+
+KEPT = 8
+"""How many balances an :class:`EquilibriumModel` keeps (the most recently useful
+first) to decide later states without a program: a balance rarely outlives the state it
+was found for (removing a block unbalances its neighbours), but decides the friction
+coefficients above the one it was found at."""
+
+KEPT_CERTIFICATES = 32
+"""How many Farkas certificates an :class:`EquilibriumModel` keeps (the most recently
+useful first): a certificate outlives many states (what falls at one step still falls
+at the next, unless its parts are taken or held)."""
 
 DOWN = (0.0, 0.0, -1.0)
 
@@ -301,19 +313,34 @@ def _tangents(
     return u, np.cross(normals, u)
 
 
-def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float64] | None:
-    """A solution ``x >= 0`` of ``matrix @ x = rhs``, or ``None`` when there is none. By
-    Farkas' lemma there is none exactly when some ``y`` has ``matrix.T @ y >= 0`` and
-    ``rhs @ y < 0``, so the program "minimise ``rhs @ y`` subject to ``matrix.T @ y >=
-    0``" has the optimum 0 when there is a solution and is unbounded otherwise; its
-    multipliers are then a solution. It is solved by Clarabel's interior point method
-    (Goulart and Chen 2024, "Clarabel: an interior-point solver for conic programs with
-    quadratic objectives": a sparse direct factorisation per iteration; 0.6 s on the
-    527-block dome where HiGHS's interior point method needs 25 s), which proves
-    unboundedness by a certificate; its unknowns are the equations (6 per part), not the
-    generators. Should it stop short of either answer (iterations, numerical trouble,
-    :data:`LP_TIME_LIMIT`), HiGHS's interior point method decides, within
-    :data:`LP_FEASIBILITY`."""
+@dataclass(frozen=True, eq=False)
+class Balance:
+    """The first program's answer: ``forces``, a solution ``x >= 0`` of ``matrix @ x =
+    rhs``, or when there is none ``certificate``, a ``y`` with ``matrix.T @ y >= 0`` and
+    ``rhs @ y < 0`` (Farkas' lemma; ``None`` when the solver that answered gave none)."""
+
+    forces: NDArray[np.float64] | None
+    certificate: NDArray[np.float64] | None = None
+
+    @property
+    def found(self) -> bool:
+        """Whether there is a balance."""
+        return self.forces is not None
+
+
+def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> Balance:
+    """Whether some ``x >= 0`` solves ``matrix @ x = rhs``. By Farkas' lemma there is none
+    exactly when some ``y`` has ``matrix.T @ y >= 0`` and ``rhs @ y < 0``, so the program
+    "minimise ``rhs @ y`` subject to ``matrix.T @ y >= 0``" has the optimum 0 when there
+    is a solution and is unbounded otherwise; its multipliers are then a solution, and
+    its ray of unboundedness the certificate ``y``. It is solved by Clarabel's interior
+    point method (Goulart and Chen 2024, "Clarabel: an interior-point solver for conic
+    programs with quadratic objectives": a sparse direct factorisation per iteration;
+    0.6 s on the 527-block dome where HiGHS's interior point method needs 25 s), which
+    proves unboundedness by that ray; its unknowns are the equations (6 per part), not
+    the generators. Should it stop short of either answer (iterations, numerical
+    trouble, :data:`LP_TIME_LIMIT`), HiGHS's interior point method decides, within
+    :data:`LP_FEASIBILITY` (with no certificate)."""
     import clarabel
 
     rows, columns = matrix.shape
@@ -329,9 +356,9 @@ def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float
         settings,
     ).solve()
     if found.status == clarabel.SolverStatus.Solved:
-        return np.maximum(np.asarray(found.z), 0.0)
+        return Balance(np.maximum(np.asarray(found.z), 0.0))
     if found.status == clarabel.SolverStatus.DualInfeasible:
-        return None
+        return Balance(None, np.asarray(found.x, dtype=np.float64))
     result = linprog(
         np.zeros(columns),
         A_eq=matrix,
@@ -342,7 +369,7 @@ def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float
     )
     if result.status not in (0, 2):
         raise NumericError(f"equilibrium program failed: {result.message}")
-    return np.asarray(result.x) if result.status == 0 else None
+    return Balance(np.asarray(result.x) if result.status == 0 else None)
 
 
 def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -388,6 +415,34 @@ def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[
     return np.asarray(result.x[columns : columns + rows] - result.x[columns + rows :])
 
 
+def _cone_directions() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The cosines and sines of the friction pyramid's generator angles."""
+    angles = 2 * np.pi * np.arange(CONE_SIDES) / CONE_SIDES
+    return np.cos(angles), np.sin(angles)
+
+
+def _per_point(weights: NDArray[np.float64], points: int) -> sp.csr_matrix:
+    """The matrix (``points * CONE_SIDES`` x ``points``) that sums each point's
+    generator columns with ``weights``, one per generator."""
+    rows = np.arange(points * CONE_SIDES)
+    return sp.csr_matrix(
+        (np.tile(weights, points), (rows, rows // CONE_SIDES)),
+        shape=(points * CONE_SIDES, points),
+    )
+
+
+def _gauge(tangent: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Per point, the least multiple of the unit pyramid's section (the polygon of the
+    generators' tangent directions) that holds the tangential force ``tangent`` (P x 2,
+    in ``u`` and ``v``): its largest projection on a side's outward normal over that
+    side's distance ``cos(pi / CONE_SIDES)`` from the axis. A force whose normal part is
+    ``N`` is inside the pyramid of ``mu`` when its gauge is at most ``mu N``."""
+    cos, sin = _cone_directions()
+    half = np.pi / CONE_SIDES
+    sides = np.stack([np.cos(np.arctan2(sin, cos) + half), np.sin(np.arctan2(sin, cos) + half)])
+    return (tangent @ sides).max(axis=1) / math.cos(half)
+
+
 @dataclass(frozen=True, eq=False)
 class EquilibriumModel:
     """The equilibrium equations of every part of an assembly, assembled once.
@@ -412,11 +467,22 @@ class EquilibriumModel:
     friction: float
     threshold: float
     _index: dict[str, int] = field(default_factory=dict, repr=False, init=False)
-    _balances: dict[float, NDArray[np.float64]] = field(
-        default_factory=dict, repr=False, init=False
+    _balances: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = field(
+        default_factory=list, repr=False, init=False
     )
-    """Per friction coefficient, the generator weights of the last balance found
+    """Balances found (at most :data:`KEPT`, the most recently useful first), each as the
+    force at every point (normal, ``u`` and ``v`` parts: P x 3) with the pyramid gauge of
+    its tangential part (P: ``mu`` times the normal part must reach it), so that one
+    balance serves every friction coefficient it fits (:meth:`stands`)."""
+    _certificates: list[tuple[NDArray[np.int64], NDArray[np.float64]]] = field(
+        default_factory=list, repr=False, init=False
+    )
+    """Farkas certificates found (at most :data:`KEPT_CERTIFICATES`, the most recently
+    useful first), each as the equations it weighs and its ``y`` on them
     (:meth:`stands`)."""
+    _needed: list[int] = field(default_factory=list, repr=False, init=False)
+    """The last answer of :meth:`friction_needed`, in steps of its resolution, where its
+    next search starts (none yet: at ``friction``)."""
 
     def __post_init__(self) -> None:
         self._index.update({name: i for i, name in enumerate(self.names)})
@@ -450,6 +516,34 @@ class EquilibriumModel:
         part = self.normal_part[rows][:, columns] + mu * self.tangent_part[rows][:, columns]
         return sp.csc_matrix(part)
 
+    @cached_property
+    def _point_wrenches(self) -> tuple[sp.csr_matrix, sp.csr_matrix, sp.csr_matrix]:
+        """The scaled wrenches (6 rows per part) of a unit force at each point along its
+        normal, ``u`` and ``v`` (three P-column matrices): generator ``s`` is the normal
+        one plus ``mu (cos t u + sin t v)``, and the ``CONE_SIDES`` angles ``t`` are
+        spread evenly, so the tangent columns are recovered as their weighted means."""
+        cos, sin = _cone_directions()
+        spread = 2.0 / CONE_SIDES
+        points = self.normal_part.shape[1] // CONE_SIDES
+        return (
+            sp.csr_matrix(self.normal_part[:, ::CONE_SIDES]),
+            sp.csr_matrix(self.tangent_part @ _per_point(spread * cos, points)),
+            sp.csr_matrix(self.tangent_part @ _per_point(spread * sin, points)),
+        )
+
+    def _keep_balance(self, weights: NDArray[np.float64], mu: float) -> None:
+        """Keep the balance of generator weights ``weights`` at ``mu`` as forces."""
+        cos, sin = _cone_directions()
+        per_point = weights.reshape(-1, CONE_SIDES)
+        forces = np.stack([per_point.sum(axis=1), mu * per_point @ cos, mu * per_point @ sin], 1)
+        self._balances.insert(0, (forces, _gauge(forces[:, 1:])))
+        del self._balances[KEPT:]
+
+    def _keep_certificate(self, rows: NDArray[np.int64], certificate: NDArray[np.float64]) -> None:
+        """Keep a Farkas certificate over the equations ``rows`` (zero on the others)."""
+        self._certificates.insert(0, (rows, certificate))
+        del self._certificates[KEPT_CERTIFICATES:]
+
     def stands(
         self,
         present: NDArray[np.bool_],
@@ -459,7 +553,7 @@ class EquilibriumModel:
     ) -> bool:
         """Whether the equations of ``present`` alone have a solution with ``fixed``
         immobile: the first program, on the corners (:func:`balance`). With ``local``,
-        the balance last found at this friction decides first where it can
+        the balances and certificates found before decide first where they can
         (:meth:`_local_verdict`); its verdicts are the whole program's."""
         free = present & ~fixed
         if not free.any():
@@ -469,18 +563,53 @@ class EquilibriumModel:
             return False
         mu = self.friction if friction is None else friction
         selected = points & self.corners
-        if local and mu in self._balances:
+        if local:
             verdict = self._local_verdict(present, free, selected, mu)
             if verdict is not None:
                 return verdict
         rows = self._rows(free)
         found = balance(self._matrix(rows, selected, mu), -self.load[rows])
-        if found is None:
+        if found.forces is None:
+            if found.certificate is not None:
+                self._keep_certificate(rows, found.certificate)
             return False
-        forces = np.zeros(self.normal_part.shape[1])
-        forces[self._columns(selected)] = found
-        self._balances[mu] = forces
+        weights = np.zeros(self.normal_part.shape[1])
+        weights[self._columns(selected)] = found.forces
+        self._keep_balance(weights, mu)
         return True
+
+    def _unbalanced(
+        self, forces: NDArray[np.float64], free: NDArray[np.bool_]
+    ) -> NDArray[np.bool_]:
+        """The ``free`` parts whose equations the point ``forces`` (P x 3) leave with a
+        residual beyond :data:`LP_FEASIBILITY`."""
+        normal, along_u, along_v = self._point_wrenches
+        wrench = normal @ forces[:, 0] + along_u @ forces[:, 1] + along_v @ forces[:, 2]
+        error = np.abs(-self.load - wrench).reshape(-1, 6).max(axis=1)
+        return free & (error > LP_FEASIBILITY)
+
+    def _certifies(
+        self,
+        certificate: tuple[NDArray[np.int64], NDArray[np.float64]],
+        free: NDArray[np.bool_],
+        selected: NDArray[np.bool_],
+        mu: float,
+    ) -> bool:
+        """Whether ``certificate`` (equations and their ``y``), restricted to the equations
+        of the ``free`` parts, proves that they have no balance over the ``selected``
+        points at ``mu``: no generator gains from it (``matrix.T @ y >= 0``, to
+        :data:`LP_FEASIBILITY` of the loads' share) while the loads do (``rhs @ y <
+        0``). A part removed takes its generators away and a part held its equations:
+        either can spoil it, which the test sees."""
+        rows, y = certificate
+        y = y * free[rows // 6]
+        share = float(-self.load[rows] @ y)
+        if share >= 0:
+            return False
+        gain = self.normal_part[rows].T @ y + mu * (self.tangent_part[rows].T @ y)
+        return bool(
+            gain[np.repeat(selected, CONE_SIDES)].min(initial=0.0) >= LP_FEASIBILITY * share
+        )
 
     def _local_verdict(
         self,
@@ -489,23 +618,46 @@ class EquilibriumModel:
         selected: NDArray[np.bool_],
         mu: float,
     ) -> bool | None:
-        """The verdict of :meth:`stands` where the balance last found at ``mu`` decides
-        it (``None`` where it does not): *stands* when that balance, without the forces
-        on parts absent from this state, still balances every free part; *falls* when
-        the parts it leaves unbalanced, grown by contacts (:data:`LOCAL_HOPS`), cannot
-        balance even with every part around them immobile (pushing on them however it
-        must): a Farkas certificate on their equations alone is one for the whole state.
+        """The verdict of :meth:`stands` where what was found before decides it (``None``
+        where it does not):
+
+        * *stands* when a balance kept, without the forces on parts absent from this
+          state, still balances every free part with forces that ``mu``'s pyramids
+          hold (a balance at one friction coefficient is one at every larger one);
+        * *falls* when a certificate kept still proves it (:meth:`_certifies`), or when
+          the parts the last balance leaves unbalanced, or pushes on with more friction
+          than ``mu`` allows, grown by contacts (:data:`LOCAL_HOPS`), cannot balance
+          even with every part around them immobile (pushing on them however it must):
+          a Farkas certificate on their equations alone is one for the whole state,
+          and is kept.
+
         Removing a block leaves its neighbours to be proved, a dozen parts, where the
         whole program has all of them; a region holding more than half the free parts
         is left to the whole program."""
-        forces = self._balances[mu] * np.repeat(selected, CONE_SIDES)
-        wrench = self.normal_part @ forces + mu * (self.tangent_part @ forces)
-        error = np.abs(-self.load - wrench).reshape(-1, 6).max(axis=1)
-        region = free & (error > LP_FEASIBILITY)
-        if not region.any():
-            self._balances[mu] = forces
-            return True
+        for index, (forces, gauge) in enumerate(self._balances):
+            if np.any((gauge - mu * forces[:, 0])[selected] > LP_FEASIBILITY):
+                continue
+            kept = forces * selected[:, None]
+            if not self._unbalanced(kept, free).any():
+                del self._balances[index]
+                self._balances.insert(0, (kept, gauge * selected))
+                return True
+        for index, certificate in enumerate(self._certificates):
+            if self._certifies(certificate, free, selected, mu):
+                self._certificates.insert(0, self._certificates.pop(index))
+                return False
+        if not self._balances:
+            return None
+        forces, gauge = self._balances[0]
+        forces = forces * selected[:, None]
+        region = self._unbalanced(forces, free)
         ends = self.point_parts
+        # and the parts on both sides of the points whose forces mu's pyramids do not hold
+        slipping = selected & (gauge - mu * forces[:, 0] > LP_FEASIBILITY)
+        region[ends[slipping].ravel()] = True
+        region &= free
+        if not region.any():
+            return None
         for _ in range(LOCAL_HOPS):
             near = np.zeros_like(region)
             near[ends[selected & region[ends[:, 0]], 1]] = True
@@ -515,7 +667,10 @@ class EquilibriumModel:
                 return None
             rows = self._rows(region)
             touching = selected & (region[ends[:, 0]] | region[ends[:, 1]])
-            if balance(self._matrix(rows, touching, mu), -self.load[rows]) is None:
+            found = balance(self._matrix(rows, touching, mu), -self.load[rows])
+            if not found.found:
+                if found.certificate is not None:
+                    self._keep_certificate(rows, found.certificate)
                 return False
         return None
 
@@ -583,21 +738,44 @@ class EquilibriumModel:
         falls: NDArray[np.bool_] | None = None,
     ) -> float | None:
         """The least friction coefficient, within ``friction / 2**FRICTION_STEPS`` (the
-        upper end of the bisection: one with which the state is shown to stand), with
+        upper end of a bisection: one with which the state is shown to stand), with
         which ``present`` stands; ``None`` when ``friction`` itself does not suffice.
-        ``falls``: :meth:`falling` at ``friction``, when already known."""
+        ``falls``: :meth:`falling` at ``friction``, when already known.
+
+        Standing is monotone in the friction coefficient (a larger pyramid holds every
+        force a smaller one does), so the answer is the least multiple ``k`` of the
+        resolution at which the state stands (0 when it stands without friction), what
+        bisection over ``[0, friction]`` finds. The search starts from the answer last
+        found: consecutive states of a plan mostly need the same friction, which two
+        programs then confirm; else it gallops away from it, then bisects."""
         if (self.falling(present, fixed) if falls is None else falls).any():
             return None
-        if self.stands(present, fixed, 0.0):
-            return 0.0
-        low, high = 0.0, self.friction
-        for _ in range(FRICTION_STEPS):
-            middle = (low + high) / 2
-            if self.stands(present, fixed, middle):
+        grid = 2**FRICTION_STEPS
+        step = self.friction / grid
+
+        def stands(k: int) -> bool:
+            return k == grid or self.stands(present, fixed, k * step)
+
+        guess = self._needed[0] if self._needed else grid
+        reach = 1
+        if stands(guess):
+            high, low = guess, guess - 1
+            while low >= 0 and stands(low):
+                high, reach = low, 2 * reach
+                low = max(high - reach, -1)
+        else:
+            low, high = guess, min(guess + 1, grid)
+            while not stands(high):
+                low, reach = high, 2 * reach
+                high = min(low + reach, grid)
+        while high - low > 1:
+            middle = (low + high) // 2
+            if stands(middle):
                 high = middle
             else:
                 low = middle
-        return high
+        self._needed[:] = [high]
+        return high * step
 
 
 def equilibrium_model(
