@@ -10,7 +10,7 @@ import pytest
 import trimesh
 
 from assemblykit.blocking import tables
-from assemblykit.blocking.directions import DirectionTable, local_table
+from assemblykit.blocking.directions import DirectionTable, local_table, mask_of, several
 from assemblykit.blocking.extended import extended_dbg, extended_free
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.blocking.tables import translation_table
@@ -21,7 +21,11 @@ from assemblykit.planning.sequence import (
     ExtendedDirections,
     Plan,
     Search,
+    _free_closures,
+    _removal,
+    _sinks,
     and_or_graph,
+    base_part,
     minimal_interlocked,
     separable,
 )
@@ -413,3 +417,38 @@ def test_plan_blocking_and_motion_agree_that_the_ball_joint_ball_lifts_out():
     assert reading.can_lift_off and min(r[2] for r in reading.lift_off) > 0.97
     volumes, touching = swept_overlaps(asm, "ball", first.direction, DISTANCES)
     assert np.all(volumes <= touching)
+
+
+@pytest.mark.parametrize(
+    ("path", "directions"),
+    [(DEMO, None), (dataset("compas_assembly/crossvault_assembly.json"), 4)],
+)
+def test_groups_found_from_infinitesimal_sinks_are_the_extended_dbgs_sinks(path, directions):
+    # the minimal sets free in Γ_t and Γ_e that leave the base, found as closures of
+    # Γ_t's sink components, are the sink components of the union of the whole DBGs,
+    # along candidate directions (all, or some at random) of the whole assembly and of
+    # random subassemblies; some are groups
+    assembly = load_assembly(path)
+    tol = assembly.tolerance()
+    translations = translation_table(assembly, tol)
+    volumes = tuple(assembly.parts[n].volume for n in assembly.names)
+    rng = np.random.default_rng(5)
+    count = len(assembly.names)
+    subsets = [np.flatnonzero(rng.random(count) < 0.7).tolist() for _ in range(5)]
+    groups = 0
+    for kept in [list(range(count)), *subsets]:
+        members = mask_of(kept)
+        base = base_part(members, volumes)
+        extended = ExtendedDirections(assembly, translations.directions, tol)
+        chosen = rng.permutation(len(translations.directions))[:directions]
+        for k in chosen.tolist():
+            union = DirectionTable.from_arcs(
+                translations.names,
+                translations.directions[[k]],
+                [list(translations.graph(k, members).edges) + extended.arcs(k, members)],
+            )
+            whole = sorted(_removal(_sinks(union, 0, members), members, volumes))
+            fresh = ExtendedDirections(assembly, translations.directions, tol)
+            assert _free_closures(translations, fresh, k, members, base) == whole
+            groups += sum(several(s) for s in whole)
+    assert groups

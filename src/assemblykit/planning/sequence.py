@@ -67,6 +67,12 @@ Narrow = Callable[[int, int, list[int]], list[int]]
 """``narrow(members, k, sets)``: the free sets (bit masks) of direction ``k`` to move."""
 LOOK_AHEAD = 12
 """Candidate directions still examined after the first removal Γ_e accepts."""
+GROUP_REJECTIONS = 16
+"""Candidate directions whose groups a narrower may reject (none of them stands under
+gravity) before the search for groups stops, and the next narrower is asked (under
+gravity: the removal leaving the fewest parts falling). A large vault, where no single
+block may go, has more than ten thousand candidate directions, each with its groups to
+close under extended blocking."""
 MotionKind = Literal["translation", "rigid"]
 
 
@@ -454,6 +460,34 @@ def _sinks(source: DirectionTable | ExtendedDirections, k: int, members: int) ->
     ]
 
 
+def _free_closures(
+    translations: DirectionTable, extended: ExtendedDirections, k: int, members: int, base: int
+) -> list[int]:
+    """The minimal sets of ``members`` that leave ``base`` behind along direction ``k``
+    with no arc of Γ_t (necessary) or Γ_e (sufficient) leaving them: the sink
+    components of the union of the two DBGs, found from Γ_t's sinks without Γ_e's whole
+    DBG. Such a set is closed in Γ_t, so it holds a sink component of Γ_t; the sink
+    component of the union holding it is that sink's closure under both graphs' arcs
+    (everything its parts' blockers, and theirs, reach), and the sinks of the union are
+    the least of these closures. A closure stops as soon as it reaches the base, so only
+    the Γ_e blockers of parts in the sets found, and of those on the way to the base,
+    are computed. (Γ_t's arcs are Γ_e's but where a direction grazes a contact, within
+    the tolerances: there the part stays, as a single part Γ_t holds does.)"""
+    necessary = translations.masks(k)
+    closures = set()
+    for start in _sinks(translations, k, members):
+        closed = frontier = start
+        while frontier and not closed >> base & 1:
+            blocked = 0
+            for i, mask in extended.blockers(k, frontier, members).items():
+                blocked |= mask | necessary[i] & members
+            frontier = blocked & ~closed
+            closed |= frontier
+        if not closed >> base & 1:
+            closures.add(closed)
+    return sorted(s for s in closures if not any(o != s and o & s == o for o in closures))
+
+
 def base_part(members: int, volumes: Sequence[float]) -> int:
     """The heaviest part of ``members``: it stays, everything else leaves it."""
     return max(bits(members), key=lambda i: (volumes[i], -i))
@@ -489,12 +523,15 @@ def _choose_removal(
 
     Single parts first: where Γ_t lets single parts leave (counted for all directions at
     once), only those parts are tested against Γ_e. When none leaves alone, the sink
-    components of Γ_e, so that groups that must leave together can. ``narrow(members,
-    k, sets)``, when given, picks among the free sets of direction ``k`` those to move
-    (one at a time, or only removals that leave stable states).
+    components of Γ_e (and Γ_t: :func:`_free_closures`), so that groups that must
+    leave together can. ``narrow(members, k, sets)``, when given, picks among the free
+    sets of direction ``k`` those to move (one at a time, or only removals that leave
+    stable states); once it has rejected the groups of :data:`GROUP_REJECTIONS`
+    directions, no more groups are tried.
     """
     free = translations.free_bits(members, members & ~(1 << base_part(members, volumes)))
     counts = np.bitwise_count(free).sum(axis=1, dtype=np.int64)
+    rejected = [0]
 
     def chosen(k: int, sets: list[int]) -> list[int]:
         return sets if narrow is None or not sets else narrow(members, k, sets)
@@ -504,7 +541,18 @@ def _choose_removal(
         return chosen(k, [1 << i for i, mask in held.items() if not mask])
 
     def groups(k: int) -> list[int]:
-        return chosen(k, _removal(_sinks(extended, k, members), members, volumes))
+        if rejected[0] >= GROUP_REJECTIONS:
+            return []
+        found = closures(k)
+        kept = chosen(k, found)
+        rejected[0] += bool(found) and not kept
+        return kept
+
+    def closures(k: int) -> list[int]:
+        if isinstance(extended, ExtendedDirections):
+            base = base_part(members, volumes)
+            return _free_closures(translations, extended, k, members, base)
+        return _removal(_sinks(extended, k, members), members, volumes)
 
     choice = None
     if counts.any():
