@@ -18,9 +18,11 @@ from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import (
+    GROUP_REJECTIONS,
     ExtendedDirections,
     Plan,
     Search,
+    _choose_removal,
     _free_closures,
     _removal,
     _sinks,
@@ -452,3 +454,22 @@ def test_groups_found_from_infinitesimal_sinks_are_the_extended_dbgs_sinks(path,
             assert _free_closures(translations, fresh, k, members, base) == whole
             groups += sum(several(s) for s in whole)
     assert groups
+
+
+def test_a_narrower_is_asked_about_the_groups_of_at_most_sixteen_directions():
+    # along each of 40 directions a and b block each other and may leave the heavy c
+    # together; a narrower that rejects every set (no removal stands) is asked about
+    # the groups of 16 directions, then no more groups are tried
+    angles = np.linspace(0.0, 1.0, 40)
+    tab = table("abc", {(float(np.cos(t)), float(np.sin(t)), 0.0): "ab ba" for t in angles})
+    asked = []
+
+    def reject(members: int, k: int, sets: list[int]) -> list[int]:
+        asked.append(sets)
+        return []
+
+    assert _choose_removal(tab, tab, 0b111, (1.0, 1.0, 9.0), None, reject) is None
+    assert asked == [[0b011]] * GROUP_REJECTIONS
+    assert GROUP_REJECTIONS == 16
+    # without a narrower the pair leaves
+    assert _choose_removal(tab, tab, 0b111, (1.0, 1.0, 9.0), None) == (0, [0b011])
