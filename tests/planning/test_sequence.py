@@ -473,3 +473,21 @@ def test_a_narrower_is_asked_about_the_groups_of_at_most_sixteen_directions():
     assert GROUP_REJECTIONS == 16
     # without a narrower the pair leaves
     assert _choose_removal(tab, tab, 0b111, (1.0, 1.0, 9.0), None) == (0, [0b011])
+
+
+def test_a_narrower_is_not_asked_along_directions_that_cannot_win():
+    # a, b and c may leave the heavy x along a diagonal, a and b along +x and along a
+    # steeper diagonal; a narrower picks one part, so after +x (the axis) no direction
+    # freeing one part can beat it and the steeper diagonal is not asked about
+    tab = table(
+        "abcx",
+        {(0.6, 0.8, 0.0): "", (1.0, 0.0, 0.0): "cx", (0.0, 0.8, 0.6): "cx"},
+    )
+    asked = []
+
+    def first(members: int, k: int, sets: list[int]) -> list[int]:
+        asked.append(k)
+        return sets[:1]
+
+    assert _choose_removal(tab, tab, 0b1111, (1.0, 1.0, 1.0, 9.0), None, first) == (1, [0b0001])
+    assert asked == [0, 1]

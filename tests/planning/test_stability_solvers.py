@@ -258,3 +258,23 @@ def test_a_balance_serves_larger_frictions_and_a_certificate_smaller_ones(monkey
     verdict = model.stands(present, held, 0.3)
     assert len(calls) > 2
     assert verdict == model.stands(present, held, 0.3, local=False)
+
+
+def test_a_state_is_solved_first_at_the_friction_the_last_one_needed(monkeypatch):
+    # the cross vault, then the vault without block 4 (the first its plan under gravity
+    # takes): asked at the model's friction, the second state is solved first at the
+    # friction the whole vault needed, and the balance found there answers both
+    tol = Tolerance.relative(5e-5)
+    assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
+    model = equilibrium_model(assembly, tol=tol)
+    whole = model.mask(None)
+    fixed = whole & model.mask(model.fixed)
+    need = model.friction_needed(whole, fixed)
+    assert need is not None and 0 < need < model.friction
+    rest = whole & ~model.mask(["4"])
+    calls = counting_programs(monkeypatch)
+    assert model.stands(rest, fixed)
+    assert model.stands(rest, fixed, need)
+    # one program over every free part (those over a few parts tried to prove a fall)
+    assert calls.count(6 * int((rest & ~fixed).sum())) == 1
+    assert model.stands(rest, fixed, need, local=False)

@@ -558,7 +558,10 @@ def _choose_removal(
     if counts.any():
         candidates = np.flatnonzero(counts)
         bounds = dict(zip(candidates.tolist(), counts[candidates].tolist(), strict=True))
-        choice = _best_direction(translations, bounds, singles, previous)
+        # a narrower picks one set: one single part
+        choice = _best_direction(
+            translations, bounds, singles, previous, None if narrow is None else 1
+        )
     if choice is None:
         bounds = _group_bounds(translations, members, volumes)
         choice = _best_direction(translations, bounds, groups, previous)
@@ -570,13 +573,17 @@ def _best_direction(
     bounds: dict[int, int],
     removal: Callable[[int], list[int]],
     previous: int | None,
+    most: int | None = None,
 ) -> tuple[int, list[int]] | None:
     """The candidate whose ``removal`` moves most, with its free sets.
 
     The previous step's direction is tried first and kept if it frees anything. Other
     candidates are visited best bound first (most parts, closest to a coordinate axis,
     then +z); the search stops when a bound cannot beat the best removal accepted, or
-    ``LOOK_AHEAD`` candidates after the first one accepted.
+    ``LOOK_AHEAD`` candidates after the first one accepted. When a removal moves
+    ``most`` parts at most (a single part, where one set is picked), a candidate that
+    could not beat the best one even so is passed over without asking ``removal``, as
+    it would be after asking.
     """
     if previous in bounds:
         sinks = removal(previous)
@@ -599,6 +606,8 @@ def _best_direction(
             if rank(k, bounds[k]) <= best[0] or patience == 0:
                 break
             patience -= 1
+            if most is not None and rank(k, min(bounds[k], most)) <= best[0]:
+                continue
         sinks = removal(k)
         if sinks and (best is None or rank(k, count_bits(union_of(sinks))) > best[0]):
             best = (rank(k, count_bits(union_of(sinks))), k, sinks)

@@ -567,6 +567,11 @@ class EquilibriumModel:
             verdict = self._local_verdict(present, free, selected, mu)
             if verdict is not None:
                 return verdict
+            # the states of a plan mostly need the friction the last one needed, and a
+            # balance found there is one here too, of use to the friction's search
+            hint = self._needed[0] * self.friction / 2**FRICTION_STEPS if self._needed else mu
+            if hint < mu and self.stands(present, fixed, hint):
+                return True
         rows = self._rows(free)
         found = balance(self._matrix(rows, selected, mu), -self.load[rows])
         if found.forces is None:
