@@ -600,7 +600,7 @@ def _strip_candidates(
     The circles of sets of at least three edges (three rulings determine a circle) are
     fitted all at once, by the normal equations of the least squares on the vertices
     centred per set; those of two edges, or whose normal equations are ill-conditioned,
-    one by one (:func:`_strip_candidate`)."""
+    one by one (:func:`_circle_fit`, by an orthogonal factorisation)."""
     if not len(label):
         return []
     _, first, cls, size = np.unique(
@@ -630,8 +630,11 @@ def _strip_candidates(
     solution = np.linalg.solve(gram, moment[:, :, None])[:, :, 0]
     centre = mean + solution[:, :2]
     radius = np.sqrt(np.maximum(solution[:, 2] + (solution[:, :2] ** 2).sum(axis=1), 0.0))
+    alone = ~determined & (size >= MIN_CURVED_FACES - 1)
+    for k in np.flatnonzero(alone).tolist():
+        centre[k], radius[k] = _circle_fit(xy[pc == k])
     miss = np.abs(np.linalg.norm(xy - centre[pc], axis=1) - radius[pc])
-    fits = determined & (np.maximum.reduceat(miss, heads) <= tol.length)
+    fits = (determined | alone) & (np.maximum.reduceat(miss, heads) <= tol.length)
     # the faces of the coplanar groups of each fitting set's edges, ascending per set
     sides = np.concatenate([adjacency[:, 0], adjacency[:, 1]])
     keep = np.tile(fits[cls], 2)
@@ -646,43 +649,7 @@ def _strip_candidates(
     off = np.abs(np.linalg.norm(planar - centre[fc][:, None], axis=2) - radius[fc][:, None])
     on = off.max(axis=1) <= tol.length
     found = np.split(near[on], np.searchsorted(fc[on], np.arange(1, len(size))))
-    candidates: list[NDArray[np.int64]] = []
-    for k, members in enumerate(_classes(label)):
-        if fits[k]:
-            candidates.append(found[k])
-        elif not determined[k] and size[k] >= MIN_CURVED_FACES - 1:
-            strip = _strip_candidate(vertices, faces, seg, tol, adjacency, edges, axes, members)
-            if strip is not None:
-                candidates.append(strip)
-    return candidates
-
-
-def _strip_candidate(
-    vertices: NDArray[np.float64],
-    faces: NDArray[np.int64],
-    seg: Segmentation,
-    tol: Tolerance,
-    adjacency: NDArray[np.int64],
-    edges: NDArray[np.int64],
-    axes: NDArray[np.float64],
-    members: NDArray[np.int64],
-) -> NDArray[np.int64] | None:
-    """:func:`_strip_candidates` for the one set of edges ``members``, by the least
-    squares circle (:func:`_circle_fit`): ``None`` when their vertices lie on none."""
-    turns = axes[members]
-    axis = (turns * np.sign(turns @ turns[0])[:, None]).mean(axis=0)
-    axis /= np.linalg.norm(axis)
-    points = vertices[np.unique(edges[members])]
-    plane = np.array(axis_basis(axis))
-    centre, radius = _circle_fit(points @ plane.T)
-    if np.abs(np.linalg.norm(points @ plane.T - centre, axis=1) - radius).max() > tol.length:
-        return None
-    near = np.sort(
-        np.concatenate([seg.faces_of(g) for g in np.unique(seg.group[adjacency[members]])])
-    )
-    corners = vertices[faces[near]] @ plane.T - centre
-    on = np.abs(np.linalg.norm(corners, axis=2) - radius).max(axis=1) <= tol.length
-    return near[on]
+    return [found[k] for k in np.flatnonzero(fits).tolist()]
 
 
 def _sphere_fits(
@@ -802,12 +769,6 @@ def _cross_norms(u: NDArray[np.float64], rows: NDArray[np.float64]) -> NDArray[n
     computes them, without its overhead on a few rows)."""
     (a, b, c), (x, y, z) = u, rows.T
     return np.sqrt((b * z - c * y) ** 2 + (c * x - a * z) ** 2 + (a * y - b * x) ** 2)
-
-
-def _classes(label: NDArray[np.int64]) -> list[NDArray[np.int64]]:
-    """The indices of each label, one array per distinct label."""
-    order = np.argsort(label, kind="stable")
-    return np.split(order, np.flatnonzero(np.diff(label[order])) + 1)
 
 
 def _widths(
