@@ -240,12 +240,17 @@ def test_the_least_friction_searched_from_the_last_answer_is_the_bisections(monk
     assert len(calls) < sum(2 + FRICTION_STEPS for _ in states) / 2
 
 
-def test_a_balance_serves_larger_frictions_and_a_certificate_smaller_ones(monkeypatch):
-    tol = Tolerance.relative(5e-5)
+def standing_vault() -> tuple[EquilibriumModel, np.ndarray, np.ndarray]:
+    """The cross vault's model with its crown joints as contacts (it stands), the mask
+    of all its parts and that of its fixed ones."""
     assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
-    model = equilibrium_model(assembly, tol=tol)
+    model = equilibrium_model(assembly, tol=Tolerance.relative(5e-5))
     present = model.mask(None)
-    fixed = present & model.mask(model.fixed)
+    return model, present, present & model.mask(model.fixed)
+
+
+def test_a_balance_serves_larger_frictions_and_a_certificate_smaller_ones(monkeypatch):
+    model, present, fixed = standing_vault()
     calls = counting_programs(monkeypatch)
     assert model.stands(present, fixed, 0.45)
     assert model.stands(present, fixed, 0.5) and model.stands(present, fixed, 0.9)
@@ -264,11 +269,7 @@ def test_a_state_is_solved_first_at_the_friction_the_last_one_needed(monkeypatch
     # the cross vault, then the vault without block 4 (the first its plan under gravity
     # takes): asked at the model's friction, the second state is solved first at the
     # friction the whole vault needed, and the balance found there answers both
-    tol = Tolerance.relative(5e-5)
-    assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
-    model = equilibrium_model(assembly, tol=tol)
-    whole = model.mask(None)
-    fixed = whole & model.mask(model.fixed)
+    model, whole, fixed = standing_vault()
     need = model.friction_needed(whole, fixed)
     assert need is not None and 0 < need < model.friction
     rest = whole & ~model.mask(["4"])
