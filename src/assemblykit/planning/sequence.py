@@ -529,9 +529,10 @@ def _choose_removal(
     stable states); once it has rejected the groups of :data:`GROUP_REJECTIONS`
     directions, no more groups are tried.
     """
-    free = translations.free_bits(members, members & ~(1 << base_part(members, volumes)))
+    base = base_part(members, volumes)
+    free = translations.free_bits(members, members & ~(1 << base))
     counts = np.bitwise_count(free).sum(axis=1, dtype=np.int64)
-    rejected = [0]
+    rejected = 0
 
     def chosen(k: int, sets: list[int]) -> list[int]:
         return sets if narrow is None or not sets else narrow(members, k, sets)
@@ -541,18 +542,16 @@ def _choose_removal(
         return chosen(k, [1 << i for i, mask in held.items() if not mask])
 
     def groups(k: int) -> list[int]:
-        if rejected[0] >= GROUP_REJECTIONS:
+        nonlocal rejected
+        if rejected >= GROUP_REJECTIONS:
             return []
-        found = closures(k)
-        kept = chosen(k, found)
-        rejected[0] += bool(found) and not kept
-        return kept
-
-    def closures(k: int) -> list[int]:
         if isinstance(extended, ExtendedDirections):
-            base = base_part(members, volumes)
-            return _free_closures(translations, extended, k, members, base)
-        return _removal(_sinks(extended, k, members), members, volumes)
+            found = _free_closures(translations, extended, k, members, base)
+        else:
+            found = _removal(_sinks(extended, k, members), members, volumes)
+        kept = chosen(k, found)
+        rejected += bool(found) and not kept
+        return kept
 
     choice = None
     if counts.any():

@@ -415,9 +415,10 @@ def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[
     return np.asarray(result.x[columns : columns + rows] - result.x[columns + rows :])
 
 
-def _cone_directions() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The cosines and sines of the friction pyramid's generator angles."""
-    angles = 2 * np.pi * np.arange(CONE_SIDES) / CONE_SIDES
+def _cone_directions(turn: float = 0.0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The cosines and sines of the friction pyramid's generator angles (turned by
+    ``turn``: by half a side, its sides' outward normals)."""
+    angles = 2 * np.pi * np.arange(CONE_SIDES) / CONE_SIDES + turn
     return np.cos(angles), np.sin(angles)
 
 
@@ -437,10 +438,8 @@ def _gauge(tangent: NDArray[np.float64]) -> NDArray[np.float64]:
     in ``u`` and ``v``): its largest projection on a side's outward normal over that
     side's distance ``cos(pi / CONE_SIDES)`` from the axis. A force whose normal part is
     ``N`` is inside the pyramid of ``mu`` when its gauge is at most ``mu N``."""
-    cos, sin = _cone_directions()
     half = np.pi / CONE_SIDES
-    sides = np.stack([np.cos(np.arctan2(sin, cos) + half), np.sin(np.arctan2(sin, cos) + half)])
-    return (tangent @ sides).max(axis=1) / math.cos(half)
+    return (tangent @ np.stack(_cone_directions(half))).max(axis=1) / math.cos(half)
 
 
 @dataclass(frozen=True, eq=False)
@@ -486,6 +485,11 @@ class EquilibriumModel:
 
     def __post_init__(self) -> None:
         self._index.update({name: i for i, name in enumerate(self.names)})
+
+    @property
+    def resolution(self) -> float:
+        """The step of :meth:`friction_needed`'s answers: ``friction / 2**FRICTION_STEPS``."""
+        return self.friction / 2**FRICTION_STEPS
 
     def mask(self, names: Iterable[str] | None) -> NDArray[np.bool_]:
         """``names`` (default: all parts) as a boolean vector over :attr:`names`."""
@@ -569,7 +573,7 @@ class EquilibriumModel:
                 return verdict
             # the states of a plan mostly need the friction the last one needed, and a
             # balance found there is one here too, of use to the friction's search
-            hint = self._needed[0] * self.friction / 2**FRICTION_STEPS if self._needed else mu
+            hint = self._needed[0] * self.resolution if self._needed else mu
             if hint < mu and self.stands(present, fixed, hint):
                 return True
         rows = self._rows(free)
@@ -756,10 +760,9 @@ class EquilibriumModel:
         if (self.falling(present, fixed) if falls is None else falls).any():
             return None
         grid = 2**FRICTION_STEPS
-        step = self.friction / grid
 
         def stands(k: int) -> bool:
-            return k == grid or self.stands(present, fixed, k * step)
+            return k == grid or self.stands(present, fixed, k * self.resolution)
 
         guess = self._needed[0] if self._needed else grid
         reach = 1
@@ -780,7 +783,7 @@ class EquilibriumModel:
             else:
                 low = middle
         self._needed[:] = [high]
-        return high * step
+        return high * self.resolution
 
 
 def equilibrium_model(
@@ -810,12 +813,11 @@ def equilibrium_model(
     scale = assembly.scale
     found = contact_points(assembly, down, tol)
 
-    angles = 2 * np.pi * np.arange(CONE_SIDES) / CONE_SIDES
+    cos, sin = _cone_directions()
     # per point and generator: the force's normal and tangential parts (P x S x 3)
     normal_force = np.repeat(found.normals[:, None, :], CONE_SIDES, axis=1)
     tangent_force = (
-        np.cos(angles)[None, :, None] * found.u[:, None, :]
-        + np.sin(angles)[None, :, None] * found.v[:, None, :]
+        cos[None, :, None] * found.u[:, None, :] + sin[None, :, None] * found.v[:, None, :]
     )
     arm = (found.points - origin) / scale
     ends = np.stack([found.second, found.first], axis=1)
