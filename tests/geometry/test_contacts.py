@@ -11,7 +11,13 @@ import pytest
 import shapely
 import trimesh
 
-from assemblykit.geometry.contacts import assembly_contacts, candidate_pairs, find_contacts
+from assemblykit.geometry.contacts import (
+    assembly_contacts,
+    assembly_surfaces,
+    candidate_pairs,
+    find_contacts,
+    near_curved_surfaces,
+)
 from assemblykit.io.compas import load_compas
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance
@@ -109,6 +115,42 @@ def test_shaft_in_a_hole_from_meshes_is_a_cylindrical_contact():
     assert abs(curved.axis @ [0, 0, 1]) == pytest.approx(1.0, abs=1e-9)
     assert curved.extent[1] - curved.extent[0] == pytest.approx(2.0, abs=1e-6)
     assert found[0].planar == ()
+
+
+def _ringed_shaft(radius: float, length: float, rings: int) -> trimesh.Trimesh:
+    """A closed shaft along z centred on the origin, its side cut into ``rings`` rings."""
+    z = np.linspace(-length / 2, length / 2, rings + 1)
+    side = np.column_stack([np.full_like(z, radius), z])
+    profile = np.vstack([[0.0, -length / 2], side, [0.0, length / 2]])
+    return trimesh.creation.revolve(profile, sections=48)
+
+
+def test_a_long_shaft_is_recognised_only_where_the_plate_around_it_reaches():
+    """A shaft 20 long in rings of 0.5 through a plate 2 thick: the curved surface that
+    contacts need is the shaft's cylinder on the rings reaching the plate's box (z in
+    [-1.5, 1.5]: 6 of 40 rings), and the contact is the same whole turn of height 2;
+    a collar touching the shaft elsewhere changes nothing of the plate's contact."""
+    shaft = _ringed_shaft(1.0, 20.0, 40)
+    cutter = trimesh.creation.cylinder(radius=1.0, height=30.0, sections=48)
+    plate = box([-3, -3, -1], [3, 3, 1]).difference(cutter, engine="manifold")
+    pair = assembly(plate=plate, shaft=shaft)
+    (near,) = near_curved_surfaces(pair, "shaft", "plate")
+    (whole,) = (s for s in assembly_surfaces(pair, "shaft") if s.kind != "plane")
+    assert (near.kind, whole.kind) == ("cylinder", "cylinder")
+    assert near.radius == pytest.approx(1.0, abs=1e-12)
+    assert len(near.faces) == len(whole.faces) * 6 // 40
+    assert set(near.faces.tolist()) < set(whole.faces.tolist())
+    heights = shaft.triangles[near.faces][:, :, 2]
+    assert (heights.min(), heights.max()) == pytest.approx((-1.5, 1.5), abs=1e-12)
+    (found,) = find_contacts(pair)
+    (curved,) = found.curved
+    assert curved.kind == "cylindrical" and curved.inner == "shaft"
+    assert curved.extent[1] - curved.extent[0] == pytest.approx(2.0, abs=1e-6)
+
+    collar = box([-2, -2, 5], [2, 2, 6]).difference(cutter, engine="manifold")
+    found_with_collar = find_contacts(assembly(plate=plate, shaft=shaft, collar=collar))
+    assert [c.pair for c in found_with_collar] == [("plate", "shaft"), ("shaft", "collar")]
+    assert repr(found_with_collar[0]) == repr(found)
 
 
 def _reference(path: Path) -> dict[frozenset[str], float]:

@@ -13,8 +13,11 @@ over all candidate pairs at once, the coplanar groups of facets
 groups of the other that lie in the same plane with the opposite normal, and their
 overlap is measured by shapely in that plane. Curved contacts are coaxial cylinders
 and cones and concentric spheres of equal size, one convex and one concave, read from
-the parts' exact or recognised surfaces; each keeps only the part of the surface of
-revolution both parts cover, as the normals there (:mod:`assemblykit.geometry.curved`).
+the parts' exact surfaces, or recognised on each part's triangles within reach of the
+other's box (:func:`near_curved_surfaces`: per pair, so a pair's contacts depend on its
+two parts alone); each keeps only the part of the surface of revolution both parts
+cover, as the normals there (:mod:`assemblykit.geometry.curved`). A coplanar group with
+a face on such a surface is a facet of it, not a planar face, and makes no planar patch.
 
 What is found is kept with the assembly: :func:`assembly_contacts` (contacts per
 tolerance) and :func:`assembly_surfaces` (surfaces per part and tolerance) fill a
@@ -59,7 +62,6 @@ from assemblykit.geometry.curved import (
 )
 from assemblykit.geometry.recognition import (
     Segmentation,
-    faces_on,
     recognise_curved,
     recognise_planes,
     segment,
@@ -589,40 +591,47 @@ def find_contacts(
         tol.length,
         None if only is None else names.index(only),
     )
-    parts_in_pairs = np.unique(pairs)
     curved_part = np.zeros(len(names), dtype=bool)
     curved_part[stack.part[np.isin(seg.region, np.flatnonzero(seg.curved))]] = True
-    surfaces: dict[int, tuple[Surface, ...]] = {}
-    excluded = np.zeros(len(stack.faces), dtype=bool)
-    for k in parts_in_pairs:
-        part = assembly.parts[names[k]]
-        if part.surfaces or curved_part[k]:
-            curved_surfaces = assembly_curved_surfaces(assembly, names[k], tol)
-            surfaces[int(k)] = curved_surfaces
-            start = stack.face_start[k]
-            excluded[start : start + len(part.mesh.faces)] = faces_on(
-                curved_surfaces, len(part.mesh.faces)
-            )
+    # per ordered pair (k, other): the curved surfaces of part k where it may touch other
+    surfaces: dict[tuple[int, int], tuple[Surface, ...]] = {}
+    for a, b in pairs.tolist():
+        for k, other in ((a, b), (b, a)):
+            if assembly.parts[names[k]].surfaces or curved_part[k]:
+                surfaces[k, other] = near_curved_surfaces(assembly, names[k], names[other], tol)
 
     group_part = stack.part[seg.order[seg.start[:-1]]]
-    usable = seg.flat & (np.bincount(seg.group, weights=excluded, minlength=len(seg.flat)) == 0)
-    g, h = _planar_matches(stack, seg, group_part, usable, part_lo, part_hi, pairs, tol)
+    g, h = _planar_matches(stack, seg, group_part, seg.flat, part_lo, part_hi, pairs, tol)
+    # a coplanar group with a face on a curved surface of its part (where that part may
+    # touch the other) is a facet of that surface, not a planar face
+    on_curved = [
+        (k * len(names) + other) * len(seg.flat) + seg.group[stack.face_start[k] + s.faces]
+        for (k, other), found in surfaces.items()
+        for s in found
+    ]
+    if on_curved:
+        keys = np.unique(np.concatenate(on_curved))
+        pg, ph = group_part[g], group_part[h]
+        facet = np.isin((pg * len(names) + ph) * len(seg.flat) + g, keys) | np.isin(
+            (ph * len(names) + pg) * len(seg.flat) + h, keys
+        )
+        g, h = g[~facet], h[~facet]
     k, patches = _planar_patches(stack, seg, g, h, tol)
     planar: dict[tuple[int, int], list[PlanarPatch]] = {}
     for m, flat in zip(k, patches, strict=True):
         planar.setdefault((int(group_part[g[m]]), int(group_part[h[m]])), []).append(flat)
 
     triangles = {
-        k: [_surface_triangles(assembly, names[k], s) for s in found]
-        for k, found in surfaces.items()
+        key: [_surface_triangles(assembly, names[key[0]], s) for s in found]
+        for key, found in surfaces.items()
     }
     curved: dict[tuple[int, int], list[CurvedPatch]] = {}
-    for a, b in pairs:
-        for sa, ta in zip(surfaces.get(int(a), ()), triangles.get(int(a), ()), strict=True):
-            for sb, tb in zip(surfaces.get(int(b), ()), triangles.get(int(b), ()), strict=True):
+    for a, b in pairs.tolist():
+        for sa, ta in zip(surfaces.get((a, b), ()), triangles.get((a, b), ()), strict=True):
+            for sb, tb in zip(surfaces.get((b, a), ()), triangles.get((b, a), ()), strict=True):
                 patch = curved_contact(sa, sb, (names[a], names[b]), (ta, tb), tol)
                 if patch is not None:
-                    curved.setdefault((int(a), int(b)), []).append(patch)
+                    curved.setdefault((a, b), []).append(patch)
 
     found = [
         Contact(names[a], names[b], tuple(planar.get(key, ())), tuple(curved.get(key, ())))
@@ -637,12 +646,14 @@ def find_contacts(
 class GeometryMemo:
     """What the geometry of an assembly's parts gave, kept in its ``memo`` slot (module
     docstring): ``contacts`` per tolerance, with the names of the parts they cover,
-    ``surfaces`` per part name and tolerance, and the ``curved`` ones among them (all
-    that contacts ask for: recognised first, without the planes)."""
+    ``surfaces`` per part name and tolerance, the ``curved`` ones among them (recognised
+    first, without the planes), and the curved surfaces ``near`` per part, other part
+    and tolerance (those contacts ask for: :func:`near_curved_surfaces`)."""
 
     contacts: dict[Tolerance, tuple[frozenset[str], list[Contact]]] = field(default_factory=dict)
     surfaces: dict[tuple[str, Tolerance], tuple[Surface, ...]] = field(default_factory=dict)
     curved: dict[tuple[str, Tolerance], tuple[Surface, ...]] = field(default_factory=dict)
+    near: dict[tuple[str, str, Tolerance], tuple[Surface, ...]] = field(default_factory=dict)
 
     def restricted(self, names: Set[str]) -> GeometryMemo:
         """What still holds for the parts ``names`` alone: the contacts among them and
@@ -654,6 +665,7 @@ class GeometryMemo:
             },
             {key: found for key, found in self.surfaces.items() if key[0] in names},
             {key: found for key, found in self.curved.items() if key[0] in names},
+            {key: found for key, found in self.near.items() if {key[0], key[1]} <= names},
         )
 
 
@@ -694,6 +706,34 @@ def assembly_curved_surfaces(
     memo = memo_of(assembly).curved
     if key not in memo:
         memo[key] = recognise_curved(part.mesh, key[1])
+    return memo[key]
+
+
+def near_curved_surfaces(
+    assembly: Assembly, name: str, other: str, tol: Tolerance | None = None
+) -> tuple[Surface, ...]:
+    """The curved surfaces of part ``name`` where it may touch part ``other``: all of its
+    exact CAD surfaces other than planes, else those recognised
+    (:func:`~assemblykit.geometry.recognition.recognise_curved`) on its triangles whose
+    bounding boxes meet ``other``'s, inflated by the length tolerance (every triangle
+    within the tolerance of ``other`` is among them), once per pair and tolerance.
+
+    So a pair's contacts depend on its two parts alone, and recognition costs what the
+    region where they meet holds rather than the whole part: on the ASAP beam, a
+    beam's end on its post is a quarter of its triangles."""
+    part = assembly.part(name)
+    if part.surfaces:
+        return tuple(s for s in part.surfaces if s.kind != "plane")
+    key = (name, other, assembly.tolerance(tol))
+    memo = memo_of(assembly).near
+    if key not in memo:
+        margin = key[2].length
+        lo, hi = assembly.part(other).mesh.bounds
+        triangles = np.asarray(part.mesh.triangles, dtype=np.float64)
+        reach = np.all(
+            (triangles.max(axis=1) >= lo - margin) & (triangles.min(axis=1) <= hi + margin), axis=1
+        )
+        memo[key] = recognise_curved(part.mesh, key[2], np.flatnonzero(reach))
     return memo[key]
 
 

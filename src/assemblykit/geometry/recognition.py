@@ -51,7 +51,7 @@ Method on meshes (all thresholds from the tolerance policy):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -465,12 +465,29 @@ def recognise(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surf
     return curved + recognise_planes(mesh, curved, tol)
 
 
-def recognise_curved(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surface, ...]:
+def recognise_curved(
+    mesh: trimesh.Trimesh,
+    tol: Tolerance | None = None,
+    within: NDArray[np.int64] | None = None,
+) -> tuple[Surface, ...]:
     """The cylinders, cones and spheres of ``mesh`` (method steps 1-4 on the strict
-    groups): all that contacts need, the planes being the coplanar groups they match."""
+    groups): all that contacts need, the planes being the coplanar groups they match.
+    ``within``: the ids of the only triangles to look at (numbered in the mesh, as the
+    surfaces' faces are): the surfaces of that region alone."""
     tol = tol or current()
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
+    if within is not None:
+        return tuple(
+            replace(s, faces=within[s.faces]) for s in _curved(vertices, faces[within], tol)
+        )
+    return _curved(vertices, faces, tol)
+
+
+def _curved(
+    vertices: NDArray[np.float64], faces: NDArray[np.int64], tol: Tolerance
+) -> tuple[Surface, ...]:
+    """The curved surfaces of the triangles ``faces`` (:func:`recognise_curved`)."""
     seg = segment(vertices, faces, tol, strict=True)
     candidates = np.flatnonzero(seg.curved)
     curved = curved_surfaces(vertices, faces, seg, tol, candidates)
