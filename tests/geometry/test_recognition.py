@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 import trimesh
 
 from assemblykit.features.primitives import Ball, Cone, Hole, Plane, Shaft, Socket
+from assemblykit.geometry import recognition
 from assemblykit.geometry.contacts import assembly_surfaces
 from assemblykit.geometry.recognition import recognise, segment
 from assemblykit.tolerance import Tolerance
@@ -124,6 +127,33 @@ def test_asap_beam_fillets_are_found():
     for s in cylinders + spheres:
         assert s.radius == pytest.approx(0.0762, abs=2e-3)
         assert s.convex
+
+
+def test_groups_regrouped_after_a_bent_one_are_measured_as_if_all_were_measured_again(
+    monkeypatch: pytest.MonkeyPatch,
+):
+    """On the ASAP beam's first part, 672 triangles sit in groups that are not flat and
+    fall back to their strict groups; only those are measured again, and every group's
+    plane, point, area, bounds, order and deviation equal measuring all groups anew."""
+    from assemblykit.io.assembly import load_assembly
+
+    bent_counts = []
+    regrouped = recognition._regrouped
+
+    def spy(*args: Any) -> Any:
+        bent_counts.append(int(args[-1].sum()))
+        return regrouped(*args)
+
+    monkeypatch.setattr(recognition, "_regrouped", spy)
+    beam = load_assembly(dataset("asap_beam_assembly"))
+    mesh = beam["0"].mesh
+    vertices, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    seg = segment(vertices, faces, beam.tolerance())
+    assert bent_counts == [672]
+    again = recognition._group_planes(vertices[faces], seg.normals, seg.areas, seg.group)
+    names = ("normal", "point", "area", "lo", "hi", "order", "start", "deviation")
+    for name, value in zip(names, again, strict=True):
+        np.testing.assert_array_equal(getattr(seg, name), value, err_msg=name)
 
 
 def _sliver_and_triangle(lift: float) -> tuple[np.ndarray, np.ndarray]:

@@ -729,9 +729,11 @@ def near_curved_surfaces(
     if key not in memo:
         margin = key[2].length
         lo, hi = assembly.part(other).mesh.bounds
-        triangles = np.asarray(part.mesh.triangles, dtype=np.float64)
+        first, second, third = np.asarray(part.mesh.triangles, dtype=np.float64).transpose(1, 0, 2)
         reach = np.all(
-            (triangles.max(axis=1) >= lo - margin) & (triangles.min(axis=1) <= hi + margin), axis=1
+            (np.maximum(np.maximum(first, second), third) >= lo - margin)
+            & (np.minimum(np.minimum(first, second), third) <= hi + margin),
+            axis=1,
         )
         memo[key] = recognise_curved(part.mesh, key[2], np.flatnonzero(reach))
     return memo[key]

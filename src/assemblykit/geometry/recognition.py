@@ -169,8 +169,9 @@ def segment(
         # join them: where a group is not flat, its faces keep their strict groups
         bent = planes[-1][group] > tol.length
         strict_group = _components(n_faces, adjacency[both])
+        kept = np.unique(group[~bent])
         group = np.unique(np.where(bent, strict_group + n_faces, group), return_inverse=True)[1]
-        planes = _group_planes(corners, normals, areas, group.astype(np.int64))
+        planes = _regrouped(planes, kept, corners, normals, areas, group.astype(np.int64), bent)
     normal, point, area, lo, hi, order, start, deviation = planes
     flat = deviation <= tol.length
     return Segmentation(
@@ -217,6 +218,27 @@ def _group_planes(
     hi = np.maximum.reduceat(high, heads) if n_groups else np.zeros((0, 3))
     offsets = np.abs(np.einsum("fkj,fj->fk", corners - point[group][:, None], normal[group]))
     deviation = np.maximum.reduceat(offsets.max(axis=1)[order], heads) if n_groups else area
+    return normal, point, area, lo, hi, order, start, deviation
+
+
+def _regrouped(
+    planes: tuple[NDArray[Any], ...],
+    kept: NDArray[np.int64],
+    corners: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    areas: NDArray[np.float64],
+    group: NDArray[np.int64],
+    bent: NDArray[np.bool_],
+) -> tuple[NDArray[Any], ...]:
+    """:func:`_group_planes` of the triangles regrouped as ``group``: the groups ``kept``
+    of ``planes`` (numbered first, in their order) are the same, and only the ``bent``
+    triangles' new groups are measured (each group's sums run over its own triangles in
+    row order, so the values are those of measuring every group again)."""
+    new = _group_planes(corners[bent], normals[bent], areas[bent], group[bent] - len(kept))
+    per_group = [np.concatenate([old[kept], fresh]) for old, fresh in zip(planes, new, strict=True)]
+    normal, point, area, lo, hi, _, _, deviation = per_group
+    order = np.argsort(group, kind="stable")
+    start = np.searchsorted(group[order], np.arange(len(area) + 1))
     return normal, point, area, lo, hi, order, start, deviation
 
 
