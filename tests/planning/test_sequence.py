@@ -20,6 +20,7 @@ from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import (
     GROUP_REJECTIONS,
     ExtendedDirections,
+    FirstAdmitted,
     Plan,
     Search,
     _choose_removal,
@@ -491,3 +492,28 @@ def test_a_narrower_is_not_asked_along_directions_that_cannot_win():
 
     assert _choose_removal(tab, tab, 0b1111, (1.0, 1.0, 1.0, 9.0), None, first) == (1, [0b0001])
     assert asked == [0, 1]
+
+
+def test_parts_a_narrower_already_rejected_get_no_extended_blocking():
+    # a and b may leave the heavy c along +x, a and d along +y; the narrower rejects a
+    # and b (their removal would not stand) and admits d: along +y only d is tested
+    # against extended blocking, and d leaves
+    tab = table("abdc", {(1.0, 0.0, 0.0): "dc", (0.0, 1.0, 0.0): "bc"})
+    tested: list[int] = []
+
+    class Spy:
+        def blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
+            tested.append(movers)
+            return tab.blockers(k, movers, among)
+
+    judged: dict[int, bool] = {}
+
+    def admits(members: int, mask: int) -> bool:
+        judged[mask] = mask == 0b0100
+        return judged[mask]
+
+    narrow = FirstAdmitted(sorted, admits, lambda members, mask: judged.get(mask) is False)
+    volumes = (1.0, 1.0, 1.0, 9.0)
+    assert _choose_removal(tab, Spy(), 0b1111, volumes, None, narrow) == (1, [0b0100])  # type: ignore[arg-type]
+    assert tested == [0b0011, 0b0100]
+    assert judged == {0b0001: False, 0b0010: False, 0b0100: True}

@@ -21,6 +21,7 @@ from assemblykit.planning.hands import hands_needed
 from assemblykit.planning.planar import planar_rigid_may_free, planar_search
 from assemblykit.planning.sequence import (
     ExtendedDirections,
+    FirstAdmitted,
     Hands,
     Interlock,
     Plan,
@@ -144,7 +145,10 @@ def _plan_under_gravity(
         lambda members: base_part(members, search.volumes),
         base_part(everything, search.volumes),
     )
-    search.narrowers = (judge.stable, judge.fewest_falling)
+    search.narrowers = (
+        FirstAdmitted(judge.ordered, judge.stands_without, judge.known_to_fall),
+        judge.fewest_falling,
+    )
     search.judge = judge.judge
     if gravity.fixed is not None:
         # declared fixed parts (a fixture) never move; the default ones only rest on the

@@ -76,6 +76,22 @@ close under extended blocking."""
 MotionKind = Literal["translation", "rigid"]
 
 
+@dataclass(frozen=True)
+class FirstAdmitted:
+    """A narrower (:data:`Narrow`) that moves the first free set, in its ``order``, that
+    it ``admits`` (``admits(members, set)``: under gravity, whether the removal stands).
+    Its verdicts do not depend on the direction; ``rejected(members, set)`` tells, at no
+    cost, a set already found not admitted: the search leaves such single parts out of
+    the extended blocking that each direction costs again (:func:`_choose_removal`)."""
+
+    order: Callable[[list[int]], list[int]]
+    admits: Callable[[int, int], bool]
+    rejected: Callable[[int, int], bool]
+
+    def __call__(self, members: int, k: int, sets: list[int]) -> list[int]:
+        return next(([m] for m in self.order(sets) if self.admits(members, m)), [])
+
+
 class ExtendedDirections:
     """The DBGs of Γ_e along fixed candidate directions, computed exactly
     (:func:`assemblykit.blocking.extended.extended_arcs`) pair by pair as the search
@@ -538,7 +554,11 @@ def _choose_removal(
         return sets if narrow is None or not sets else narrow(members, k, sets)
 
     def singles(k: int) -> list[int]:
-        held = extended.blockers(k, row_mask(free[k]), members)
+        movers = row_mask(free[k])
+        if isinstance(narrow, FirstAdmitted):
+            # a part the narrower already rejected would be rejected again: no Γ_e for it
+            movers = mask_of(i for i in bits(movers) if not narrow.rejected(members, 1 << i))
+        held = extended.blockers(k, movers, members)
         return chosen(k, [1 << i for i, mask in held.items() if not mask])
 
     def groups(k: int) -> list[int]:

@@ -1060,7 +1060,7 @@ class StateJudge:
         self._assessed[key] = found
         return found
 
-    def _ordered(self, sets: list[int]) -> list[int]:
+    def ordered(self, sets: list[int]) -> list[int]:
         """Fewest parts first, then the highest (a set's highest centre), then index."""
 
         def key(mask: int) -> tuple[int, float, int]:
@@ -1069,18 +1069,21 @@ class StateJudge:
 
         return sorted(sets, key=key)
 
-    def stable(self, members: int, k: int, sets: list[int]) -> list[int]:
-        """The first set (:meth:`_ordered`) whose removal stands with the holds allowed,
-        alone; none if there is none (``k``, the direction, does not matter)."""
-        for mask in self._ordered(sets):
-            if self.assess(members, mask).stands:
-                return [mask]
-        return []
+    def stands_without(self, members: int, moved: int) -> bool:
+        """Whether moving ``moved`` out of ``members`` stands with the holds allowed (the
+        planner moves the first such set, in :meth:`ordered`, alone)."""
+        return self.assess(members, moved).stands
+
+    def known_to_fall(self, members: int, moved: int) -> bool:
+        """Whether moving ``moved`` out of ``members`` was judged already, and does not
+        stand (nothing is computed)."""
+        found = self._assessed.get((members, moved))
+        return found is not None and not found.stands
 
     def fewest_falling(self, members: int, k: int, sets: list[int]) -> list[int]:
         """The set whose removal leaves the fewest parts falling (a step that does not
         stand, reported as such)."""
-        return [min(self._ordered(sets), key=lambda m: int(self.assess(members, m).falls.sum()))]
+        return [min(self.ordered(sets), key=lambda m: int(self.assess(members, m).falls.sum()))]
 
     def judge(self, members: int, moved: int) -> StepStability:
         """The step's stability, with the least friction its states need."""
