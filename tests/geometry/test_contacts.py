@@ -13,6 +13,7 @@ import trimesh
 
 from assemblykit.geometry.contacts import (
     assembly_contacts,
+    assembly_curved_surfaces,
     assembly_surfaces,
     candidate_pairs,
     find_contacts,
@@ -129,7 +130,9 @@ def test_a_long_shaft_is_recognised_only_where_the_plate_around_it_reaches():
     """A shaft 20 long in rings of 0.5 through a plate 2 thick: the curved surface that
     contacts need is the shaft's cylinder on the rings reaching the plate's box (z in
     [-1.5, 1.5]: 6 of 40 rings), and the contact is the same whole turn of height 2;
-    a collar touching the shaft elsewhere changes nothing of the plate's contact."""
+    a collar touching the shaft elsewhere changes nothing of the plate's contact. The
+    plate's hole fills the shaft's box, more than a quarter of the plate's triangles:
+    the plate's whole surfaces serve (recognised once for all its pairs)."""
     shaft = _ringed_shaft(1.0, 20.0, 40)
     cutter = trimesh.creation.cylinder(radius=1.0, height=30.0, sections=48)
     plate = box([-3, -3, -1], [3, 3, 1]).difference(cutter, engine="manifold")
@@ -140,6 +143,7 @@ def test_a_long_shaft_is_recognised_only_where_the_plate_around_it_reaches():
     assert near.radius == pytest.approx(1.0, abs=1e-12)
     assert len(near.faces) == len(whole.faces) * 6 // 40
     assert set(near.faces.tolist()) < set(whole.faces.tolist())
+    assert near_curved_surfaces(pair, "plate", "shaft") is assembly_curved_surfaces(pair, "plate")
     heights = shaft.triangles[near.faces][:, :, 2]
     assert (heights.min(), heights.max()) == pytest.approx((-1.5, 1.5), abs=1e-12)
     (found,) = find_contacts(pair)

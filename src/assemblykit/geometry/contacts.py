@@ -709,6 +709,13 @@ def assembly_curved_surfaces(
     return memo[key]
 
 
+WHOLE_SHARE = 0.25
+"""The share of a part's triangles within reach of another part beyond which the curved
+surfaces of the whole part serve that pair (:func:`near_curved_surfaces`): recognised
+once, and kept for all its pairs and its features, they cost less than regions that
+large recognised again pair by pair (a housing touching a dozen parts)."""
+
+
 def near_curved_surfaces(
     assembly: Assembly, name: str, other: str, tol: Tolerance | None = None
 ) -> tuple[Surface, ...]:
@@ -716,7 +723,9 @@ def near_curved_surfaces(
     exact CAD surfaces other than planes, else those recognised
     (:func:`~assemblykit.geometry.recognition.recognise_curved`) on its triangles whose
     bounding boxes meet ``other``'s, inflated by the length tolerance (every triangle
-    within the tolerance of ``other`` is among them), once per pair and tolerance.
+    within the tolerance of ``other`` is among them), once per pair and tolerance; when
+    these are more than :data:`WHOLE_SHARE` of its triangles, those of the whole part
+    (:func:`assembly_curved_surfaces`, kept for every pair and for its features).
 
     So a pair's contacts depend on its two parts alone, and recognition costs what the
     region where they meet holds rather than the whole part: on the ASAP beam, a
@@ -730,12 +739,18 @@ def near_curved_surfaces(
         margin = key[2].length
         lo, hi = assembly.part(other).mesh.bounds
         first, second, third = np.asarray(part.mesh.triangles, dtype=np.float64).transpose(1, 0, 2)
-        reach = np.all(
-            (np.maximum(np.maximum(first, second), third) >= lo - margin)
-            & (np.minimum(np.minimum(first, second), third) <= hi + margin),
-            axis=1,
+        reach = np.flatnonzero(
+            np.all(
+                (np.maximum(np.maximum(first, second), third) >= lo - margin)
+                & (np.minimum(np.minimum(first, second), third) <= hi + margin),
+                axis=1,
+            )
         )
-        memo[key] = recognise_curved(part.mesh, key[2], np.flatnonzero(reach))
+        memo[key] = (
+            assembly_curved_surfaces(assembly, name, tol)
+            if len(reach) > WHOLE_SHARE * len(first)
+            else recognise_curved(part.mesh, key[2], reach)
+        )
     return memo[key]
 
 
