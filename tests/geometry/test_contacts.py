@@ -263,6 +263,53 @@ def test_a_normal_turned_further_than_the_tolerance_leads_its_own_class():
     assert leader.tolist() == [0, 1]
 
 
+def _snap_one_leader_at_a_time(directions, spreads, scatter, tol):
+    """snap_classes as its docstring states it, each patch compared with every leader."""
+    width = [np.linalg.svd(p, compute_uv=False)[1] / np.sqrt(len(p)) for p in spreads]
+    leader, sign, leaders = list(range(len(directions))), [1.0] * len(directions), []
+    for i in np.argsort(-np.array(width), kind="stable").tolist():
+        best = None
+        for k in leaders:
+            facing = -1.0 if directions[k] @ directions[i] < 0 else 1.0
+            turn = np.cross(directions[i], facing * directions[k])
+            sine = np.linalg.norm(turn)
+            if sine == 0:
+                continue
+            lever = np.linalg.norm(np.cross(turn / sine, spreads[i]), axis=1).max()
+            if sine * lever <= min(2 * (scatter[i] + scatter[k]), tol.length) and (
+                best is None or sine < best[0]
+            ):
+                best = (sine, k, facing)
+        if best is None:
+            leaders.append(i)
+        else:
+            leader[i], sign[i] = best[1], best[2]
+    return leader, sign
+
+
+def test_snapping_compares_each_patch_with_every_leader_as_stated():
+    """Patches on the three axes, many with exactly one direction (exact faces, which
+    the search keeps apart as leaders of one line) and some tilted by 1e-7 with scatter:
+    the classes equal those of comparing each patch with every leader one by one."""
+    from assemblykit.geometry.contacts import snap_classes
+
+    rng = np.random.default_rng(7)
+    tol = Tolerance(scale=1.0, rel_length=1e-4)
+    joined = 0
+    for _ in range(60):
+        n = 40
+        axes = np.vstack([np.eye(3), -np.eye(3)])[rng.integers(0, 6, n)]
+        directions = axes + rng.choice([0.0, 1e-7], n)[:, None] * rng.normal(size=(n, 3))
+        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+        spreads = [rng.normal(size=(4, 3)) for _ in range(n)]
+        scatter = rng.choice([0.0, 1e-6, 1e-5], n)
+        leader, sign = snap_classes(directions, spreads, scatter, tol)
+        expected = _snap_one_leader_at_a_time(directions, spreads, scatter, tol)
+        assert (leader.tolist(), sign.tolist()) == expected
+        joined += int((leader != np.arange(n)).sum())
+    assert joined > 1000
+
+
 def test_the_pieces_of_one_face_make_one_patch():
     # part a is two boxes side by side with a crack of 1e-9 (far below the tolerance,
     # 1e-6 x 2.45) between them: two coplanar faces under box c, joined into one patch,

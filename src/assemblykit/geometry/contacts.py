@@ -830,26 +830,58 @@ def snap_classes(
     order = np.argsort(-width, kind="stable")
     leader = np.arange(len(directions), dtype=np.int64)
     sign = np.ones(len(directions))
-    leaders: list[int] = []
-    for i in order:
-        if leaders:
-            facing = np.where(directions[leaders] @ directions[i] < 0, -1.0, 1.0)
-            stack = directions[leaders] * facing[:, None]
-            turn = np.cross(directions[i], stack)
+    # leaders along one line (the same direction up to its sign) turn a patch alike: a
+    # patch is compared with each line once, then with the leaders of the lines it may
+    # join (only their scatter differs). Exact faces that share a direction do not join
+    # (they turn by nothing), so a box packing has thousands of leaders on three lines.
+    lines = np.zeros((0, 3))
+    members: list[list[int]] = []
+    loosest: list[float] = []
+    line_of: dict[tuple[float, ...], int] = {}
+    position: dict[int, int] = {}
+    for i in order.tolist():
+        d = directions[i]
+        if len(lines):
+            facing = np.where(lines @ d < 0, -1.0, 1.0)
+            turn = np.cross(d, lines * facing[:, None])
             sines = np.linalg.norm(turn, axis=1)
             hinge = turn / np.maximum(sines, np.finfo(float).tiny)[:, None]
             # how far each point is from each turning axis through the middle
             lever = np.linalg.norm(np.cross(hinge[:, None, :], spreads[i][None]), axis=2)
             moved = sines * (lever.max(axis=1) if lever.size else 0.0)
-            allowed = np.minimum(2.0 * (scatter[i] + scatter[leaders]), tol.length)
-            ok = (moved <= allowed) & (sines > 0)
-            if ok.any():
-                k = int(np.flatnonzero(ok)[np.argmin(sines[ok])])
-                leader[i] = leaders[k]
-                sign[i] = facing[k]
+            near = (moved <= np.minimum(2.0 * (scatter[i] + np.array(loosest)), tol.length)) & (
+                sines > 0
+            )
+            best: tuple[float, int, int] | None = None
+            for u in np.flatnonzero(near).tolist():
+                group = members[u]
+                allowed = np.minimum(2.0 * (scatter[i] + scatter[group]), tol.length)
+                first = group[int(np.argmax(moved[u] <= allowed))]
+                if best is None or (sines[u], position[first]) < best[:2]:
+                    best = (float(sines[u]), position[first], first)
+            if best is not None:
+                leader[i] = best[2]
+                sign[i] = -1.0 if directions[best[2]] @ d < 0 else 1.0
                 continue
-        leaders.append(int(i))
+        position[i] = len(position)
+        key = _line_key(d)
+        if key not in line_of:
+            line_of[key] = len(members)
+            lines = np.vstack([lines, d])
+            members.append([])
+            loosest.append(-np.inf)
+        u = line_of[key]
+        members[u].append(i)
+        loosest[u] = max(loosest[u], float(scatter[i]))
     return leader, sign
+
+
+def _line_key(d: NDArray[np.float64]) -> tuple[float, ...]:
+    """The line of direction ``d``: ``d`` or ``-d``, whichever has its first nonzero
+    coordinate positive (zeros unsigned)."""
+    nonzero = np.flatnonzero(d)
+    line = -d if len(nonzero) and d[nonzero[0]] < 0 else d
+    return tuple(np.where(line == 0, 0.0, line).tolist())
 
 
 def snapped(contacts: list[Contact], tol: Tolerance) -> list[Contact]:
