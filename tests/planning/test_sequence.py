@@ -512,7 +512,9 @@ def test_parts_a_narrower_already_rejected_get_no_extended_blocking():
         judged[mask] = mask == 0b0100
         return judged[mask]
 
-    narrow = FirstAdmitted(sorted, admits, lambda members, mask: judged.get(mask) is False)
+    narrow = FirstAdmitted(
+        sorted, admits, lambda members: sum(m for m, ok in judged.items() if not ok)
+    )
     volumes = (1.0, 1.0, 1.0, 9.0)
     assert _choose_removal(tab, Spy(), 0b1111, volumes, None, narrow) == (1, [0b0100])  # type: ignore[arg-type]
     assert tested == [0b0011, 0b0100]

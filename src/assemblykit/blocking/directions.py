@@ -13,7 +13,7 @@ directions. Sets of parts are Python integers, bit ``i`` for the ``i``-th part
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import networkx as nx
@@ -131,10 +131,12 @@ class DirectionTable:
 
     def _components(
         self, members: int
-    ) -> Iterator[tuple[NDArray[np.bool_], NDArray[np.int64], NDArray[np.bool_]]]:
-        """Per distinct DBG induced on ``members``: the directions that have it, each
-        member's strong component (labels over ``members`` in bit order, by scipy's
-        ``connected_components``) and which components are sinks (no arc leaves them)."""
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.bool_]]:
+        """The strong components of each distinct DBG induced on ``members``: per
+        direction, the row of its DBG; per row and member (in bit order), its component;
+        per component, whether it is a sink (no arc leaves it). The distinct DBGs are
+        taken as one graph, their disjoint union, whose strong components are theirs:
+        one call to scipy's ``connected_components`` for all of them."""
         inside = self.vector(members)
         nodes = np.flatnonzero(inside)
         index = np.full(len(self.names), -1, dtype=np.int64)
@@ -144,17 +146,14 @@ class DirectionTable:
         patterns, which = np.unique(
             np.packbits(self.slots[:, columns], axis=1), axis=0, return_inverse=True
         )
-        which = np.ravel(which)
-        for row, pattern in enumerate(patterns):
-            arcs = np.unpackbits(pattern, count=len(columns)).astype(bool)
-            tails, heads = moving[arcs], blocker[arcs]
-            graph = coo_matrix(
-                (np.ones(len(tails)), (tails, heads)), shape=(len(nodes), len(nodes))
-            )
-            count, label = connected_components(graph, directed=True, connection="strong")
-            sink = np.ones(count, dtype=bool)
-            sink[label[tails][label[tails] != label[heads]]] = False
-            yield which == row, label, sink
+        rows, arcs = np.nonzero(np.unpackbits(patterns, axis=1, count=len(columns)))
+        tails, heads = rows * len(nodes) + moving[arcs], rows * len(nodes) + blocker[arcs]
+        size = len(patterns) * len(nodes)
+        union = coo_matrix((np.ones(len(tails)), (tails, heads)), shape=(size, size))
+        count, label = connected_components(union, directed=True, connection="strong")
+        sink = np.ones(count, dtype=bool)
+        sink[label[tails][label[tails] != label[heads]]] = False
+        return np.ravel(which), label.reshape(len(patterns), len(nodes)), sink
 
     def free_set_sizes(self, members: int, keep: int) -> NDArray[np.int64]:
         """Per direction, how many parts of ``members`` its free sets take away: the
@@ -162,19 +161,17 @@ class DirectionTable:
         "Directional Blocking Graph"), but for the component holding part ``keep``.
         Directions with the same DBG share one computation."""
         place = count_bits(members & ((1 << keep) - 1))
-        out = np.zeros(len(self.directions), dtype=np.int64)
-        for directions, label, sink in self._components(members):
-            sink[label[place]] = False
-            out[directions] = np.count_nonzero(sink[label])
-        return out
+        which, label, sink = self._components(members)
+        taken = sink[label] & (label != label[:, place : place + 1])
+        sizes: NDArray[np.int64] = np.count_nonzero(taken, axis=1).astype(np.int64)
+        return sizes[which]
 
     def separating(self, members: int) -> NDArray[np.bool_]:
         """Per direction, whether its DBG induced on ``members`` is not strongly
         connected: some proper, non-empty part of ``members`` is free along it."""
-        out = np.zeros(len(self.directions), dtype=bool)
-        for directions, label, _ in self._components(members):
-            out[directions] = label.max(initial=0) > 0
-        return out
+        which, label, _ = self._components(members)
+        split: NDArray[np.bool_] = np.any(label != label[:, :1], axis=1)
+        return split[which]
 
     def incomplete(self, members: int) -> list[int]:
         """The directions along which some part of ``members`` does not block another:

@@ -80,13 +80,14 @@ MotionKind = Literal["translation", "rigid"]
 class FirstAdmitted:
     """A narrower (:data:`Narrow`) that moves the first free set, in its ``order``, that
     it ``admits`` (``admits(members, set)``: under gravity, whether the removal stands).
-    Its verdicts do not depend on the direction; ``rejected(members, set)`` tells, at no
-    cost, a set already found not admitted: the search leaves such single parts out of
-    the extended blocking that each direction costs again (:func:`_choose_removal`)."""
+    Its verdicts do not depend on the direction; ``rejected(members)`` tells, at no
+    cost, the single parts (a mask) already found not admitted: the search leaves them
+    out of the extended blocking that each direction costs again
+    (:func:`_choose_removal`)."""
 
     order: Callable[[list[int]], list[int]]
     admits: Callable[[int, int], bool]
-    rejected: Callable[[int, int], bool]
+    rejected: Callable[[int], int]
 
     def __call__(self, members: int, k: int, sets: list[int]) -> list[int]:
         return next(([m] for m in self.order(sets) if self.admits(members, m)), [])
@@ -557,7 +558,7 @@ def _choose_removal(
         movers = row_mask(free[k])
         if isinstance(narrow, FirstAdmitted):
             # a part the narrower already rejected would be rejected again: no Γ_e for it
-            movers = mask_of(i for i in bits(movers) if not narrow.rejected(members, 1 << i))
+            movers &= ~narrow.rejected(members)
         held = extended.blockers(k, movers, members)
         return chosen(k, [1 << i for i, mask in held.items() if not mask])
 

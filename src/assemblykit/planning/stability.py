@@ -473,12 +473,10 @@ class EquilibriumModel:
     force at every point (normal, ``u`` and ``v`` parts: P x 3) with the pyramid gauge of
     its tangential part (P: ``mu`` times the normal part must reach it), so that one
     balance serves every friction coefficient it fits (:meth:`stands`)."""
-    _certificates: list[tuple[NDArray[np.int64], NDArray[np.float64]]] = field(
-        default_factory=list, repr=False, init=False
-    )
+    _certificates: list[NDArray[np.float64]] = field(default_factory=list, repr=False, init=False)
     """Farkas certificates found (at most :data:`KEPT_CERTIFICATES`, the most recently
-    useful first), each as the equations it weighs and its ``y`` on them
-    (:meth:`stands`)."""
+    useful first), each as its ``y`` over every equation, zero on those it does not
+    weigh (:meth:`stands`)."""
     _needed: list[int] = field(default_factory=list, repr=False, init=False)
     """The last answer of :meth:`friction_needed`, in steps of its resolution, where its
     next search starts (none yet: at ``friction``)."""
@@ -545,8 +543,16 @@ class EquilibriumModel:
 
     def _keep_certificate(self, rows: NDArray[np.int64], certificate: NDArray[np.float64]) -> None:
         """Keep a Farkas certificate over the equations ``rows`` (zero on the others)."""
-        self._certificates.insert(0, (rows, certificate))
+        y = np.zeros(len(self.load))
+        y[rows] = certificate
+        self._certificates.insert(0, y)
         del self._certificates[KEPT_CERTIFICATES:]
+
+    @cached_property
+    def _transposed(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """The normal and tangent parts transposed (a row per generator): a certificate's
+        gain per generator is one product with each."""
+        return sp.csr_matrix(self.normal_part.T), sp.csr_matrix(self.tangent_part.T)
 
     def stands(
         self,
@@ -599,23 +605,23 @@ class EquilibriumModel:
 
     def _certifies(
         self,
-        certificate: tuple[NDArray[np.int64], NDArray[np.float64]],
+        certificate: NDArray[np.float64],
         free: NDArray[np.bool_],
         selected: NDArray[np.bool_],
         mu: float,
     ) -> bool:
-        """Whether ``certificate`` (equations and their ``y``), restricted to the equations
+        """Whether ``certificate`` (its ``y``), restricted to the equations
         of the ``free`` parts, proves that they have no balance over the ``selected``
         points at ``mu``: no generator gains from it (``matrix.T @ y >= 0``, to
         :data:`LP_FEASIBILITY` of the loads' share) while the loads do (``rhs @ y <
         0``). A part removed takes its generators away and a part held its equations:
         either can spoil it, which the test sees."""
-        rows, y = certificate
-        y = y * free[rows // 6]
-        share = float(-self.load[rows] @ y)
+        y = certificate * np.repeat(free, 6)
+        share = float(-self.load @ y)
         if share >= 0:
             return False
-        gain = self.normal_part[rows].T @ y + mu * (self.tangent_part[rows].T @ y)
+        normal, tangent = self._transposed
+        gain = normal @ y + mu * (tangent @ y)
         return bool(
             gain[np.repeat(selected, CONE_SIDES)].min(initial=0.0) >= LP_FEASIBILITY * share
         )
@@ -984,6 +990,7 @@ class StateJudge:
         self._stands: dict[tuple[bytes, bytes], bool] = {}
         self._falling: dict[tuple[bytes, bytes], NDArray[np.bool_]] = {}
         self._assessed: dict[tuple[int, int], _Assessment] = {}
+        self._single_falls: dict[int, int] = {}
 
     def stands(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> bool:
         """:meth:`EquilibriumModel.stands`, once per state."""
@@ -1058,6 +1065,8 @@ class StateJudge:
             falling=falling,
         )
         self._assessed[key] = found
+        if not found.stands and moved & (moved - 1) == 0:
+            self._single_falls[members] = self._single_falls.get(members, 0) | moved
         return found
 
     def ordered(self, sets: list[int]) -> list[int]:
@@ -1074,11 +1083,10 @@ class StateJudge:
         planner moves the first such set, in :meth:`ordered`, alone)."""
         return self.assess(members, moved).stands
 
-    def known_to_fall(self, members: int, moved: int) -> bool:
-        """Whether moving ``moved`` out of ``members`` was judged already, and does not
-        stand (nothing is computed)."""
-        found = self._assessed.get((members, moved))
-        return found is not None and not found.stands
+    def known_to_fall(self, members: int) -> int:
+        """The parts of ``members`` (a mask) whose removal alone was judged already and
+        does not stand (nothing is computed)."""
+        return self._single_falls.get(members, 0)
 
     def fewest_falling(self, members: int, k: int, sets: list[int]) -> list[int]:
         """The set whose removal leaves the fewest parts falling (a step that does not
