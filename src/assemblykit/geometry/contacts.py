@@ -732,20 +732,15 @@ def near_curved_surfaces(
     beam's end on its post is 24% of its triangles, a post's top on the beam 6%."""
     part = assembly.part(name)
     if part.surfaces:
-        return tuple(s for s in part.surfaces if s.kind != "plane")
+        return assembly_curved_surfaces(assembly, name, tol)
     key = (name, other, assembly.tolerance(tol))
     memo = memo_of(assembly).near
     if key not in memo:
-        margin = key[2].length
         lo, hi = assembly.part(other).mesh.bounds
         first, second, third = np.asarray(part.mesh.triangles, dtype=np.float64).transpose(1, 0, 2)
-        reach = np.flatnonzero(
-            np.all(
-                (np.maximum(np.maximum(first, second), third) >= lo - margin)
-                & (np.minimum(np.minimum(first, second), third) <= hi + margin),
-                axis=1,
-            )
-        )
+        low = np.minimum(np.minimum(first, second), third)
+        high = np.maximum(np.maximum(first, second), third)
+        reach = np.flatnonzero(_boxes_overlap(low, high, lo, hi, key[2].length))
         memo[key] = (
             assembly_curved_surfaces(assembly, name, tol)
             if len(reach) > WHOLE_SHARE * len(first)
