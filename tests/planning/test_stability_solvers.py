@@ -15,7 +15,7 @@ import scipy.sparse as sp
 from scipy.optimize import linprog
 
 from assemblykit.io.assembly import load_assembly
-from assemblykit.model.assembly import Assembly
+from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning import stability
 from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import (
@@ -28,7 +28,7 @@ from assemblykit.planning.stability import (
 )
 from assemblykit.tolerance import Tolerance
 from datasets import dataset
-from stability_blocks import block_on_slope, corbels, overhanging_stack
+from stability_blocks import block_on_slope, box, corbels, overhanging_stack
 
 FRICTIONS = (0.0, 0.1, 0.3, 0.5)
 
@@ -190,6 +190,63 @@ def test_the_slack_program_falls_back_to_highs_when_clarabel_stops_short(monkeyp
     # by hand: |1 - x| + |1 - 2x| is least, 0.5, at x = 0.5: residuals (0.5, 0)
     np.testing.assert_allclose(vertex, [0.5, 0.0], atol=1e-7)
     np.testing.assert_allclose(interior, vertex, atol=1e-7)
+
+
+def two_stacks() -> Assembly:
+    """On one ground slab, two stacks of two unit cubes 3 apart, the left one's top
+    overhanging by 0.4 (its centre over its support: it stands), the right one's by 0.6
+    (it falls); and a loose cube touching nothing."""
+    return Assembly(
+        [
+            Part("ground", box((8, 1, 1), (-1, 0, -1))),
+            Part("left", box((1, 1, 1), (0, 0, 0))),
+            Part("left_top", box((1, 1, 1), (0.4, 0, 1))),
+            Part("right", box((1, 1, 1), (3, 0, 0))),
+            Part("right_top", box((1, 1, 1), (3.6, 0, 1))),
+            Part("loose", box((1, 1, 1), (20, 0, 5))),
+        ]
+    )
+
+
+def test_the_slack_program_is_solved_piece_by_piece_and_pieces_are_kept(monkeypatch):
+    model = equilibrium_model(two_stacks(), friction=0.5, fixed=["ground"])
+    present, fixed = model.mask(None), model.mask(["ground"])
+    pieces = model.pieces(present, fixed)
+    assert sorted(sorted(model.names[i] for i in np.flatnonzero(p)) for p in pieces) == [
+        ["left", "left_top"],
+        ["loose"],
+        ["right", "right_top"],
+    ]
+    calls = []
+    original = stability.least_residuals
+
+    def counted(matrix, rhs):
+        calls.append(matrix.shape[0] // 6)
+        return original(matrix, rhs)
+
+    monkeypatch.setattr(stability, "least_residuals", counted)
+    residuals = dict(zip(model.names, model.slack(present, fixed), strict=True))
+    # one program per piece that touches something, each over its own parts' equations
+    assert sorted(calls) == [2, 2]
+    # the loose cube keeps its whole weight, the right top falls, the left stack stands
+    assert residuals["loose"] == pytest.approx(1.0)
+    assert residuals["right_top"] > 1e-3 > 10 * model.threshold and residuals["ground"] == 0.0
+    assert max(residuals["left"], residuals["left_top"]) < model.threshold
+    # the same residuals as the whole program over every free part at once
+    free = present & ~fixed
+    rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
+    selected = present[model.point_parts[:, 0]] & present[model.point_parts[:, 1]]
+    whole = original(model._matrix(rows, selected & model.corners, 0.5), -model.load[rows])
+    falls = np.abs(whole).reshape(-1, 6).max(axis=1) > model.threshold
+    named = [n for n, f in zip(np.array(model.names)[free], falls, strict=True) if f]
+    assert named == ["right_top", "loose"]
+    assert [n for n in model.names if residuals[n] > model.threshold] == named
+    # the left top taken away: the right piece is kept, only the left one is solved again
+    calls.clear()
+    without = present & ~model.mask(["left_top"])
+    again = dict(zip(model.names, model.slack(without, fixed), strict=True))
+    assert calls == [1]
+    assert again["right_top"] == residuals["right_top"]
 
 
 def bisected(model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray) -> float | None:

@@ -58,6 +58,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linprog
+from scipy.sparse.csgraph import connected_components
 
 from assemblykit.errors import InputError, NumericError
 from assemblykit.geometry.contacts import assembly_contacts
@@ -95,6 +96,10 @@ KEPT = 8
 first) to decide later states without a program: a balance rarely outlives the state it
 was found for (removing a block unbalances its neighbours), but decides the friction
 coefficients above the one it was found at."""
+
+KEPT_RESIDUALS = 256
+"""How many pieces' residuals an :class:`EquilibriumModel` keeps (:meth:`slack`): a
+piece of a state that no removal since has touched has the same ones."""
 
 KEPT_CERTIFICATES = 32
 """How many Farkas certificates an :class:`EquilibriumModel` keeps (the most recently
@@ -477,6 +482,12 @@ class EquilibriumModel:
     """Farkas certificates found (at most :data:`KEPT_CERTIFICATES`, the most recently
     useful first), each as its ``y`` over every equation, zero on those it does not
     weigh (:meth:`stands`)."""
+    _residuals: dict[tuple[bytes, bytes, float], NDArray[np.float64]] = field(
+        default_factory=dict, repr=False, init=False
+    )
+    """The residuals of pieces of states (:meth:`slack`), per piece, the state's immobile
+    parts and the friction coefficient (at most :data:`KEPT_RESIDUALS`, the oldest
+    forgotten first)."""
     _needed: list[int] = field(default_factory=list, repr=False, init=False)
     """The last answer of :meth:`friction_needed`, in steps of its resolution, where its
     next search starts (none yet: at ``friction``)."""
@@ -704,6 +715,23 @@ class EquilibriumModel:
             return np.zeros(len(self.names))
         return self.slack(present, fixed, friction)
 
+    def pieces(
+        self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]
+    ) -> list[NDArray[np.bool_]]:
+        """The free parts of a state in pieces that no force point joins (connected
+        components of the contacts between free parts; immobile parts join nothing, as
+        they take any wrench). The programs of a state are those of its pieces side by
+        side: no generator acts on the equations of two pieces."""
+        free = present & ~fixed
+        ends = self.point_parts
+        joined = free[ends[:, 0]] & free[ends[:, 1]]
+        count = len(self.names)
+        graph = sp.coo_matrix(
+            (np.ones(int(joined.sum())), (ends[joined, 0], ends[joined, 1])), shape=(count, count)
+        )
+        _, label = connected_components(graph, directed=False)
+        return [free & (label == piece) for piece in np.unique(label[free])]
+
     def slack(
         self,
         present: NDArray[np.bool_],
@@ -711,20 +739,35 @@ class EquilibriumModel:
         friction: float | None = None,
     ) -> NDArray[np.float64]:
         """The slack program of :meth:`residuals` alone, for a state known not to stand:
-        per part, the largest scaled residual of its equations at its optimum."""
-        out = np.zeros(len(self.names))
-        free = present & ~fixed
-        rows = self._rows(free)
-        points = self._touching(present)
-        if not points.any():
-            # nothing touches: every free part keeps its whole weight as residual
-            out[free] = np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
-            return out
-        # the corners span the same wrenches as every point, so the same residuals
+        per part, the largest scaled residual of its equations at its optimum. It is
+        solved piece by piece (:meth:`pieces`), and a piece's residuals are kept: a
+        removal elsewhere leaves them as they were."""
         mu = self.friction if friction is None else friction
-        corners = self._matrix(rows, points & self.corners, mu)
-        out[free] = np.abs(least_residuals(corners, -self.load[rows])).reshape(-1, 6).max(axis=1)
+        out = np.zeros(len(self.names))
+        immobile = (present & fixed).tobytes()
+        for piece in self.pieces(present, fixed):
+            key = (piece.tobytes(), immobile, mu)
+            if key not in self._residuals:
+                self._residuals[key] = self._piece_residuals(present, piece, mu)
+                if len(self._residuals) > KEPT_RESIDUALS:
+                    del self._residuals[next(iter(self._residuals))]
+            out[piece] = self._residuals[key]
         return out
+
+    def _piece_residuals(
+        self, present: NDArray[np.bool_], piece: NDArray[np.bool_], mu: float
+    ) -> NDArray[np.float64]:
+        """The residuals of one piece's parts at the slack program's optimum, on the
+        corners of its points (they span the same wrenches as every point: the same
+        residuals); a piece that touches nothing keeps its whole weight as residual."""
+        rows = self._rows(piece)
+        points = self._touching(present) & (
+            piece[self.point_parts[:, 0]] | piece[self.point_parts[:, 1]]
+        )
+        if not points.any():
+            return np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
+        corners = self._matrix(rows, points & self.corners, mu)
+        return np.abs(least_residuals(corners, -self.load[rows])).reshape(-1, 6).max(axis=1)
 
     def falling(
         self, present: NDArray[np.bool_], fixed: NDArray[np.bool_], friction: float | None = None
