@@ -37,7 +37,8 @@ beyond the tolerance are those that cannot be in equilibrium (they would fall). 
 optimum is not unique on a state that falls; the parts named are those left unbalanced
 by *some* least-residual balance, the support of the interior of its optimal face, to
 which Clarabel's interior point method converges (:func:`least_residuals`), so the set
-does not depend on a solver's pivots. A plan asks about states that differ by a block,
+does not depend on a solver's pivots; it is solved for each piece of the state (free
+parts that no force point joins: :meth:`EquilibriumModel.pieces`) on its own. A plan asks about states that differ by a block,
 a hold or the friction coefficient from one already decided: the balances and Farkas
 certificates found before answer many of them with no program, or from a few parts'
 equations (:meth:`EquilibriumModel.stands`). Loads are homogeneous in rigid-block
