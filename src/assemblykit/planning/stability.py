@@ -38,13 +38,13 @@ optimum is not unique on a state that falls; the parts named are those left unba
 by *some* least-residual balance, the support of the interior of its optimal face, to
 which Clarabel's interior point method converges (:func:`least_residuals`), so the set
 does not depend on a solver's pivots; it is solved for each piece of the state (free
-parts that no force point joins: :meth:`EquilibriumModel.pieces`) on its own. A plan asks about states that differ by a block,
-a hold or the friction coefficient from one already decided: the balances and Farkas
-certificates found before answer many of them with no program, or from a few parts'
-equations (:meth:`EquilibriumModel.stands`). Loads are homogeneous in rigid-block
-equilibrium (scaling gravity scales every force), so the margin reported is the least
-friction coefficient with which the state stands, to a resolution of ``mu / 32``
-(:meth:`EquilibriumModel.friction_needed`).
+parts that no force point joins: :meth:`EquilibriumModel.pieces`) on its own. A plan
+asks about states that differ by a block, a hold or the friction coefficient from one
+already decided: the balances and Farkas certificates found before answer many of them
+with no program, or from a few parts' equations (:meth:`EquilibriumModel.stands`).
+Loads are homogeneous in rigid-block equilibrium (scaling gravity scales every force),
+so the margin reported is the least friction coefficient with which the state stands,
+to a resolution of ``mu / 32`` (:meth:`EquilibriumModel.friction_needed`).
 """
 
 from __future__ import annotations
