@@ -102,10 +102,13 @@ KEPT_RESIDUALS = 256
 """How many pieces' residuals an :class:`EquilibriumModel` keeps (:meth:`slack`): a
 piece of a state that no removal since has touched has the same ones."""
 
-KEPT_CERTIFICATES = 32
+KEPT_CERTIFICATES = 128
 """How many Farkas certificates an :class:`EquilibriumModel` keeps (the most recently
 useful first): a certificate outlives many states (what falls at one step still falls
-at the next, unless its parts are taken or held)."""
+at the next, unless its parts are taken or held). A plan's step finds a few dozen, one
+per candidate that falls, and asks about most of those candidates again at the next
+step: with 32 kept, the cross vault's first 39 steps solved 1,114 programs, with 128
+(or 512) 639."""
 
 DOWN = (0.0, 0.0, -1.0)
 
