@@ -88,9 +88,12 @@ largest programs measured, the 527-block dome's first and the 184-block cross va
 slack program, take 0.5 to 1.2 s and 0.2 to 0.3 s on two shared cores:
 benchmarks/bench_stability.py)."""
 
-LOCAL_HOPS = 3
+LOCAL_HOPS = 1
 """How many contacts :meth:`EquilibriumModel.stands` grows the region of unbalanced
-parts by, one at a time, before it leaves the verdict to the whole program."""
+parts by, one at a time, before it leaves the verdict to the whole program. A region
+that a contact more does not prove falling rarely falls with two or three more: the
+cross vault's first 39 steps solve 359 programs in 40 s with one, 502 in 41 s with two,
+639 in 43 s with three, and 372 in 63 s with none (128 certificates kept)."""
 
 KEPT = 8
 """How many balances an :class:`EquilibriumModel` keeps (the most recently useful
