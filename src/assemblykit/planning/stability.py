@@ -524,6 +524,10 @@ class EquilibriumModel:
         """The force points between two parts of ``present``."""
         return present[self.point_parts[:, 0]] & present[self.point_parts[:, 1]]
 
+    def _acting_on(self, parts: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """The force points with a part of ``parts`` on one side or the other."""
+        return parts[self.point_parts[:, 0]] | parts[self.point_parts[:, 1]]
+
     def _columns(self, selected: NDArray[np.bool_]) -> NDArray[np.int64]:
         """The generator columns of the ``selected`` points."""
         return (CONE_SIDES * np.flatnonzero(selected)[:, None] + np.arange(CONE_SIDES)).ravel()
@@ -699,7 +703,7 @@ class EquilibriumModel:
             if 2 * int(region.sum()) > int(free.sum()):
                 return None
             rows = self._rows(region)
-            touching = selected & (region[ends[:, 0]] | region[ends[:, 1]])
+            touching = selected & self._acting_on(region)
             found = balance(self._matrix(rows, touching, mu), -self.load[rows])
             if not found.found:
                 if found.certificate is not None:
@@ -768,9 +772,7 @@ class EquilibriumModel:
         corners of its points (they span the same wrenches as every point: the same
         residuals); a piece that touches nothing keeps its whole weight as residual."""
         rows = self._rows(piece)
-        points = self._touching(present) & (
-            piece[self.point_parts[:, 0]] | piece[self.point_parts[:, 1]]
-        )
+        points = self._touching(present) & self._acting_on(piece)
         if not points.any():
             return np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
         corners = self._matrix(rows, points & self.corners, mu)
