@@ -38,6 +38,7 @@ from assemblykit.blocking.ndbg import (
     build_ndbg,
 )
 from assemblykit.blocking.obstacles import of_meshes
+from assemblykit.deprecation import moved
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.tolerance import Tolerance
@@ -284,3 +285,6 @@ def parts_to_remove_before(
         if len(pushed) < len(best_set):
             best_set = pushed
     return best_set
+
+
+__getattr__ = moved(__name__, {"separable_by_translations": "assemblykit.planning.planner"})

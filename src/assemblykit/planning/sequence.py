@@ -56,6 +56,7 @@ from assemblykit.blocking.directions import (
     union_of,
 )
 from assemblykit.blocking.extended import extended_arcs
+from assemblykit.deprecation import moved
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -816,3 +817,12 @@ def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDAr
         return overlay_faces(sets, tol).directions
 
     return directions
+
+
+__getattr__ = moved(
+    __name__,
+    {
+        "plan": "assemblykit.planning.planner",
+        "separable_by_translations": "assemblykit.planning.planner",
+    },
+)

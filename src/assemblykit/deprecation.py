@@ -1,0 +1,26 @@
+"""Public names that moved: the old name keeps working, with a :class:`DeprecationWarning`
+naming the new home (docs/architecture.md, "Deprecated names")."""
+
+from __future__ import annotations
+
+import importlib
+import warnings
+from collections.abc import Callable, Mapping
+from typing import Any
+
+
+def moved(module: str, homes: Mapping[str, str]) -> Callable[[str], Any]:
+    """A module-level ``__getattr__`` for ``module``: a name of ``homes`` is looked up in
+    the module it moved to, imported when asked for (a higher layer, which ``module`` may
+    not import), after a :class:`DeprecationWarning`; any other name is missing."""
+
+    def __getattr__(name: str) -> Any:
+        home = homes.get(name)
+        if home is None:
+            raise AttributeError(f"module {module!r} has no attribute {name!r}")
+        warnings.warn(
+            f"{module}.{name} is deprecated; use {home}.{name}", DeprecationWarning, stacklevel=2
+        )
+        return getattr(importlib.import_module(home), name)
+
+    return __getattr__
