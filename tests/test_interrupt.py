@@ -3,11 +3,13 @@
 written and starts no more work, and numerical warnings stay off stderr unless
 ``--debug``.
 
-Each test starts ``assemblykit`` with :mod:`subprocess` through a tiny launcher that says
-"ready" on stdout right before calling :func:`assemblykit.cli.main`, so that the signal
-is sent once the command runs (a signal during Python's own start-up is not ours to
-handle). The batch tests replace the Python of the batch's children by a shell script
-(``sys.executable``), so that which child starts, answers or hangs is set by the test.
+Each test starts ``assemblykit`` with :mod:`subprocess` through a tiny launcher that
+says "ready" on stdout right before calling :func:`assemblykit.cli.main`, so that the
+signal is sent once the command runs (a signal during Python's own start-up is not ours
+to handle). The plan test sends it once the planner is at work on its blocking graph,
+which the launcher marks with a file. The batch tests replace the Python of the batch's
+children by a shell script (``sys.executable``), so that which child starts, answers or
+hangs is set by the test.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -72,7 +75,7 @@ def interrupt(child: subprocess.Popen[str]) -> tuple[int, str, float]:
     return child.returncode, err, time.monotonic() - sent
 
 
-def wait_for(condition, what: str) -> None:
+def wait_for(condition: Callable[[], object], what: str) -> None:
     """Poll ``condition`` (generously: slow machines are slow, not wrong)."""
     deadline = time.monotonic() + 120
     while not condition():
@@ -93,10 +96,24 @@ def brick_wall(path: Path, rows: int) -> Path:
     return path
 
 
+WORKING = """
+from pathlib import Path
+import assemblykit.blocking.tables as tables
+computed = tables.blocking_graph
+def marked(*args, **kwargs):
+    Path({marker!r}).touch()
+    return computed(*args, **kwargs)
+tables.blocking_graph = marked
+"""
+"""Launcher setup: the file ``marker`` appears as the planner starts a blocking graph."""
+
+
 def test_ctrl_c_ends_plan_with_130_and_one_line(tmp_path: Path) -> None:
     wall = brick_wall(tmp_path / "wall.yaml", 20)
-    child = start(["plan", str(wall), "--json"], tmp_path)
-    time.sleep(1.0)  # into the work (loading, contacts, blocking); any moment must do
+    marker = tmp_path / "working"
+    setup = WORKING.format(marker=str(marker))
+    child = start(["plan", str(wall), "--json"], tmp_path, setup=setup)
+    wait_for(lambda: marker.exists() or child.poll() is not None, "the planner at work")
     code, err, seconds = interrupt(child)
     assert code == INTERRUPTED == 130
     assert err.strip() == "assemblykit: interrupted"
@@ -161,7 +178,7 @@ tasks.load_task = loud
 
 def test_runtime_warnings_reach_stderr_only_with_debug(tmp_path: Path) -> None:
     task = Path(__file__).resolve().parents[1] / "src/assemblykit/examples/tasks/four_bar.yaml"
-    runs = {}
+    runs: dict[bool, str] = {}
     for extra in ([], ["--debug"]):
         child = start(["solve", str(task), "--json", *extra], tmp_path, setup=LOUD_LOAD)
         out, err = child.communicate(timeout=120)

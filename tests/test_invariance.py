@@ -143,6 +143,7 @@ def mating_size(document: dict[str, Any]) -> float:
     return float(np.linalg.norm(cloud.max(axis=0) - cloud.min(axis=0)))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("source", MATING, ids=lambda p: p.stem)
 def test_mating_answers_survive_jitter_and_scaling(capsys, tmp_path, source):
     document = yaml.safe_load(source.read_text(encoding="utf-8"))

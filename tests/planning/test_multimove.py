@@ -185,6 +185,7 @@ def test_plan_command_moves_multi(capsys):
     assert code == 2 and "convex pieces" in err
 
 
+@pytest.mark.slow
 def test_plan_command_on_burrtools_files_compares_with_the_stored_level(capsys):
     pelikan = str(dataset("burrtools/PelikanBurr.xmpuzzle"))
     code, out, err = run(capsys, "plan", pelikan, "--moves", "multi", "--json")
@@ -277,6 +278,7 @@ def has_monotone_plan(voxels: list[np.ndarray]) -> bool:
     return apart(tuple(range(len(voxels))))
 
 
+@pytest.mark.slow
 def test_every_six_piece_burr_comes_apart_at_the_level_burrtools_stores():
     path = dataset("burrtools/SolidSixPieceBurrs.xmpuzzle")
     assert solution_count(path) == 314

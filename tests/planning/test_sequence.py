@@ -286,6 +286,7 @@ def test_interlocked_rings_are_stuck():
     assert result.and_or is not None and result.and_or.plans == 0
 
 
+@pytest.mark.slow
 def test_crossvault_plan_takes_all_184_blocks_apart():
     assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
     result = plan(assembly)
@@ -426,6 +427,7 @@ def test_plan_blocking_and_motion_agree_that_the_ball_joint_ball_lifts_out():
     ("path", "directions"),
     [(DEMO, None), (dataset("compas_assembly/crossvault_assembly.json"), 4)],
 )
+@pytest.mark.slow
 def test_groups_found_from_infinitesimal_sinks_are_the_extended_dbgs_sinks(path, directions):
     # the minimal sets free in Γ_t and Γ_e that leave the base, found as closures of
     # Γ_t's sink components, are the sink components of the union of the whole DBGs,

@@ -136,6 +136,7 @@ def test_the_least_residual_balance_names_every_equation_some_optimum_leaves_unb
     assert np.abs(unique).max() < LP_FEASIBILITY
 
 
+@pytest.mark.slow
 def test_local_verdicts_are_those_of_the_whole_program_on_a_vault_taken_down():
     """The cross vault taken down from its highest block, one block at a time: at each
     state and two friction coefficients, also with its highest block held, the verdict
