@@ -61,6 +61,7 @@ PUBLIC_NAMES: tuple[str, ...] = (
     "assemblykit.planning.planner",
     "assemblykit.render.render",
     # errors and input limits (README.md, docs/architecture.md, docs/tutorial.md)
+    "assemblykit.deprecation.moved",
     "assemblykit.errors.AssemblyKitError",
     "assemblykit.errors.InputError",
     "assemblykit.errors.TaskSyntaxError",

@@ -57,7 +57,7 @@ from assemblykit.blocking.directions import (
 )
 from assemblykit.blocking.extended import extended_arcs
 from assemblykit.deprecation import moved
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance, order_key
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
@@ -507,8 +507,11 @@ def _free_closures(
 
 
 def base_part(members: int, volumes: Sequence[float]) -> int:
-    """The heaviest part of ``members``: it stays, everything else leaves it."""
-    return max(bits(members), key=lambda i: (volumes[i], -i))
+    """The heaviest part of ``members`` (to :data:`~assemblykit.tolerance.ORDER_RESOLUTION`
+    of the largest volume; the lowest index of equals): it stays, everything else leaves
+    it."""
+    scale = max(volumes[i] for i in bits(members))
+    return max(bits(members), key=lambda i: (order_key(volumes[i], scale), -i))
 
 
 def _removal(sinks: list[int], members: int, volumes: Sequence[float]) -> list[int]:
@@ -611,14 +614,17 @@ def _best_direction(
         if sinks:
             return previous, sinks
 
+    # directions compared to ORDER_RESOLUTION: mirror images rank alike, by index
+    levels = np.round(translations.directions / ORDER_RESOLUTION)
+
     def rank(k: int, moved: int) -> tuple[float, ...]:
-        direction = translations.directions[k]
+        direction = levels[k]
         return (moved, float(np.abs(direction).max()), float(direction[2]), -k)
 
     # the candidates by decreasing rank, sorted on arrays (tens of thousands on the dome)
     keys = np.fromiter(bounds, dtype=np.int64, count=len(bounds))
     moved = np.fromiter(bounds.values(), dtype=np.int64, count=len(bounds))
-    directions = translations.directions[keys]
+    directions = levels[keys]
     order = np.lexsort((keys, -directions[:, 2], -np.abs(directions).max(axis=1), -moved))
     best: tuple[tuple[float, ...], int, list[int]] | None = None
     patience = LOOK_AHEAD

@@ -63,7 +63,7 @@ from scipy.sparse.csgraph import connected_components
 
 from assemblykit.errors import InputError, NumericError
 from assemblykit.geometry.contacts import assembly_contacts
-from assemblykit.tolerance import MIN_REL_LENGTH, Tolerance
+from assemblykit.tolerance import MIN_REL_LENGTH, Tolerance, order_key
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
@@ -474,6 +474,9 @@ class EquilibriumModel:
     point_parts: NDArray[np.int64]
     corners: NDArray[np.bool_]
     heights: NDArray[np.float64]
+    offsets: NDArray[np.float64]
+    """Each centre's distance from the vertical through the middle of the assembly's
+    bounds (what orders parts of equal height: :attr:`levels`)."""
     fixed: tuple[str, ...]
     friction: float
     threshold: float
@@ -501,6 +504,23 @@ class EquilibriumModel:
 
     def __post_init__(self) -> None:
         self._index.update({name: i for i, name in enumerate(self.names)})
+
+    @cached_property
+    def levels(self) -> NDArray[np.int64]:
+        """The parts in the order in which they are taken down (a rank each): the highest
+        first, and of equal heights the nearest the middle (a keystone before its
+        corbels), both compared by :func:`order_key` at the scale of the assembly, so
+        that mirror images are equal whatever the rounding (then by index)."""
+        if not len(self.heights):
+            return np.zeros(0, dtype=np.int64)
+        scale = float(np.ptp(self.heights) + self.offsets.max())
+        keys = [
+            (order_key(float(h), scale), order_key(float(r), scale), i)
+            for i, (h, r) in enumerate(zip(self.heights, self.offsets, strict=True))
+        ]
+        ranks = np.empty(len(keys), dtype=np.int64)
+        ranks[[i for *_, i in sorted(keys)]] = np.arange(len(keys))
+        return ranks
 
     @property
     def resolution(self) -> float:
@@ -906,6 +926,7 @@ def equilibrium_model(
         point_parts=ends,
         corners=found.corners,
         heights=centres @ down,
+        offsets=np.linalg.norm(np.cross(centres - origin, down), axis=1),
         fixed=tuple(fixed) if fixed is not None else lowest_parts(assembly, down, tol),
         friction=float(friction),
         threshold=max(tol.rel_length, LP_FEASIBILITY),
@@ -1075,7 +1096,7 @@ class StateJudge:
             return held, self.stands(present, fixed)
         now = self.falling(present, fixed)
         while now.any() and int(held.sum()) < budget:
-            top = min(np.flatnonzero(now), key=lambda i: (self.model.heights[i], i))
+            top = min(np.flatnonzero(now), key=lambda i: (int(self.model.levels[i]), i))
             held[top] = True
             if int(held.sum()) == budget:
                 return held, self.stands(present, fixed | held)
@@ -1122,11 +1143,12 @@ class StateJudge:
         return found
 
     def ordered(self, sets: list[int]) -> list[int]:
-        """Fewest parts first, then the highest (a set's highest centre), then index."""
+        """Fewest parts first, then the highest (a set's highest centre, to
+        :data:`~assemblykit.tolerance.ORDER_RESOLUTION`), then index."""
 
-        def key(mask: int) -> tuple[int, float, int]:
+        def key(mask: int) -> tuple[int, int, int]:
             inside = self.vector(mask)
-            return (int(inside.sum()), float(self.model.heights[inside].min()), mask)
+            return (int(inside.sum()), int(self.model.levels[inside].min()), mask)
 
         return sorted(sets, key=key)
 

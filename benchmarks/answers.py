@@ -1,0 +1,89 @@
+"""The JSON answers of every bundled example, one file each, for comparing installs.
+
+Run ``python benchmarks/answers.py OUT`` with one install, again with another, then
+``diff -r OUT1 OUT2``: plans, verdicts and poses must be identical (the deterministic
+ordering rule of docs/architecture.md, "Tolerances"). Keys that measure the run rather
+than the answer (times, versions) are left out. CI compares the newest and the lowest
+dependency versions that pyproject.toml allows.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from importlib.resources import files
+from pathlib import Path
+from typing import Any
+
+EXAMPLES = Path(str(files("assemblykit") / "examples"))
+DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
+
+VOLATILE = {"seconds", "elapsed", "time", "times", "version", "timings"}
+"""Keys about the run, not the answer."""
+
+
+def jobs() -> list[tuple[str, list[str]]]:
+    """(output name, command arguments) for every bundled example."""
+    found: list[tuple[str, list[str]]] = []
+    for task in sorted((EXAMPLES / "tasks").glob("*.*")):
+        found.append((f"solve_{task.name}", ["solve", str(task)]))
+    for problem in sorted((EXAMPLES / "mating").glob("*.yaml")):
+        found.append((f"mate_{problem.name}", ["mate", str(problem)]))
+    for folder in sorted(p for p in (EXAMPLES / "motion").iterdir() if p.is_dir()):
+        for spec in sorted(folder.glob("*.yaml")):
+            found.append((f"motion_{folder.name}_{spec.name}", ["motion", str(spec)]))
+    for shape in sorted((EXAMPLES / "planar").glob("*.yaml")):
+        found.append((f"plan_{shape.name}", ["plan", str(shape)]))
+    gearbox = str(EXAMPLES / "gearbox_demo" / "gearbox.yaml")
+    found.append(("plan_gearbox", ["plan", gearbox]))
+    found.append(("contacts_gearbox", ["contacts", gearbox]))
+    for puzzle in sorted((EXAMPLES / "puzzles").iterdir()):
+        found.append((f"plan_{puzzle.name}", ["plan", str(puzzle), "--moves", "multi"]))
+    arch = DATA / "compas_assembly" / "arch_assembly.json"
+    stack = DATA / "compas_assembly" / "stack_assembly.json"
+    found.append(("plan_arch", ["plan", str(arch)]))
+    found.append(("plan_arch_gravity_3", ["plan", str(arch), "--gravity", "--holds", "3"]))
+    found.append(("plan_stack_gravity", ["plan", str(stack), "--gravity"]))
+    found.append(("plan_beam", ["plan", str(DATA / "asap_beam_assembly")]))
+    return found
+
+
+DIGITS = 6
+"""Decimals kept of every number: the precision real data is written to (a pose computed
+in another order of summation differs in its last bits, not in these)."""
+
+
+def stripped(value: Any) -> Any:
+    """``value`` without the :data:`VOLATILE` keys, at any depth, its numbers rounded to
+    :data:`DIGITS` decimals (and -0 written 0)."""
+    if isinstance(value, dict):
+        return {k: stripped(v) for k, v in value.items() if k not in VOLATILE}
+    if isinstance(value, list):
+        return [stripped(v) for v in value]
+    if isinstance(value, float):
+        return round(value, DIGITS) + 0.0
+    return value
+
+
+def main() -> None:
+    out = Path(sys.argv[1])
+    out.mkdir(parents=True, exist_ok=True)
+    for name, argv in jobs():
+        run = subprocess.run(
+            [sys.executable, "-m", "assemblykit", *argv, "--json"],
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+        try:
+            answer = stripped(json.loads(run.stdout))
+        except json.JSONDecodeError:
+            answer = {"exit": run.returncode, "stderr": run.stderr.strip().splitlines()[-1:]}
+        text = json.dumps(answer, indent=1, sort_keys=True)
+        (out / f"{name}.json").write_text(text + "\n", encoding="utf-8")
+        print(f"{name:<40} exit {run.returncode}")
+
+
+if __name__ == "__main__":
+    main()
