@@ -12,12 +12,13 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-from importlib.resources import files
 from pathlib import Path
 from typing import Any
 
-EXAMPLES = Path(str(files("assemblykit") / "examples"))
-DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "src" / "assemblykit" / "examples"
+DATA = ROOT / "tests" / "data"
+"""The files of this checkout, whichever install runs them (their paths are in answers)."""
 
 VOLATILE = {"seconds", "elapsed", "time", "times", "version", "timings"}
 """Keys about the run, not the answer."""
