@@ -15,7 +15,9 @@ run each, loading and contacts excluded unless said; the machine is named first)
   balance it last found instead);
 * plans with gravity: the ASAP beam (also without gravity) and the COMPAS arch with three
   holds, each followed by the time of the stability work alone: assembling the
-  equations and checking every state of the plan once; the cross vault's first 20
+  equations and checking every state of the plan once, the programs the plan solved,
+  and every state's verdict decided again by a fresh model's whole program on every
+  polygon vertex (an independent check); the cross vault's first 20
   steps with three holds, with the programs they ran; its whole plan with one hold only
   with ``--crossvault-plan`` (minutes: from step 40 on no single block's removal
   stands, and each step then asks which parts would fall).
@@ -26,11 +28,13 @@ The dome is skipped unless ``$ASSEMBLYKIT_DATA`` holds
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import os
 import platform
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import clarabel
@@ -39,7 +43,9 @@ import scipy
 
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io.assembly import load_assembly
+from assemblykit.model.assembly import Assembly
 from assemblykit.planning.planner import plan
+from assemblykit.planning.sequence import Plan
 from assemblykit.planning.stability import CONE_SIDES, EquilibriumModel, Gravity, equilibrium_model
 from assemblykit.tolerance import Tolerance
 from datasets import dataset
@@ -81,23 +87,69 @@ def whole(name: str, path: Path | None, tol: Tolerance | None = None) -> bool | 
     return found.stands
 
 
+@contextlib.contextmanager
+def counting_programs() -> Iterator[dict[str, int]]:
+    """Count the first programs (``stands``) and slack programs a model solves inside
+    the block."""
+    counts = {"stands": 0, "slack": 0}
+    originals = {name: getattr(EquilibriumModel, name) for name in counts}
+
+    def counted(name: str) -> Callable[..., object]:
+        def call(self: EquilibriumModel, *args: object, **kwargs: object) -> object:
+            counts[name] += 1
+            return originals[name](self, *args, **kwargs)
+
+        return call
+
+    for name in counts:
+        setattr(EquilibriumModel, name, counted(name))
+    try:
+        yield counts
+    finally:
+        for name, method in originals.items():
+            setattr(EquilibriumModel, name, method)
+
+
+def checked_verdicts(assembly: Assembly, result: Plan, tol: Tolerance | None) -> str:
+    """Each state of a plan under gravity decided again by a fresh model's whole program
+    on every polygon vertex (none of the plan's shortcuts), with the parts it holds: how
+    many verdicts agree, and the steps that do not."""
+    model = equilibrium_model(assembly, tol=tol)
+    every = dataclasses.replace(model, corners=np.ones_like(model.corners))
+    fixed = every.mask(every.fixed)
+    wrong = []
+    for number, step in enumerate(result.steps, start=1):
+        assert step.stability is not None
+        rest = every.mask(step.rest)
+        held = rest & (fixed | every.mask(step.stability.held))
+        if every.stands(rest, held, local=False) is not step.stability.stands:
+            wrong.append(number)
+    agree = len(result.steps) - len(wrong)
+    return f"{agree} of {len(result.steps)} verdicts agree" + (f" (not: {wrong})" if wrong else "")
+
+
 def planned(
     name: str, path: Path | None, gravity: Gravity | None, tol: Tolerance | None = None
 ) -> None:
-    """Time a plan (contacts included) with or without gravity."""
+    """Time a plan (contacts included) with or without gravity, count the programs it
+    solved, and under gravity check every state's verdict independently."""
     if path is None:
         print(f"{name:<24} skipped (not bundled; set ASSEMBLYKIT_DATA)")
         return
     assembly = load_assembly(path)
     start = time.perf_counter()
-    result = plan(assembly, tol, gravity=gravity, max_and_or_parts=0)
+    with counting_programs() as counts:
+        result = plan(assembly, tol, gravity=gravity, max_and_or_parts=0)
     seconds = time.perf_counter() - start
     verdict = "no gravity"
     if result.gravity is not None:
         holds = max((len(s.stability.held) for s in result.steps if s.stability), default=0)
         standing = sum(bool(s.stability and s.stability.stands) for s in result.steps)
         stable = "every state stands" if result.gravity.stable else "some states fall"
-        verdict = f"{stable} ({standing} steps stand), at most {holds} held"
+        verdict = (
+            f"{stable} ({standing} steps stand), at most {holds} held; "
+            f"{counts['stands']} first programs, {counts['slack']} slack programs"
+        )
     steps = len(result.steps)
     print(f"{name:<24} {len(result.parts):>4} parts {seconds:8.3f} s  {steps} steps, {verdict}")
     if result.gravity is not None:
@@ -117,44 +169,19 @@ def planned(
             model.stands(rest, rest & (fixed | model.mask(step.stability.held)), local=False)
         seconds = time.perf_counter() - start
         print(f"{'':<24} one first program per state, solved whole: {seconds:.3f} s")
-
-
-class _Enough(Exception):
-    """Raised from the progress callback to stop a plan after some steps."""
+        print(f"{'':<24} independent check: {checked_verdicts(assembly, result, tol)}")
 
 
 def first_steps(path: Path | None, steps: int, tol: Tolerance) -> None:
     """Time the first ``steps`` steps of the cross vault's plan with gravity and three
-    holds (contacts included), stopped from the progress callback, and count the
-    programs they ran."""
+    holds (contacts included; ``max_steps``), and count the programs they ran."""
     if path is None:
         print(f"{'crossvault states':<24} skipped (not bundled; set ASSEMBLYKIT_DATA)")
         return
-    counts = {"stands": 0, "slack": 0}
-    originals = {name: getattr(EquilibriumModel, name) for name in counts}
-
-    def counted(name: str) -> Callable[..., object]:
-        def call(self: EquilibriumModel, *args: object, **kwargs: object) -> object:
-            counts[name] += 1
-            return originals[name](self, *args, **kwargs)
-
-        return call
-
-    def progress(stage: str, done: int, total: int) -> None:
-        if stage == "planning" and done >= steps:
-            raise _Enough
-
     assembly = load_assembly(path)
-    for name in counts:
-        setattr(EquilibriumModel, name, counted(name))
     start = time.perf_counter()
-    try:
-        plan(assembly, tol, 0, progress, gravity=Gravity(holds=3))
-    except _Enough:
-        pass
-    finally:
-        for name, method in originals.items():
-            setattr(EquilibriumModel, name, method)
+    with counting_programs() as counts:
+        plan(assembly, tol, 0, gravity=Gravity(holds=3), max_steps=steps)
     seconds = time.perf_counter() - start
     label = f"crossvault, first {steps}"
     print(

@@ -450,6 +450,12 @@ def _gravity(
     "[default: the parts touching the lowest plane].",
 )
 @click.option("--one-at-a-time", is_flag=True, help="Move one free set (a part) per step.")
+@click.option(
+    "--max-steps",
+    type=click.IntRange(min=0),
+    default=None,
+    help="Stop after this many steps; the parts not yet taken apart are listed as unfinished.",
+)
 @json_option
 @tolerance_option
 @as_written_option
@@ -471,6 +477,7 @@ def plan_cmd(
     holds: int,
     fixed: tuple[str, ...],
     one_at_a_time: bool,
+    max_steps: int | None,
     as_json: bool,
     tolerance: float | None,
     as_written: bool,
@@ -487,8 +494,10 @@ def plan_cmd(
 
     if moves != "monotone" and (html is not None or png is not None):
         raise InputError(f"--html and --png draw translation plans: not with --moves {moves}")
-    if moves != "monotone" and (gravity is not None or one_at_a_time):
-        raise InputError(f"--gravity and --one-at-a-time plan translations, not --moves {moves}")
+    if moves != "monotone" and (gravity is not None or one_at_a_time or max_steps is not None):
+        raise InputError(
+            f"--gravity, --one-at-a-time and --max-steps plan translations, not --moves {moves}"
+        )
 
     if html is not None:
         checked_output(html, "--html", HTML_SUFFIXES)
@@ -526,6 +535,7 @@ def plan_cmd(
                 max_hands=max_hands,
                 gravity=_gravity(gravity, friction, holds, fixed),
                 one_at_a_time=one_at_a_time,
+                max_steps=max_steps,
             )
             if html is not None:
                 from assemblykit.viz.viewer import write_report

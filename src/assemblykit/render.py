@@ -262,6 +262,8 @@ def _assembly_table(plan: Plan) -> Table:
 
 def _disassembly_table(plan: Plan) -> Table:
     title = "feasible" if plan.feasible else "infeasible"
+    if plan.unfinished:
+        title = f"stopped at its step limit, {fmt.count(len(plan.unfinished), 'part')} left"
     if plan.and_or is not None:
         title += f", {plan.and_or.plans} plan(s) in the AND/OR graph"
     if plan.gravity is not None:
@@ -283,6 +285,8 @@ def _disassembly_table(plan: Plan) -> Table:
         if step.stability is not None:
             cells += step.stability.cells()
         table.add_row(*cells)
+    if plan.unfinished:
+        table.add_row("-", fmt.name_list(plan.unfinished), "-", "not yet taken apart", "-")
     for lock in plan.interlocked:
         freed = "rigid motion may free" if lock.rigid_may_free else "locked"
         table.add_row("-", ", ".join(lock.parts), "-", f"interlocked ({freed})", "-")

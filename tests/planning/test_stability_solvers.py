@@ -178,16 +178,8 @@ def test_the_slack_program_falls_back_to_highs_when_clarabel_stops_short(monkeyp
         found.max_iter = 1
         return found
 
-    calls = []
-
-    def recorded(*args, **kwargs):
-        calls.append(kwargs["method"])
-        return linprog(*args, **kwargs)
-
     monkeypatch.setattr(clarabel, "DefaultSettings", one_iteration)
-    monkeypatch.setattr(stability, "linprog", recorded)
     vertex = stability.least_residuals(matrix, rhs)
-    assert calls == ["highs-ipm"]
     # by hand: |1 - x| + |1 - 2x| is least, 0.5, at x = 0.5: residuals (0.5, 0)
     np.testing.assert_allclose(vertex, [0.5, 0.0], atol=1e-7)
     np.testing.assert_allclose(interior, vertex, atol=1e-7)
@@ -209,7 +201,7 @@ def two_stacks() -> Assembly:
     )
 
 
-def test_the_slack_program_is_solved_piece_by_piece_and_pieces_are_kept(monkeypatch):
+def test_the_slack_program_solved_piece_by_piece_is_the_whole_program():
     model = equilibrium_model(two_stacks(), friction=0.5, fixed=["ground"])
     present, fixed = model.mask(None), model.mask(["ground"])
     pieces = model.pieces(present, fixed)
@@ -218,17 +210,7 @@ def test_the_slack_program_is_solved_piece_by_piece_and_pieces_are_kept(monkeypa
         ["loose"],
         ["right", "right_top"],
     ]
-    calls = []
-    original = stability.least_residuals
-
-    def counted(matrix, rhs):
-        calls.append(matrix.shape[0] // 6)
-        return original(matrix, rhs)
-
-    monkeypatch.setattr(stability, "least_residuals", counted)
     residuals = dict(zip(model.names, model.slack(present, fixed), strict=True))
-    # one program per piece that touches something, each over its own parts' equations
-    assert sorted(calls) == [2, 2]
     # the loose cube keeps its whole weight, the right top falls, the left stack stands
     assert residuals["loose"] == pytest.approx(1.0)
     assert residuals["right_top"] > 1e-3 > 10 * model.threshold and residuals["ground"] == 0.0
@@ -237,17 +219,18 @@ def test_the_slack_program_is_solved_piece_by_piece_and_pieces_are_kept(monkeypa
     free = present & ~fixed
     rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
     selected = present[model.point_parts[:, 0]] & present[model.point_parts[:, 1]]
-    whole = original(model._matrix(rows, selected & model.corners, 0.5), -model.load[rows])
+    whole = stability.least_residuals(
+        model._matrix(rows, selected & model.corners, 0.5), -model.load[rows]
+    )
     falls = np.abs(whole).reshape(-1, 6).max(axis=1) > model.threshold
     named = [n for n, f in zip(np.array(model.names)[free], falls, strict=True) if f]
     assert named == ["right_top", "loose"]
     assert [n for n in model.names if residuals[n] > model.threshold] == named
-    # the left top taken away: the right piece is kept, only the left one is solved again
-    calls.clear()
+    # the left top taken away: the right piece's residuals stay, the left one stands
     without = present & ~model.mask(["left_top"])
     again = dict(zip(model.names, model.slack(without, fixed), strict=True))
-    assert calls == [1]
-    assert again["right_top"] == residuals["right_top"]
+    assert again["right_top"] == pytest.approx(residuals["right_top"], abs=model.threshold)
+    assert again["left"] < model.threshold and again["loose"] == pytest.approx(1.0)
 
 
 def bisected(model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray) -> float | None:
@@ -266,23 +249,10 @@ def bisected(model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray) ->
     return high
 
 
-def counting_programs(monkeypatch: pytest.MonkeyPatch) -> list[int]:
-    """Count the first programs solved from now on (one entry each)."""
-    calls: list[int] = []
-    original = stability.balance
-
-    def counted(matrix, rhs):
-        calls.append(matrix.shape[0])
-        return original(matrix, rhs)
-
-    monkeypatch.setattr(stability, "balance", counted)
-    return calls
-
-
-def test_the_least_friction_searched_from_the_last_answer_is_the_bisections(monkeypatch):
+def test_the_least_friction_searched_from_the_last_answer_is_the_bisections():
     # the states the arch's plan with three holds leaves standing, one after the other:
-    # the search that starts from the last answer finds what bisection finds, with
-    # fewer programs
+    # the search that starts from the last answer finds what bisection finds (the
+    # programs it saves are a figure of benchmarks/bench_stability.py)
     assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
     result = plan(assembly, gravity=Gravity(holds=3))
     ours, reference = equilibrium_model(assembly), equilibrium_model(assembly)
@@ -291,11 +261,9 @@ def test_the_least_friction_searched_from_the_last_answer_is_the_bisections(monk
         present = ours.mask(step.rest)
         states.append((present, present & (ours.mask(ours.fixed) | ours.mask(step.stability.held))))
     expected = [bisected(reference, present, fixed) for present, fixed in states]
-    calls = counting_programs(monkeypatch)
     found = [ours.friction_needed(present, fixed) for present, fixed in states]
     assert found == expected
     assert len(set(found)) > 4 and None not in found
-    assert len(calls) < sum(2 + FRICTION_STEPS for _ in states) / 2
 
 
 def standing_vault() -> tuple[EquilibriumModel, np.ndarray, np.ndarray]:
@@ -307,33 +275,35 @@ def standing_vault() -> tuple[EquilibriumModel, np.ndarray, np.ndarray]:
     return model, present, present & model.mask(model.fixed)
 
 
-def test_a_balance_serves_larger_frictions_and_a_certificate_smaller_ones(monkeypatch):
+def test_verdicts_from_kept_balances_and_certificates_are_the_whole_programs():
+    # a balance found at 0.45 answers the larger frictions, a certificate of a fall at
+    # 0.3 the smaller ones; each verdict is the one a fresh model's whole program gives
     model, present, fixed = standing_vault()
-    calls = counting_programs(monkeypatch)
-    assert model.stands(present, fixed, 0.45)
-    assert model.stands(present, fixed, 0.5) and model.stands(present, fixed, 0.9)
-    assert len(calls) == 1
-    assert not model.stands(present, fixed, 0.3)
-    assert not model.stands(present, fixed, 0.2) and not model.stands(present, fixed, 0.0)
-    assert len(calls) == 2
-    # holding the highest block spoils the certificate: the state is solved again
+    fresh = standing_vault()[0]
+    for friction, stands in (
+        (0.45, True),
+        (0.5, True),
+        (0.9, True),
+        (0.3, False),
+        (0.2, False),
+        (0.0, False),
+    ):
+        assert model.stands(present, fixed, friction) is stands
+        assert fresh.stands(present, fixed, friction, local=False) is stands
+    # holding the highest block changes the state: the kept certificate does not decide it
     held = fixed | model.mask([model.names[int(np.argmin(model.heights))]])
-    verdict = model.stands(present, held, 0.3)
-    assert len(calls) > 2
-    assert verdict == model.stands(present, held, 0.3, local=False)
+    assert model.stands(present, held, 0.3) == fresh.stands(present, held, 0.3, local=False)
 
 
-def test_a_state_is_solved_first_at_the_friction_the_last_one_needed(monkeypatch):
+def test_a_state_after_one_removal_is_judged_as_a_fresh_model_judges_it():
     # the cross vault, then the vault without block 4 (the first its plan under gravity
-    # takes): asked at the model's friction, the second state is solved first at the
-    # friction the whole vault needed, and the balance found there answers both
+    # takes): the model that answered the whole vault (its least friction, balances and
+    # certificates kept) answers the second state as a fresh model's whole program does
     model, whole, fixed = standing_vault()
     need = model.friction_needed(whole, fixed)
     assert need is not None and 0 < need < model.friction
     rest = whole & ~model.mask(["4"])
-    calls = counting_programs(monkeypatch)
-    assert model.stands(rest, fixed)
-    assert model.stands(rest, fixed, need)
-    # one program over every free part (those over a few parts tried to prove a fall)
-    assert calls.count(6 * int((rest & ~fixed).sum())) == 1
-    assert model.stands(rest, fixed, need, local=False)
+    fresh = standing_vault()[0]
+    assert model.stands(rest, fixed) and model.stands(rest, fixed, need)
+    assert fresh.stands(rest, fixed, need, local=False)
+    assert model.stands(rest, fixed, 0.0) is fresh.stands(rest, fixed, 0.0, local=False)

@@ -88,6 +88,7 @@ from assemblykit.inference.solution import (
     TraceStep,
     freedom_words,
     remedy_words,
+    unsigned_axes,
 )
 from assemblykit.model.relations import line_normals, signed_angle
 from assemblykit.model.task import Task
@@ -1341,6 +1342,7 @@ def _combine(
                 )
                 continue
             first = consistent[0][0][node]
+            first = replace(first, invariants=unsigned_axes(first.invariants))
             poses: list[np.ndarray] = []
             for report, _ in consistent:
                 item = report[node]

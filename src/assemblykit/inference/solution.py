@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from assemblykit.algebra import Kind
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance
 
 
 class Status(StrEnum):
@@ -53,6 +53,27 @@ MOTIONS: tuple[str, ...] = (*Kind, MECHANISM)
 and :data:`MECHANISM`."""
 
 INVARIANT_KEYS = ("point", "direction", "normal", "center", "pitch")
+
+UNSIGNED_KEYS = ("direction", "normal")
+"""The invariants whose sign says nothing: a slide along ``u`` is the slide along
+``-u``, a turn or screw about ``u`` the one about ``-u`` (same pitch), a plane's motions
+those of its flipped normal (:func:`unsigned_axes`)."""
+
+
+def unsigned_axes(invariants: Mapping[str, Any]) -> dict[str, Any]:
+    """``invariants`` with each unsigned direction (:data:`UNSIGNED_KEYS`) turned so that
+    its first component larger than :data:`~assemblykit.tolerance.ORDER_RESOLUTION` of
+    its length is positive: the deterministic sign of docs/architecture.md,
+    "Tolerances" (``(0, -1, 0)`` and ``(1e-32, 1, 0)`` both become ``(0, 1, 0)``'s sign)."""
+    out = dict(invariants)
+    for key in UNSIGNED_KEYS:
+        if key not in out:
+            continue
+        vector = np.asarray(out[key], dtype=np.float64)
+        large = np.flatnonzero(np.abs(vector) > ORDER_RESOLUTION * np.linalg.norm(vector))
+        if len(large) and vector[large[0]] < 0:
+            out[key] = -vector + 0.0
+    return out
 
 
 def _plain(value: Any) -> Any:

@@ -70,11 +70,14 @@ def planar_tables(
     )
 
 
-def planar_search(model: PolygonAssembly, tol: Tolerance, report: Progress) -> Search:
+def planar_search(
+    model: PolygonAssembly, tol: Tolerance, report: Progress, max_steps: int | None = None
+) -> Search:
     """The planner's search over a polygon assembly, run: Γ_t bounds and Γ_e accepts
-    along every region of the common arrangement (:func:`planar_tables`)."""
+    along every region of the common arrangement (:func:`planar_tables`), stopping after
+    ``max_steps`` steps when given."""
     translations, extended, volumes = planar_tables(model, tol)
-    search = Search(translations, extended, volumes, report, [], [])
+    search = Search(translations, extended, volumes, report, [], [], max_steps=max_steps)
     search.disassemble(mask_of(range(len(translations.names))))
     return search
 

@@ -12,7 +12,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
-from assemblykit.blocking.directions import DirectionTable, bits, mask_of
+from assemblykit.blocking.directions import DirectionTable, bits, mask_of, union_of
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.tables import translation_slots, translation_table
@@ -63,6 +63,7 @@ def plan(
     *,
     gravity: Gravity | None = None,
     one_at_a_time: bool = False,
+    max_steps: int | None = None,
 ) -> Plan:
     """Plan the disassembly of ``assembly`` by extended translations (seed 004).
 
@@ -80,7 +81,12 @@ def plan(
     moved set, held at its base) stands with at most ``gravity.holds`` parts held; when
     no step does, the one leaving the fewest parts falling is taken and reported as not
     standing.
+
+    ``max_steps`` stops the search after that many steps: the parts not yet taken
+    apart are the plan's ``unfinished`` ones, and the plan is not feasible.
     """
+    if max_steps is not None and max_steps < 0:
+        raise InputError(f"max_steps must be 0 or more, not {max_steps}")
     tol = assembly.tolerance(tol)
     names = tuple(assembly.names)
     report: Progress = progress or (lambda stage, done, total: None)
@@ -89,7 +95,7 @@ def plan(
         if gravity is not None or one_at_a_time:
             raise InputError("--gravity and --one-at-a-time need 3D parts, not 2D polygons")
 
-        planar = planar_search(assembly, tol, report)
+        planar = planar_search(assembly, tol, report, max_steps)
         return finish_plan(assembly, planar, tol, max_and_or_parts, max_hands, report)
     translations = translation_table(assembly, tol)
     extended = ExtendedDirections(assembly, translations.directions, tol)
@@ -104,6 +110,7 @@ def plan(
         exact_candidates(assembly, tol),
         translation_slots(assembly, translations, tol),
         (one_set,) if one_at_a_time else (),
+        max_steps=max_steps,
     )
     if gravity is None:
         search.disassemble(mask_of(range(len(names))))
@@ -221,7 +228,16 @@ def finish_plan(
     elif search.locked:
         hands = Hands(None, max_hands)
     report("done", len(names), len(names))
-    return Plan(names, tuple(search.steps), interlocks, and_or, len(translations.directions), hands)
+    unfinished = tuple(names[i] for i in bits(union_of(search.unfinished)))
+    return Plan(
+        names,
+        tuple(search.steps),
+        interlocks,
+        and_or,
+        len(translations.directions),
+        hands,
+        unfinished=unfinished,
+    )
 
 
 def _interlock(

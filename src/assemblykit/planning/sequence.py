@@ -37,7 +37,7 @@ every two-handed partition accepted by Γ_e is built too, and its plans are coun
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -335,11 +335,15 @@ class Plan:
     gravity: GravityReport | None = None
     """Set when planned under gravity: the settings, whether the whole assembly stands
     and whether every state of the plan stands with its holds."""
+    unfinished: tuple[str, ...] = ()
+    """The parts not yet taken apart when the plan stopped at its step limit
+    (``max_steps`` of :func:`assemblykit.planning.planner.plan`): neither separated nor
+    shown stuck."""
 
     @property
     def feasible(self) -> bool:
         """True when every part is separated by the steps."""
-        return not self.interlocked
+        return not self.interlocked and not self.unfinished
 
     @property
     def stuck(self) -> tuple[str, ...]:
@@ -399,12 +403,19 @@ class Plan:
             "hands": None if self.hands is None else self.hands.to_dict(),
             "assembly_steps": [step.to_dict() for step in self.assembly_steps],
             "gravity": None if self.gravity is None else self.gravity.to_dict(),
+            "unfinished": list(self.unfinished),
         }
 
     def __repr__(self) -> str:
+        if self.unfinished:
+            verdict = f"stopped at its step limit, {fmt.count(len(self.unfinished), 'part')} left"
+        elif self.feasible:
+            verdict = "feasible"
+        else:
+            verdict = f"infeasible, stuck: {fmt.name_list(self.stuck)}"
         return fmt.summary(
             "Plan",
-            "feasible" if self.feasible else f"infeasible, stuck: {fmt.name_list(self.stuck)}",
+            verdict,
             fmt.count(len(self.steps), "step"),
             fmt.count(len(self.parts), "part"),
         )
@@ -664,6 +675,10 @@ class Search:
     ground: int = 0
     """Parts that stay where they are (fixed parts declared under gravity): a set holding
     nothing else is not taken apart."""
+    max_steps: int | None = None
+    """Stop after this many steps (``None``: go on until every set is apart or stopped)."""
+    unfinished: list[int] = field(default_factory=list)
+    """The sets not taken apart because :attr:`max_steps` was reached (bit masks)."""
 
     def _choose(self, members: int, previous: int | None) -> tuple[int, list[int]] | None:
         """The next removal from ``members``: each narrower in turn, then the same once
@@ -700,6 +715,9 @@ class Search:
         while pending:
             current = pending.pop()
             while several(current) and current & ~self.ground:
+                if self.max_steps is not None and len(self.steps) >= self.max_steps:
+                    self.unfinished.append(current)
+                    break
                 choice = self._choose(current, previous)
                 if choice is None:
                     self.locked.append(current)
