@@ -2,9 +2,9 @@
 
 Run ``python benchmarks/answers.py OUT`` with one install, again with another, then
 ``diff -r OUT1 OUT2``: plans, verdicts and poses must be identical (the deterministic
-ordering rule of docs/architecture.md, "Tolerances"). Keys that measure the run rather
-than the answer (times, versions) are left out. Known difference: the sign of the axis
-of a slide reported by ``solve`` (``triangle.rapt``: "+Y" or "-Y") is not yet canonical.
+ordering rule and the signs of docs/architecture.md, "Tolerances"). Keys that measure
+the run rather than the answer (times, versions) are left out. The commands run two at
+a time (one per core of a small machine).
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -67,23 +68,31 @@ def stripped(value: Any) -> Any:
     return value
 
 
+def answer(argv: list[str]) -> tuple[int, str]:
+    """The exit code of ``assemblykit ARGV --json`` and its answer as stable JSON text
+    (:func:`stripped`), or its last line on stderr when it printed no JSON."""
+    run = subprocess.run(
+        [sys.executable, "-m", "assemblykit", *argv, "--json"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    try:
+        found = stripped(json.loads(run.stdout))
+    except json.JSONDecodeError:
+        found = {"exit": run.returncode, "stderr": run.stderr.strip().splitlines()[-1:]}
+    return run.returncode, json.dumps(found, indent=1, sort_keys=True)
+
+
 def main() -> None:
     out = Path(sys.argv[1])
     out.mkdir(parents=True, exist_ok=True)
-    for name, argv in jobs():
-        run = subprocess.run(
-            [sys.executable, "-m", "assemblykit", *argv, "--json"],
-            capture_output=True,
-            text=True,
-            check=False,
-        )
-        try:
-            answer = stripped(json.loads(run.stdout))
-        except json.JSONDecodeError:
-            answer = {"exit": run.returncode, "stderr": run.stderr.strip().splitlines()[-1:]}
-        text = json.dumps(answer, indent=1, sort_keys=True)
-        (out / f"{name}.json").write_text(text + "\n", encoding="utf-8")
-        print(f"{name:<40} exit {run.returncode}")
+    named = jobs()
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        results = pool.map(answer, [argv for _, argv in named])
+        for (name, _), (code, text) in zip(named, results, strict=True):
+            (out / f"{name}.json").write_text(text + "\n", encoding="utf-8")
+            print(f"{name:<40} exit {code}")
 
 
 if __name__ == "__main__":

@@ -278,6 +278,20 @@ def has_monotone_plan(voxels: list[np.ndarray]) -> bool:
     return apart(tuple(range(len(voxels))))
 
 
+@pytest.mark.parametrize("solution", [0, 128, 256, 257, 290, 313])
+def test_a_sample_of_six_piece_burrs_comes_apart_at_the_stored_level(solution):
+    # solutions 257..313 have no monotone plan: each needs two moves for a separation
+    # (every one of the 314 is checked in the slow tier)
+    puzzle = load_puzzle(dataset("burrtools/SolidSixPieceBurrs.xmpuzzle"), solution=solution)
+    voxels = [p.voxels for p in puzzle.pieces]
+    result = plan_voxels(puzzle.names, voxels)
+    assert result.feasible and result.level == puzzle.level
+    replay(result, {p.name: p.voxels for p in puzzle.pieces})
+    monotone = solution < 257
+    assert has_monotone_plan(voxels) is monotone
+    assert (max(result.root.levels()) > 1) is not monotone
+
+
 @pytest.mark.slow
 def test_every_six_piece_burr_comes_apart_at_the_level_burrtools_stores():
     path = dataset("burrtools/SolidSixPieceBurrs.xmpuzzle")
