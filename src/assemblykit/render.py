@@ -288,8 +288,7 @@ def _disassembly_table(plan: Plan) -> Table:
     if plan.unfinished:
         table.add_row("-", fmt.name_list(plan.unfinished), "-", "not yet taken apart", "-")
     for lock in plan.interlocked:
-        freed = "rigid motion may free" if lock.rigid_may_free else "locked"
-        table.add_row("-", ", ".join(lock.parts), "-", f"interlocked ({freed})", "-")
+        table.add_row("-", ", ".join(lock.parts), "-", lock.reason, "-")
         if lock.held:
             table.add_row("-", ", ".join(lock.held), "-", "held by the interlock", "-")
     if plan.hands is not None and plan.hands.moves:

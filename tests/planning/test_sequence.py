@@ -33,6 +33,7 @@ from assemblykit.planning.sequence import (
     separable,
 )
 from datasets import dataset
+from stability_blocks import box
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
@@ -521,3 +522,19 @@ def test_parts_a_narrower_already_rejected_get_no_extended_blocking():
     assert _choose_removal(tab, Spy(), 0b1111, volumes, None, narrow) == (1, [0b0100])  # type: ignore[arg-type]
     assert tested == [0b0011, 0b0100]
     assert judged == {0b0001: False, 0b0010: False, 0b0100: True}
+
+
+def test_a_stopped_set_names_its_interfering_pairs_with_their_volumes():
+    # a peg 0.2 wide pressed 0.1 deep into the wall of a cup it sits in: no shape
+    # interlock holds it, their shared 0.2 x 0.1 x 1 block does
+    cup = trimesh.boolean.difference(
+        [box((3, 3, 2), (0, 0, 0)), box((1, 1, 2), (1, 1, 1))], engine="manifold"
+    )
+    peg = box((1.1, 0.2, 1), (1, 1.4, 1))
+    result = plan(Assembly([Part("cup", cup), Part("peg", peg)]), max_and_or_parts=0)
+    assert not result.feasible and set(result.stuck) == {"cup", "peg"}
+    (lock,) = result.interlocked
+    ((a, b, volume),) = lock.interfering
+    assert {a, b} == {"cup", "peg"} and volume == pytest.approx(0.1 * 0.2 * 1.0, rel=1e-9)
+    assert lock.reason.startswith("interfering (") and "0.02" in lock.reason
+    assert result.to_dict()["interlocked"][0]["interfering"][0]["volume"] == pytest.approx(0.02)

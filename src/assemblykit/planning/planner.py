@@ -17,6 +17,7 @@ from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.tables import translation_slots, translation_table
 from assemblykit.errors import InputError
+from assemblykit.geometry.interference import interferences
 from assemblykit.planning.hands import hands_needed
 from assemblykit.planning.planar import planar_rigid_may_free, planar_search
 from assemblykit.planning.sequence import (
@@ -249,11 +250,16 @@ def _interlock(
     tol: Tolerance,
 ) -> Interlock:
     parts = tuple(names[i] for i in bits(members))
+    held = tuple(names[i] for i in bits(locked & ~members))
+    interfering: tuple[tuple[str, str, float], ...] = ()
+    if not isinstance(assembly, PolygonAssembly):
+        interfering = tuple(interferences(assembly.subset([*parts, *held]), tol))
     return Interlock(
         parts=parts,
         translation_locked=not separable(translations, members),
         rigid_may_free=rigid_may_free(assembly, parts, tol),
-        held=tuple(names[i] for i in bits(locked & ~members)),
+        held=held,
+        interfering=interfering,
     )
 
 

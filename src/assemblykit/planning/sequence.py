@@ -211,6 +211,10 @@ class Interlock:
     """The other parts of the set where the search stopped: free from the minimal set
     or from the rest alone, but no candidate direction separates any of them from the
     others (a part trapped behind the interlock, or a second interlock linked to it)."""
+    interfering: tuple[tuple[str, str, float], ...] = ()
+    """The pairs of the set (``parts`` and ``held``) that share a volume beyond the
+    interference threshold, ``(a, b, volume)``: a shared volume blocks a pair in every
+    direction, so these, not an interlock of shapes, may be what stops the set."""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON form."""
@@ -219,7 +223,16 @@ class Interlock:
             "held": list(self.held),
             "translation_locked": self.translation_locked,
             "rigid_may_free": self.rigid_may_free,
+            "interfering": [{"a": a, "b": b, "volume": v} for a, b, v in self.interfering],
         }
+
+    @property
+    def reason(self) -> str:
+        """Why the set is stopped, in words."""
+        if self.interfering:
+            pairs = "; ".join(f"{a} / {b} share {v:.3g}" for a, b, v in self.interfering)
+            return f"interfering ({pairs})"
+        return "interlocked (rigid motion may free)" if self.rigid_may_free else "interlocked"
 
 
 AndOrNode = frozenset[str] | tuple[str, frozenset[str], frozenset[str]]

@@ -444,12 +444,18 @@ def _part_list(assembly: Assembly, plan: Plan) -> str:
 
 def _interlock_table(plan: Plan) -> str:
     return fmt.html_table(
-        ("parts", "locked for infinitesimal translations", "a rigid motion may free them"),
+        (
+            "parts",
+            "locked for infinitesimal translations",
+            "a rigid motion may free them",
+            "interfering pairs (shared volume)",
+        ),
         [
             (
                 ", ".join(lock.parts),
                 "yes" if lock.translation_locked else "no",
                 "yes" if lock.rigid_may_free else "no",
+                "; ".join(f"{a} / {b} ({v:.3g})" for a, b, v in lock.interfering) or "none",
             )
             for lock in plan.interlocked
         ],
