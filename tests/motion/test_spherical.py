@@ -53,9 +53,9 @@ def _region_and_ball(path: Path) -> tuple[np.ndarray, np.ndarray]:
     return region - patch.center, np.array(ball.unilateral.to_dict()["lift_off"])
 
 
-def _check_cup(region: np.ndarray, rays: np.ndarray) -> None:
-    # the cup is cut at z = -2 on the sphere of radius 10 about the origin
-    assert np.max(region[:, 2]) <= -2.0 + 1e-6
+def _check_cup(region: np.ndarray, rays: np.ndarray, rim: float = 1e-6) -> None:
+    # the cup is cut at z = -2 on the sphere of radius 10 about the origin (up to ``rim``)
+    assert np.max(region[:, 2]) <= -2.0 + rim
     assert np.min(region[:, 2]) == pytest.approx(-10.0, abs=0.05)
     # free translations d·n ≤ 0 for every n of the cap z ≤ -0.2: bounded by the
     # rim cone, whose extreme rays make the angle asin(0.2) with +z
@@ -70,5 +70,10 @@ def test_the_meshed_ball_touches_its_cup_only_below_the_rim() -> None:
 @pytest.mark.cad
 def test_the_step_ball_touches_its_cup_only_below_the_rim_and_lifts_out() -> None:
     pytest.importorskip("OCP")
-    pytest.importorskip("assemblykit.io.step")
-    _check_cup(*_region_and_ball(BALL_JOINT / "ball_joint.step"))
+    step = pytest.importorskip("assemblykit.io.step")
+    # the STEP cup's mesh lies inside the solid, its rim moved within the linear
+    # deflection (docs/geometry.md, "STEP tessellation"): a fraction of the cup's size
+    path = BALL_JOINT / "ball_joint.step"
+    cup = max(load_assembly(path).parts.values(), key=lambda p: len(p.mesh.faces))
+    deflection = step.LINEAR_DEFLECTION * float(np.linalg.norm(np.ptp(cup.mesh.bounds, axis=0)))
+    _check_cup(*_region_and_ball(path), rim=deflection)

@@ -1,0 +1,416 @@
+"""Fits at nominal size read from STEP (docs/geometry.md, "STEP tessellation"): a pin in
+a hole of its own diameter, and bolts through a plate, with nuts. The exact solids share
+no volume (OCCT's boolean common, an independent check), and their meshes, tessellated
+inside the solids, share none either: no interference, cylindrical contacts, and plans
+whose every step an independent sweep confirms. Read with the kernel's own
+tessellation (every vertex on its surface) the same files overlap, and the planner
+finds nothing to take apart: these tests fail without the rule. A catalogue of
+concave faces checks the rule on every kind of surface read from STEP."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import manifold3d
+import numpy as np
+import pytest
+
+from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.geometry.interference import interferences, overlap_volume, solid
+from assemblykit.geometry.tessellation import sags_out
+from assemblykit.io import step as step_module
+from assemblykit.io.assembly import load_assembly
+from assemblykit.io.step import LINEAR_DEFLECTION
+from assemblykit.planning.planner import plan
+
+pytest.importorskip("OCP")
+
+pytestmark = pytest.mark.cad
+
+# shared volume (mm^3) still counted as none: float rounding of touching meshes
+NOISE = 1e-9
+Z = np.array([0.0, 0.0, 1.0])
+
+
+def write_step(path, *shapes) -> None:
+    from OCP.BRep import BRep_Builder
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TopoDS import TopoDS_Compound
+
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    for shape in shapes:
+        builder.Add(compound, shape)
+    writer = STEPControl_Writer()
+    writer.Transfer(compound, STEPControl_AsIs)
+    writer.Write(str(path))
+
+
+def cylinder(centre, radius: float, height: float, turn: float = 0.0, axis=(0, 0, 1)):
+    """A cylinder from ``centre`` along ``axis``; ``turn`` (degrees) turns its seam, and so
+    its tessellation, about the axis."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+    axis = np.asarray(axis, dtype=float)
+    seam = np.cross(axis, [0.0, 1.0, 0.0] if abs(axis[1]) < 0.9 else [1.0, 0.0, 0.0])
+    seam /= np.linalg.norm(seam)
+    seam = seam * math.cos(math.radians(turn)) + np.cross(axis, seam) * math.sin(math.radians(turn))
+    frame = gp_Ax2(gp_Pnt(*map(float, centre)), gp_Dir(*axis), gp_Dir(*seam))
+    return BRepPrimAPI_MakeCylinder(frame, radius, height).Shape()
+
+
+def box(corner, size):
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+
+    return BRepPrimAPI_MakeBox(gp_Pnt(*map(float, corner)), *map(float, size)).Shape()
+
+
+def cut(a, b):
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+
+    return BRepAlgoAPI_Cut(a, b).Shape()
+
+
+def fuse(a, b):
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+
+    return BRepAlgoAPI_Fuse(a, b).Shape()
+
+
+def common_volume(a, b) -> float:
+    """OCCT's exact volume of ``a ∩ b`` (boolean common of the B-reps)."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    properties = GProp_GProps()
+    BRepGProp.VolumeProperties_s(BRepAlgoAPI_Common(a, b).Shape(), properties)
+    return abs(properties.Mass())
+
+
+def kernel_tessellation(path):
+    """The assembly read with the kernel's tessellation as it is (vertices on the exact
+    surfaces, chords of holes in the void)."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(step_module, "inside_vertices", lambda vertices, faces, surfaces: vertices)
+        return load_assembly(path)
+
+
+def swept_overlap(mesh, direction, length: float, obstacle) -> float:
+    """The volume the closed mesh ``obstacle`` shares with all that ``mesh`` passes
+    through when translated by ``length`` along unit ``direction``: the solid where it
+    starts and the prisms swept by its triangles that face the move (a point passed
+    through lies on the segment from the last point where the start solid is left, on
+    such a triangle); prisms whose boxes do not overlap the obstacle's are left out."""
+    vertices, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    step = length * np.asarray(direction, dtype=float)
+    corners = vertices[faces]
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    facing = corners[normals @ direction > 1e-9 * np.linalg.norm(normals, axis=1)]
+    prisms = np.concatenate([facing, facing + step], axis=1)
+    low, high = obstacle.bounds
+    meets = np.all((prisms.min(axis=1) < high) & (prisms.max(axis=1) > low), axis=1)
+    pieces = [solid(mesh)]
+    pieces += [manifold3d.Manifold.hull_points(p) for p in prisms[meets]]
+    sweep = manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add)
+    return float((sweep ^ solid(obstacle)).volume())
+
+
+def sweep_overlaps(asm, steps, reverse: bool = False) -> list[float]:
+    """Per step of a plan, the largest volume the moving parts, swept along its direction
+    (or the opposite one) well past the assembly, share with a part still in place (the
+    parts of ``rest``)."""
+    length = 2.0 * float(np.linalg.norm(np.ptp(asm.bounds, axis=0)))
+    return [
+        max(
+            swept_overlap(
+                asm.parts[name].mesh,
+                -move.direction if reverse else move.direction,
+                length,
+                asm.parts[other].mesh,
+            )
+            for name in move.parts
+            for other in move.rest
+        )
+        for move in steps
+    ]
+
+
+@dataclass(frozen=True)
+class Read:
+    """Solids written to a STEP file and the file read back: with the rule
+    (``assembly``) and with the kernel's tessellation as it is (``kernel``)."""
+
+    shapes: tuple[Any, ...]
+    assembly: Any
+    kernel: Any
+
+
+def read(path, *shapes) -> Read:
+    write_step(path, *shapes)
+    return Read(shapes, load_assembly(path), kernel_tessellation(path))
+
+
+PLATE, PIN = "solid1", "solid2"
+
+
+@pytest.fixture(scope="module")
+def pin_in_hole(tmp_path_factory) -> Read:
+    """A 40 x 40 x 10 plate with a through hole of radius 5 and a pin of radius exactly 5
+    through it, its seam turned by 3 degrees (as two parts from two sources would be)."""
+    plate = cut(box((-20, -20, 0), (40, 40, 10)), cylinder((0, 0, -10), 5.0, 40.0))
+    pin = cylinder((0, 0, -10), 5.0, 30.0, turn=3.0)
+    return read(tmp_path_factory.mktemp("fits") / "pin.step", plate, pin)
+
+
+def test_a_pin_in_a_hole_of_its_diameter_touches_it_and_shares_no_volume(pin_in_hole):
+    (plate, pin), asm, kernel = pin_in_hole.shapes, pin_in_hole.assembly, pin_in_hole.kernel
+    assert common_volume(plate, pin) <= NOISE
+    # the kernel's tessellation: the plate's chords cut into the pin (0.49 mm^3)
+    assert overlap_volume(kernel[PLATE].mesh, kernel[PIN].mesh) > 0.1
+    assert [pair[:2] for pair in interferences(kernel)] == [(PLATE, PIN)]
+    assert overlap_volume(asm[PLATE].mesh, asm[PIN].mesh) <= NOISE
+    assert interferences(asm) == []
+    (contact,) = assembly_contacts(asm)
+    (fit,) = contact.curved
+    assert (contact.pair, fit.kind, fit.inner, fit.radius) == (
+        (PLATE, PIN),
+        "cylindrical",
+        PIN,
+        5.0,
+    )
+    # the hole's vertices moved off the circle by less than the linear deflection
+    moved = np.linalg.norm(asm[PLATE].mesh.vertices - kernel[PLATE].mesh.vertices, axis=1)
+    diagonal = float(np.linalg.norm(np.ptp(asm[PLATE].mesh.bounds, axis=0)))
+    assert 0 < moved.max() <= LINEAR_DEFLECTION * diagonal
+    np.testing.assert_array_equal(asm[PIN].mesh.vertices, kernel[PIN].mesh.vertices)
+    np.testing.assert_array_equal(asm[PLATE].mesh.faces, kernel[PLATE].mesh.faces)
+
+
+def test_the_pin_leaves_along_its_axis_through_a_free_sweep(pin_in_hole):
+    asm, kernel = pin_in_hole.assembly, pin_in_hole.kernel
+    found = plan(asm)
+    assert found.feasible
+    assert [abs(float(s.direction @ Z)) for s in found.steps] == pytest.approx([1.0])
+    assert max(sweep_overlaps(asm, found.steps)) <= NOISE
+    # the same sweep through the kernel's tessellation cuts into the plate, where the
+    # planner finds no way out at all
+    assert min(sweep_overlaps(kernel, found.steps)) > 0.1
+    assert not plan(kernel).feasible
+
+
+BOLTS, NUTS = ("solid2", "solid3"), ("solid4", "solid5")
+
+
+@pytest.fixture(scope="module")
+def bolted(tmp_path_factory) -> Read:
+    """A 60 x 30 x 8 plate with two holes of radius 4; in each a bolt of radius 4 (a head
+    of radius 7 on the plate) and a nut (radius 7, hole of radius 4) under the plate,
+    each cylinder's seam turned differently."""
+    plate = box((-30, -15, 0), (60, 30, 8))
+    bolts, nuts = [], []
+    for k, x in enumerate((-15.0, 15.0)):
+        plate = cut(plate, cylinder((x, 0, -1), 4.0, 10.0))
+        shank = cylinder((x, 0, -5), 4.0, 13.0, turn=5 + 7 * k)
+        bolts.append(fuse(shank, cylinder((x, 0, 8), 7.0, 4.0, turn=11)))
+        nut = cylinder((x, 0, -5), 7.0, 5.0, turn=2)
+        nuts.append(cut(nut, cylinder((x, 0, -6), 4.0, 7.0, turn=17 + 3 * k)))
+    return read(tmp_path_factory.mktemp("fits") / "bolted.step", plate, *bolts, *nuts)
+
+
+def test_bolts_and_nuts_at_nominal_size_fit_without_interference(bolted):
+    shapes, asm, kernel = bolted.shapes, bolted.assembly, bolted.kernel
+    assert max(common_volume(a, b) for i, a in enumerate(shapes) for b in shapes[i + 1 :]) <= NOISE
+    # the kernel's tessellation: each hole's chords cut into its bolt
+    assert {pair[:2] for pair in interferences(kernel)} == {
+        (PLATE, BOLTS[0]),
+        (PLATE, BOLTS[1]),
+        (BOLTS[0], NUTS[0]),
+        (BOLTS[1], NUTS[1]),
+    }
+    assert interferences(asm) == []
+    fits = {c.pair: c.curved for c in assembly_contacts(asm) if c.curved}
+    assert set(fits) == {(PLATE, b) for b in BOLTS} | set(zip(BOLTS, NUTS, strict=True))
+    assert all(f.kind == "cylindrical" and f.radius == 4.0 for (f,) in fits.values())
+
+
+def test_the_bolts_leave_along_their_axes_through_free_sweeps(bolted):
+    asm = bolted.assembly
+    found = plan(asm)
+    assert found.feasible
+    bolts_out = [move for move in found.steps if set(move.parts) & set(BOLTS)]
+    assert bolts_out
+    assert all(abs(float(move.direction @ Z)) == pytest.approx(1.0) for move in bolts_out)
+    assert max(sweep_overlaps(asm, found.steps)) <= NOISE
+    # the check is not blind: the bolts cannot go the other way
+    assert min(sweep_overlaps(asm, bolts_out, reverse=True)) > 1.0
+
+
+def rotated(shape, axis, degrees: float):
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt, gp_Trsf
+
+    turn = gp_Trsf()
+    turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(*axis)), math.radians(degrees))
+    return BRepBuilderAPI_Transform(shape, turn).Shape()
+
+
+def moved_to(shape, x: float):
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_Transform
+    from OCP.gp import gp_Trsf, gp_Vec
+
+    move = gp_Trsf()
+    move.SetTranslation(gp_Vec(x, 0, 0))
+    return BRepBuilderAPI_Transform(shape, move).Shape()
+
+
+def filleted(shape, radius: float, pick):
+    """``shape`` with its circular edges ``pick(circle)`` rounded."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
+    from OCP.GeomAbs import GeomAbs_CurveType
+    from OCP.TopAbs import TopAbs_ShapeEnum
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    rounding = BRepFilletAPI_MakeFillet(shape)
+    edges = TopExp_Explorer(shape, TopAbs_ShapeEnum.TopAbs_EDGE)
+    while edges.More():
+        edge = TopoDS.Edge(edges.Current())
+        curve = BRepAdaptor_Curve(edge)
+        if curve.GetType() == GeomAbs_CurveType.GeomAbs_Circle and pick(curve.Circle()):
+            rounding.Add(radius, edge)
+        edges.Next()
+    return rounding.Shape()
+
+
+CONCAVE = (
+    "countersink",
+    "slanted",
+    "socket",
+    "rounded rim",
+    "shoulder",
+    "groove",
+    "ring",
+    "D hole",
+    "crossing",
+    "slot",
+)
+
+
+@pytest.fixture(scope="module")
+def concave_faces(tmp_path_factory):
+    """One solid per way a concave face meets the faces around it, side by side in one
+    file, read back: the part of each, by name."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCone, BRepPrimAPI_MakeSphere, BRepPrimAPI_MakeTorus
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+    def along(z: float):
+        return gp_Ax2(gp_Pnt(0, 0, z), gp_Dir(0, 0, 1))
+
+    bored = cut(box((-10, -10, 0), (20, 20, 8)), cylinder((0, 0, -1), 3.0, 10.0))
+    shapes = {
+        # a hole and its countersink: a female cone and a cylinder, coaxial
+        "countersink": cut(bored, BRepPrimAPI_MakeCone(along(5), 3.0, 6.0, 3.0001).Shape()),
+        # a hole through a face at 35 degrees to its axis: the rim slides along the face
+        "slanted": cut(
+            rotated(box((-15, -15, -3), (30, 30, 6)), (1, 0, 0), 35),
+            cylinder((0, 0, -20), 4.0, 40.0),
+        ),
+        # a shallow socket: its rim slides in the face, off the sphere's centre
+        "socket": cut(
+            box((-10, -10, -10), (20, 20, 10)), BRepPrimAPI_MakeSphere(gp_Pnt(0, 0, 2), 6).Shape()
+        ),
+        # a hole with a rounded rim: a male torus, concave about the axis, tangent to the face
+        "rounded rim": filleted(bored, 1.0, lambda c: abs(c.Location().Z() - 8) < 1e-9),
+        # a stepped shaft with a fillet in its shoulder: a female torus, inner half
+        "shoulder": filleted(
+            fuse(cylinder((0, 0, 0), 6.0, 5.0), cylinder((0, 0, 5), 3.0, 8.0)),
+            1.0,
+            lambda c: abs(c.Location().Z() - 5) < 1e-9 and abs(c.Radius() - 3) < 1e-9,
+        ),
+        # a bore with a round groove: a female torus, outer half, between two cylinders
+        "groove": cut(
+            cut(box((-10, -10, 0), (20, 20, 12)), cylinder((0, 0, -1), 4.0, 14.0)),
+            BRepPrimAPI_MakeTorus(along(6), 4.0, 1.2).Shape(),
+        ),
+        "ring": BRepPrimAPI_MakeTorus(along(0), 6.0, 2.0).Shape(),
+        # a hole with a flat: a plane parallel to the axis cuts the cylinder
+        "D hole": fuse(bored, box((-5, 2.0, 0), (10, 3, 8))),
+        # two holes crossing: the rim lies on both cylinders
+        "crossing": cut(
+            cut(box((-10, -10, -10), (20, 20, 20)), cylinder((0, 0, -11), 4.0, 22.0)),
+            cylinder((-11, 0, 0), 3.0, 22.0, axis=(1, 0, 0)),
+        ),
+        # a slot: half circles tangent to flat sides, whose ends cannot move
+        "slot": cut(
+            box((-12, -8, 0), (24, 16, 6)),
+            fuse(
+                fuse(cylinder((-5, 0, -1), 3.0, 8.0), cylinder((5, 0, -1), 3.0, 8.0)),
+                box((-5, -3, -1), (10, 6, 8)),
+            ),
+        ),
+    }
+    assert tuple(shapes) == CONCAVE
+    path = tmp_path_factory.mktemp("fits") / "concave.step"
+    write_step(path, *(moved_to(s, 40.0 * k) for k, s in enumerate(shapes.values())))
+    return dict(zip(CONCAVE, load_assembly(path), strict=True))
+
+
+def material_side(surface, points, normals) -> np.ndarray:
+    """How far ``points`` lie from ``surface`` on its material side (negative: in the
+    void); a torus's material side is read from the triangles' outward ``normals``."""
+    if surface.kind == "sphere":
+        return np.linalg.norm(points - surface.point, axis=1) - surface.radius
+    rel = points - surface.point
+    along = rel @ surface.axis
+    off = rel - np.outer(along, surface.axis)
+    rho = np.linalg.norm(off, axis=1)
+    if surface.kind == "cylinder":
+        return rho - surface.radius
+    if surface.kind == "cone":
+        return (rho - along * math.tan(surface.half_angle)) * math.cos(surface.half_angle)
+    tube = np.column_stack([rho - surface.radius, along])
+    from_tube = np.linalg.norm(tube, axis=1) - surface.minor_radius
+    out = (tube[:, :1] * off / rho[:, None]) + tube[:, 1:] * surface.axis
+    male = float(np.einsum("ij,ij->", normals, out)) > 0
+    return -from_tube if male else from_tube
+
+
+def test_the_solids_have_every_kind_of_concave_surface(concave_faces):
+    kinds = {s.kind for part in concave_faces.values() for s in part.surfaces if sags_out(s)}
+    assert kinds == {"cylinder", "cone", "sphere", "torus"}
+
+
+@pytest.mark.parametrize("name", CONCAVE)
+def test_every_concave_face_lies_in_its_solid_within_the_deflection(concave_faces, name):
+    part = concave_faces[name]
+    mesh, vertices = part.mesh, np.asarray(part.mesh.vertices)
+    diagonal = float(np.linalg.norm(np.ptp(mesh.bounds, axis=0)))
+    deflection = LINEAR_DEFLECTION * diagonal
+    assert mesh.is_watertight and mesh.is_winding_consistent
+    bary = np.array([(i, j, 5 - i - j) for i in range(6) for j in range(6 - i)]) / 5
+    for surface in part.surfaces:
+        corners = vertices[np.asarray(mesh.faces)[surface.faces]]
+        if surface.kind == "plane":
+            # planar faces stay planar
+            offsets = (corners.reshape(-1, 3) - surface.point) @ surface.axis
+            assert np.abs(offsets).max() <= 1e-9 * diagonal
+            continue
+        if not sags_out(surface):
+            continue
+        normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        points = np.einsum("bk,tkd->tbd", bary, corners).reshape(-1, 3)
+        depth = material_side(surface, points, np.repeat(normals, len(bary), axis=0))
+        # every point of the face's triangles in the material, but where the rounded
+        # rim's vertices stay in the face it is tangent to: there the arcs sag by the
+        # square of the sag over the fillet's radius (1)
+        slack = deflection**2 if name == "rounded rim" else 1e-12 * diagonal
+        assert depth.min() >= -slack, (surface.kind, depth.min())
+        # and every vertex within the linear deflection of the surface
+        ends = material_side(surface, corners.reshape(-1, 3), np.repeat(normals, 3, axis=0))
+        assert np.abs(ends).max() <= deflection, surface.kind

@@ -1,0 +1,473 @@
+"""STEP files as CAD tools write them: analytic faces stored as B-splines, a solid that
+BRepMesh does not mesh, product names that are placeholders, repeated or escaped
+(ISO 10303-21:2016 §6.4.3), products of several solids."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from assemblykit.errors import GeometryError
+from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.io import step
+from assemblykit.io.assembly import load_assembly
+from assemblykit.io.step import declared_solids, decode_step_string, distinct_products
+
+cad = pytest.mark.cad
+
+GRIPPER = Path("/work/shared/data/step_gripper/gripper.step")
+
+
+def _write_step(path: Path, *shapes: Any) -> None:
+    """``shapes`` written by Open CASCADE's STEP writer, unnamed."""
+    from OCP.BRep import BRep_Builder
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.TopoDS import TopoDS_Compound
+
+    compound, builder = TopoDS_Compound(), BRep_Builder()
+    builder.MakeCompound(compound)
+    for shape in shapes:
+        builder.Add(compound, shape)
+    writer = STEPControl_Writer()
+    writer.Transfer(compound, STEPControl_AsIs)
+    writer.Write(str(path))
+
+
+def _at(x: float, y: float, z: float) -> Any:
+    from OCP.gp import gp_Trsf, gp_Vec
+    from OCP.TopLoc import TopLoc_Location
+
+    move = gp_Trsf()
+    move.SetTranslation(gp_Vec(x, y, z))
+    return TopLoc_Location(move)
+
+
+class _Document:
+    """An XCAF document written by OCP's XCAF writer: products (``product``), placed in
+    assemblies (``place``), optionally named; an instance may be named too."""
+
+    def __init__(self) -> None:
+        from OCP.TCollection import TCollection_ExtendedString
+        from OCP.TDocStd import TDocStd_Document
+        from OCP.XCAFDoc import XCAFDoc_DocumentTool
+
+        self.document = TDocStd_Document(TCollection_ExtendedString("MDTV-XCAF"))
+        self.tool = XCAFDoc_DocumentTool.ShapeTool_s(self.document.Main())
+
+    @staticmethod
+    def _named(label: Any, name: str | None) -> Any:
+        from OCP.TCollection import TCollection_ExtendedString
+        from OCP.TDataStd import TDataStd_Name
+
+        if name is not None:
+            TDataStd_Name.Set_s(label, TCollection_ExtendedString(name))
+        return label
+
+    def assembly(self, name: str) -> Any:
+        return self._named(self.tool.NewShape(), name)
+
+    def product(self, name: str | None, *shapes: Any) -> Any:
+        """A product of ``shapes`` (a compound when there are several); ``None``: XCAF
+        names it after its shape type."""
+        from OCP.BRep import BRep_Builder
+        from OCP.TopoDS import TopoDS_Compound
+
+        shape = shapes[0]
+        if len(shapes) > 1:
+            shape, builder = TopoDS_Compound(), BRep_Builder()
+            builder.MakeCompound(shape)
+            for part in shapes:
+                builder.Add(shape, part)
+        return self._named(self.tool.AddShape(shape, False), name)
+
+    def place(
+        self, assembly: Any, product: Any, at: tuple[float, float, float], name: str | None = None
+    ) -> None:
+        self._named(self.tool.AddComponent(assembly, product, _at(*at)), name)
+
+    def write(self, path: Path) -> Path:
+        from OCP.STEPCAFControl import STEPCAFControl_Writer
+        from OCP.STEPControl import STEPControl_AsIs
+
+        self.tool.UpdateAssemblies()
+        writer = STEPCAFControl_Writer()
+        writer.SetNameMode(True)
+        writer.Transfer(self.document, STEPControl_AsIs)
+        writer.Write(str(path))
+        return path
+
+
+def _box(x: float, y: float, z: float, at: tuple[float, float, float] = (0, 0, 0)) -> Any:
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
+    from OCP.gp import gp_Pnt
+
+    return BRepPrimAPI_MakeBox(gp_Pnt(*at), x, y, z).Shape()
+
+
+def _cylinder(radius: float, height: float, at: tuple[float, float, float]) -> Any:
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+    return BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(*at), gp_Dir(0, 0, 1)), radius, height).Shape()
+
+
+def _nurbs(shape: Any) -> Any:
+    """``shape`` with every face's surface (and edge's curve) made a B-spline."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+
+    return BRepBuilderAPI_NurbsConvert(shape, True).Shape()
+
+
+# -- analytic faces stored as B-splines ---------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def bspline_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The plate with a through hole of radius 5 and the shaft of radius 5 in it, every
+    face a B-spline surface."""
+    pytest.importorskip("OCP")
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+
+    plate = BRepAlgoAPI_Cut(_box(40, 40, 10, (-20, -20, 0)), _cylinder(5, 40, (0, 0, -10))).Shape()
+    path = tmp_path_factory.mktemp("bspline") / "parts.step"
+    _write_step(path, _nurbs(plate), _nurbs(_cylinder(5, 30, (0, 0, -10))))
+    return path
+
+
+@cad
+def test_bspline_faces_keep_their_cylinders_and_planes(bspline_step):
+    text = bspline_step.read_text()
+    assert "B_SPLINE_SURFACE" in text
+    assert "CYLINDRICAL_SURFACE" not in text and "PLANE(" not in text
+    asm = load_assembly(bspline_step)
+    plate, shaft = asm["solid1"].surfaces, asm["solid2"].surfaces
+    for surfaces, convex, planes in ((shaft, True, 2), (plate, False, 6)):
+        (cylinder,) = [s for s in surfaces if s.kind == "cylinder"]
+        assert cylinder.radius == pytest.approx(5.0, abs=1e-6)
+        assert cylinder.convex is convex
+        assert abs(cylinder.axis @ [0, 0, 1]) == pytest.approx(1.0, abs=1e-9)
+        np.testing.assert_allclose(cylinder.point[:2], [0, 0], atol=1e-6)
+        assert sorted(s.kind for s in surfaces) == ["cylinder"] + ["plane"] * planes
+    top = [s for s in shaft if s.kind == "plane" and s.axis @ [0, 0, 1] > 0.5]
+    assert len(top) == 1 and top[0].point[2] == pytest.approx(20.0, abs=1e-6)
+
+
+@cad
+def test_bspline_shaft_in_its_hole_is_a_cylindrical_contact(bspline_step):
+    contacts = {c.pair: c for c in assembly_contacts(load_assembly(bspline_step))}
+    assert set(contacts) == {("solid1", "solid2")}
+    (cylinder,) = contacts["solid1", "solid2"].curved
+    assert (cylinder.kind, cylinder.inner) == ("cylindrical", "solid2")
+    assert cylinder.radius == pytest.approx(5.0, abs=1e-6)
+    assert cylinder.extent == pytest.approx((0.0, 10.0), abs=1e-6)
+
+
+@cad
+def test_a_placed_bspline_face_keeps_its_placed_axis(tmp_path):
+    pytest.importorskip("OCP")
+    doc = _Document()
+    rig = doc.assembly("rig")
+    doc.place(rig, doc.product("shaft", _nurbs(_cylinder(2, 8, (0, 0, 0)))), (10, -3, 1))
+    asm = load_assembly(doc.write(tmp_path / "placed.step"))
+    (cylinder,) = [s for s in asm["shaft"].surfaces if s.kind == "cylinder"]
+    assert cylinder.radius == pytest.approx(2.0, abs=1e-6)
+    np.testing.assert_allclose(cylinder.point, [10, -3, 1], atol=1e-6)
+
+
+# -- a solid that BRepMesh does not mesh --------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def three_parts(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A plate (40 x 20 x 5), a pin (radius 2, height 10) standing on it and a ball
+    (radius 3) lying on it, three named products."""
+    pytest.importorskip("OCP")
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeSphere
+    from OCP.gp import gp_Pnt
+
+    doc = _Document()
+    rig = doc.assembly("rig")
+    doc.place(rig, doc.product("plate", _box(40, 20, 5)), (0, 0, 0))
+    doc.place(rig, doc.product("pin", _cylinder(2, 10, (0, 0, 0))), (10, 10, 5))
+    doc.place(
+        rig, doc.product("ball", BRepPrimAPI_MakeSphere(gp_Pnt(0, 0, 0), 3).Shape()), (30, 10, 8)
+    )
+    return doc.write(tmp_path_factory.mktemp("mesh") / "three.step")
+
+
+def _failing(monkeypatch: pytest.MonkeyPatch, fails: Callable[[str, Any, int], bool]) -> None:
+    """BRepMesh's triangles of the faces for which ``fails(kind, face, asked)`` holds are
+    not there (``kind``: the name of the face's surface type, ``asked``: how many times
+    that face's triangles were asked for before)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+
+    original = step._face_triangles
+    calls: dict[int, int] = {}
+
+    def triangles(ocp: Any, face: Any) -> tuple[np.ndarray, np.ndarray]:
+        asked = calls.get(hash(face), 0)
+        calls[hash(face)] = asked + 1
+        surface = BRepAdaptor_Surface(face)
+        if fails(surface.GetType().name.removeprefix("GeomAbs_"), surface, asked):
+            return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+        return original(ocp, face)
+
+    monkeypatch.setattr(step, "_face_triangles", triangles)
+
+
+def _at_the_bottom(kind: str, surface: Any) -> bool:
+    """Whether a face is the plate's bottom face: the only one in the plane z = 0."""
+    if kind != "Plane":
+        return False
+    plane = surface.Plane()
+    return abs(plane.Axis().Direction().Z()) == 1 and plane.Location().Z() == 0
+
+
+@cad
+def test_a_face_left_unmeshed_once_is_meshed_again(three_parts, monkeypatch):
+    # the pin's side, the only cylinder, the first time
+    _failing(monkeypatch, lambda kind, surface, asked: kind == "Cylinder" and asked == 0)
+    asm = load_assembly(three_parts)
+    assert asm.names == ["plate", "pin", "ball"] and asm.skipped == ()
+    assert asm["pin"].mesh.is_watertight
+    assert asm["pin"].volume == pytest.approx(np.pi * 4 * 10, rel=1e-2)
+    assert [s.radius for s in asm["pin"].surfaces if s.kind == "cylinder"] == [2.0]
+    (warning,) = asm.warnings
+    assert warning.startswith("pin: BRepMesh left 1 face untriangulated; meshed again with")
+
+
+@cad
+def test_the_hole_of_a_face_never_meshed_is_closed(three_parts, monkeypatch):
+    _failing(monkeypatch, lambda kind, surface, asked: _at_the_bottom(kind, surface))
+    asm = load_assembly(three_parts)
+    assert asm.names == ["plate", "pin", "ball"] and asm.skipped == ()
+    assert asm["plate"].mesh.is_watertight
+    assert asm["plate"].volume == pytest.approx(40 * 20 * 5, rel=1e-9)
+    assert [s.kind for s in asm["plate"].surfaces] == ["plane"] * 5
+    assert asm.warnings == (
+        "plate: BRepMesh left 1 face untriangulated; the hole this leaves in its mesh is "
+        "closed by a fan of triangles",
+    )
+
+
+@cad
+def test_a_part_whose_holes_cannot_be_closed_is_its_convex_hull(three_parts, monkeypatch):
+    # the pin without its side: closing its two circles would leave no volume
+    _failing(monkeypatch, lambda kind, surface, asked: kind == "Cylinder")
+    asm = load_assembly(three_parts)
+    assert asm.names == ["plate", "pin", "ball"] and asm.skipped == ()
+    assert asm["pin"].mesh.is_watertight and asm["pin"].surfaces == ()
+    assert asm["pin"].volume == pytest.approx(np.pi * 4 * 10, rel=1e-2)
+    np.testing.assert_allclose(asm["pin"].mesh.bounds, [[8, 8, 5], [12, 12, 15]], atol=1e-2)
+    assert asm.warnings == ("pin: BRepMesh left 1 face untriangulated; its convex hull is used",)
+    assert asm["ball"].volume == pytest.approx(4 / 3 * np.pi * 27, rel=1e-2)
+
+
+@cad
+def test_a_part_with_nothing_usable_is_skipped_and_the_others_kept(three_parts, monkeypatch):
+    # the ball's only face: its two poles are all that is left
+    _failing(monkeypatch, lambda kind, surface, asked: kind == "Sphere")
+    asm = load_assembly(three_parts)
+    assert asm.names == ["plate", "pin"]
+    (skipped,) = asm.skipped
+    assert skipped.item == "ball"
+    assert skipped.reason.startswith("BRepMesh left 1 face untriangulated")
+    assert skipped.reason.endswith("the part is left out")
+    assert asm.to_dict()["skipped"] == [skipped.to_dict()]
+
+
+@cad
+def test_a_file_without_any_part_is_an_error(tmp_path, monkeypatch):
+    pytest.importorskip("OCP")
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeSphere
+    from OCP.gp import gp_Pnt
+
+    path = tmp_path / "ball.step"
+    _write_step(path, BRepPrimAPI_MakeSphere(gp_Pnt(0, 0, 0), 3).Shape())
+    _failing(monkeypatch, lambda kind, surface, asked: True)
+    with pytest.raises(GeometryError, match=r"ball\.step.*solid1: BRepMesh left 1 face"):
+        load_assembly(path)
+
+
+@cad
+@pytest.mark.slow
+def test_the_gripper_loads_every_part():
+    """``gripper.step`` of online-robotics/CAD-data (commit 74ada1e), 144 solids:
+    BRepMesh never triangulates a conical face of each of the two M2 screws inside the
+    servos."""
+    if not GRIPPER.is_file():
+        pytest.skip(f"{GRIPPER} is absent")
+    start = time.perf_counter()
+    asm = load_assembly(GRIPPER)
+    took = time.perf_counter() - start
+    print(f"gripper: {len(asm.parts)} parts, {len(asm.skipped)} skipped in {took:.1f} s")
+    assert len(asm.parts) + len(asm.skipped) == 144
+    screws = [n for n in asm.names if "M2 x 4" in n]
+    assert len(screws) == 2 - len(asm.skipped)
+    assert len(asm.warnings) == 2
+    for warning in asm.warnings:
+        assert "M2 x 4" in warning and "BRepMesh left 1 face untriangulated" in warning
+    assert all(asm[n].mesh.is_watertight for n in asm.names)
+    assert "M3 Locknut_12_2" in asm.parts and "Laserteil 7_3" in asm.parts
+    assert set(asm.groups) == {
+        "Gripper",
+        "SG90 - Micro Servo 9g - Tower Pro v2",
+        "SG90 - Micro Servo 9g - Tower Pro v2 (2)",
+        "Nuts and Bolts",
+    }
+
+
+# -- names --------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def named_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``rig`` places: an unnamed product three times (twice as named instances), a
+    ``bracket`` of two solids twice, a ``lock`` of two solids once, and two different
+    products both named ``Body``, each twice; and two different subassemblies both named
+    ``arm``, each holding the same ``pad``."""
+    pytest.importorskip("OCP")
+    doc = _Document()
+    rig = doc.assembly("rig")
+    wheel = doc.product(None, _box(1, 1, 1))
+    doc.place(rig, wheel, (0, 0, 0), "left wheel")
+    doc.place(rig, wheel, (2, 0, 0), "right wheel")
+    doc.place(rig, wheel, (4, 0, 0))
+    bracket = doc.product("bracket", _box(1, 1, 1), _box(1, 1, 1, (2, 0, 0)))
+    doc.place(rig, bracket, (0, 10, 0))
+    doc.place(rig, bracket, (0, 20, 0))
+    doc.place(rig, doc.product("lock", _box(1, 1, 1), _box(1, 1, 1, (2, 0, 0))), (0, 30, 0))
+    small, large = doc.product("Body", _box(1, 1, 1)), doc.product("Body", _box(2, 2, 2))
+    for x in (0, 5):
+        doc.place(rig, small, (x, 40, 0))
+    for x in (0, 5):
+        doc.place(rig, large, (x, 50, 0))
+    pad = doc.product("pad", _box(1, 1, 1))
+    for y in (60, 70):
+        arm = doc.assembly("arm")
+        doc.place(arm, pad, (0, 0, 0))
+        doc.place(rig, arm, (0, y, 0))
+    return doc.write(tmp_path_factory.mktemp("names") / "rig.step")
+
+
+@cad
+def test_names_follow_products_instances_and_solids(named_step):
+    asm = load_assembly(named_step)
+    corners = {
+        "left wheel": (0, 0),
+        "right wheel": (2, 0),
+        "solid3": (4, 0),
+        "bracket_1_1": (0, 10),
+        "bracket_1_2": (2, 10),
+        "bracket_2_1": (0, 20),
+        "bracket_2_2": (2, 20),
+        "lock_1": (0, 30),
+        "lock_2": (2, 30),
+        "Body_1": (0, 40),
+        "Body_2": (5, 40),
+        "Body (2)_1": (0, 50),
+        "Body (2)_2": (5, 50),
+        "pad_1": (0, 60),
+        "pad_2": (0, 70),
+    }
+    assert asm.names == list(corners)
+    for name, corner in corners.items():
+        np.testing.assert_allclose(asm[name].mesh.bounds[0][:2], corner, atol=1e-9)
+    assert asm["Body (2)_1"].volume == pytest.approx(8.0)
+    assert asm.groups == {"arm": ("pad_1",), "arm (2)": ("pad_2",)}
+
+
+@pytest.mark.parametrize(
+    ("named", "names"),
+    [
+        ([("Body", "a"), ("Body", "a"), ("Body", "b")], ["Body", "Body", "Body (2)"]),
+        ([("Body", "a"), ("Body (2)", "c"), ("Body", "b")], ["Body", "Body (2)", "Body (3)"]),
+        ([("", "a"), ("pin", "b"), ("", "c")], ["", "pin", ""]),
+    ],
+)
+def test_distinct_products_of_one_name_get_distinct_names(named, names):
+    assert distinct_products(named) == names
+
+
+ESCAPED = {
+    "Pe\\X\\E7a": "Peça",
+    "Pe\\X\\87a": "Pe\x87a",  # a C1 control in ISO 8859-1, as the gripper has it
+    "\\X2\\00E700E9\\X0\\x": "çéx",
+    "\\X2\\D83DDE00\\X0\\": "\U0001f600",
+    "\\X4\\0001F600\\X0\\": "\U0001f600",
+    "\\S\\g": "ç",
+    "\\PB\\\\S\\1": "ą",
+    "a\\\\b": "a\\b",
+    "it''s": "it's",
+}
+MALFORMED = {
+    "\\\\X\\41": "\\X\\41",
+    "100\\% \\X2\\00E\\X0\\": "100\\% \\X2\\00E\\X0\\",
+}
+
+
+@pytest.mark.parametrize(("text", "decoded"), [*ESCAPED.items(), *MALFORMED.items()])
+def test_step_strings_decode_as_iso_10303_21_says(text, decoded):
+    assert decode_step_string(text) == decoded
+
+
+def _encoded(text: str, astral_in_x2: bool) -> str:
+    """``text`` as a STEP string's content, every character outside printable ASCII
+    escaped."""
+    out = []
+    for char in text:
+        code = ord(char)
+        if char in "\\'":
+            out.append(char * 2)
+        elif 0x20 <= code < 0x7F:
+            out.append(char)
+        elif code < 0x100:
+            out.append(f"\\X\\{code:02X}")
+        elif code < 0x10000 or astral_in_x2:
+            out.append("\\X2\\" + char.encode("utf-16-be").hex().upper() + "\\X0\\")
+        else:
+            out.append(f"\\X4\\{code:08X}\\X0\\")
+    return "".join(out)
+
+
+@given(st.text(), st.booleans())
+def test_decoding_undoes_encoding(text, astral_in_x2):
+    assert decode_step_string(_encoded(text, astral_in_x2)) == text
+
+
+def test_declared_solid_names_are_decoded():
+    text = "#7=MANIFOLD_SOLID_BREP('Pe\\X\\E7a \\X2\\00E9\\X0\\ it''s',#8);"
+    assert declared_solids(text) == [("#7", "MANIFOLD_SOLID_BREP", "Peça é it's")]
+
+
+@pytest.fixture(scope="module")
+def escaped_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A file written by OCP whose product names were replaced, in its text, by the
+    escaped strings of ``ESCAPED``."""
+    pytest.importorskip("OCP")
+    doc = _Document()
+    rig = doc.assembly("rig")
+    for i in range(len(ESCAPED)):
+        doc.place(rig, doc.product(f"NAME{i}X", _box(1, 1, 1)), (2 * i, 0, 0))
+    path = doc.write(tmp_path_factory.mktemp("escaped") / "raw.step")
+    text = path.read_text()
+    for i, escaped in enumerate(ESCAPED):
+        text = text.replace(f"NAME{i}X", escaped)
+    path.write_text(text)
+    return path
+
+
+@cad
+def test_product_names_come_decoded(escaped_step):
+    asm = load_assembly(escaped_step)
+    # the two smileys are two products of one name
+    expected = list(ESCAPED.values())
+    expected[4] = "\U0001f600 (2)"
+    assert asm.names == expected
