@@ -451,6 +451,27 @@ def _gravity(
 )
 @click.option("--one-at-a-time", is_flag=True, help="Move one free set (a part) per step.")
 @click.option(
+    "--join",
+    nargs=2,
+    multiple=True,
+    metavar="A B",
+    help="Treat parts A and B as one rigid part (glued, welded, riveted); repeatable.",
+)
+@click.option(
+    "--join-interfering",
+    is_flag=True,
+    help="Treat every set of parts that share a volume as one rigid part.",
+)
+@click.option(
+    "--ignore-overlap",
+    type=_OptionRange(min=0.0),
+    default=None,
+    metavar="V",
+    help="Parts sharing at most this volume (model units cubed) are designed "
+    "interference: it is cut from the smaller one [default: 10% of the smaller "
+    "part's volume; 0 cuts nothing].",
+)
+@click.option(
     "--max-steps",
     type=click.IntRange(min=0),
     default=None,
@@ -477,6 +498,9 @@ def plan_cmd(
     holds: int,
     fixed: tuple[str, ...],
     one_at_a_time: bool,
+    join: tuple[tuple[str, str], ...],
+    join_interfering: bool,
+    ignore_overlap: float | None,
     max_steps: int | None,
     as_json: bool,
     tolerance: float | None,
@@ -515,6 +539,16 @@ def plan_cmd(
     with _progress_bar() as bar:
         update = _updater(bar)
         loaded = _plan_input(assembly, tol, as_written, problem, solution)
+        from assemblykit.io.burrtools import VoxelAssembly
+        from assemblykit.model.assembly import Assembly
+
+        if isinstance(loaded, Assembly) and not isinstance(loaded, VoxelAssembly):
+            from assemblykit.geometry.overlaps import resolve_overlaps
+
+            update("interfering parts", 0, 1)
+            loaded = resolve_overlaps(loaded, join, join_interfering, ignore_overlap)
+        elif join or join_interfering:
+            raise InputError("--join and --join-interfering need 3D parts")
         if getattr(loaded, "dimension", 3) == 2 and gltf is not None:
             raise InputError("--gltf draws meshes: not for a 2D polygon assembly")
         if getattr(loaded, "dimension", 3) == 2 and (html is not None or png is not None):

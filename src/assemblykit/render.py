@@ -243,7 +243,23 @@ def _rigid(result: RigidBlockingGraph) -> Table:
 def _plan(result: Plan) -> Group:
     """The disassembly steps (and the interlocked sets when infeasible) and the assembly
     order (Wilson & Latombe 1992)."""
-    return Group(_disassembly_table(result), _assembly_table(result))
+    tables = [_disassembly_table(result), _assembly_table(result)]
+    if result.overlaps:
+        tables.append(_overlap_table(result))
+    return Group(*tables)
+
+
+def _overlap_table(plan: Plan) -> Table:
+    table = Table(title="Interfering parts (shared volume, what was done)")
+    for column in ("parts", "volume", "resolution"):
+        table.add_column(column)
+    for overlap in plan.overlaps:
+        table.add_row(
+            f"{overlap.a} / {overlap.b}",
+            f"{overlap.volume:.4g}",
+            overlap.resolution or "left as it is: an obstacle in every direction",
+        )
+    return table
 
 
 def _assembly_table(plan: Plan) -> Table:

@@ -59,6 +59,24 @@ class Skipped:
         return {"item": self.item, "reason": self.reason}
 
 
+@dataclass(frozen=True)
+class Overlap:
+    """Two parts that share a volume beyond the interference threshold, ``volume`` in
+    cubed model units, and what was done about it (``resolution``): ``"trimmed from
+    NAME"`` (designed interference: the shared volume was cut from that part), ``"joined"``
+    (the two move as one part) or ``""`` (left as it is: an obstacle in every direction).
+    :func:`assemblykit.geometry.overlaps.resolve_overlaps` finds and resolves them."""
+
+    a: str
+    b: str
+    volume: float
+    resolution: str = ""
+
+    def to_dict(self) -> dict[str, str | float]:
+        """JSON form: ``a``, ``b``, ``volume`` and ``resolution``."""
+        return {"a": self.a, "b": self.b, "volume": self.volume, "resolution": self.resolution}
+
+
 @dataclass(eq=False)
 class Part:
     """One rigid part: ``mesh`` in world (assembled) position, ``pose`` the 4x4 transform
@@ -93,6 +111,8 @@ class Assembly:
     ``skipped`` lists what the loader could not read (:class:`Skipped`) and ``warnings``
     what the reader reported while reading. ``groups`` names sets of parts the input
     keeps together (a STEP file's subassemblies), each listing its parts in order.
+    ``overlaps`` lists the interfering pairs found and what was done about each
+    (:class:`Overlap`; empty until :func:`assemblykit.geometry.overlaps.resolve_overlaps`).
     ``memo`` is the slot where the geometry layer keeps what it computed from the parts
     (:class:`Derived`; ``None`` until it is asked).
     """
@@ -111,6 +131,7 @@ class Assembly:
         skipped: Iterable[Skipped] = (),
         warnings: Iterable[str] = (),
         groups: Mapping[str, Iterable[str]] | None = None,
+        overlaps: Iterable[Overlap] = (),
     ) -> None:
         items = parts.values() if isinstance(parts, Mapping) else parts
         self.parts: dict[str, Part] = {p.name: p for p in items}
@@ -128,6 +149,7 @@ class Assembly:
         self.precision = precision
         self.skipped = tuple(skipped)
         self.warnings = tuple(warnings)
+        self.overlaps = tuple(overlaps)
         self.memo: Derived | None = None
 
     def __len__(self) -> int:
@@ -251,6 +273,7 @@ class Assembly:
             skipped=other.skipped,
             warnings=other.warnings,
             groups=other.groups,
+            overlaps=other.overlaps,
         )
 
     def _kept(self, parts: Iterable[Part], scale: float | None) -> Self:

@@ -237,6 +237,7 @@ def finish_plan(
         and_or,
         len(translations.directions),
         hands,
+        overlaps=getattr(assembly, "overlaps", ()),
         unfinished=unfinished,
     )
 

@@ -60,7 +60,7 @@ from assemblykit.deprecation import moved
 from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance, order_key
 
 if TYPE_CHECKING:
-    from assemblykit.model.assembly import Assembly
+    from assemblykit.model.assembly import Assembly, Overlap
     from assemblykit.planning.stability import GravityReport, StepStability
 
 Progress = Callable[[str, int, int], None]
@@ -348,6 +348,9 @@ class Plan:
     gravity: GravityReport | None = None
     """Set when planned under gravity: the settings, whether the whole assembly stands
     and whether every state of the plan stands with its holds."""
+    overlaps: tuple[Overlap, ...] = ()
+    """The interfering pairs of the assembly planned and what was done about each
+    (:func:`assemblykit.geometry.overlaps.resolve_overlaps`)."""
     unfinished: tuple[str, ...] = ()
     """The parts not yet taken apart when the plan stopped at its step limit
     (``max_steps`` of :func:`assemblykit.planning.planner.plan`): neither separated nor
@@ -417,6 +420,7 @@ class Plan:
             "assembly_steps": [step.to_dict() for step in self.assembly_steps],
             "gravity": None if self.gravity is None else self.gravity.to_dict(),
             "unfinished": list(self.unfinished),
+            "overlaps": [overlap.to_dict() for overlap in self.overlaps],
         }
 
     def __repr__(self) -> str:

@@ -1,0 +1,169 @@
+"""Interfering parts as a fitter reads them (docs/planning.md, "Interfering parts").
+
+CAD models often draw parts overlapping on purpose: a self-tapping screw at its thread's
+diameter in a smaller pilot hole, a press-fitted pin, meshing gear teeth, wood joints.
+Taken literally, each such pair shares a volume and blocks itself in every direction
+(:mod:`assemblykit.geometry.interference`), so nothing comes apart. A fitter reads them
+otherwise, and :func:`resolve_overlaps` does the same, saying what it did for each pair:
+
+* **joined** parts (``join``, and with ``join_interfering`` every connected set of
+  interfering parts) become one rigid part named ``A+B``: the union of their solids
+  (manifold3d);
+* **designed interference**: a pair sharing at most ``ignore_overlap`` (default:
+  ``DESIGNED_SHARE`` of the smaller part's volume) has the shared volume cut from the
+  smaller part, with all of that part in the shared volume's shadow along the axis it
+  was pressed in by (:func:`insertion_axis`): the screw loses its thread's ring along its
+  whole shank, the pin its press fit, so it touches the other and leaves the way it went
+  in (unscrewing, for a screw: its helical motion follows the same axis);
+* any other pair is left as it is, an obstacle in every direction, and named with its
+  volume wherever it stops a plan.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable, Sequence
+from dataclasses import replace
+
+import manifold3d
+import networkx as nx
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+
+from assemblykit.geometry.interference import interferences, solid
+from assemblykit.model.assembly import Assembly, Overlap, Part
+from assemblykit.tolerance import Tolerance
+
+DESIGNED_SHARE = 0.1
+"""The largest shared volume, as a fraction of the smaller part's volume, read as
+designed interference by default: a screw at its thread's diameter in a pilot hole 0.1
+smaller (Ø3.0 in Ø2.9) shares about 7% of its shank, a press fit well under 1%; parts
+sharing more are taken as a modelling error and left as obstacles."""
+
+
+def mesh_of(body: manifold3d.Manifold) -> trimesh.Trimesh:
+    """The closed triangle mesh of a manifold3d solid."""
+    out = body.to_mesh64()
+    return trimesh.Trimesh(
+        np.asarray(out.vert_properties[:, :3], dtype=np.float64),
+        np.asarray(out.tri_verts, dtype=np.int64),
+        process=True,
+    )
+
+
+def joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> Assembly:
+    """``assembly`` with each group of parts made one rigid part named by joining its
+    members' names with ``+`` (in the assembly's order), its mesh the union of theirs;
+    groups that share a part are one group. The joined part keeps no exact surfaces."""
+    return _joined(assembly, groups)[0]
+
+
+def _joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> tuple[Assembly, dict[str, str]]:
+    """:func:`joined`, and the name of the part each joined part became."""
+    graph: nx.Graph = nx.Graph()
+    for group in groups:
+        names = [assembly.part(name).name for name in group]
+        graph.add_nodes_from(names)
+        graph.add_edges_from(itertools.pairwise(names))
+    order = {name: k for k, name in enumerate(assembly.parts)}
+    result, into = assembly, {}
+    for component in sorted(nx.connected_components(graph), key=lambda c: min(order[n] for n in c)):
+        members = sorted(component, key=order.__getitem__)
+        if len(members) < 2:
+            continue
+        union = manifold3d.Manifold.batch_boolean(
+            [solid(assembly.parts[n].mesh, n) for n in members], manifold3d.OpType.Add
+        )
+        first = assembly.parts[members[0]]
+        part = Part("+".join(members), mesh_of(union), source=first.source)
+        rest = [n for n in result.parts if n not in component]
+        result = result.subset(rest).with_part(part)
+        into.update(dict.fromkeys(members, part.name))
+    return result, into
+
+
+def insertion_axis(shared: trimesh.Trimesh) -> NDArray[np.float64]:
+    """The axis along which a shared volume was pressed in: of its principal axes of
+    inertia, the one along which its shadow is smallest (the ring a screw's thread shares
+    with its hole casts the ring along the screw's axis, a pin's press fit likewise)."""
+    axes = np.asarray(shared.principal_inertia_vectors, dtype=np.float64)
+    normals, areas = np.asarray(shared.face_normals), np.asarray(shared.area_faces)
+    shadows = [float(np.abs(normals @ axis) @ areas) / 2 for axis in axes]
+    return axes[int(np.argmin(shadows))]
+
+
+def _extruded_shadow(
+    shared: trimesh.Trimesh, axis: NDArray[np.float64], length: float
+) -> manifold3d.Manifold:
+    """The prism of the shadow of ``shared`` along ``axis``, ``length`` long each way."""
+    u = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
+    u /= np.linalg.norm(u)
+    v = np.cross(axis, u)
+    flat = np.asarray(shared.vertices) @ np.column_stack([u, v])
+    triangles = flat[np.asarray(shared.faces)]
+    a, b = triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]
+    signed = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    triangles = np.where((signed < 0)[:, None, None], triangles[:, ::-1], triangles)
+    shadow = manifold3d.CrossSection(
+        [t for t, a in zip(triangles, np.abs(signed), strict=True) if a > 0],
+        manifold3d.FillRule.Positive,
+    )
+    prism = manifold3d.Manifold.extrude(shadow, 2 * length)
+    frame = np.column_stack([u, v, axis, -length * axis])
+    return prism.transform(frame)
+
+
+def _trimmed(part: Part, other: Part) -> Part:
+    """``part`` without what it shares with ``other``, and without the rest of ``part``
+    in that shared volume's shadow along its :func:`insertion_axis`: a screw loses its
+    thread's ring along the whole shank, so that it leaves along its axis through the
+    hole it is screwed into. No exact surfaces are kept (its faces are no longer those of
+    the file)."""
+    mine = solid(part.mesh, part.name)
+    shared = mesh_of(_bodies(mine ^ solid(other.mesh, other.name)))
+    size = float(np.linalg.norm(np.ptp(np.vstack([part.mesh.bounds, other.mesh.bounds]), axis=0)))
+    cut = mine - _extruded_shadow(shared, insertion_axis(shared), 2 * size)
+    return replace(part, mesh=mesh_of(_bodies(cut)), surfaces=())
+
+
+def _bodies(body: manifold3d.Manifold) -> manifold3d.Manifold:
+    """``body`` without the sheets of no volume a boolean leaves where faces only touch
+    (pieces under ``1e-6`` of its volume)."""
+    pieces = [piece for piece in body.decompose() if piece.volume() > 1e-6 * body.volume()]
+    return manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add)
+
+
+def resolve_overlaps(
+    assembly: Assembly,
+    join: Sequence[Sequence[str]] = (),
+    join_interfering: bool = False,
+    ignore_overlap: float | None = None,
+    tol: Tolerance | None = None,
+) -> Assembly:
+    """``assembly`` with its interfering parts resolved as the module docstring says,
+    and :attr:`~assemblykit.model.assembly.Assembly.overlaps` listing every interfering
+    pair of the input with its volume and resolution. ``ignore_overlap`` is a volume in
+    cubed model units (``0``: cut nothing; ``None``: ``DESIGNED_SHARE`` of the smaller
+    part's volume)."""
+    tol = assembly.tolerance(tol)
+    found = interferences(assembly, tol)
+    groups = [list(group) for group in join]
+    if join_interfering:
+        groups += [[a, b] for a, b, _ in found]
+    result, into = _joined(assembly, groups)
+    overlaps = []
+    for a, b, volume in found:
+        if a in into and into[a] == into.get(b):
+            overlaps.append(Overlap(a, b, volume, "joined"))
+            continue
+        small, large = sorted((assembly.parts[a], assembly.parts[b]), key=lambda p: p.volume)
+        limit = DESIGNED_SHARE * small.volume if ignore_overlap is None else ignore_overlap
+        if volume > limit or small.name not in result.parts or large.name not in result.parts:
+            overlaps.append(Overlap(a, b, volume))
+            continue
+        result = result.with_part(_trimmed(result.parts[small.name], assembly.parts[large.name]))
+        overlaps.append(Overlap(a, b, volume, f"trimmed from {small.name}"))
+    prepared = type(result).like(result, scale=result.scale)
+    prepared.overlaps = tuple(overlaps)
+    return prepared

@@ -1,0 +1,129 @@
+"""Interfering parts read as a fitter reads them (geometry/overlaps.py): designed
+interference cut from the smaller part, joined parts, and pairs left as obstacles, each
+reported with its volume; on hand-built parts whose shared volumes are known, with the
+cut checked by manifold3d and the plans' directions known by hand."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.geometry.interference import overlap_volume
+from assemblykit.geometry.overlaps import DESIGNED_SHARE, joined, resolve_overlaps
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning.planner import plan
+from cli_runs import run
+from stability_blocks import box
+
+
+def cup_and_peg() -> Assembly:
+    """A cup (3 x 3 x 2, a 1 x 1 well from z = 1) and a peg 1.1 x 0.2 x 1 standing in the
+    well, 0.1 of it pressed into the well's wall: they share 0.1 x 0.2 x 1 = 0.02, 9% of
+    the peg."""
+    cup = trimesh.boolean.difference(
+        [box((3, 3, 2), (0, 0, 0)), box((1, 1, 2), (1, 1, 1))], engine="manifold"
+    )
+    return Assembly([Part("cup", cup), Part("peg", box((1.1, 0.2, 1), (1, 1.4, 1)))])
+
+
+def screw_in_plate(thread: float = 1.5, hole: float = 1.45) -> Assembly:
+    """A plate 10 x 10 x 4 with a hole of radius ``hole`` along z, and a screw of radius
+    ``thread`` through it with a head (radius 2.5, 1.5 high) resting on the plate."""
+    plate = trimesh.boolean.difference(
+        [
+            box((10, 10, 4), (-5, -5, 0)),
+            trimesh.creation.cylinder(hole, 10, sections=64),
+        ],
+        engine="manifold",
+    )
+    shank = trimesh.creation.cylinder(thread, 6, sections=64)
+    shank.apply_translation([0, 0, 1])
+    head = trimesh.creation.cylinder(2.5, 1.5, sections=64)
+    head.apply_translation([0, 0, 4.75])
+    screw = trimesh.boolean.union([shank, head], engine="manifold")
+    return Assembly([Part("plate", plate), Part("screw", screw)])
+
+
+def test_designed_interference_is_cut_from_the_smaller_part_and_reported():
+    prepared = resolve_overlaps(cup_and_peg())
+    ((a, b, volume, resolution),) = [(o.a, o.b, o.volume, o.resolution) for o in prepared.overlaps]
+    assert {a, b} == {"cup", "peg"} and volume == pytest.approx(0.02, rel=1e-9)
+    assert resolution == "trimmed from peg"
+    peg, cup = prepared.parts["peg"].mesh, prepared.parts["cup"].mesh
+    assert peg.volume == pytest.approx(0.22 - 0.02, rel=1e-9) and cup.volume == pytest.approx(17.0)
+    assert overlap_volume(peg, cup) == pytest.approx(0.0, abs=1e-12)
+    result = plan(prepared, max_and_or_parts=0)
+    assert result.feasible and result.overlaps == prepared.overlaps
+    np.testing.assert_allclose(result.steps[0].direction, [0, 0, 1], atol=1e-9)
+
+
+@pytest.mark.parametrize("limit", [0.0, 0.019])
+def test_a_shared_volume_beyond_the_limit_is_an_obstacle_named_in_the_plan(limit):
+    prepared = resolve_overlaps(cup_and_peg(), ignore_overlap=limit)
+    (overlap,) = prepared.overlaps
+    assert overlap.resolution == "" and prepared.parts["peg"].volume == pytest.approx(0.22)
+    result = plan(prepared, max_and_or_parts=0, max_hands=2)
+    assert not result.feasible
+    assert result.interlocked[0].interfering[0][2] == pytest.approx(0.02)
+    assert result.to_dict()["overlaps"] == [overlap.to_dict()]
+
+
+def test_a_share_beyond_the_default_is_left_as_it_is():
+    # the peg pressed 0.2 into the wall shares 0.04 of its 0.24: beyond DESIGNED_SHARE
+    parts = cup_and_peg()
+    pressed = Assembly([parts.parts["cup"], Part("peg", box((1.2, 0.2, 1), (1, 1.4, 1)))])
+    (overlap,) = resolve_overlaps(pressed).overlaps
+    assert overlap.volume / 0.24 > DESIGNED_SHARE and overlap.resolution == ""
+
+
+@pytest.mark.parametrize("how", ["join", "join_interfering"])
+def test_joined_parts_move_as_one(how):
+    options = {"join": [["peg", "cup"]]} if how == "join" else {"join_interfering": True}
+    prepared = resolve_overlaps(cup_and_peg(), **options)
+    assert list(prepared.parts) == ["cup+peg"]
+    assert prepared.parts["cup+peg"].volume == pytest.approx(17.0 + 0.22 - 0.02, rel=1e-9)
+    assert [o.resolution for o in prepared.overlaps] == ["joined"]
+
+
+def test_joining_chains_of_parts_and_unknown_names():
+    three = Assembly([*cup_and_peg(), Part("lid", box((3, 3, 1), (0, 0, 2)))])
+    together = joined(three, [["cup", "peg"], ["lid", "peg"]])
+    assert list(together.parts) == ["cup+peg+lid"]
+    with pytest.raises(Exception, match="no part named 'nut'"):
+        joined(three, [["cup", "nut"]])
+
+
+def test_a_screw_in_a_smaller_hole_leaves_along_its_axis():
+    # a thread of radius 1.5 in a pilot hole of 1.45: the ring they share is cut from the
+    # screw, which then unscrews up its axis (its head lies on the plate)
+    prepared = resolve_overlaps(screw_in_plate())
+    (overlap,) = prepared.overlaps
+    assert overlap.resolution == "trimmed from screw" and overlap.volume > 0.1
+    result = plan(prepared, max_and_or_parts=0)
+    assert result.feasible
+    (step,) = result.steps
+    assert step.parts == ("screw",)
+    np.testing.assert_allclose(step.direction, [0, 0, 1], atol=1e-9)
+    assert not plan(screw_in_plate(), max_and_or_parts=0).feasible
+
+
+def test_the_plan_command_cuts_designed_interference_and_says_so(capsys, tmp_path):
+    folder = tmp_path / "screwed"
+    folder.mkdir()
+    for part in screw_in_plate():
+        part.mesh.export(folder / f"{part.name}.stl")
+    code, out, err = run(capsys, "plan", str(folder), "--json")
+    assert code == 0, err
+    found = json.loads(out)
+    assert found["feasible"] and found["overlaps"][0]["resolution"] == "trimmed from screw"
+    code, out, err = run(capsys, "plan", str(folder), "--json", "--ignore-overlap", "0")
+    assert code == 0, err
+    found = json.loads(out)
+    assert not found["feasible"] and found["interlocked"][0]["interfering"]
+    code, out, err = run(capsys, "plan", str(folder), "--join", "screw", "plate", "--json")
+    assert code == 0, err
+    found = json.loads(out)
+    assert found["parts"] == ["plate+screw"] and found["overlaps"][0]["resolution"] == "joined"
