@@ -54,12 +54,14 @@ def all_convex(assembly: Assembly, parts: Iterable[str]) -> bool:
     return all(cache.convex(name) for name in parts)
 
 
-def extended_terms(assembly: Assembly, tol: Tolerance) -> list[BlockingTerm]:
-    """One cone term per pair of convex bodies of every pair of parts, both ways (all
-    parts must be unions of convex bodies, :func:`all_convex`)."""
+def extended_terms(
+    assembly: Assembly, tol: Tolerance, parts: Iterable[str] | None = None
+) -> list[BlockingTerm]:
+    """One cone term per pair of convex bodies of every pair of ``parts`` (default: all),
+    both ways (those parts must be unions of convex bodies, :func:`all_convex`)."""
     cache = BlockingCache.of(assembly).obstacles
     terms: list[BlockingTerm] = []
-    for a, b in itertools.combinations(cache.names, 2):
+    for a, b in itertools.combinations(cache.names if parts is None else parts, 2):
         for cone in cache.cones_of(a, b, tol):
             terms.append(BlockingTerm(a, b, cone))
             terms.append(BlockingTerm(b, a, -cone))

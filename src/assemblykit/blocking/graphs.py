@@ -127,6 +127,17 @@ def blocking_graph(
     ):
         local = blocking_graph(assembly, "infinitesimal", names, tol)
         graphs[key] = sampled_ndbg(of_meshes(assembly), names, local, tol)
+    if (
+        key not in graphs
+        and motion == "extended"
+        and not isinstance(assembly, PolygonAssembly)
+        and not all_convex(of_meshes(assembly), assembly.names)
+    ):
+        # convex parts of an assembly with others that are not: cones among them alone
+        # (a stopped set of boards in a cabinet with slotted brackets)
+        terms = extended_terms(of_meshes(assembly), tol, names)
+        dimension = getattr(assembly, "dimension", 3)
+        graphs[key] = build_ndbg(names, motion, terms, len(contacts), tol, dimension)
     if key not in graphs:
         terms = [
             t

@@ -25,7 +25,8 @@ the pairs tested for one node of the search serve every other.
 The chosen plan removes, at each step, every part that leaves alone along one
 direction, or when no part leaves alone, every minimal free set (sink strong
 component, "Directional Blocking Graph") of one direction: parts that can go in
-parallel share a step. The previous step's direction is kept while it frees anything (fewer
+parallel share a step, and the sets of one step, which stay together, are then taken
+apart as one set. The previous step's direction is kept while it frees anything (fewer
 direction changes, shallower trees); otherwise the direction freeing the most parts
 wins, then directions along a coordinate axis, then lifting (+z). Removing parts never
 makes the rest harder to take apart (a partition of a set restricts to a partition of
@@ -726,7 +727,15 @@ class Search:
         return True
 
     def disassemble(self, members: int) -> None:
-        """Append the steps that take ``members`` apart, or record it as interlocked."""
+        """Append the steps that take ``members`` apart, or record it as interlocked.
+
+        A step moves its free sets to infinity together, so they are then taken apart
+        as one set: each is in the way of the others, as a set left stopped is in the
+        way of whatever is still to come out near it (docs/planning.md, "How a plan is
+        found", "Sets that leave together stay together"). Taken apart sink by sink,
+        the posts beside a drawer whose joints are modelled overlapping would leave
+        their brackets through its sides, which left with them. Single parts moved at
+        one step need no more steps."""
         previous: int | None = None
         pending = [members]
         while pending:
@@ -743,7 +752,8 @@ class Search:
                 moved = union_of(sinks)
                 self._record(k, moved, current)
                 previous = k
-                pending.extend(s for s in sinks if several(s))
+                if any(several(s) for s in sinks):
+                    pending.append(moved)  # together, not sink by sink
                 current &= ~moved
 
     def _record(self, k: int, moved: int, members: int) -> None:
