@@ -11,6 +11,7 @@ line, "assemblykit: interrupted").
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import json
 import re
@@ -304,7 +305,7 @@ def _progress_bar() -> Any:
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     err = console(stderr=True)
-    return Progress(
+    bar = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
@@ -313,6 +314,11 @@ def _progress_bar() -> Any:
         transient=True,
         disable=not err.is_terminal,
     )
+    if bar.disable:
+        # never started nor stopped: rich before 14.3 ends even a disabled bar with a
+        # blank line on a stream that is not a terminal
+        return contextlib.nullcontext(bar)
+    return bar
 
 
 def _updater(bar: Any) -> Callable[[str, int, int], None]:

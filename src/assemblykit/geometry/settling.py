@@ -73,7 +73,11 @@ def overlap_gradient(
     )
     runs = np.asarray(mesh.run_index, dtype=np.int64) // 3
     owner = np.repeat(np.asarray(mesh.run_original_id, dtype=np.int64), np.diff(runs))
-    return volume, area_normals[owner == a_id].sum(axis=0)
+    gradient = area_normals[owner == a_id].sum(axis=0)
+    # opposite faces (the sides of a layer) cancel up to the rounding of the boolean's
+    # vertices: a component below the resolution of the gradient's length is that residue
+    gradient[np.abs(gradient) <= np.finfo(np.float64).eps * np.linalg.norm(gradient)] = 0.0
+    return volume, gradient
 
 
 def settle(

@@ -30,6 +30,8 @@ GLYPH_FRACTION = 0.12
 """Size of arcs and arrows, as a fraction of the assembly's bounding-box diagonal."""
 
 ARC_POINTS = 48
+GLYPH_ZORDER = 3
+"""Drawing order of the PNG's axes, arrows and labels: above the parts (zorder 1)."""
 LIFT_OFF_COLOR = "#d62728"
 
 
@@ -214,14 +216,17 @@ def write_motion_png(
     """Write a PNG (matplotlib, Agg canvas) of the parts, each drawn translucent in its
     colour, with the invariants of its motion: the axis line of a revolute, cylindrical
     or helical motion (through the part, 3 glyph sizes long) with its label, the double
-    arrow of a prismatic one, the centre of a spherical one. Returns ``path``."""
+    arrow of a prismatic one, the centre of a spherical one, drawn over the parts.
+    Returns ``path``."""
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     colors = part_colors(assembly.names)
     size = GLYPH_FRACTION * assembly.scale
     figure = Figure(figsize=(7.0, 5.5))
-    ax = figure.add_subplot(projection="3d")
+    # the glyphs go over every part: sorted by depth, they would be drawn behind the
+    # translucent faces in front of them and come out pale
+    ax = figure.add_subplot(projection="3d", computed_zorder=False)
     for name, part in assembly.parts.items():
         mesh = part.mesh
         triangles = np.asarray(mesh.vertices, dtype=np.float64)[np.asarray(mesh.faces)]
@@ -237,16 +242,25 @@ def write_motion_png(
             u = np.asarray(data["axis"]["direction"], dtype=np.float64)
             foot = point + ((center - point) @ u) * u
             line = np.array([foot - 1.5 * size * u, foot + 1.5 * size * u])
-            ax.plot(*line.T, color="black", linewidth=2.0)
-            ax.text(*line[1], f"{name}: {data['motion']}", fontsize=8)
+            ax.plot(*line.T, color="black", linewidth=2.0, zorder=GLYPH_ZORDER)
+            ax.text(*line[1], f"{name}: {data['motion']}", fontsize=8, zorder=GLYPH_ZORDER)
         elif "direction" in data:
             u = np.asarray(data["direction"], dtype=np.float64)
             for sign in (1.0, -1.0):
-                ax.quiver(*center, *(sign * size * u), color="black", linewidth=2.0)
-            ax.text(*(center + size * u), f"{name}: {data['motion']}", fontsize=8)
+                ax.quiver(
+                    *center, *(sign * size * u), color="black", linewidth=2.0, zorder=GLYPH_ZORDER
+                )
+            ax.text(
+                *(center + size * u), f"{name}: {data['motion']}", fontsize=8, zorder=GLYPH_ZORDER
+            )
         elif "center" in data:
-            ax.scatter(*np.asarray(data["center"], dtype=np.float64), color="black", s=30)
-            ax.text(*center, f"{name}: {data['motion']}", fontsize=8)
+            ax.scatter(
+                *np.asarray(data["center"], dtype=np.float64),
+                color="black",
+                s=30,
+                zorder=GLYPH_ZORDER,
+            )
+            ax.text(*center, f"{name}: {data['motion']}", fontsize=8, zorder=GLYPH_ZORDER)
     lo, hi = np.asarray(assembly.bounds, dtype=np.float64)
     for setter, a, b in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), lo, hi, strict=True):
         setter(a, b)
