@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+import trimesh
 
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.io.assembly import load_assembly
@@ -30,6 +31,7 @@ from assemblykit.planning.stability import (
 )
 from assemblykit.tolerance import Tolerance
 from datasets import dataset
+from plan_checks import assert_steps_clear
 from stability_blocks import block_on_slope, box, corbels, overhanging_stack
 
 MU = 0.5
@@ -365,3 +367,21 @@ def test_the_arch_on_its_springers_names_what_falls_at_each_falling_step():
         named = set(step["would_fall"])
         assert named and {n for n, r in residual.items() if r > 10 * every.threshold} <= named
         assert all(residual[n] > every.threshold / 10 for n in named)
+
+
+def test_under_gravity_parts_lift_and_never_leave_through_the_ground():
+    # gravity along -y: a slab on the ground (y from 0 to 1) with a pin standing in a
+    # through hole, flush with the ground, and a nut lying loose on the slab. Taking the
+    # pin out downwards would pass through the ground the slab stands on; the pin lifts
+    # out along +y, and the nut lifts rather than sliding off sideways
+    slab = trimesh.boolean.difference(
+        [box((6, 1, 6), (-3, 0, -3)), box((1, 3, 1), (-0.5, -1, -0.5))], engine="manifold"
+    )
+    pin = box((1, 2, 1), (-0.5, 0, -0.5))
+    nut = box((1, 0.5, 1), (1.5, 1, 1.5))
+    assembly = Assembly([Part("slab", slab), Part("pin", pin), Part("nut", nut)])
+    result = plan(assembly, gravity=Gravity(direction=(0.0, -1.0, 0.0)), max_and_or_parts=0)
+    assert result.feasible and {s.parts for s in result.steps} == {("pin",), ("nut",)}
+    for step in result.steps:
+        np.testing.assert_allclose(step.direction, [0.0, 1.0, 0.0], atol=1e-9)
+    assert_steps_clear(assembly, result)

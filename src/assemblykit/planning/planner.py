@@ -36,7 +36,13 @@ from assemblykit.planning.sequence import (
     one_set,
     separable,
 )
-from assemblykit.planning.stability import Gravity, GravityReport, StateJudge, equilibrium_model
+from assemblykit.planning.stability import (
+    Gravity,
+    GravityReport,
+    StateJudge,
+    equilibrium_model,
+    gravity_direction,
+)
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -158,6 +164,7 @@ def _plan_under_gravity(
         judge.fewest_falling,
     )
     search.judge = judge.judge
+    search.up = -gravity_direction(gravity.direction)
     if gravity.fixed is not None:
         # declared fixed parts (a fixture) never move; the default ones only rest on the
         # ground, and are taken off it last

@@ -568,6 +568,7 @@ def _choose_removal(
     volumes: Sequence[float],
     previous: int | None,
     narrow: Narrow | None = None,
+    up: NDArray[np.float64] | None = None,
 ) -> tuple[int, list[int]] | None:
     """The direction index and the free sets of Γ_e it removes from ``members``.
 
@@ -613,11 +614,11 @@ def _choose_removal(
         bounds = dict(zip(candidates.tolist(), counts[candidates].tolist(), strict=True))
         # a narrower picks one set: one single part
         choice = _best_direction(
-            translations, bounds, singles, previous, None if narrow is None else 1
+            translations, bounds, singles, previous, None if narrow is None else 1, up
         )
     if choice is None:
         bounds = _group_bounds(translations, members, volumes)
-        choice = _best_direction(translations, bounds, groups, previous)
+        choice = _best_direction(translations, bounds, groups, previous, None, up)
     return choice
 
 
@@ -627,6 +628,7 @@ def _best_direction(
     removal: Callable[[int], list[int]],
     previous: int | None,
     most: int | None = None,
+    up: NDArray[np.float64] | None = None,
 ) -> tuple[int, list[int]] | None:
     """The candidate whose ``removal`` moves most, with its free sets.
 
@@ -637,24 +639,33 @@ def _best_direction(
     ``most`` parts at most (a single part, where one set is picked), a candidate that
     could not beat the best one even so is passed over without asking ``removal``, as
     it would be after asking.
+
+    Under gravity (``up``, the unit vector against it) a direction with a downward
+    component is no candidate: a part taken to infinity along it would pass through the
+    ground the fixed parts stand on. Of the others, lifting ranks before sliding
+    sideways, after the parts moved (docs/planning.md, "Under gravity").
     """
+    # directions compared to ORDER_RESOLUTION: mirror images rank alike, by index
+    levels = np.round(translations.directions / ORDER_RESOLUTION)
+    rise = np.zeros(len(levels)) if up is None else np.sign(levels @ up)
+    if up is not None:
+        bounds = {k: n for k, n in bounds.items() if rise[k] >= 0}
     if previous in bounds:
         sinks = removal(previous)
         if sinks:
             return previous, sinks
 
-    # directions compared to ORDER_RESOLUTION: mirror images rank alike, by index
-    levels = np.round(translations.directions / ORDER_RESOLUTION)
-
     def rank(k: int, moved: int) -> tuple[float, ...]:
         direction = levels[k]
-        return (moved, float(np.abs(direction).max()), float(direction[2]), -k)
+        return (moved, float(rise[k]), float(np.abs(direction).max()), float(direction[2]), -k)
 
     # the candidates by decreasing rank, sorted on arrays (tens of thousands on the dome)
     keys = np.fromiter(bounds, dtype=np.int64, count=len(bounds))
     moved = np.fromiter(bounds.values(), dtype=np.int64, count=len(bounds))
     directions = levels[keys]
-    order = np.lexsort((keys, -directions[:, 2], -np.abs(directions).max(axis=1), -moved))
+    order = np.lexsort(
+        (keys, -directions[:, 2], -np.abs(directions).max(axis=1), -rise[keys], -moved)
+    )
     best: tuple[tuple[float, ...], int, list[int]] | None = None
     patience = LOOK_AHEAD
     for k in keys[order].tolist():
@@ -693,6 +704,9 @@ class Search:
     ground: int = 0
     """Parts that stay where they are (fixed parts declared under gravity): a set holding
     nothing else is not taken apart."""
+    up: NDArray[np.float64] | None = None
+    """Under gravity, the unit vector against it: no direction with a downward component
+    is taken, and lifting goes before sliding (:func:`_best_direction`)."""
     max_steps: int | None = None
     """Stop after this many steps (``None``: go on until every set is apart or stopped)."""
     unfinished: list[int] = field(default_factory=list)
@@ -708,7 +722,13 @@ class Search:
                 return None
             for narrow in narrowers:
                 choice = _choose_removal(
-                    self.translations, self.extended, members, self.volumes, previous, narrow
+                    self.translations,
+                    self.extended,
+                    members,
+                    self.volumes,
+                    previous,
+                    narrow,
+                    self.up,
                 )
                 if choice is not None:
                     return choice
