@@ -16,24 +16,11 @@ from assemblykit.features.primitives import Ball, Hole, Shaft, Socket
 from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import LINEAR_DEFLECTION, declared_solids, numbered
+from step_files import write_step
 
 pytest.importorskip("OCP")
 
 pytestmark = pytest.mark.cad
-
-
-def write_step(path, *shapes) -> None:
-    from OCP.BRep import BRep_Builder
-    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
-    from OCP.TopoDS import TopoDS_Compound
-
-    compound, builder = TopoDS_Compound(), BRep_Builder()
-    builder.MakeCompound(compound)
-    for shape in shapes:
-        builder.Add(compound, shape)
-    writer = STEPControl_Writer()
-    writer.Transfer(compound, STEPControl_AsIs)
-    writer.Write(str(path))
 
 
 @pytest.fixture(scope="module")

@@ -24,6 +24,7 @@ from assemblykit.io import step as step_module
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import LINEAR_DEFLECTION
 from assemblykit.planning.planner import plan
+from step_files import write_step
 
 pytest.importorskip("OCP")
 
@@ -32,20 +33,6 @@ pytestmark = pytest.mark.cad
 # shared volume (mm^3) still counted as none: float rounding of touching meshes
 NOISE = 1e-9
 Z = np.array([0.0, 0.0, 1.0])
-
-
-def write_step(path, *shapes) -> None:
-    from OCP.BRep import BRep_Builder
-    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
-    from OCP.TopoDS import TopoDS_Compound
-
-    compound, builder = TopoDS_Compound(), BRep_Builder()
-    builder.MakeCompound(compound)
-    for shape in shapes:
-        builder.Add(compound, shape)
-    writer = STEPControl_Writer()
-    writer.Transfer(compound, STEPControl_AsIs)
-    writer.Write(str(path))
 
 
 def cylinder(centre, radius: float, height: float, turn: float = 0.0, axis=(0, 0, 1)):

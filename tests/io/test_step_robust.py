@@ -4,7 +4,6 @@ BRepMesh does not mesh, product names that are placeholders, repeated or escaped
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -19,25 +18,10 @@ from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io import step
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import declared_solids, decode_step_string, distinct_products
+from datasets import dataset
+from step_files import write_step
 
 cad = pytest.mark.cad
-
-GRIPPER = Path("/work/shared/data/step_gripper/gripper.step")
-
-
-def _write_step(path: Path, *shapes: Any) -> None:
-    """``shapes`` written by Open CASCADE's STEP writer, unnamed."""
-    from OCP.BRep import BRep_Builder
-    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
-    from OCP.TopoDS import TopoDS_Compound
-
-    compound, builder = TopoDS_Compound(), BRep_Builder()
-    builder.MakeCompound(compound)
-    for shape in shapes:
-        builder.Add(compound, shape)
-    writer = STEPControl_Writer()
-    writer.Transfer(compound, STEPControl_AsIs)
-    writer.Write(str(path))
 
 
 def _at(x: float, y: float, z: float) -> Any:
@@ -137,7 +121,7 @@ def bspline_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
     plate = BRepAlgoAPI_Cut(_box(40, 40, 10, (-20, -20, 0)), _cylinder(5, 40, (0, 0, -10))).Shape()
     path = tmp_path_factory.mktemp("bspline") / "parts.step"
-    _write_step(path, _nurbs(plate), _nurbs(_cylinder(5, 30, (0, 0, -10))))
+    write_step(path, _nurbs(plate), _nurbs(_cylinder(5, 30, (0, 0, -10))))
     return path
 
 
@@ -290,7 +274,7 @@ def test_a_file_without_any_part_is_an_error(tmp_path, monkeypatch):
     from OCP.gp import gp_Pnt
 
     path = tmp_path / "ball.step"
-    _write_step(path, BRepPrimAPI_MakeSphere(gp_Pnt(0, 0, 0), 3).Shape())
+    write_step(path, BRepPrimAPI_MakeSphere(gp_Pnt(0, 0, 0), 3).Shape())
     _failing(monkeypatch, lambda kind, surface, asked: True)
     with pytest.raises(GeometryError, match=r"ball\.step.*solid1: BRepMesh left 1 face"):
         load_assembly(path)
@@ -302,12 +286,7 @@ def test_the_gripper_loads_every_part():
     """``gripper.step`` of online-robotics/CAD-data (commit 74ada1e), 144 solids:
     BRepMesh never triangulates a conical face of each of the two M2 screws inside the
     servos."""
-    if not GRIPPER.is_file():
-        pytest.skip(f"{GRIPPER} is absent")
-    start = time.perf_counter()
-    asm = load_assembly(GRIPPER)
-    took = time.perf_counter() - start
-    print(f"gripper: {len(asm.parts)} parts, {len(asm.skipped)} skipped in {took:.1f} s")
+    asm = load_assembly(dataset("step_gripper/gripper.step"))
     assert len(asm.parts) + len(asm.skipped) == 144
     screws = [n for n in asm.names if "M2 x 4" in n]
     assert len(screws) == 2 - len(asm.skipped)
