@@ -474,7 +474,7 @@ def _gravity(
     default=None,
     metavar="V",
     help="Parts sharing at most this volume (model units cubed) are designed "
-    "interference: it is cut from the smaller one [default: 10% of the smaller "
+    "interference: it is cut from the smaller one [default: 25% of the smaller "
     "part's volume; 0 cuts nothing].",
 )
 @click.option(
