@@ -53,9 +53,11 @@ def convex_bodies(
     moves their surface by at most the tolerance."""
     tol = tol or current()
     bodies = [mesh] if mesh.body_count < 2 else mesh.split(only_watertight=False)
-    # a shell facing inwards bounds a cavity, not a solid: the part is not convex
-    if any(body.is_watertight and body.volume < 0 for body in bodies):
-        return None
+    # a shell facing inwards bounds a cavity, not a solid: the part is not convex (a
+    # body of no volume, a sheet a boolean left, has no centre of mass: not an error)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if any(body.is_watertight and body.volume < 0 for body in bodies):
+            return None
     if not all(_convex_within(body, tol) for body in bodies):
         return None
     return [np.asarray(body.vertices, dtype=np.float64) for body in bodies]
