@@ -3,11 +3,18 @@
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
-import pytest
-from hypothesis import settings
+# One thread per process for the linear algebra libraries: the suite runs one process
+# per core (pytest-xdist), and more threads than cores only wait on each other. Set
+# before numpy is first imported (the test modules import it after this file).
+for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
+
+import pytest  # noqa: E402
+from hypothesis import settings  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
