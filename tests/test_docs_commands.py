@@ -53,9 +53,17 @@ def test_the_documents_show_commands():
     assert readme[0] == "assemblykit demo"
 
 
+# commands whose work other tests of the default tier already do, with checks: run in
+# the slow tier (a plan of the Pelikan burr, a burr with no monotone plan)
+SLOW = ("PelikanBurr.xmpuzzle --moves multi", "SolidSixPieceBurrs.xmpuzzle --moves multi")
+
+
 @pytest.mark.parametrize(
     "command, expected",
-    [(c, e) for _, _, c, e in COMMANDS],
+    [
+        pytest.param(c, e, marks=[pytest.mark.slow] if any(m in c for m in SLOW) else [])
+        for _, _, c, e in COMMANDS
+    ],
     ids=[f"{d}:{n}" for d, n, _, _ in COMMANDS],
 )
 def test_documented_command_runs(command, expected, tmp_path, monkeypatch):

@@ -8,6 +8,8 @@ draws from the last balance it found are checked here too."""
 
 from __future__ import annotations
 
+import functools
+
 import clarabel
 import numpy as np
 import pytest
@@ -266,11 +268,16 @@ def test_the_least_friction_searched_from_the_last_answer_is_the_bisections():
     assert len(set(found)) > 4 and None not in found
 
 
+@functools.cache
+def cross_vault() -> Assembly:
+    """The cross vault, read once (each test builds its own models from it)."""
+    return load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
+
+
 def standing_vault() -> tuple[EquilibriumModel, np.ndarray, np.ndarray]:
-    """The cross vault's model with its crown joints as contacts (it stands), the mask
-    of all its parts and that of its fixed ones."""
-    assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
-    model = equilibrium_model(assembly, tol=Tolerance.relative(5e-5))
+    """A new model of the cross vault with its crown joints as contacts (it stands), the
+    mask of all its parts and that of its fixed ones."""
+    model = equilibrium_model(cross_vault(), tol=Tolerance.relative(5e-5))
     present = model.mask(None)
     return model, present, present & model.mask(model.fixed)
 
