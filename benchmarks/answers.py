@@ -3,18 +3,20 @@
 Run ``python benchmarks/answers.py OUT`` with one install, again with another, then
 ``diff -r OUT1 OUT2``: plans, verdicts and poses must be identical (the deterministic
 ordering rule and the signs of docs/architecture.md, "Tolerances"). Keys that measure
-the run rather than the answer (times, versions) are left out. The commands run two at
-a time (one per core of a small machine).
+the run rather than the answer (times, versions) are left out. The commands run in this
+process, one after the other (the imports are paid once).
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
-import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
+
+from assemblykit.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "src" / "assemblykit" / "examples"
@@ -69,31 +71,31 @@ def stripped(value: Any) -> Any:
 
 
 def answer(argv: list[str]) -> tuple[int, str]:
-    """The exit code of ``assemblykit ARGV --json`` and its answer as stable JSON text
-    (:func:`stripped`), or its last line on stderr when it printed no JSON."""
-    run = subprocess.run(
-        [sys.executable, "-m", "assemblykit", *argv, "--json"],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    """The exit code of ``assemblykit ARGV --json``, run in this process, and its answer
+    as stable JSON text (:func:`stripped`), or its last line on stderr when it printed no
+    JSON."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            main([*argv, "--json"])
+            code = 0
+        except SystemExit as done:
+            code = int(done.code or 0)
     try:
-        found = stripped(json.loads(run.stdout))
+        found = stripped(json.loads(out.getvalue()))
     except json.JSONDecodeError:
-        found = {"exit": run.returncode, "stderr": run.stderr.strip().splitlines()[-1:]}
-    return run.returncode, json.dumps(found, indent=1, sort_keys=True)
+        found = {"exit": code, "stderr": err.getvalue().strip().splitlines()[-1:]}
+    return code, json.dumps(found, indent=1, sort_keys=True)
 
 
-def main() -> None:
+def main_answers() -> None:
     out = Path(sys.argv[1])
     out.mkdir(parents=True, exist_ok=True)
-    named = jobs()
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        results = pool.map(answer, [argv for _, argv in named])
-        for (name, _), (code, text) in zip(named, results, strict=True):
-            (out / f"{name}.json").write_text(text + "\n", encoding="utf-8")
-            print(f"{name:<40} exit {code}")
+    for name, argv in jobs():
+        code, text = answer(argv)
+        (out / f"{name}.json").write_text(text + "\n", encoding="utf-8")
+        print(f"{name:<40} exit {code}")
 
 
 if __name__ == "__main__":
-    main()
+    main_answers()
