@@ -1,5 +1,6 @@
 """Blocks whose equilibrium is computed by hand, shared by the stability tests: a cube
-on a slope, an overhanging stack of cubes and a corbelled arch."""
+on a slope, an overhanging stack of cubes and a corbelled arch; and the slack program
+written out independently of the model's own (:func:`whole_residuals`)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import numpy as np
 import trimesh
 
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning.stability import CONE_SIDES, EquilibriumModel, least_residuals
 
 
 def box(extents: tuple[float, ...], low: tuple[float, ...]) -> trimesh.Trimesh:
@@ -56,3 +58,18 @@ def corbels(keystone: bool) -> Assembly:
     if keystone:
         parts.append(Part("keystone", box((0.4, 1, 1), (-0.2, 0, 1))))
     return Assembly(parts)
+
+
+def whole_residuals(
+    model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray
+) -> dict[str, float]:
+    """Per free part of a state, its largest scaled residual at the slack program's
+    optimum, written out from the model's public arrays over every free part and every
+    polygon vertex at once (the model solves it piece by piece, on corners)."""
+    free = present & ~fixed
+    rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
+    points = present[model.point_parts[:, 0]] & present[model.point_parts[:, 1]]
+    columns = np.flatnonzero(np.repeat(points, CONE_SIDES))
+    matrix = (model.normal_part + model.friction * model.tangent_part)[rows][:, columns]
+    residual = np.abs(least_residuals(matrix.tocsc(), -model.load[rows])).reshape(-1, 6)
+    return dict(zip(np.array(model.names)[free], residual.max(axis=1), strict=True))

@@ -37,8 +37,10 @@ beyond the tolerance are those that cannot be in equilibrium (they would fall). 
 optimum is not unique on a state that falls; the parts named are those left unbalanced
 by *some* least-residual balance, the support of the interior of its optimal face, to
 which Clarabel's interior point method converges (:func:`least_residuals`), so the set
-does not depend on a solver's pivots; it is solved for each piece of the state (free
-parts that no force point joins: :meth:`EquilibriumModel.pieces`) on its own. A plan
+does not depend on a solver's pivots. It converges to :data:`SLACK_ACCURACY`, well past
+the least residual itself: before that, which parts keep a residual depends on how the
+program is written. It is solved for each piece of the state (free parts that no force
+point joins: :meth:`EquilibriumModel.pieces`) on its own. A plan
 asks about states that differ by a block, a hold or the friction coefficient from one
 already decided: the balances and Farkas certificates found before answer many of them
 with no program, or from a few parts' equations (:meth:`EquilibriumModel.stands`).
@@ -94,6 +96,19 @@ parts by, one at a time, before it leaves the verdict to the whole program. A re
 that a contact more does not prove falling rarely falls with two or three more: the
 cross vault's first 39 steps solve 359 programs in 40 s with one, 502 in 41 s with two,
 639 in 43 s with three, and 372 in 63 s with none (128 certificates kept)."""
+
+SLACK_ACCURACY = 1e-10
+"""Clarabel's gap and feasibility tolerances in the slack program (its defaults are 1e-8,
+which an answer that stops short of these must still meet). The least residual is
+reached well before the residuals settle on the parts: on a state that falls, moving
+residual onto a part can raise the sum by very little, so an answer within 1e-8 of the
+optimum can leave a part a hundredth of its weight unbalanced where the converged one
+leaves 1e-9, and which parts depends on the columns (corners or every vertex) and on
+whether the program is solved whole or piece by piece. On the 137 falling states of the
+cross vault's plan under gravity, the parts named at 1e-8 differed in 11 states from
+those of programs solved to 1e-12; at 1e-10 in none, whole or by pieces, on corners or
+on every vertex (elsewhere only in parts within ten times the tolerance, the rounding
+band of any threshold), for about a tenth more time in the slack programs."""
 
 KEPT = 8
 """How many balances an :class:`EquilibriumModel` keeps (the most recently useful
@@ -393,7 +408,9 @@ def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[
     defined by the program alone, where a vertex optimum names a subset that depends on
     the solver's pivots. Solved by Clarabel in dual form ("maximise ``rhs @ y`` with
     ``matrix.T @ y <= 0`` and ``-1 <= y <= 1``", the unknowns being the equations), whose
-    multipliers are ``x`` and the two signs of ``r``. Should it stop short of an optimum,
+    multipliers are ``x`` and the two signs of ``r``, to :data:`SLACK_ACCURACY` (an
+    answer that stops short of it is taken when it meets Clarabel's default tolerances,
+    1e-8). Should it stop short of those,
     HiGHS's interior point method with crossover answers (a vertex of that face), and
     :class:`NumericError` if it fails too."""
     import clarabel
@@ -403,6 +420,9 @@ def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.time_limit = LP_TIME_LIMIT
+    settings.tol_gap_abs = settings.tol_gap_rel = settings.tol_feas = SLACK_ACCURACY
+    settings.reduced_tol_gap_abs = settings.reduced_tol_gap_rel = 1e-8
+    settings.reduced_tol_feas = 1e-8
     found = clarabel.DefaultSolver(
         sp.csc_matrix((rows, rows)),
         -np.asarray(rhs, dtype=np.float64),
@@ -789,8 +809,9 @@ class EquilibriumModel:
         self, present: NDArray[np.bool_], piece: NDArray[np.bool_], mu: float
     ) -> NDArray[np.float64]:
         """The residuals of one piece's parts at the slack program's optimum, on the
-        corners of its points (they span the same wrenches as every point: the same
-        residuals); a piece that touches nothing keeps its whole weight as residual."""
+        corners of its points (they span the same wrenches as every point: the same least
+        residual and the same parts left unbalanced, :data:`SLACK_ACCURACY`); a piece
+        that touches nothing keeps its whole weight as residual."""
         rows = self._rows(piece)
         points = self._touching(present) & self._acting_on(piece)
         if not points.any():
@@ -962,6 +983,12 @@ class StepStability:
     stands: bool
     friction_needed: float | None
     friction: float
+    unbalanced: float | None = None
+    """When the step does not stand: the largest share of a part's weight that no
+    balance of the contact forces carries (the slack program's residual, without the
+    holds beyond the grips): how far beyond :attr:`threshold` the fall is."""
+    threshold: float = 0.0
+    """The residual beyond which a part falls (the model's tolerance)."""
 
     @property
     def margin(self) -> float | None:
@@ -971,13 +998,17 @@ class StepStability:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON keys added to a step: ``held``, ``would_fall``, ``stands``,
-        ``friction_needed``, ``stability_margin``."""
+        ``friction_needed``, ``stability_margin`` (the friction that may be lost), and for
+        a step that does not stand ``unbalanced`` with the ``fall_threshold`` it is
+        compared to (how far the verdict is from the solver's tolerance)."""
         return {
             "held": list(self.held),
             "would_fall": list(self.would_fall),
             "stands": self.stands,
             "friction_needed": self.friction_needed,
             "stability_margin": self.margin,
+            "unbalanced": self.unbalanced,
+            "fall_threshold": self.threshold,
         }
 
     def cells(self) -> list[str]:
@@ -1026,12 +1057,19 @@ class _Assessment:
     held: NDArray[np.bool_]
     stands: bool
     states: tuple[tuple[NDArray[np.bool_], NDArray[np.bool_]], ...]
-    falling: Callable[[], NDArray[np.bool_]]
+    residual: Callable[[], NDArray[np.float64]]
+    """Per part, its residual without the holds (a slack program per state that falls)."""
+    threshold: float
+
+    @cached_property
+    def residuals(self) -> NDArray[np.float64]:
+        """Per part, the share of its weight left unbalanced without the holds."""
+        return self.residual()
 
     @cached_property
     def falls(self) -> NDArray[np.bool_]:
         """The parts that would fall without the holds."""
-        return self.falling()
+        return self.residuals > self.threshold
 
 
 class StateJudge:
@@ -1061,7 +1099,7 @@ class StateJudge:
         self.ground_base = ground_base
         self.fixed = model.mask(model.fixed)
         self._stands: dict[tuple[bytes, bytes], bool] = {}
-        self._falling: dict[tuple[bytes, bytes], NDArray[np.bool_]] = {}
+        self._falling: dict[tuple[bytes, bytes], NDArray[np.float64]] = {}
         self._assessed: dict[tuple[int, int], _Assessment] = {}
         self._single_falls: dict[int, int] = {}
 
@@ -1072,17 +1110,21 @@ class StateJudge:
             self._stands[key] = self.model.stands(present, fixed)
         return self._stands[key]
 
-    def falling(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> NDArray[np.bool_]:
-        """:meth:`EquilibriumModel.falling`, once per state: the slack program only when
+    def residual(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> NDArray[np.float64]:
+        """:meth:`EquilibriumModel.residuals`, once per state: the slack program only when
         :meth:`stands` says it does not."""
         key = (present.tobytes(), fixed.tobytes())
         if key not in self._falling:
             self._falling[key] = (
-                np.zeros_like(present)
+                np.zeros(len(present))
                 if self.stands(present, fixed)
-                else self.model.slack(present, fixed) > self.model.threshold
+                else self.model.slack(present, fixed)
             )
         return self._falling[key]
+
+    def falling(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """:meth:`EquilibriumModel.falling`, once per state (:meth:`residual`)."""
+        return self.residual(present, fixed) > self.model.threshold
 
     def _hold(
         self, present: NDArray[np.bool_], fixed: NDArray[np.bool_], budget: int
@@ -1127,15 +1169,16 @@ class StateJudge:
             held_moved, moved_ok = self._hold(taken, grip, budget - int(held_rest.sum()))
         held = grip | base_held | held_rest | held_moved
 
-        def falling() -> NDArray[np.bool_]:
-            falls = self.falling(rest, rest & ground)
-            return falls | self.falling(taken, grip) if several else falls
+        def residual() -> NDArray[np.float64]:
+            left = self.residual(rest, rest & ground)
+            return np.maximum(left, self.residual(taken, grip)) if several else left
 
         found = _Assessment(
             held=held,
             stands=rest_ok and moved_ok and int(held.sum()) <= self.holds,
             states=((rest, (rest & ground) | held_rest), (taken, grip | held_moved)),
-            falling=falling,
+            residual=residual,
+            threshold=self.model.threshold,
         )
         self._assessed[key] = found
         if not found.stands and moved & (moved - 1) == 0:
@@ -1182,4 +1225,6 @@ class StateJudge:
             stands=found.stands,
             friction_needed=None if None in needed else max(needed, default=0.0),  # type: ignore[type-var]
             friction=self.model.friction,
+            unbalanced=None if found.stands else float(found.residuals.max()),
+            threshold=self.model.threshold,
         )
