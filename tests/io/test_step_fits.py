@@ -401,3 +401,48 @@ def test_every_concave_face_lies_in_its_solid_within_the_deflection(concave_face
         # and every vertex within the linear deflection of the surface
         ends = material_side(surface, corners.reshape(-1, 3), np.repeat(normals, 3, axis=0))
         assert np.abs(ends).max() <= deflection, surface.kind
+
+
+@pytest.fixture(scope="module")
+def self_tapping(tmp_path_factory) -> Read:
+    """A 20 x 20 x 6 plate with a pilot hole of radius 1.45 and a self-tapping screw of
+    radius 1.5 (0.1 mm larger in diameter, a head of radius 2.8 on the plate): the exact
+    solids share the ring between the two cylinders."""
+    plate = cut(box((-10, -10, 0), (20, 20, 6)), cylinder((0, 0, -1), 1.45, 8.0))
+    screw = fuse(cylinder((0, 0, 0.5), 1.5, 5.6, turn=4), cylinder((0, 0, 6), 2.8, 2.0))
+    return read(tmp_path_factory.mktemp("fits") / "tapping.step", plate, screw)
+
+
+def test_a_trimmed_screw_keeps_its_surfaces_and_fits_its_pilot_hole(self_tapping):
+    from assemblykit.geometry.overlaps import resolve_overlaps
+    from assemblykit.motion.freedom import part_motion
+
+    (plate, screw), asm = self_tapping.shapes, self_tapping.assembly
+    shared = common_volume(plate, screw)
+    # the ring: pi (1.5^2 - 1.45^2) x 5.5 mm of shank in the plate, by OCCT and by hand
+    assert shared == pytest.approx(math.pi * (1.5**2 - 1.45**2) * 5.5, rel=1e-6)
+    prepared = resolve_overlaps(asm)
+    (overlap,) = prepared.overlaps
+    assert overlap.resolution == f"trimmed from {PIN}"
+    # the meshes lie inside their solids: they share a little less than the solids
+    assert 0.9 * shared < overlap.volume <= shared
+    trimmed = prepared[PIN]
+    assert overlap_volume(trimmed.mesh, prepared[PLATE].mesh) <= 1e-6 * shared
+    assert interferences(prepared) == []
+    # the shank cut to the pilot hole is a shaft of its radius on the hole's axis, the
+    # head's flat underside is still the plane it was
+    shafts = [s for s in trimmed.surfaces if s.kind == "cylinder" and s.radius == 1.45]
+    assert shafts and all(s.convex for s in shafts)
+    assert all(abs(float(s.axis @ Z)) == pytest.approx(1.0) for s in shafts)
+    planes = [s for s in trimmed.surfaces if s.kind == "plane" and s.axis @ Z < -0.99]
+    assert any(abs(float(s.point @ Z) - 6.0) <= 1e-9 for s in planes)
+    # so the screw fits the hole as a cylinder: it turns and slides on its axis
+    (fit,) = next(c for c in assembly_contacts(prepared) if c.curved).curved
+    assert (fit.kind, fit.inner, fit.radius) == ("cylindrical", PIN, 1.45)
+    freedom = part_motion(prepared, PIN)
+    assert freedom.dof >= 1
+    found = plan(prepared)
+    assert found.feasible
+    (step,) = found.steps
+    assert step.parts == (PIN,) and float(step.direction @ Z) == pytest.approx(1.0)
+    assert max(sweep_overlaps(prepared, found.steps)) <= 1e-6 * shared

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import manifold3d
 import numpy as np
 import trimesh
+from numpy.typing import NDArray
 
 from assemblykit.errors import GeometryError
 from assemblykit.geometry.contacts import candidate_pairs
@@ -23,12 +24,27 @@ if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
 
 
-def solid(mesh: trimesh.Trimesh, name: str | None = None) -> manifold3d.Manifold:
-    """The manifold3d solid of a closed triangle mesh (float64 vertices)."""
+def solid(
+    mesh: trimesh.Trimesh, name: str | None = None, *, original_id: int | None = None
+) -> manifold3d.Manifold:
+    """The manifold3d solid of a closed triangle mesh (float64 vertices). With
+    ``original_id`` (from ``manifold3d.Manifold.reserve_ids``) its triangles carry their
+    index as face id under that id, so that the triangles of a boolean's result tell
+    which of them they come from
+    (:func:`assemblykit.geometry.overlaps.traced_mesh`)."""
+    numbered: dict[str, NDArray[np.generic]] = {}
+    if original_id is not None:
+        count = len(mesh.faces)
+        numbered = {
+            "face_id": np.arange(count, dtype=np.uint64),
+            "run_index": np.array([0, 3 * count], dtype=np.uint64),
+            "run_original_id": np.array([original_id], dtype=np.uint32),
+        }
     result = manifold3d.Manifold(
         manifold3d.Mesh64(
             vert_properties=np.ascontiguousarray(mesh.vertices, dtype=np.float64),
             tri_verts=np.ascontiguousarray(mesh.faces, dtype=np.uint64),
+            **numbered,
         )
     )
     if result.status() != manifold3d.Error.NoError:

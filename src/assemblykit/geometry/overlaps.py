@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from assemblykit.geometry.interference import interferences, solid
 from assemblykit.model.assembly import Assembly, Overlap, Part
+from assemblykit.model.surfaces import Surface
 from assemblykit.tolerance import Tolerance
 
 DESIGNED_SHARE = 0.25
@@ -45,12 +46,28 @@ taken as a modelling error and left as obstacles."""
 
 def mesh_of(body: manifold3d.Manifold) -> trimesh.Trimesh:
     """The closed triangle mesh of a manifold3d solid."""
+    return traced_mesh(body, -1)[0]
+
+
+def traced_mesh(
+    body: manifold3d.Manifold, original_id: int
+) -> tuple[trimesh.Trimesh, NDArray[np.int64]]:
+    """The closed triangle mesh of a manifold3d solid, and per triangle the index of the
+    triangle it lies on in the solid made with ``original_id``
+    (:func:`~assemblykit.geometry.interference.solid`), or -1 where it comes from
+    another solid."""
     out = body.to_mesh64()
-    return trimesh.Trimesh(
-        np.asarray(out.vert_properties[:, :3], dtype=np.float64),
-        np.asarray(out.tri_verts, dtype=np.int64),
-        process=True,
+    faces = np.asarray(out.tri_verts, dtype=np.int64)
+    mesh = trimesh.Trimesh(
+        np.asarray(out.vert_properties[:, :3], dtype=np.float64), faces, process=True
     )
+    source = np.full(len(faces), -1, dtype=np.int64)
+    bounds = np.asarray(out.run_index, dtype=np.int64) // 3
+    for run, original in enumerate(np.asarray(out.run_original_id).tolist()):
+        if original == original_id >= 0:
+            start, stop = bounds[run], bounds[run + 1]
+            source[start:stop] = np.asarray(out.face_id[start:stop], dtype=np.int64)
+    return mesh, source
 
 
 def joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> Assembly:
@@ -115,17 +132,65 @@ def _extruded_shadow(
     return prism.transform(frame)
 
 
-def _trimmed(part: Part, other: Part) -> Part:
+def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part:
     """``part`` without what it shares with ``other``, and without the rest of ``part``
     in that shared volume's shadow along its :func:`insertion_axis`: a screw loses its
     thread's ring along the whole shank, so that it leaves along its axis through the
-    hole it is screwed into. No exact surfaces are kept (its faces are no longer those of
-    the file)."""
-    mine = solid(part.mesh, part.name)
+    hole it is screwed into. Its exact surfaces keep the triangles that remain of them
+    (:func:`_cut_surfaces`)."""
+    original_id = manifold3d.Manifold.reserve_ids(1)
+    mine = solid(part.mesh, part.name, original_id=original_id)
     shared = mesh_of(_bodies(mine ^ solid(other.mesh, other.name)))
     size = float(np.linalg.norm(np.ptp(np.vstack([part.mesh.bounds, other.mesh.bounds]), axis=0)))
-    cut = mine - _extruded_shadow(shared, insertion_axis(shared), 2 * size)
-    return replace(part, mesh=mesh_of(_bodies(cut)), surfaces=())
+    axis = insertion_axis(shared)
+    cut = _bodies(mine - _extruded_shadow(shared, axis, 2 * size))
+    mesh, source = traced_mesh(cut, original_id)
+    surfaces = _cut_surfaces(part, other, mesh, source, axis, tol) if part.surfaces else ()
+    return replace(part, mesh=mesh, surfaces=surfaces)
+
+
+CUT_RADIUS_SHARE = 0.05
+"""How far, as a share of its radius, the cut a part's trimming leaves may lie from a
+cylinder of the other part and still be taken as lying on it (:func:`_cut_surfaces`):
+the cut runs along the other part's tessellated hole, whose facets lie within the
+tessellation's deflection of the exact cylinder (io/step.py)."""
+
+
+def _cut_surfaces(
+    part: Part,
+    other: Part,
+    mesh: trimesh.Trimesh,
+    source: NDArray[np.int64],
+    axis: NDArray[np.float64],
+    tol: Tolerance,
+) -> tuple[Surface, ...]:
+    """The exact surfaces of ``part`` trimmed by ``other`` to ``mesh``, whose triangles
+    lie on those of ``part`` numbered ``source`` (-1: on the cut): each surface of
+    ``part`` over the triangles left of it, and the cut, where it lies on a cylinder of
+    ``other`` along ``axis`` (within ``CUT_RADIUS_SHARE`` of its radius), as that
+    cylinder seen from ``part``'s side (a pilot hole becomes the trimmed screw's shank)."""
+    corners = np.asarray(mesh.triangles, dtype=np.float64)
+    kept = []
+    for surface in part.surfaces:
+        faces = np.flatnonzero(np.isin(source, surface.faces))
+        if len(faces):
+            kept.append(surface.on_faces(faces, corners[faces]))
+    cut = np.flatnonzero(source < 0)
+    for surface in other.surfaces:
+        if not len(cut) or surface.kind != "cylinder" or surface.axis is None:
+            continue
+        if abs(float(surface.axis @ axis)) < 1.0 - tol.mesh_angle:
+            continue
+        offset = corners[cut].reshape(-1, 3) - surface.point
+        across = np.linalg.norm(offset - np.outer(offset @ surface.axis, surface.axis), axis=1)
+        near = np.abs(across - surface.radius) <= max(tol.length, CUT_RADIUS_SHARE * surface.radius)
+        on = near.reshape(-1, 3).all(axis=1)
+        if on.any():
+            faces = cut[on]
+            flipped = replace(surface, convex=not surface.convex)
+            kept.append(flipped.on_faces(faces, corners[faces]))
+            cut = cut[~on]
+    return tuple(kept)
 
 
 def _bodies(body: manifold3d.Manifold) -> manifold3d.Manifold:
@@ -163,7 +228,9 @@ def resolve_overlaps(
         if volume > limit or small.name not in result.parts or large.name not in result.parts:
             overlaps.append(Overlap(a, b, volume))
             continue
-        result = result.with_part(_trimmed(result.parts[small.name], assembly.parts[large.name]))
+        result = result.with_part(
+            _trimmed(result.parts[small.name], assembly.parts[large.name], tol)
+        )
         overlaps.append(Overlap(a, b, volume, f"trimmed from {small.name}"))
     prepared = type(result).like(result, scale=result.scale)
     prepared.overlaps = tuple(overlaps)

@@ -8,7 +8,7 @@ A plain value: read exactly from CAD (:mod:`assemblykit.io.step`) and kept on th
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -62,3 +62,22 @@ class Surface:
             minor_radius=self.minor_radius,
             male=self.convex,
         )
+
+    def on_faces(self, faces: NDArray[np.int64], corners: NDArray[np.float64]) -> Surface:
+        """This surface over the triangles ``faces`` alone (their corners ``corners``,
+        ``len(faces) x 3 x 3``): its area, and for a cylinder or cone its extent along
+        the axis (and a cylinder's foot), measured again on them. Used when a boolean
+        cuts a part and some triangles of a surface remain (docs/planning.md,
+        "Interfering parts")."""
+        edges = corners[:, 1:] - corners[:, :1]
+        area = float(np.linalg.norm(np.cross(edges[:, 0], edges[:, 1]), axis=1).sum() / 2)
+        point, extent = self.point, self.extent
+        if self.kind in ("cylinder", "cone") and len(faces):
+            assert self.axis is not None
+            along = (corners.reshape(-1, 3) - self.point) @ self.axis
+            if self.kind == "cylinder":
+                point = self.point + along.min() * self.axis
+                extent = (0.0, float(np.ptp(along)))
+            else:
+                extent = (float(along.min()), float(along.max()))
+        return replace(self, point=point, faces=faces, area=area, extent=extent)
