@@ -263,28 +263,35 @@ def facing_groups(
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Usable group pairs ``(g, h)``, ``g`` of the first part of a pair and ``h`` of the
     second, whose bounding boxes overlap each other's part and each other (inflated by
-    ``margin``), vectorised over all pairs."""
+    ``margin``), in the order of the pairs, then of ``g``, then of ``h``: one bulk R-tree
+    query of every usable group's box against all of them, so the work follows the
+    groups that meet rather than every group of one part times every group of the
+    other (a threaded screw's thousands of facets in a plate's hole)."""
     candidates = np.flatnonzero(usable)
-    candidates = candidates[np.argsort(group_part[candidates], kind="stable")]
-    count = np.bincount(group_part[candidates], minlength=len(part_lo))
-    start = np.cumsum(count) - count
-
-    def near(side: int, other: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-        owners = pairs[:, side]
-        pair_of = np.repeat(np.arange(len(pairs), dtype=np.int64), count[owners])
-        groups = candidates[_expand(start[owners], count[owners])]
-        partner = pairs[pair_of, other]
-        keep = _boxes_overlap(
-            seg.lo[groups], seg.hi[groups], part_lo[partner], part_hi[partner], margin
-        )
-        return pair_of[keep], groups[keep]
-
-    pair_a, groups_a = near(0, 1)
-    pair_b, groups_b = near(1, 0)
-    i, j = _cross_join(pair_a, pair_b, len(pairs))
-    g, h = groups_a[i], groups_b[j]
-    keep = _boxes_overlap(seg.lo[g], seg.hi[g], seg.lo[h], seg.hi[h], margin)
-    return g[keep], h[keep]
+    lo, hi = seg.lo[candidates], seg.hi[candidates]
+    if not len(candidates) or not len(pairs):
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    tree = index.Index(
+        ((k, tuple(box), None) for k, box in enumerate(np.hstack([lo - margin, hi + margin]))),
+        properties=index.Property(dimension=3),
+    )
+    found, counts = tree.intersection_v(np.ascontiguousarray(lo), np.ascontiguousarray(hi))
+    g = np.repeat(candidates, counts.astype(np.int64))
+    h = candidates[found.astype(np.int64)]
+    # the pair (first part, second part) of each hit, where it is one of ``pairs``
+    size = len(part_lo)
+    keys = pairs[:, 0] * size + pairs[:, 1]
+    order = np.argsort(keys, kind="stable")
+    key = group_part[g] * size + group_part[h]
+    at = np.minimum(np.searchsorted(keys[order], key), len(keys) - 1)
+    listed = keys[order][at] == key
+    g, h, pair = g[listed], h[listed], order[at[listed]]
+    first, second = pairs[pair, 0], pairs[pair, 1]
+    keep = _boxes_overlap(seg.lo[g], seg.hi[g], part_lo[second], part_hi[second], margin)
+    keep &= _boxes_overlap(seg.lo[h], seg.hi[h], part_lo[first], part_hi[first], margin)
+    g, h, pair = g[keep], h[keep], pair[keep]
+    ranked = np.lexsort((h, g, pair))
+    return g[ranked], h[ranked]
 
 
 def _planar_matches(
@@ -336,23 +343,54 @@ def _triangles_2d(
     return np.stack([np.einsum("tkj,tj->tk", corners, u), np.einsum("tkj,tj->tk", corners, v)], -1)
 
 
+OVERLAP_CHUNK = 1 << 20
+"""How many triangle pairs :func:`triangle_overlaps` projects and intersects at once: the
+pairs of large coplanar groups (a plate on a plate) run to millions, and their 2D
+triangles, boxes and polygons are made chunk by chunk to bound the memory they take."""
+
+
 def triangle_overlaps(
     stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], margin: float
 ) -> tuple[NDArray[np.int64], NDArray[Any], NDArray[np.float64], NDArray[np.float64]]:
     """Where the triangles of groups ``g[k]`` and ``h[k]`` overlap, projected on the plane
     of ``g[k]`` with the frame ``(u[k], v[k])``: the non-empty intersections of triangle
-    pairs whose 2D boxes overlap by more than ``margin`` (shapely, vectorised), each with
-    its ``owner`` ``k``. Returns ``owner, pieces, u, v``."""
-    match = np.arange(len(g), dtype=np.int64)
-    size_g = seg.start[g + 1] - seg.start[g]
-    size_h = seg.start[h + 1] - seg.start[h]
-    owner_a = np.repeat(match, size_g)
-    faces_a = seg.order[_expand(seg.start[g], size_g)]
-    owner_b = np.repeat(match, size_h)
-    faces_b = seg.order[_expand(seg.start[h], size_h)]
-    i, j = _cross_join(owner_a, owner_b, len(g))
-    owner = owner_a[i]
+    pairs whose 2D boxes overlap by more than ``margin`` (shapely, vectorised, over
+    chunks of about ``OVERLAP_CHUNK`` triangle pairs), each with its ``owner`` ``k``.
+    Returns ``owner, pieces, u, v``."""
     u, v = axis_basis(seg.normal[g]) if len(g) else (np.zeros((0, 3)), np.zeros((0, 3)))
+    work = np.cumsum((seg.start[g + 1] - seg.start[g]) * (seg.start[h + 1] - seg.start[h]))
+    cuts = np.searchsorted(
+        work, np.arange(OVERLAP_CHUNK, int(work[-1]) if len(g) else 0, OVERLAP_CHUNK)
+    )
+    owners, pieces = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=object)]
+    for chunk in np.split(np.arange(len(g), dtype=np.int64), np.unique(cuts + 1)):
+        found = _chunk_overlaps(stack, seg, g, h, chunk, u, v, margin)
+        owners.append(found[0])
+        pieces.append(found[1])
+    return np.concatenate(owners), np.concatenate(pieces), u, v
+
+
+def _chunk_overlaps(
+    stack: PartStack,
+    seg: Segmentation,
+    g: NDArray[np.int64],
+    h: NDArray[np.int64],
+    match: NDArray[np.int64],
+    u: NDArray[np.float64],
+    v: NDArray[np.float64],
+    margin: float,
+) -> tuple[NDArray[np.int64], NDArray[Any]]:
+    """:func:`triangle_overlaps` for the group pairs ``match`` (consecutive indices)."""
+    if not len(match):
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=object)
+    size_g = seg.start[g[match] + 1] - seg.start[g[match]]
+    size_h = seg.start[h[match] + 1] - seg.start[h[match]]
+    owner_a = np.repeat(match, size_g)
+    faces_a = seg.order[_expand(seg.start[g[match]], size_g)]
+    owner_b = np.repeat(match, size_h)
+    faces_b = seg.order[_expand(seg.start[h[match]], size_h)]
+    i, j = _cross_join(owner_a - match[0], owner_b - match[0], len(match))
+    owner = owner_a[i]
     tri_a = _triangles_2d(stack.vertices[stack.faces[faces_a[i]]], u[owner], v[owner])
     tri_b = _triangles_2d(stack.vertices[stack.faces[faces_b[j]]], u[owner], v[owner])
     width = np.minimum(tri_a.max(axis=1), tri_b.max(axis=1)) - np.maximum(
@@ -362,7 +400,7 @@ def triangle_overlaps(
     pieces = shapely.intersection(shapely.polygons(tri_a[keep]), shapely.polygons(tri_b[keep]))
     owner = owner[keep]
     solid = shapely.area(pieces) > 0
-    return owner[solid], pieces[solid], u, v
+    return owner[solid], pieces[solid]
 
 
 def _planar_patches(

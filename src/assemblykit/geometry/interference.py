@@ -25,18 +25,25 @@ if TYPE_CHECKING:
 
 
 def solid(
-    mesh: trimesh.Trimesh, name: str | None = None, *, original_id: int | None = None
+    mesh: trimesh.Trimesh,
+    name: str | None = None,
+    *,
+    original_id: int | None = None,
+    face_ids: NDArray[np.int64] | None = None,
 ) -> manifold3d.Manifold:
     """The manifold3d solid of a closed triangle mesh (float64 vertices). With
-    ``original_id`` (from ``manifold3d.Manifold.reserve_ids``) its triangles carry their
-    index as face id under that id, so that the triangles of a boolean's result tell
-    which of them they come from
-    (:func:`assemblykit.geometry.overlaps.traced_mesh`)."""
+    ``original_id`` (from ``manifold3d.Manifold.reserve_ids``) its triangles carry
+    ``face_ids`` (default: their indices) under that id, so that the triangles of a
+    boolean's result tell which face they lie on
+    (:func:`assemblykit.geometry.overlaps.traced_mesh`). manifold3d keeps every edge
+    between triangles of different ids; fewer ids (one per surface) leave it more to
+    simplify and make its booleans faster."""
     numbered: dict[str, NDArray[np.generic]] = {}
     if original_id is not None:
         count = len(mesh.faces)
+        ids = np.arange(count) if face_ids is None else face_ids
         numbered = {
-            "face_id": np.arange(count, dtype=np.uint64),
+            "face_id": np.ascontiguousarray(ids, dtype=np.uint64),
             "run_index": np.array([0, 3 * count], dtype=np.uint64),
             "run_original_id": np.array([original_id], dtype=np.uint32),
         }

@@ -31,7 +31,7 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-from assemblykit.geometry.interference import interferences, solid
+from assemblykit.geometry.interference import interference_threshold, interferences, solid
 from assemblykit.model.assembly import Assembly, Overlap, Part
 from assemblykit.model.surfaces import Surface
 from assemblykit.tolerance import Tolerance
@@ -52,15 +52,16 @@ def mesh_of(body: manifold3d.Manifold) -> trimesh.Trimesh:
 def traced_mesh(
     body: manifold3d.Manifold, original_id: int
 ) -> tuple[trimesh.Trimesh, NDArray[np.int64]]:
-    """The closed triangle mesh of a manifold3d solid, and per triangle the index of the
-    triangle it lies on in the solid made with ``original_id``
+    """The closed triangle mesh of a manifold3d solid, and per triangle the face id of
+    the face it lies on in the solid made with ``original_id``
     (:func:`~assemblykit.geometry.interference.solid`), or -1 where it comes from
-    another solid."""
+    another solid. The mesh is taken as manifold3d gives it, its vertices already
+    shared: merging the ones closer than trimesh's merge distance (a boolean leaves
+    edges of 1e-10 where faces nearly meet) would open it."""
     out = body.to_mesh64()
-    faces = np.asarray(out.tri_verts, dtype=np.int64)
-    mesh = trimesh.Trimesh(
-        np.asarray(out.vert_properties[:, :3], dtype=np.float64), faces, process=True
-    )
+    faces = np.array(out.tri_verts, dtype=np.int64)
+    vertices = np.array(out.vert_properties[:, :3], dtype=np.float64)
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
     source = np.full(len(faces), -1, dtype=np.int64)
     bounds = np.asarray(out.run_index, dtype=np.int64) // 3
     for run, original in enumerate(np.asarray(out.run_original_id).tolist()):
@@ -137,10 +138,20 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part:
     in that shared volume's shadow along its :func:`insertion_axis`: a screw loses its
     thread's ring along the whole shank, so that it leaves along its axis through the
     hole it is screwed into. Its exact surfaces keep the triangles that remain of them
-    (:func:`_cut_surfaces`)."""
+    (:func:`_cut_surfaces`). A part that an earlier cut already took out of ``other``
+    (a screw through two plates, trimmed along its whole shank by the first) is left
+    as it is: what it still shares is rounding, whose shadow means nothing."""
+    # the triangles of surface k numbered k, the others each their own number after them
+    count = len(part.surfaces)
+    ids = count + np.arange(len(part.mesh.faces))
+    for k, surface in enumerate(part.surfaces):
+        ids[surface.faces] = k
     original_id = manifold3d.Manifold.reserve_ids(1)
-    mine = solid(part.mesh, part.name, original_id=original_id)
-    shared = mesh_of(_bodies(mine ^ solid(other.mesh, other.name)))
+    mine = solid(part.mesh, part.name, original_id=original_id, face_ids=ids)
+    common = mine ^ solid(other.mesh, other.name)
+    if common.volume() <= interference_threshold(part.mesh, other.mesh, tol):
+        return part
+    shared = mesh_of(_bodies(common))
     size = float(np.linalg.norm(np.ptp(np.vstack([part.mesh.bounds, other.mesh.bounds]), axis=0)))
     axis = insertion_axis(shared)
     cut = _bodies(mine - _extruded_shadow(shared, axis, 2 * size))
@@ -165,14 +176,15 @@ def _cut_surfaces(
     tol: Tolerance,
 ) -> tuple[Surface, ...]:
     """The exact surfaces of ``part`` trimmed by ``other`` to ``mesh``, whose triangles
-    lie on those of ``part`` numbered ``source`` (-1: on the cut): each surface of
+    lie on the surfaces of ``part`` numbered ``source`` (its k-th surface k, -1 on the
+    cut, others beyond the surfaces' count): each surface of
     ``part`` over the triangles left of it, and the cut, where it lies on a cylinder of
     ``other`` along ``axis`` (within ``CUT_RADIUS_SHARE`` of its radius), as that
     cylinder seen from ``part``'s side (a pilot hole becomes the trimmed screw's shank)."""
     corners = np.asarray(mesh.triangles, dtype=np.float64)
     kept = []
-    for surface in part.surfaces:
-        faces = np.flatnonzero(np.isin(source, surface.faces))
+    for k, surface in enumerate(part.surfaces):
+        faces = np.flatnonzero(source == k)
         if len(faces):
             kept.append(surface.on_faces(faces, corners[faces]))
     cut = np.flatnonzero(source < 0)
