@@ -202,6 +202,16 @@ def triple_signs(
     return signs
 
 
+def _incidences(
+    vertex: NDArray[np.int64], circle: NDArray[np.int64], circles: int
+) -> NDArray[np.int64]:
+    """The distinct rows ``(vertex, circle)``, sorted, by one sort of one key per row
+    (where many circles meet at a point, as the holes of a plate all do at its normal,
+    there are millions of rows)."""
+    keys = np.unique(vertex.astype(np.int64) * circles + circle)
+    return np.column_stack([keys // circles, keys % circles])
+
+
 def _vertices(
     normals: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int8]]:
@@ -242,14 +252,14 @@ def _vertices(
         if count == nv:
             break
         nv = count
-        vertex_circle = np.unique(np.column_stack([label[pairs_of], circles_of]), axis=0)
+        vertex_circle = _incidences(label[pairs_of], circles_of, c)
         cuts = np.flatnonzero(np.diff(vertex_circle[:, 0])) + 1
         for group in np.split(vertex_circle[:, 1], cuts):
             if len(group) > 2:
                 a, b = np.triu_indices(len(group), 1)
                 ids = pair_id(group[a], group[b])
                 src, linked = np.r_[src, ids], np.r_[linked, np.full(len(ids), ids[0])]
-    vertex_circle = np.unique(np.column_stack([label[pairs_of], circles_of]), axis=0)
+    vertex_circle = _incidences(label[pairs_of], circles_of, c)
     cross = np.cross(normals[ii], normals[jj])
     strength = np.linalg.norm(cross, axis=1)
     best = np.empty(nv, dtype=np.int64)
