@@ -128,3 +128,36 @@ def test_the_plan_command_cuts_designed_interference_and_says_so(capsys, tmp_pat
     assert code == 0, err
     found = json.loads(out)
     assert found["parts"] == ["plate+screw"] and found["overlaps"][0]["resolution"] == "joined"
+
+
+def polygon_area(radius: float, sections: int = 64) -> float:
+    """Area of the regular polygon trimesh makes for a cylinder of ``radius``."""
+    return sections / 2 * radius**2 * np.sin(2 * np.pi / sections)
+
+
+def test_a_screw_through_two_plates_is_cut_once_along_its_whole_shank():
+    # plates 4 thick at z in [0, 4] and [4, 8], each with a pilot hole of radius 1.45;
+    # the screw (radius 1.5 from z = -1 to 8, a head of radius 2.5 up to 9.5) loses the
+    # ring between the two radii along its whole length, once: the second plate then
+    # shares nothing with it and cuts nothing more
+    def plate(z: float) -> trimesh.Trimesh:
+        hole = trimesh.creation.cylinder(1.45, 20, sections=64)
+        return trimesh.boolean.difference(
+            [box((10, 10, 4), (-5, -5, z)), hole], engine="manifold"
+        )
+
+    shank = trimesh.creation.cylinder(1.5, 9, sections=64)
+    shank.apply_translation([0, 0, 3.5])
+    head = trimesh.creation.cylinder(2.5, 1.5, sections=64)
+    head.apply_translation([0, 0, 8.75])
+    screw = trimesh.boolean.union([shank, head], engine="manifold")
+    parts = [Part("lower", plate(0.0)), Part("upper", plate(4.0)), Part("screw", screw)]
+    prepared = resolve_overlaps(Assembly(parts))
+    assert [o.resolution for o in prepared.overlaps] == ["trimmed from screw"] * 2
+    ring = polygon_area(1.5) - polygon_area(1.45)
+    expected = polygon_area(1.45) * 9 + (polygon_area(2.5) - ring) * 1.5
+    trimmed = prepared.parts["screw"].mesh
+    assert trimmed.is_watertight and trimmed.volume == pytest.approx(expected, rel=1e-7)
+    result = plan(prepared, max_and_or_parts=0)
+    assert result.feasible and result.steps[0].parts == ("screw",)
+    np.testing.assert_allclose(result.steps[0].direction, [0, 0, 1], atol=1e-9)

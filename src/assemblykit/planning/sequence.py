@@ -39,7 +39,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
-from functools import cache
+from functools import cache, cached_property
 from typing import TYPE_CHECKING, Any, Literal
 
 import networkx as nx
@@ -47,6 +47,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
+from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.directions import (
     DirectionTable,
     bits,
@@ -97,9 +98,19 @@ class FirstAdmitted:
 
 class ExtendedDirections:
     """The DBGs of Γ_e along fixed candidate directions, computed exactly
-    (:func:`assemblykit.blocking.extended.extended_arcs`) pair by pair as the search
-    asks for them, and kept: per direction and moving part, the parts already tested
-    as blockers and those found blocking."""
+    (:func:`assemblykit.blocking.extended.extended_arcs`) part by part as the search
+    asks for them, and kept: per direction, the moving parts already tested and the
+    parts that block each of them.
+
+    A part is tested along a direction once, against every other part: blocking is
+    pairwise, so its blockers among any set of parts are read off. Parts that are not
+    unions of convex bodies go to the projection test
+    (:mod:`assemblykit.geometry.occlusion`), whose cost is projecting the meshes around
+    them: a closure (:func:`_free_closures`) asks about a few more parts at a time,
+    dozens of times along one direction, so it has all such parts of the set tested
+    there at once (``whole``), and the meshes are projected once. Convex parts' cones
+    are cheap to read and are tested only when asked about (a vault has thousands of
+    candidate directions)."""
 
     def __init__(self, assembly: Assembly, directions: NDArray[np.float64], tol: Tolerance) -> None:
         self.assembly = assembly
@@ -107,23 +118,52 @@ class ExtendedDirections:
         self.index = {name: i for i, name in enumerate(self.names)}
         self.directions = directions
         self.tol = tol
-        self._tested: dict[tuple[int, int], int] = {}
+        self._tested: set[tuple[int, int]] = set()
         self._blocking: dict[tuple[int, int], int] = {}
+        self._first: dict[tuple[int, ...], int] = {}
 
-    def blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
+    def same_as(self, k: int) -> int:
+        """The first candidate direction the same as direction ``k`` to the mesh angle
+        tolerance (their coordinates rounded to it) where some part goes to the
+        projection test: each part's arrangement of contact circles gives its own copy
+        of a direction such as +z, a few 1e-8 apart on tessellated CAD, and the search
+        asks along many of them; Γ_e is computed along the first. Where every part is a
+        union of convex bodies, cones decide exactly along ``k`` itself."""
+        if not any(self._projected):
+            return k
+        key = tuple(np.round(self.directions[k] / self.tol.mesh_angle).astype(np.int64).tolist())
+        return self._first.setdefault(key, k)
+
+    @cached_property
+    def _projected(self) -> tuple[bool, ...]:
+        """Per part, whether it is not a union of convex bodies (its blocking goes to
+        the projection test)."""
+        obstacles = BlockingCache.of(self.assembly).obstacles
+        return tuple(not obstacles.convex(name) for name in self.names)
+
+    def blockers(self, k: int, movers: int, among: int, *, whole: bool = False) -> dict[int, int]:
         """Per part of ``movers``, the mask of its blockers in ``among`` along ``k``;
-        only the pairs not tested before are computed, in one call."""
-        untested = [i for i in bits(movers) if among & ~self._tested.get((k, i), 1 << i)]
+        the parts not tested along ``k`` before are tested, in one call, with every
+        untested part of ``among`` that goes to the projection test when ``whole``
+        (class docstring)."""
+        k = self.same_as(k)
+        untested = [i for i in bits(movers) if (k, i) not in self._tested]
+        if whole and any(self._projected[i] for i in untested):
+            asked = set(untested)
+            untested += [
+                i
+                for i in bits(among)
+                if self._projected[i] and (k, i) not in self._tested and i not in asked
+            ]
         if untested:
             arcs = extended_arcs(
                 self.assembly,
                 self.directions[k],
                 [self.names[i] for i in untested],
-                [self.names[j] for j in bits(among)],
+                self.names,
                 self.tol,
             )
-            for i in untested:
-                self._tested[(k, i)] = self._tested.get((k, i), 1 << i) | among
+            self._tested.update((k, i) for i in untested)
             for a, b in arcs:
                 key = (k, self.index[a])
                 self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
@@ -526,7 +566,7 @@ def _free_closures(
         closed = frontier = start
         while frontier and not closed >> base & 1:
             blocked = 0
-            for i, mask in extended.blockers(k, frontier, members).items():
+            for i, mask in extended.blockers(k, frontier, members, whole=True).items():
                 blocked |= mask | necessary[i] & members
             frontier = blocked & ~closed
             closed |= frontier
