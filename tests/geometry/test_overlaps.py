@@ -142,9 +142,7 @@ def test_a_screw_through_two_plates_is_cut_once_along_its_whole_shank():
     # shares nothing with it and cuts nothing more
     def plate(z: float) -> trimesh.Trimesh:
         hole = trimesh.creation.cylinder(1.45, 20, sections=64)
-        return trimesh.boolean.difference(
-            [box((10, 10, 4), (-5, -5, z)), hole], engine="manifold"
-        )
+        return trimesh.boolean.difference([box((10, 10, 4), (-5, -5, z)), hole], engine="manifold")
 
     shank = trimesh.creation.cylinder(1.5, 9, sections=64)
     shank.apply_translation([0, 0, 3.5])
