@@ -8,7 +8,7 @@ and what was done about them, the plan (feasible or the stuck parts, steps), the
 seconds of each stage and the peak resident memory of the process so far, next to the
 targets: a file of up to 34 parts loaded, contacts and plan in <= 10 CPU s and <= 1 GB,
 144 parts in <= 30 CPU s. The gripper is planned for its first ``--gripper-steps``
-steps (default 12; 0: to the end), the parts not yet taken apart counted as unfinished.
+steps (default 8; 0: to the end), the parts not yet taken apart counted as unfinished.
 
 Run: python benchmarks/bench_step.py [--gripper-steps N]
 """
@@ -80,7 +80,7 @@ def bench(path: Path, max_steps: int | None = None) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--gripper-steps", type=int, default=12)
+    parser.add_argument("--gripper-steps", type=int, default=8)
     steps = parser.parse_args().gripper_steps
     for path in sorted(EXAMPLES.rglob("*.step")):
         bench(path)
