@@ -183,6 +183,11 @@ def test_the_pin_leaves_along_its_axis_through_a_free_sweep(pin_in_hole):
     found = plan(asm)
     assert found.feasible
     assert [abs(float(s.direction @ Z)) for s in found.steps] == pytest.approx([1.0])
+    # pulled out of its hole: a pin (no thread modelled, no interference)
+    (step,) = found.steps
+    fastener = step.fastener
+    assert fastener is not None and (fastener.part, fastener.kind) == (PIN, "pin")
+    assert fastener.holes == (PLATE,) and abs(float(fastener.axis @ Z)) == pytest.approx(1.0)
     assert max(sweep_overlaps(asm, found.steps)) <= NOISE
     # the same sweep through the kernel's tessellation cuts into the plate, where the
     # planner finds no way out at all
@@ -446,3 +451,11 @@ def test_a_trimmed_screw_keeps_its_surfaces_and_fits_its_pilot_hole(self_tapping
     (step,) = found.steps
     assert step.parts == (PIN,) and float(step.direction @ Z) == pytest.approx(1.0)
     assert max(sweep_overlaps(prepared, found.steps)) <= 1e-6 * shared
+    # a fitter reads it as a screw turned out of the plate along its axis
+    assert step.fastener is not None
+    assert step.to_dict()["fastener"] == {
+        "part": PIN,
+        "kind": "screw",
+        "axis": [0.0, 0.0, 1.0],
+        "holes": [PLATE],
+    }

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from assemblykit.blocking.directions import DirectionTable, bits, mask_of, union_of
 from assemblykit.blocking.graphs import blocking_graph
@@ -18,6 +18,8 @@ from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.tables import translation_slots, translation_table
 from assemblykit.errors import InputError
 from assemblykit.geometry.interference import interferences
+from assemblykit.model.assembly import Assembly
+from assemblykit.planning.fasteners import step_fastener
 from assemblykit.planning.hands import hands_needed
 from assemblykit.planning.planar import planar_rigid_may_free, planar_search
 from assemblykit.planning.sequence import (
@@ -44,9 +46,6 @@ from assemblykit.planning.stability import (
     gravity_direction,
 )
 from assemblykit.tolerance import Tolerance
-
-if TYPE_CHECKING:
-    from assemblykit.model.assembly import Assembly
 
 
 def rigid_may_free(
@@ -237,9 +236,15 @@ def finish_plan(
         hands = Hands(None, max_hands)
     report("done", len(names), len(names))
     unfinished = tuple(names[i] for i in bits(union_of(search.unfinished)))
+    steps = tuple(search.steps)
+    if isinstance(assembly, Assembly):
+        steps = tuple(
+            replace(s, fastener=step_fastener(assembly, s.parts, s.direction, s.rest, tol))
+            for s in steps
+        )
     return Plan(
         names,
-        tuple(search.steps),
+        steps,
         interlocks,
         and_or,
         len(translations.directions),

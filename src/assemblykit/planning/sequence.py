@@ -63,6 +63,7 @@ from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance, order_key
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly, Overlap
+    from assemblykit.planning.fasteners import Fastener
     from assemblykit.planning.stability import GravityReport, StepStability
 
 Progress = Callable[[str, int, int], None]
@@ -218,6 +219,9 @@ class Step:
     stability: StepStability | None = None
     """Under gravity: the parts held, those that would fall without the holds, the
     least friction needed (:mod:`assemblykit.planning.stability`)."""
+    fastener: Fastener | None = None
+    """The pin or screw the step draws out of its holes along their axis
+    (:mod:`assemblykit.planning.fasteners`)."""
 
     def __repr__(self) -> str:
         return fmt.summary(
@@ -233,6 +237,7 @@ class Step:
             "rest": list(self.rest),
             "blocking": [list(arc) for arc in self.blocking],
             **({} if self.stability is None else self.stability.to_dict()),
+            **({} if self.fastener is None else {"fastener": self.fastener.to_dict()}),
         }
 
 

@@ -1,0 +1,71 @@
+"""Fasteners named in plans (planning/fasteners.py): a part drawn out of round holes
+along their axis is a pin, or a screw where it interferes with a hole by design; on
+hand-built meshes whose fits and directions are known by hand. (The STEP cases, a pin
+in a hole of its diameter and a self-tapping screw, are in tests/io/test_step_fits.py.)"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from assemblykit.geometry.overlaps import resolve_overlaps
+from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning.planner import plan
+from stability_blocks import box
+
+
+def rod_through_blocks(rod: float, hole: float) -> Assembly:
+    """Two blocks 8 x 8 x 3 side by side along x (x in [-4, 4] and [4, 12]) with a hole
+    of radius ``hole`` along x at y = z = 0 through both, on a base plate below them,
+    and a rod of radius ``rod`` 20 long through both holes, its head (radius 2.5, 1
+    long) against the first block's outer face at x = -4."""
+    drill = trimesh.creation.cylinder(hole, 40, sections=48)
+    drill.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
+    blocks = [
+        trimesh.boolean.difference([box((8, 8, 3), (x, -4, -1.5)), drill], engine="manifold")
+        for x in (-4.0, 4.0)
+    ]
+    shank = trimesh.creation.cylinder(rod, 16, sections=48)
+    head = trimesh.creation.cylinder(2.5, 1.0, sections=48)
+    shank.apply_translation([0, 0, 8])
+    head.apply_translation([0, 0, -0.5])
+    pin = trimesh.boolean.union([shank, head], engine="manifold")
+    pin.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
+    pin.apply_translation([-4, 0, 0])
+    return Assembly(
+        [
+            Part("first", blocks[0]),
+            Part("second", blocks[1]),
+            Part("rod", pin),
+            Part("base", box((16, 8, 1), (-4, -4, -2.5))),
+        ]
+    )
+
+
+@pytest.mark.parametrize(("rod", "kind"), [(1.0, "pin"), (1.04, "screw")])
+def test_a_rod_drawn_out_of_two_holes_is_named_with_both(rod, kind):
+    # at the holes' radius it is a pin; 0.04 larger it cuts a thread into both blocks
+    # by design (resolved by trimming it) and is a screw
+    prepared = resolve_overlaps(rod_through_blocks(rod, 1.0))
+    assert len(prepared.overlaps) == (2 if kind == "screw" else 0)
+    result = plan(prepared, max_and_or_parts=0)
+    assert result.feasible
+    (out,) = [s for s in result.steps if "rod" in s.parts]
+    assert out.parts == ("rod",)
+    # out along -x, the head's side: through both holes and nothing else
+    np.testing.assert_allclose(out.direction, [-1, 0, 0], atol=1e-9)
+    # the second block may slide off the rod's far end first (+x): the rod then
+    # leaves the first block's hole alone
+    holes = [name for name in ("first", "second") if name in out.rest]
+    assert holes[0] == "first"
+    found = out.to_dict()["fastener"]
+    assert found["axis"] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)
+    assert {k: v for k, v in found.items() if k != "axis"} == {
+        "part": "rod",
+        "kind": kind,
+        "holes": holes,
+    }
+    # the blocks lifted off the base are no fasteners
+    assert all(s.fastener is None for s in result.steps if "rod" not in s.parts)
+    assert all("fastener" not in s.to_dict() for s in result.steps if "rod" not in s.parts)
