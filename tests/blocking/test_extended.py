@@ -214,3 +214,20 @@ def test_repeated_cones_give_the_same_blocked_set():
         assert a.symmetric_difference(b).area <= 1e-12
     for d in rng.normal(size=(200, 3)):
         assert once.contains(d) == thrice.contains(d)
+
+
+@pytest.mark.parametrize("example", ["gearbox_demo", "interlock.step", "key_in_steps"])
+def test_one_blocker_each_tells_the_same_parts_apart(example):
+    # with first_only every blocked part keeps one true arc, and no free part gets one:
+    # along the coordinate axes and a tilted direction, compared with every arc
+    from assemblykit.blocking.extended import extended_arcs
+
+    found = sorted((Path(__file__).parents[2] / "src/assemblykit/examples").rglob(example))
+    asm = load_assembly(found[0])
+    tol = asm.tolerance()
+    names = list(asm.names)
+    for d in [*np.eye(3), *-np.eye(3), np.array([0.3, -0.5, 0.81])]:
+        every = extended_arcs(asm, d, names, names, tol)
+        some = extended_arcs(asm, d, names, names, tol, first_only=True)
+        assert some <= every
+        assert {a for a, _ in some} == {a for a, _ in every}

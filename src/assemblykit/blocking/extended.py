@@ -93,11 +93,15 @@ def extended_arcs(
     movers: Iterable[str],
     blockers: Iterable[str],
     tol: Tolerance,
+    *,
+    first_only: bool = False,
 ) -> set[tuple[str, str]]:
     """The arcs ``(i, j)``, ``i`` among ``movers`` and ``j ≠ i`` among ``blockers``,
     such that ``j`` blocks the extended translation of ``i`` along ``direction``: cones
     for pairs of convex parts, the projection test for the others (all of their pairs at
-    once: one projection of each mesh serves every pair, so no coarser test first)."""
+    once: one projection of each mesh serves every pair, so no coarser test first).
+    With ``first_only``, at least one arc of each blocked mover and maybe no more:
+    which movers leave, at the cost of finding one blocker each."""
     d = np.asarray(direction, dtype=np.float64).ravel()
     d = d / np.linalg.norm(d)
     cache = BlockingCache.of(assembly).obstacles
@@ -112,8 +116,13 @@ def extended_arcs(
             elif any(blocks_along(c, d)[0] for c in cache.cones_of(moving, blocker, tol)):
                 arcs.add((moving, blocker))
     plain = [pair for pair in projected if not cache.backout(*pair, tol).any()]
-    arcs |= _occluded(assembly, d, plain, {}, tol)
+    if first_only:
+        blocked = {moving for moving, _ in arcs}
+        plain = [pair for pair in plain if pair[0] not in blocked]
+    arcs |= _occluded(assembly, d, plain, {}, tol, first_only)
     for moving, blocker in projected:
+        if first_only and any(a == moving for a, _ in arcs):
+            continue
         shift = cache.backout(moving, blocker, tol)
         if shift.any():
             arcs |= _occluded(assembly, d, [(moving, blocker)], {moving: shift}, tol)
@@ -126,9 +135,11 @@ def _occluded(
     pairs: list[tuple[str, str]],
     shifts: dict[str, NDArray[np.float64]],
     tol: Tolerance,
+    first_only: bool = False,
 ) -> set[tuple[str, str]]:
     """Which of ``pairs`` (moving, blocker) block along ``direction`` by the projection
-    test, parts in ``shifts`` translated by them first."""
+    test, parts in ``shifts`` translated by them first (with ``first_only``, one pair
+    at least of each blocked moving part: :func:`extended_arcs`)."""
     if not pairs:
         return set()
     names = sorted({name for pair in pairs for name in pair})
@@ -142,7 +153,8 @@ def _occluded(
         for name, mesh in zip(names, meshes, strict=True)
     ]
     view = shadows(meshes, direction, tol)
-    return {(names[i], names[j]) for i, j in occluded_pairs(view, allowed, tol)}
+    found = occluded_pairs(view, allowed, tol, first_only=first_only)
+    return {(names[i], names[j]) for i, j in found}
 
 
 def extended_dbg(

@@ -256,19 +256,29 @@ def _meets(
 
 
 def occluded_pairs(
-    view: Shadows, allowed: NDArray[np.bool_], tol: Tolerance | None = None
+    view: Shadows,
+    allowed: NDArray[np.bool_],
+    tol: Tolerance | None = None,
+    *,
+    first_only: bool = False,
 ) -> set[tuple[int, int]]:
     """The pairs ``(i, j)`` of meshes such that ``j`` blocks the extended translation of
     ``i`` along the view direction, among those with ``allowed[i, j]`` (module
     docstring). First among the largest projected triangles of each mesh
     (``_FIRST_TRIANGLES``): most blocking pairs have a pair of triangles that shows it
-    there, and only the others are then examined over all their triangles."""
+    there, and only the others are then examined over all their triangles. With
+    ``first_only``, a mesh found blocked by one is not examined further: each blocked
+    mesh has at least one pair, the others may be missing (whether a part can leave,
+    not all that holds it)."""
     tol = tol or current()
-    found = _occluded_among(view, allowed, _largest(view, _FIRST_TRIANGLES), tol)
+    found = _occluded_among(view, allowed, _largest(view, _FIRST_TRIANGLES), tol, first_only)
     rest = allowed.copy()
     for i, j in found:
         rest[i, j] = False
-    return found | _occluded_among(view, rest, np.ones(len(view.owner), dtype=bool), tol)
+        if first_only:
+            rest[i] = False
+    every = np.ones(len(view.owner), dtype=bool)
+    return found | _occluded_among(view, rest, every, tol, first_only)
 
 
 def _largest(view: Shadows, count: int) -> NDArray[np.bool_]:
@@ -286,12 +296,16 @@ def _largest(view: Shadows, count: int) -> NDArray[np.bool_]:
 
 
 def _occluded_among(
-    view: Shadows, allowed: NDArray[np.bool_], among: NDArray[np.bool_], tol: Tolerance
+    view: Shadows,
+    allowed: NDArray[np.bool_],
+    among: NDArray[np.bool_],
+    tol: Tolerance,
+    first_only: bool = False,
 ) -> set[tuple[int, int]]:
     """:func:`occluded_pairs` over the triangles ``among`` alone (a subset shows only
     pairs that block). Triangle pairs are examined by decreasing :meth:`Shadows.bound`
     within each pair of meshes, the pairs of meshes in turn, and a pair of meshes stops
-    being examined once it blocks."""
+    being examined once it blocks (with ``first_only``, every pair of its moving mesh)."""
     backward = np.flatnonzero(among & (view.facing <= 0) & np.any(allowed, axis=1)[view.owner])
     forward = np.flatnonzero(among & (view.facing >= 0) & np.any(allowed, axis=0)[view.owner])
     if not len(backward) or not len(forward):
@@ -321,6 +335,8 @@ def _occluded_among(
         lo, chunk = lo + chunk, 2 * chunk
         pair = view.owner[b] * size + view.owner[f]
         fresh = ~np.isin(pair, [i * size + j for i, j in found])
+        if first_only:
+            fresh &= ~np.isin(view.owner[b], [i for i, _ in found])
         b, f, pair = b[fresh], f[fresh], pair[fresh]
         points, corner, area, perimeter = triangle_overlaps(view.flat[b], view.flat[f])
         which, at = np.nonzero(corner & (area > tol.length * perimeter)[:, None])

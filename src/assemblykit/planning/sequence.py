@@ -122,6 +122,8 @@ class ExtendedDirections:
         self._tested: set[tuple[int, int]] = set()
         self._blocking: dict[tuple[int, int], int] = {}
         self._first: dict[tuple[int, ...], int] = {}
+        self._witness: dict[tuple[int, int], int] = {}
+        self._clear: dict[tuple[int, int], int] = {}
 
     def same_as(self, k: int) -> int:
         """The first candidate direction the same as direction ``k`` to the mesh angle
@@ -169,6 +171,44 @@ class ExtendedDirections:
                 key = (k, self.index[a])
                 self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
+
+    def leaving(self, k: int, movers: int, among: int) -> int:
+        """The parts of ``movers`` that no part of ``among`` blocks along ``k``, as a
+        mask. Where the blockers of a part are not known, one blocker is enough to keep
+        it (:func:`~assemblykit.blocking.extended.extended_arcs` with ``first_only``);
+        a part found free of a set stays free of its subsets, and a part's blocker
+        keeps it while that blocker is in ``among``."""
+        k = self.same_as(k)
+        free, unknown = 0, []
+        for i in bits(movers):
+            if (k, i) in self._tested:
+                free |= 0 if self._blocking.get((k, i), 0) & among & ~(1 << i) else 1 << i
+            elif among & ~self._clear.get((k, i), 0) == 0:
+                free |= 1 << i
+            else:
+                witness = self._witness.get((k, i))
+                if witness is None or not among >> witness & 1:
+                    unknown.append(i)
+        if unknown:
+            arcs = extended_arcs(
+                self.assembly,
+                self.directions[k],
+                [self.names[i] for i in unknown],
+                [self.names[j] for j in bits(among)],
+                self.tol,
+                first_only=True,
+            )
+            found: dict[int, int] = {}
+            for a, b in arcs:
+                i, j = self.index[a], self.index[b]
+                found[i] = min(j, found.get(i, j))
+            for i in unknown:
+                if i in found:
+                    self._witness[(k, i)] = found[i]
+                else:
+                    self._clear[(k, i)] = among
+                    free |= 1 << i
+        return free
 
     def arcs(self, k: int, members: int | None = None) -> list[tuple[int, int]]:
         """The arcs ``(i, j)``, "j blocks i", of the DBG along direction ``k`` among
@@ -638,6 +678,8 @@ def _choose_removal(
         if isinstance(narrow, FirstAdmitted):
             # a part the narrower already rejected would be rejected again: no Γ_e for it
             movers &= ~narrow.rejected(members)
+        if isinstance(extended, ExtendedDirections):
+            return chosen(k, [1 << i for i in bits(extended.leaving(k, movers, members))])
         held = extended.blockers(k, movers, members)
         return chosen(k, [1 << i for i, mask in held.items() if not mask])
 
