@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -21,10 +21,8 @@ class ContactAssembly:
     names: list[str]
     given: list[Contact]
     dimension: int = 3
-    calls: list[int] = field(default_factory=list)
 
     def contacts(self, tol: Tolerance | None = None) -> list[Contact]:
-        self.calls.append(1)
         return self.given
 
     def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
