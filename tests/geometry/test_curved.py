@@ -6,13 +6,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.geometry.curved import (
     arc_angles,
     cone_generators,
     covered_arcs,
+    generating_arc,
     intersect_arcs,
+    revolution_normals,
 )
 from assemblykit.io.assembly import load_assembly
 from assemblykit.tolerance import Tolerance
@@ -43,6 +47,60 @@ def test_an_arc_is_sampled_at_its_ends_and_at_most_a_step_apart() -> None:
         arc_angles(np.array([[0.0, 2 * PI]]), PI / 2), [0, PI / 2, PI, 1.5 * PI]
     )
     np.testing.assert_allclose(arc_angles(np.array([[0.2, 0.5]]), PI / 2), [0.2, 0.5])
+
+
+def _blocked(normals: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    # the union of the open half-spaces n . d > 0: the directions some normal blocks
+    return (directions @ normals.T > 1e-9).any(axis=1)
+
+
+def test_pieces_of_a_cylinder_give_the_one_arc_that_generates_their_normals() -> None:
+    # pieces within a quarter turn: the arc from the first start to the last end
+    pieces = np.array([[0.1, 0.3], [0.5, 0.6], [1.0, 1.4]])
+    np.testing.assert_allclose(generating_arc(pieces, 1e-9), [[0.1, 1.4]])
+    # the largest gap, 0.4 to 5.0, runs across azimuth 0 the other way round: the arc
+    # starts at 5.0 and ends at 0.4 + 2 pi
+    np.testing.assert_allclose(
+        generating_arc(np.array([[0.0, 0.4], [5.0, 5.5]]), 1e-9), [[5.0, 0.4 + 2 * PI]]
+    )
+    # no gap of a half turn: the whole plane of normals
+    spread = np.array([[0.0, 0.2], [2.0, 2.2], [4.0, 4.2]])
+    np.testing.assert_allclose(generating_arc(spread, 1e-9), [[0.0, 2 * PI]])
+    # a half-round groove keeps its half turn (the direction out of it stays free)
+    np.testing.assert_allclose(generating_arc(np.array([[PI, 2 * PI]]), 1e-9), [[PI, 2 * PI]])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(
+            st.floats(0.0, 2 * PI - 0.02, allow_nan=False), st.floats(0.01, 1.5, allow_nan=False)
+        ),
+        min_size=1,
+        max_size=6,
+    )
+)
+def test_the_generating_arc_blocks_what_the_pieces_block(pieces) -> None:
+    # the union of half-spaces of the pieces' normals (sampled finely, every 0.002 rad)
+    # against that of the few normals of the one arc, on directions all round the axis
+    arcs = intersect_arcs(
+        np.array([[0.0, 2 * PI]]),
+        np.array([[lo, min(lo + width, 2 * PI)] for lo, width in pieces]),
+        1e-9,
+    )
+    axis = np.array([0.2, -0.3, 0.9]) / np.linalg.norm([0.2, -0.3, 0.9])
+    fine = revolution_normals(axis, np.concatenate([np.arange(lo, hi, 0.002) for lo, hi in arcs]))
+    few = revolution_normals(axis, arc_angles(generating_arc(arcs, 1e-9), PI / 2))
+    assert len(few) <= 5
+    rng = np.random.default_rng(len(pieces))
+    directions = rng.normal(size=(400, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    # directions near the boundary of the blocked set (within the sampling's 0.002) aside
+    margin = np.abs((directions @ fine.T).max(axis=1)) > 0.01
+    assert margin.sum() > 300
+    np.testing.assert_array_equal(
+        _blocked(fine, directions)[margin], _blocked(few, directions)[margin]
+    )
 
 
 def test_the_triangles_of_a_half_cylinder_cover_half_a_turn() -> None:

@@ -56,6 +56,7 @@ from assemblykit.geometry.curved import (
     axis_frame,
     cone_generators,
     covered_arcs,
+    generating_arc,
     intersect_arcs,
     revolution_normals,
     sphere_region,
@@ -570,7 +571,7 @@ def curved_contact(
         return None
     kind: CurvedKind = "cylindrical" if first.kind == "cylinder" else "conical"
     if kind == "cylindrical":
-        normals = revolution_normals(axis, arc_angles(arcs, ARC_STEP))
+        normals = revolution_normals(axis, arc_angles(generating_arc(arcs, gap), ARC_STEP))
     else:
         angles = arc_angles(arcs, TURN / CONE_AZIMUTHS)
         normals = revolution_normals(axis, angles, first.half_angle)

@@ -15,7 +15,8 @@ ball, the male cone) that generate that cone:
 * coaxial cylinders and cones: the azimuths about the axis that both surfaces cover, as
   arcs (:func:`covered_arcs`, :func:`intersect_arcs`); an arc's normals are its ends and
   points at most a quarter turn apart, whose non-negative combinations are every normal
-  of the arc (:func:`arc_angles`). For a cylinder this is exact, and since the
+  of the arc (:func:`arc_angles`). A cylinder's arcs, all in one plane, are first
+  replaced by the one arc that generates their cone (:func:`generating_arc`). For a cylinder this is exact, and since the
   constraint ``n . (v + omega x p)`` at a point ``p`` of one end circle is linear in
   ``n`` (``n . (omega x n) = 0``), the same normals at both ends also make the rigid
   (twist) constraints exact. A cone's normals are not coplanar: it is sampled every
@@ -122,6 +123,25 @@ def intersect_arcs(
     hi = np.minimum(a[:, None, 1], b[None, :, 1]).ravel()
     kept = hi - lo > gap
     return _merge(np.column_stack([lo[kept], hi[kept]]), gap)
+
+
+def generating_arc(arcs: NDArray[np.float64], gap: float) -> NDArray[np.float64]:
+    """One arc whose normals generate the same cone as the normals of ``arcs`` (sorted,
+    as :func:`_merge` gives them): the normals of a cylinder lie in one plane, so their
+    non-negative combinations are the whole plane when no gap between the arcs reaches a
+    half turn (``gap`` radians short of it, the tolerance), and otherwise the arc from
+    the end of the largest gap round to its start. A tessellated surface covered in many
+    pieces thus has the few normals of :func:`arc_angles` on that one arc, and every
+    constraint linear in the normal (blocking, twists, contact forces) is the same."""
+    if len(arcs) == 0 or arcs[0, 1] - arcs[0, 0] >= TURN:
+        return arcs
+    ends = np.r_[arcs[1:, 0], arcs[0, 0] + TURN]
+    gaps = ends - arcs[:, 1]
+    widest = int(np.argmax(gaps))
+    if gaps[widest] < math.pi - gap:
+        return np.array([[0.0, TURN]])
+    start = ends[widest] % TURN
+    return np.array([[start, start + TURN - gaps[widest]]])
 
 
 def arc_angles(arcs: NDArray[np.float64], step: float) -> NDArray[np.float64]:
