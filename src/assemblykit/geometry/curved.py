@@ -15,12 +15,13 @@ ball, the male cone) that generate that cone:
 * coaxial cylinders and cones: the azimuths about the axis that both surfaces cover, as
   arcs (:func:`covered_arcs`, :func:`intersect_arcs`); an arc's normals are its ends and
   points at most a quarter turn apart, whose non-negative combinations are every normal
-  of the arc (:func:`arc_angles`). A cylinder's arcs, all in one plane, are first
-  replaced by the one arc that generates their cone (:func:`generating_arc`). For a cylinder this is exact, and since the
-  constraint ``n . (v + omega x p)`` at a point ``p`` of one end circle is linear in
-  ``n`` (``n . (omega x n) = 0``), the same normals at both ends also make the rigid
-  (twist) constraints exact. A cone's normals are not coplanar: it is sampled every
-  ``1 / CONE_AZIMUTHS`` of a turn, which can only leave out blocked directions;
+  of the arc (:func:`arc_angles`); a cylinder's arcs, all in one plane, are first
+  replaced by the one arc that generates their cone (:func:`generating_arc`). For a
+  cylinder this is exact, and since the constraint ``n . (v + omega x p)`` at a point
+  ``p`` of one end circle is linear in ``n`` (``n . (omega x n) = 0``), the same
+  normals at both ends also make the rigid (twist) constraints exact. A cone's normals
+  are not coplanar: it is sampled every ``1 / CONE_AZIMUTHS`` of a turn, which can only
+  leave out blocked directions;
 * concentric spheres: the directions from the centre that lie on both surfaces
   (:func:`sphere_region`: a vertex of one surface lies on the other iff its direction
   lies in one of the other's spherical triangles), reduced to the extreme rays of their
