@@ -469,6 +469,12 @@ def _gravity(
     help="Treat every set of parts that share a volume as one rigid part.",
 )
 @click.option(
+    "--split-products",
+    is_flag=True,
+    help="Plan the solids of a product of several solids (a STEP multi-body part) as "
+    "separate parts [default: one part named after the product].",
+)
+@click.option(
     "--ignore-overlap",
     type=_OptionRange(min=0.0),
     default=None,
@@ -506,6 +512,7 @@ def plan_cmd(
     one_at_a_time: bool,
     join: tuple[tuple[str, str], ...],
     join_interfering: bool,
+    split_products: bool,
     ignore_overlap: float | None,
     max_steps: int | None,
     as_json: bool,
@@ -552,7 +559,13 @@ def plan_cmd(
             from assemblykit.geometry.overlaps import resolve_overlaps
 
             update("interfering parts", 0, 1)
-            loaded = resolve_overlaps(loaded, join, join_interfering, ignore_overlap)
+            loaded = resolve_overlaps(
+                loaded,
+                join,
+                join_interfering,
+                ignore_overlap,
+                join_products=not split_products,
+            )
         elif join or join_interfering:
             raise InputError("--join and --join-interfering need 3D parts")
         if getattr(loaded, "dimension", 3) == 2 and gltf is not None:

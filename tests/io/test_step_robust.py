@@ -15,10 +15,13 @@ from hypothesis import strategies as st
 
 from assemblykit.errors import GeometryError
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.geometry.overlaps import resolve_overlaps
 from assemblykit.io import step
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import declared_solids, decode_step_string, distinct_products
+from assemblykit.planning.planner import plan
 from datasets import dataset
+from plan_checks import assert_steps_clear
 from step_files import write_step
 
 cad = pytest.mark.cad
@@ -361,6 +364,67 @@ def test_names_follow_products_instances_and_solids(named_step):
         np.testing.assert_allclose(asm[name].mesh.bounds[0][:2], corner, atol=1e-9)
     assert asm["Body (2)_1"].volume == pytest.approx(8.0)
     assert asm.groups == {"arm": ("pad_1",), "arm (2)": ("pad_2",)}
+    assert asm.products == {
+        "bracket_1": ("bracket_1_1", "bracket_1_2"),
+        "bracket_2": ("bracket_2_1", "bracket_2_2"),
+        "lock": ("lock_1", "lock_2"),
+    }
+
+
+def _cut(shape: Any, *tools: Any) -> Any:
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+
+    for tool in tools:
+        shape = BRepAlgoAPI_Cut(shape, tool).Shape()
+    return shape
+
+
+@pytest.fixture(scope="module")
+def locknut_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A plate (z 0 to 2, a hole of radius 1.5), a screw of radius 1.5 through it (its
+    head of radius 3 below) and a ``locknut`` product of two solids above the plate: the
+    nut (z 2 to 6, a hole of radius 1.5, a cavity of radius 2.5 from z 3.5 to 4.5) and
+    its nylon insert, the ring filling the cavity, whose hole (radius 1.2) the screw's
+    thread cuts into."""
+    pytest.importorskip("OCP")
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
+
+    doc = _Document()
+    rig = doc.assembly("rig")
+    plate = _cut(_box(20, 20, 2, (-10, -10, 0)), _cylinder(1.5, 4, (0, 0, -1)))
+    screw = BRepAlgoAPI_Fuse(_cylinder(1.5, 7, (0, 0, 0)), _cylinder(3, 1, (0, 0, -1))).Shape()
+    cavity = _cylinder(2.5, 1, (0, 0, 3.5))
+    nut = _cut(_box(8, 8, 4, (-4, -4, 2)), _cylinder(1.5, 6, (0, 0, 1)), cavity)
+    insert = _cut(_cylinder(2.5, 1, (0, 0, 3.5)), _cylinder(1.2, 2, (0, 0, 3)))
+    doc.place(rig, doc.product("plate", plate), (0, 0, 0))
+    doc.place(rig, doc.product("screw", screw), (0, 0, 0))
+    doc.place(rig, doc.product("locknut", nut, insert), (0, 0, 0))
+    return doc.write(tmp_path_factory.mktemp("locknut") / "locknut.step")
+
+
+@cad
+def test_a_locknut_of_two_solids_is_planned_as_one_part(locknut_step):
+    # the insert is captured in the nut: no translation separates them, as no fitter
+    # would; the product is one part, and the screw's thread in the insert (a ring of
+    # pi (1.5^2 - 1.2^2) x 1 = 2.545) is cut from the screw as designed interference
+    asm = load_assembly(locknut_step)
+    assert asm.names == ["plate", "screw", "locknut_1", "locknut_2"]
+    assert asm.products == {"locknut": ("locknut_1", "locknut_2")}
+    prepared = resolve_overlaps(asm)
+    assert sorted(prepared.names) == ["locknut", "plate", "screw"]
+    assert prepared["locknut"].volume == pytest.approx(
+        asm["locknut_1"].volume + asm["locknut_2"].volume, rel=1e-9
+    )
+    (overlap,) = prepared.overlaps
+    assert {overlap.a, overlap.b} == {"screw", "locknut"}
+    assert overlap.volume == pytest.approx(np.pi * (1.5**2 - 1.2**2), rel=0.02)
+    assert overlap.resolution == "trimmed from screw"
+    result = plan(prepared, max_and_or_parts=0)
+    assert result.feasible and ("locknut",) in [s.parts for s in result.steps]
+    assert_steps_clear(prepared, result)
+    # planned solid by solid, the insert stays locked in its nut
+    apart = plan(resolve_overlaps(asm, join_products=False), max_and_or_parts=0)
+    assert not apart.feasible and {"locknut_1", "locknut_2"} <= set(apart.stuck)
 
 
 @pytest.mark.parametrize(

@@ -9,6 +9,7 @@ surface, i.e. when ``volume > tol.length x min(area_a, area_b)``.
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from typing import TYPE_CHECKING
 
 import manifold3d
@@ -96,17 +97,24 @@ def _boxes_meet(mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh) -> bool:
     )
 
 
-def interferences(assembly: Assembly, tol: Tolerance | None = None) -> list[tuple[str, str, float]]:
+def interferences(
+    assembly: Assembly, tol: Tolerance | None = None, among: Collection[str] | None = None
+) -> list[tuple[str, str, float]]:
     """``(a, b, volume)`` for every pair of parts of ``assembly`` that interfere, in part
-    order; only pairs whose bounding boxes overlap are tested (R-tree broad phase)."""
+    order (with ``among``, the pairs with a part of it); only pairs whose bounding boxes
+    overlap are tested (R-tree broad phase)."""
     tol = assembly.tolerance(tol)
     names = list(assembly.parts)
     if len(names) < 2:
         return []
     bounds = np.array([p.mesh.bounds for p in assembly.parts.values()])
+    pairs = candidate_pairs(bounds, 0.0)
+    if among is not None:
+        asked = np.isin(np.array(names, dtype=object), list(among))
+        pairs = pairs[asked[pairs].any(axis=1)]
     solids = {}
     found = []
-    for i, j in candidate_pairs(bounds, 0.0):
+    for i, j in pairs:
         a, b = assembly.parts[names[i]], assembly.parts[names[j]]
         for k, part in ((i, a), (j, b)):
             if k not in solids:

@@ -8,7 +8,9 @@ otherwise, and :func:`resolve_overlaps` does the same, saying what it did for ea
 
 * **joined** parts (``join``, and with ``join_interfering`` every connected set of
   interfering parts) become one rigid part named ``A+B``: the union of their solids
-  (manifold3d);
+  (manifold3d). The solids of one product of several solids (a locknut's nut and its
+  nylon insert, captured in it) are one physical part, joined and named after the
+  product, unless ``join_products`` is false;
 * **designed interference**: a pair sharing at most ``ignore_overlap`` (default:
   ``DESIGNED_SHARE`` of the smaller part's volume) has the shared volume cut from the
   smaller part, with all of that part in the shared volume's shadow along the axis it
@@ -22,7 +24,7 @@ otherwise, and :func:`resolve_overlaps` does the same, saying what it did for ea
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
 
 import manifold3d
@@ -78,13 +80,19 @@ def joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> Assembly:
     return _joined(assembly, groups)[0]
 
 
-def _joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> tuple[Assembly, dict[str, str]]:
-    """:func:`joined`, and the name of the part each joined part became."""
+def _joined(
+    assembly: Assembly,
+    groups: Iterable[Iterable[str]],
+    named: Mapping[str, Iterable[str]] | None = None,
+) -> tuple[Assembly, dict[str, str]]:
+    """:func:`joined`, and the name of the part each joined part became; a joined part
+    whose members are exactly those of a ``named`` group takes that group's name."""
     graph: nx.Graph = nx.Graph()
-    for group in groups:
+    for group in [*groups, *(named or {}).values()]:
         names = [assembly.part(name).name for name in group]
         graph.add_nodes_from(names)
         graph.add_edges_from(itertools.pairwise(names))
+    names_of = {frozenset(members): name for name, members in (named or {}).items()}
     order = {name: k for k, name in enumerate(assembly.parts)}
     result, into = assembly, {}
     for component in sorted(nx.connected_components(graph), key=lambda c: min(order[n] for n in c)):
@@ -95,7 +103,8 @@ def _joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> tuple[Assemb
             [solid(assembly.parts[n].mesh, n) for n in members], manifold3d.OpType.Add
         )
         first = assembly.parts[members[0]]
-        part = Part("+".join(members), mesh_of(union), source=first.source)
+        name = names_of.get(frozenset(members), "+".join(members))
+        part = Part(name, mesh_of(union), source=first.source)
         rest = [n for n in result.parts if n not in component]
         result = result.subset(rest).with_part(part)
         into.update(dict.fromkeys(members, part.name))
@@ -218,31 +227,44 @@ def resolve_overlaps(
     join_interfering: bool = False,
     ignore_overlap: float | None = None,
     tol: Tolerance | None = None,
+    *,
+    join_products: bool = True,
 ) -> Assembly:
     """``assembly`` with its interfering parts resolved as the module docstring says,
     and :attr:`~assemblykit.model.assembly.Assembly.overlaps` listing every interfering
-    pair of the input with its volume and resolution. ``ignore_overlap`` is a volume in
-    cubed model units (``0``: cut nothing; ``None``: ``DESIGNED_SHARE`` of the smaller
-    part's volume)."""
+    pair with its volume and resolution. ``ignore_overlap`` is a volume in cubed model
+    units (``0``: cut nothing; ``None``: ``DESIGNED_SHARE`` of the smaller part's
+    volume). With ``join_products``, the solids of each product of several solids
+    (:attr:`~assemblykit.model.assembly.Assembly.products`: a locknut's nut and nylon
+    insert) are one part named after the product. A joined part is measured again
+    against the other parts, so a screw through a locknut meets nut and insert as one
+    part, and its designed interference with them is cut as any other."""
     tol = assembly.tolerance(tol)
     found = interferences(assembly, tol)
     groups = [list(group) for group in join]
     if join_interfering:
         groups += [[a, b] for a, b, _ in found]
-    result, into = _joined(assembly, groups)
-    overlaps = []
-    for a, b, volume in found:
-        if a in into and into[a] == into.get(b):
-            overlaps.append(Overlap(a, b, volume, "joined"))
-            continue
-        small, large = sorted((assembly.parts[a], assembly.parts[b]), key=lambda p: p.volume)
+    result, into = _joined(assembly, groups, assembly.products if join_products else None)
+    overlaps = [
+        Overlap(a, b, volume, "joined")
+        for a, b, volume in found
+        if a in into and into[a] == into.get(b)
+    ]
+    pending = [(a, b, volume) for a, b, volume in found if a not in into and b not in into]
+    if into:
+        order = {name: k for k, name in enumerate(result.parts)}
+        pending = sorted(
+            {*pending, *interferences(result, tol, among=set(into.values()))},
+            key=lambda pair: (order[pair[0]], order[pair[1]]),
+        )
+    whole = dict(result.parts)
+    for a, b, volume in pending:
+        small, large = sorted((whole[a], whole[b]), key=lambda p: p.volume)
         limit = DESIGNED_SHARE * small.volume if ignore_overlap is None else ignore_overlap
-        if volume > limit or small.name not in result.parts or large.name not in result.parts:
+        if volume > limit:
             overlaps.append(Overlap(a, b, volume))
             continue
-        result = result.with_part(
-            _trimmed(result.parts[small.name], assembly.parts[large.name], tol)
-        )
+        result = result.with_part(_trimmed(result.parts[small.name], large, tol))
         overlaps.append(Overlap(a, b, volume, f"trimmed from {small.name}"))
     prepared = type(result).like(result, scale=result.scale)
     prepared.overlaps = tuple(overlaps)

@@ -17,7 +17,9 @@ uses it), read through OCP's XCAF document:
   (``pin_1``, ``pin_2``; ``Body (2)_1``, ``Body (2)_2``);
 * the solids of a product made of several solids are numbered in order after the name
   of their instance: ``bracket_1``, ``bracket_2`` for a product used once, and
-  ``bracket_2_1`` for the first solid of its second instance.
+  ``bracket_2_1`` for the first solid of its second instance. The assembly's
+  ``products`` list them under their instance's name (``bracket``, ``bracket_2``): one
+  physical part, which ``plan`` moves as one (docs/planning.md, "Interfering parts").
 
 A numbered name already taken by another part is skipped (:func:`numbered`). The
 products that are assemblies below the whole (subassemblies) become the assembly's
@@ -746,25 +748,31 @@ def distinct_products(named: Sequence[tuple[str, str]]) -> list[str]:
     return [chosen.get(item, "") for item in named]
 
 
-def _part_names(solids: Sequence[_Solid]) -> list[str]:
-    """The parts' names (module docstring): the products' names made distinct
-    (:func:`distinct_products`), the placements of one product numbered
-    (:func:`numbered`), the solids of a product of several numbered after their
-    placement's name; ``solid<i>`` for a solid without a name."""
+def _placement_names(solids: Sequence[_Solid]) -> list[str]:
+    """Per solid, the name of the placement it belongs to: its product's name made
+    distinct (:func:`distinct_products`), the placements of one product numbered
+    (:func:`numbered`); ``""`` for a solid without a name."""
     bases = distinct_products([(s.name, s.key) for s in solids])
     placements: dict[int, str] = {}
     for solid, base in zip(solids, bases, strict=True):
         if base:
             placements.setdefault(solid.instance, base)
     placed = dict(zip(placements, numbered(list(placements.values())), strict=True))
+    return [placed[s.instance] if base else "" for s, base in zip(solids, bases, strict=True)]
+
+
+def _part_names(solids: Sequence[_Solid], placements: Sequence[str]) -> list[str]:
+    """The parts' names (module docstring): each solid's placement name
+    (:func:`_placement_names`), the solids of a product of several numbered after it;
+    ``solid<i>`` for a solid without a name."""
     names = []
-    for i, (solid, base) in enumerate(zip(solids, bases, strict=True), start=1):
-        if not base:
+    for i, (solid, placement) in enumerate(zip(solids, placements, strict=True), start=1):
+        if not placement:
             names.append(f"solid{i}")
         elif solid.piece:
-            names.append(f"{placed[solid.instance]}_{solid.piece}")
+            names.append(f"{placement}_{solid.piece}")
         else:
-            names.append(placed[solid.instance])
+            names.append(placement)
     return names if len(set(names)) == len(names) else numbered(names)
 
 
@@ -884,7 +892,12 @@ def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     if not solids:
         said = f": {'; '.join(warnings)}" if warnings else ""
         raise GeometryError(f"no solids in STEP file{said}", source=source)
-    names = _part_names(solids)
+    placements = _placement_names(solids)
+    names = _part_names(solids, placements)
+    products: dict[str, list[str]] = {}
+    for solid, placement, name in zip(solids, placements, names, strict=True):
+        if solid.piece and placement:
+            products.setdefault(placement, []).append(name)
     parts: list[Part] = []
     unmeshed: list[Skipped] = []
     notes: list[str] = []
@@ -912,4 +925,5 @@ def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         skipped=[*_skipped_solids(declared, reader.Reader().Model(), distinct), *unmeshed],
         warnings=[*warnings, *notes],
         groups=groups,
+        products=products,
     )

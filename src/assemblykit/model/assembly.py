@@ -110,7 +110,9 @@ class Assembly:
     (:mod:`assemblykit.geometry.precision`); lengths are never compared more finely.
     ``skipped`` lists what the loader could not read (:class:`Skipped`) and ``warnings``
     what the reader reported while reading. ``groups`` names sets of parts the input
-    keeps together (a STEP file's subassemblies), each listing its parts in order.
+    keeps together (a STEP file's subassemblies), each listing its parts in order;
+    ``products`` the parts that are solids of one product of several solids (a STEP
+    file's multi-body part: a locknut's nut and nylon insert), by the product's name.
     ``overlaps`` lists the interfering pairs found and what was done about each
     (:class:`Overlap`; empty until :func:`assemblykit.geometry.overlaps.resolve_overlaps`).
     ``memo`` is the slot where the geometry layer keeps what it computed from the parts
@@ -132,6 +134,7 @@ class Assembly:
         warnings: Iterable[str] = (),
         groups: Mapping[str, Iterable[str]] | None = None,
         overlaps: Iterable[Overlap] = (),
+        products: Mapping[str, Iterable[str]] | None = None,
     ) -> None:
         items = parts.values() if isinstance(parts, Mapping) else parts
         self.parts: dict[str, Part] = {p.name: p for p in items}
@@ -139,6 +142,11 @@ class Assembly:
             group: kept
             for group, names in (groups or {}).items()
             if (kept := tuple(n for n in names if n in self.parts))
+        }
+        self.products: dict[str, tuple[str, ...]] = {
+            product: kept
+            for product, names in (products or {}).items()
+            if len(kept := tuple(n for n in names if n in self.parts)) > 1
         }
         self.units = units
         self.units_source = units_source
@@ -260,7 +268,7 @@ class Assembly:
     ) -> Self:
         """An assembly of ``parts`` (default: those of ``other``) with everything else
         taken from ``other``: units, source, policy, precision, what was skipped, the
-        warnings and groups; ``scale`` as given (``None``: measured from the parts)."""
+        warnings, groups and products; ``scale`` as given (``None``: measured from the parts)."""
         return cls(
             other.parts.values() if parts is None else parts,
             units=other.units,
@@ -274,6 +282,7 @@ class Assembly:
             warnings=other.warnings,
             groups=other.groups,
             overlaps=other.overlaps,
+            products=other.products,
         )
 
     def _kept(self, parts: Iterable[Part], scale: float | None) -> Self:
