@@ -349,6 +349,11 @@ OVERLAP_CHUNK = 1 << 20
 pairs of large coplanar groups (a plate on a plate) run to millions, and their 2D
 triangles, boxes and polygons are made chunk by chunk to bound the memory they take."""
 
+OUTLINE_PAIRS = 4096
+"""Group pairs of more triangle pairs than this are intersected outline to outline (the
+union of each group's triangles, which tile it), at a cost that follows the triangles'
+count rather than its product: two plates' faces of thousands of triangles each."""
+
 
 def triangle_overlaps(
     stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], margin: float
@@ -356,9 +361,29 @@ def triangle_overlaps(
     """Where the triangles of groups ``g[k]`` and ``h[k]`` overlap, projected on the plane
     of ``g[k]`` with the frame ``(u[k], v[k])``: the non-empty intersections of triangle
     pairs whose 2D boxes overlap by more than ``margin`` (shapely, vectorised, over
-    chunks of about ``OVERLAP_CHUNK`` triangle pairs), each with its ``owner`` ``k``.
-    Returns ``owner, pieces, u, v``."""
+    chunks of about ``OVERLAP_CHUNK`` triangle pairs), each with its ``owner`` ``k``
+    (in order); for a pair of more than ``OUTLINE_PAIRS`` triangle pairs, the one
+    intersection of the two groups' outlines. Returns ``owner, pieces, u, v``."""
     u, v = axis_basis(seg.normal[g]) if len(g) else (np.zeros((0, 3)), np.zeros((0, 3)))
+    work = (seg.start[g + 1] - seg.start[g]) * (seg.start[h + 1] - seg.start[h])
+    small, large = np.flatnonzero(work <= OUTLINE_PAIRS), np.flatnonzero(work > OUTLINE_PAIRS)
+    by_triangle = _triangle_pieces(stack, seg, g[small], h[small], u[small], v[small], margin)
+    by_outline = _outline_pieces(stack, seg, g[large], h[large], u[large], v[large])
+    owner = np.concatenate([small[by_triangle[0]], large[by_outline[0]]])
+    order = np.argsort(owner, kind="stable")
+    return owner[order], np.concatenate([by_triangle[1], by_outline[1]])[order], u, v
+
+
+def _triangle_pieces(
+    stack: PartStack,
+    seg: Segmentation,
+    g: NDArray[np.int64],
+    h: NDArray[np.int64],
+    u: NDArray[np.float64],
+    v: NDArray[np.float64],
+    margin: float,
+) -> tuple[NDArray[np.int64], NDArray[Any]]:
+    """:func:`triangle_overlaps` triangle by triangle, chunk by chunk."""
     work = np.cumsum((seg.start[g + 1] - seg.start[g]) * (seg.start[h + 1] - seg.start[h]))
     cuts = np.searchsorted(
         work, np.arange(OVERLAP_CHUNK, int(work[-1]) if len(g) else 0, OVERLAP_CHUNK)
@@ -368,7 +393,47 @@ def triangle_overlaps(
         found = _chunk_overlaps(stack, seg, g, h, chunk, u, v, margin)
         owners.append(found[0])
         pieces.append(found[1])
-    return np.concatenate(owners), np.concatenate(pieces), u, v
+    return np.concatenate(owners), np.concatenate(pieces)
+
+
+def _outline_pieces(
+    stack: PartStack,
+    seg: Segmentation,
+    g: NDArray[np.int64],
+    h: NDArray[np.int64],
+    u: NDArray[np.float64],
+    v: NDArray[np.float64],
+) -> tuple[NDArray[np.int64], NDArray[Any]]:
+    """:func:`triangle_overlaps` outline to outline: each group's outline made once in
+    its frame (``g``'s) and intersected; the pairs whose overlap has an area."""
+    if not len(g):
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=object)
+    unique, first = np.unique(g, return_index=True)
+    outline_g = _outlines(stack, seg, unique, u[first], v[first])
+    shared = shapely.intersection(
+        outline_g[np.searchsorted(unique, g)], _outlines(stack, seg, h, u, v)
+    )
+    owner = np.flatnonzero(shapely.area(shared) > 0)
+    return owner, shared[owner]
+
+
+def _outlines(
+    stack: PartStack,
+    seg: Segmentation,
+    groups: NDArray[np.int64],
+    u: NDArray[np.float64],
+    v: NDArray[np.float64],
+) -> NDArray[Any]:
+    """Per group, the union of its triangles projected with the frame ``(u, v)``."""
+    size = seg.start[groups + 1] - seg.start[groups]
+    owner = np.repeat(np.arange(len(groups), dtype=np.int64), size)
+    faces = seg.order[_expand(seg.start[groups], size)]
+    triangles = shapely.polygons(
+        _triangles_2d(stack.vertices[stack.faces[faces]], u[owner], v[owner])
+    )
+    outlines = np.empty(len(groups), dtype=object)
+    outlines[:] = [shapely.union_all(t) for t in np.split(triangles, np.cumsum(size)[:-1])]
+    return outlines
 
 
 def _chunk_overlaps(
