@@ -321,3 +321,29 @@ def test_the_pieces_of_one_face_make_one_patch():
     (patch,) = contact.planar
     assert patch.area == pytest.approx(1.0, abs=1e-8)
     np.testing.assert_allclose(patch.normal, [0, 0, 1], atol=1e-12)
+
+
+def _fine_box(extents, corner, size: float) -> trimesh.Trimesh:
+    """A box tessellated into triangles no longer than ``size`` (a CAD face's mesh)."""
+    box = trimesh.creation.box(extents=extents)
+    box.apply_translation(np.asarray(corner) + np.asarray(extents) / 2)
+    vertices, faces = trimesh.remesh.subdivide_to_size(box.vertices, box.faces, size)
+    return trimesh.Trimesh(vertices, faces)
+
+
+@pytest.mark.parametrize("size", [0.4, 3.0])
+def test_a_plate_on_a_finely_meshed_plate_touches_on_their_common_square(size):
+    # 6 x 6 on 10 x 10, a corner 3 in along x and 2 along y: the contact is the square
+    # [3, 9] x [2, 8] at z = 1, area 36, whether its faces hold thousands of triangles
+    # (intersected outline to outline, OUTLINE_PAIRS) or a few (triangle by triangle)
+    base = _fine_box((10, 10, 1), (0, 0, 0), size)
+    top = _fine_box((6, 6, 1), (3, 2, 1), size)
+    assert (len(base.faces) > 1000) is (size < 1)
+    (contact,) = assembly_contacts(Assembly([Part("base", base), Part("top", top)]))
+    (patch,) = contact.planar
+    assert patch.area == pytest.approx(36.0, rel=1e-9)
+    np.testing.assert_allclose(np.abs(patch.normal), [0, 0, 1], atol=1e-12)
+    np.testing.assert_allclose(patch.polygon.min(axis=0), [3, 2, 1], atol=1e-9)
+    np.testing.assert_allclose(patch.polygon.max(axis=0), [9, 8, 1], atol=1e-9)
+    square = shapely.Polygon(patch.polygon[:, :2])
+    assert square.symmetric_difference(shapely.box(3, 2, 9, 8)).area < 1e-9
