@@ -246,7 +246,18 @@ def _plan(result: Plan) -> Group:
     tables = [_disassembly_table(result), _assembly_table(result)]
     if result.overlaps:
         tables.append(_overlap_table(result))
+    if result.joined:
+        tables.append(_joined_table(result))
     return Group(*tables)
+
+
+def _joined_table(plan: Plan) -> Table:
+    table = Table(title="Parts planned as one")
+    for column in ("part", "made of"):
+        table.add_column(column)
+    for name, members in plan.joined.items():
+        table.add_row(name, ", ".join(members))
+    return table
 
 
 def _overlap_table(plan: Plan) -> Table:

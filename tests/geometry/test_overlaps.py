@@ -128,6 +128,7 @@ def test_the_plan_command_cuts_designed_interference_and_says_so(capsys, tmp_pat
     assert code == 0, err
     found = json.loads(out)
     assert found["parts"] == ["plate+screw"] and found["overlaps"][0]["resolution"] == "joined"
+    assert found["joined"] == {"plate+screw": ["plate", "screw"]}
 
 
 def polygon_area(radius: float, sections: int = 64) -> float:

@@ -412,6 +412,7 @@ def test_a_locknut_of_two_solids_is_planned_as_one_part(locknut_step):
     assert asm.products == {"locknut": ("locknut_1", "locknut_2")}
     prepared = resolve_overlaps(asm)
     assert sorted(prepared.names) == ["locknut", "plate", "screw"]
+    assert prepared.joined == {"locknut": ("locknut_1", "locknut_2")}
     assert prepared["locknut"].volume == pytest.approx(
         asm["locknut_1"].volume + asm["locknut_2"].volume, rel=1e-9
     )
@@ -421,6 +422,7 @@ def test_a_locknut_of_two_solids_is_planned_as_one_part(locknut_step):
     assert overlap.resolution == "trimmed from screw"
     result = plan(prepared, max_and_or_parts=0)
     assert result.feasible and ("locknut",) in [s.parts for s in result.steps]
+    assert result.to_dict()["joined"] == {"locknut": ["locknut_1", "locknut_2"]}
     assert_steps_clear(prepared, result)
     # planned solid by solid, the insert stays locked in its nut
     apart = plan(resolve_overlaps(asm, join_products=False), max_and_or_parts=0)

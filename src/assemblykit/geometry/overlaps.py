@@ -232,7 +232,8 @@ def resolve_overlaps(
 ) -> Assembly:
     """``assembly`` with its interfering parts resolved as the module docstring says,
     and :attr:`~assemblykit.model.assembly.Assembly.overlaps` listing every interfering
-    pair with its volume and resolution. ``ignore_overlap`` is a volume in cubed model
+    pair with its volume and resolution (``joined``: the parts each joined part is made
+    of). ``ignore_overlap`` is a volume in cubed model
     units (``0``: cut nothing; ``None``: ``DESIGNED_SHARE`` of the smaller part's
     volume). With ``join_products``, the solids of each product of several solids
     (:attr:`~assemblykit.model.assembly.Assembly.products`: a locknut's nut and nylon
@@ -268,4 +269,8 @@ def resolve_overlaps(
         overlaps.append(Overlap(a, b, volume, f"trimmed from {small.name}"))
     prepared = type(result).like(result, scale=result.scale)
     prepared.overlaps = tuple(overlaps)
+    members: dict[str, list[str]] = {}
+    for name, part in into.items():
+        members.setdefault(part, []).append(name)
+    prepared.joined = {part: tuple(names) for part, names in members.items()}
     return prepared

@@ -114,7 +114,8 @@ class Assembly:
     ``products`` the parts that are solids of one product of several solids (a STEP
     file's multi-body part: a locknut's nut and nylon insert), by the product's name.
     ``overlaps`` lists the interfering pairs found and what was done about each
-    (:class:`Overlap`; empty until :func:`assemblykit.geometry.overlaps.resolve_overlaps`).
+    (:class:`Overlap`; empty until :func:`assemblykit.geometry.overlaps.resolve_overlaps`),
+    and ``joined`` the parts that were made one, by the name of the part they became.
     ``memo`` is the slot where the geometry layer keeps what it computed from the parts
     (:class:`Derived`; ``None`` until it is asked).
     """
@@ -135,6 +136,7 @@ class Assembly:
         groups: Mapping[str, Iterable[str]] | None = None,
         overlaps: Iterable[Overlap] = (),
         products: Mapping[str, Iterable[str]] | None = None,
+        joined: Mapping[str, Iterable[str]] | None = None,
     ) -> None:
         items = parts.values() if isinstance(parts, Mapping) else parts
         self.parts: dict[str, Part] = {p.name: p for p in items}
@@ -158,6 +160,7 @@ class Assembly:
         self.skipped = tuple(skipped)
         self.warnings = tuple(warnings)
         self.overlaps = tuple(overlaps)
+        self.joined = {name: tuple(members) for name, members in (joined or {}).items()}
         self.memo: Derived | None = None
 
     def __len__(self) -> int:
@@ -268,7 +271,8 @@ class Assembly:
     ) -> Self:
         """An assembly of ``parts`` (default: those of ``other``) with everything else
         taken from ``other``: units, source, policy, precision, what was skipped, the
-        warnings, groups and products; ``scale`` as given (``None``: measured from the parts)."""
+        warnings, groups, products, overlaps and joined parts; ``scale`` as given
+        (``None``: measured from the parts)."""
         return cls(
             other.parts.values() if parts is None else parts,
             units=other.units,
@@ -283,6 +287,7 @@ class Assembly:
             groups=other.groups,
             overlaps=other.overlaps,
             products=other.products,
+            joined=other.joined,
         )
 
     def _kept(self, parts: Iterable[Part], scale: float | None) -> Self:

@@ -250,6 +250,7 @@ def finish_plan(
         len(translations.directions),
         hands,
         overlaps=getattr(assembly, "overlaps", ()),
+        joined=getattr(assembly, "joined", {}),
         unfinished=unfinished,
     )
 

@@ -37,7 +37,7 @@ every two-handed partition accepted by Γ_e is built too, and its plans are coun
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cache, cached_property
 from typing import TYPE_CHECKING, Any, Literal
@@ -437,6 +437,9 @@ class Plan:
     overlaps: tuple[Overlap, ...] = ()
     """The interfering pairs of the assembly planned and what was done about each
     (:func:`assemblykit.geometry.overlaps.resolve_overlaps`)."""
+    joined: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    """The parts planned as one, by the name of the part they became (products of
+    several solids, ``--join``: :func:`assemblykit.geometry.overlaps.resolve_overlaps`)."""
     unfinished: tuple[str, ...] = ()
     """The parts not yet taken apart when the plan stopped at its step limit
     (``max_steps`` of :func:`assemblykit.planning.planner.plan`): neither separated nor
@@ -507,6 +510,7 @@ class Plan:
             "gravity": None if self.gravity is None else self.gravity.to_dict(),
             "unfinished": list(self.unfinished),
             "overlaps": [overlap.to_dict() for overlap in self.overlaps],
+            "joined": {name: list(members) for name, members in self.joined.items()},
         }
 
     def __repr__(self) -> str:
