@@ -26,6 +26,8 @@ from assemblykit.planning.stability import (
     LP_FEASIBILITY,
     EquilibriumModel,
     Gravity,
+    _balances,
+    _proves_none,
     equilibrium_model,
 )
 from assemblykit.tolerance import Tolerance
@@ -314,3 +316,20 @@ def test_a_state_after_one_removal_is_judged_as_a_fresh_model_judges_it():
     assert model.stands(rest, fixed) and model.stands(rest, fixed, need)
     assert fresh.stands(rest, fixed, need, local=False)
     assert model.stands(rest, fixed, 0.0) is fresh.stands(rest, fixed, 0.0, local=False)
+
+
+def test_an_almost_answer_is_taken_only_when_it_checks_out():
+    # x1 + x2 = -1 has no x >= 0: y = 1 proves it (rhs . y = -1 < 0, both columns gain
+    # 1), however long y is; y = -1 proves nothing. x1 + 2 x2 = 3 is balanced by (1, 1)
+    # and not by (1, 0.9) beyond the feasibility tolerance
+    none = sp.csc_matrix(np.array([[1.0, 1.0]]))
+    assert _proves_none(none, np.array([-1.0]), np.array([1.0]))
+    assert _proves_none(none, np.array([-1.0]), np.array([8.5e10]))
+    assert not _proves_none(none, np.array([-1.0]), np.array([-1.0]))
+    # a column that loses by more than the tolerance spoils it
+    mixed = sp.csc_matrix(np.array([[1.0, -1.0]]))
+    assert not _proves_none(mixed, np.array([-1.0]), np.array([1.0]))
+    some = sp.csc_matrix(np.array([[1.0, 2.0]]))
+    assert _balances(some, np.array([3.0]), np.array([1.0, 1.0]))
+    assert _balances(some, np.array([3.0]), np.array([1.0, 1.0 + LP_FEASIBILITY / 4]))
+    assert not _balances(some, np.array([3.0]), np.array([1.0, 0.9]))

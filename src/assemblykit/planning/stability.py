@@ -365,9 +365,12 @@ def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> Balance:
     programs with quadratic objectives": a sparse direct factorisation per iteration;
     0.6 s on the 527-block dome where HiGHS's interior point method needs 25 s), which
     proves unboundedness by that ray; its unknowns are the equations (6 per part), not
-    the generators. Should it stop short of either answer (iterations, numerical
-    trouble, :data:`LP_TIME_LIMIT`), HiGHS's interior point method decides, within
-    :data:`LP_FEASIBILITY` (with no certificate)."""
+    the generators. An answer it calls *almost* solved, or a ray it calls almost one of
+    unboundedness, is taken once checked (:func:`_balances`, :func:`_proves_none`: on
+    the cross vault a state nearly in balance gives a ray of length 1e11 after 187
+    iterations that certifies it by a wide margin). Should it stop short of either
+    answer (iterations, numerical trouble, :data:`LP_TIME_LIMIT`), HiGHS's interior
+    point method decides, within :data:`LP_FEASIBILITY` (with no certificate)."""
     import clarabel
 
     rows, columns = matrix.shape
@@ -382,10 +385,15 @@ def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> Balance:
         [clarabel.NonnegativeConeT(columns)],
         settings,
     ).solve()
-    if found.status == clarabel.SolverStatus.Solved:
-        return Balance(np.maximum(np.asarray(found.z), 0.0))
-    if found.status == clarabel.SolverStatus.DualInfeasible:
-        return Balance(None, np.asarray(found.x, dtype=np.float64))
+    status, done = found.status, clarabel.SolverStatus
+    forces = np.maximum(np.asarray(found.z, dtype=np.float64), 0.0)
+    ray = np.asarray(found.x, dtype=np.float64)
+    if status == done.Solved or (status == done.AlmostSolved and _balances(matrix, rhs, forces)):
+        return Balance(forces)
+    if status == done.DualInfeasible or (
+        status == done.AlmostDualInfeasible and _proves_none(matrix, rhs, ray)
+    ):
+        return Balance(None, ray)
     result = linprog(
         np.zeros(columns),
         A_eq=matrix,
@@ -397,6 +405,22 @@ def balance(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> Balance:
     if result.status not in (0, 2):
         raise NumericError(f"equilibrium program failed: {result.message}")
     return Balance(np.asarray(result.x) if result.status == 0 else None)
+
+
+def _balances(matrix: sp.csc_matrix, rhs: NDArray[np.float64], forces: NDArray[np.float64]) -> bool:
+    """Whether ``forces`` solve ``matrix @ x = rhs`` to :data:`LP_FEASIBILITY` of the
+    largest load: an answer the solver calls almost solved, checked."""
+    error = np.abs(matrix @ forces - rhs).max(initial=0.0)
+    return bool(error <= LP_FEASIBILITY * max(1.0, float(np.abs(rhs).max(initial=0.0))))
+
+
+def _proves_none(matrix: sp.csc_matrix, rhs: NDArray[np.float64], ray: NDArray[np.float64]) -> bool:
+    """Whether ``ray`` is a Farkas certificate that ``matrix @ x = rhs`` has no
+    ``x >= 0``: ``rhs @ ray < 0`` while no column loses by it (``matrix.T @ ray >= 0``, to
+    :data:`LP_FEASIBILITY` of ``rhs @ ray``), as :meth:`EquilibriumModel._certifies`
+    reads a kept one: an answer the solver calls almost infeasible, checked."""
+    share = float(rhs @ ray)
+    return share < 0 and bool((matrix.T @ ray).min(initial=0.0) >= LP_FEASIBILITY * share)
 
 
 def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
