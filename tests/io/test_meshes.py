@@ -109,6 +109,42 @@ def test_open_mesh_that_cannot_be_closed_is_rejected(tmp_path):
         read_mesh(path)
 
 
+def _open_box(folder: Path, name: str, missing: list[int]) -> Path:
+    """A unit box (corner at the origin) with the faces ``missing`` left out."""
+    cube = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    kept = np.delete(cube.faces, missing, axis=0)
+    path = folder / name
+    trimesh.Trimesh(cube.vertices, kept, process=False).export(path)
+    return path
+
+
+def test_a_box_missing_one_side_is_closed_and_the_repair_said(tmp_path):
+    # the two triangles of one side gone: a quad hole, which fill_holes closes exactly
+    cube = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    side = np.flatnonzero(np.isclose(cube.triangles_center[:, 0], 1.0))
+    assert len(side) == 2
+    path = _open_box(tmp_path, "lid.stl", side.tolist())
+    asm = load_assembly(path)
+    assert asm["lid"].mesh.is_watertight and asm["lid"].volume == pytest.approx(1.0, abs=1e-12)
+    (note,) = asm.warnings
+    assert "lid.stl" in note and "4 edges bordered holes" in note and "filled" in note
+    # the same file in a folder and in a manifest says so too
+    (tmp_path / "parts.yaml").write_text("parts:\n  - {name: lid, mesh: lid.stl}\n")
+    assert load_assembly(tmp_path / "parts.yaml").warnings == (note,)
+    assert load_assembly(tmp_path).warnings == (note,)
+
+
+def test_a_box_missing_a_side_and_a_half_is_refused_with_its_holes(tmp_path):
+    # three triangles gone from two sides: a hole bent over the box's edge, which no
+    # exact repair closes
+    cube = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    side = np.flatnonzero(np.isclose(cube.triangles_center[:, 0], 1.0)).tolist()
+    top = np.flatnonzero(np.isclose(cube.triangles_center[:, 2], 1.0)).tolist()
+    path = _open_box(tmp_path, "broken.stl", [*side, top[0]])
+    with pytest.raises(GeometryError, match=r"broken\.stl.*edges border holes that are not flat"):
+        read_mesh(path)
+
+
 def edge_piece(path: Path) -> Path:
     """Two unit cubes sharing only the edge x = y = 1, written as one mesh (its vertices
     on that edge shared: four faces meet there)."""

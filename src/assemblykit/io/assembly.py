@@ -60,12 +60,14 @@ def load_assembly(path: str | Path, tol: Tolerance | None = None, settle: bool =
 
         return load_burrtools(path, tol)
     if suffix in MESH_SUFFIXES:
-        part = Part(path.stem, read_mesh(path), source=str(path))
+        notes: list[str] = []
+        part = Part(path.stem, read_mesh(path, notes), source=str(path))
         return Assembly(
             [part],
             source=str(path),
             policy=tol,
             precision=coordinate_precision(part.mesh.vertices),
+            warnings=notes,
         )
     raise GeometryError(
         "unknown assembly kind (expected a mesh folder, .yaml manifest, .step, COMPAS .json "

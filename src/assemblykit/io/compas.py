@@ -69,8 +69,12 @@ def _coordinate(vertex: Any, axis: str) -> float:
     return float(value)
 
 
-def mesh_from_compas(data: Any, source: str, where: str) -> trimesh.Trimesh:
-    """The triangle mesh of a COMPAS mesh payload (``vertex`` and ``face`` dicts)."""
+def mesh_from_compas(
+    data: Any, source: str, where: str, notes: list[str] | None = None
+) -> trimesh.Trimesh:
+    """The triangle mesh of a COMPAS mesh payload (``vertex`` and ``face`` dicts),
+    repaired (:func:`~assemblykit.io.meshes.repaired`, which says in ``notes`` what it
+    closed)."""
     vertices = data.get("vertex") if isinstance(data, Mapping) else None
     faces = data.get("face") if isinstance(data, Mapping) else None
     if not isinstance(vertices, Mapping) or not isinstance(faces, Mapping) or not faces:
@@ -93,7 +97,7 @@ def mesh_from_compas(data: Any, source: str, where: str) -> trimesh.Trimesh:
     if not triangles:
         raise SchemaError("no face has three vertices", source=source, where=where)
     mesh = trimesh.Trimesh(vertices=xyz, faces=np.array(triangles, dtype=np.int64), process=False)
-    return repaired(mesh, f"{source}: {where}")
+    return repaired(mesh, f"{source}: {where}", notes)
 
 
 def _blocks(data: Any, source: str) -> list[tuple[str, Any, str]]:
@@ -124,14 +128,20 @@ def load_compas(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     path = Path(path)
     source = str(path)
     data = read_json(read_text(path, "COMPAS file"), source)
+    notes: list[str] = []
     parts = [
-        Part(name, mesh_from_compas(mesh, source, where), source=source)
+        Part(name, mesh_from_compas(mesh, source, where, notes), source=source)
         for name, mesh, where in _blocks(data, source)
     ]
     if not parts:
         raise GeometryError("no blocks", source=source)
     assembly = Assembly(
-        parts, units=DEFAULT_UNITS, units_source="default", source=source, policy=tol
+        parts,
+        units=DEFAULT_UNITS,
+        units_source="default",
+        source=source,
+        policy=tol,
+        warnings=notes,
     )
     assembly.precision = joint_mismatch(assembly, tol)
     return assembly

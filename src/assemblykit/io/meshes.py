@@ -57,8 +57,9 @@ MAX_MESH_COORDINATE = 1e10
 by 1e8 as 64-bit integers (at most 9.2e18), which overflows beyond about 9e10."""
 
 
-def read_mesh(path: str | Path) -> trimesh.Trimesh:
-    """Read one mesh file (scenes are flattened into one mesh), repaired and checked.
+def read_mesh(path: str | Path, notes: list[str] | None = None) -> trimesh.Trimesh:
+    """Read one mesh file (scenes are flattened into one mesh), repaired and checked
+    (:func:`repaired`, which says in ``notes`` what it closed).
 
     Raises :class:`GeometryError` naming the file if it is missing, unreadable, empty,
     has non-finite vertices, or cannot be made watertight."""
@@ -72,11 +73,17 @@ def read_mesh(path: str | Path) -> trimesh.Trimesh:
         raise GeometryError(f"cannot read mesh: {bad}", source=source) from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise GeometryError("no triangles in mesh", source=source)
-    return repaired(loaded, source)
+    return repaired(loaded, source, notes)
 
 
-def repaired(mesh: trimesh.Trimesh, source: str | None = None) -> trimesh.Trimesh:
-    """``mesh`` with trimesh's repairs applied, or :class:`GeometryError` naming ``source``."""
+def repaired(
+    mesh: trimesh.Trimesh, source: str | None = None, notes: list[str] | None = None
+) -> trimesh.Trimesh:
+    """``mesh`` with trimesh's repairs applied, or :class:`GeometryError` naming ``source``.
+    An open mesh is closed only where every hole is flat (its border in one plane, to
+    the mesh tolerance: the missing faces were flat too) and trimesh's ``fill_holes``
+    fills it, which ``notes`` is told with the number of edges that bordered holes;
+    any other open mesh is refused."""
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     if not np.all(np.isfinite(vertices)):
         bad = int(np.count_nonzero(~np.all(np.isfinite(vertices), axis=1)))
@@ -97,9 +104,26 @@ def repaired(mesh: trimesh.Trimesh, source: str | None = None) -> trimesh.Trimes
     if not fixed.is_watertight:
         fixed = _split_at_shared_edges(fixed)
     if not fixed.is_watertight:
+        edges = fixed.edges_sorted[trimesh.grouping.group_rows(fixed.edges_sorted, require_count=1)]
+        border = len(edges)
+        if not _flat_holes(fixed, edges):
+            raise GeometryError(
+                f"mesh is not closed (watertight): {border} edges border holes that are "
+                "not flat, which no exact repair closes",
+                source=source,
+            )
         trimesh.repair.fill_holes(fixed)
-    if not fixed.is_watertight:
-        raise GeometryError("mesh is not closed (watertight) and cannot be repaired", source=source)
+        if not fixed.is_watertight:
+            raise GeometryError(
+                f"mesh is not closed (watertight): {border} edges border holes that "
+                "trimesh's fill_holes cannot close",
+                source=source,
+            )
+        if notes is not None:
+            notes.append(
+                f"{source}: the mesh was open ({border} edges bordered holes); "
+                "its holes were filled (trimesh fill_holes)"
+            )
     with np.errstate(invalid="ignore", divide="ignore"):  # trimesh divides by the volume
         trimesh.repair.fix_normals(fixed)
         volume = float(fixed.volume)
@@ -110,6 +134,19 @@ def repaired(mesh: trimesh.Trimesh, source: str | None = None) -> trimesh.Trimes
     if abs(volume) <= current().mesh_rel_length * scale**3:
         raise GeometryError("mesh encloses no volume (flat)", source=source)
     return fixed
+
+
+def _flat_holes(mesh: trimesh.Trimesh, edges: NDArray[np.int64]) -> bool:
+    """Whether each hole of ``mesh``, bordered by the connected ``edges`` (met by one face
+    each), lies in one plane within the mesh tolerance of its size."""
+    scale = float(np.linalg.norm(mesh.extents))
+    for loop in trimesh.graph.connected_components(edges):
+        points = np.asarray(mesh.vertices)[np.asarray(loop, dtype=np.int64)]
+        if len(points) > 3:
+            spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)[-1]
+            if spread > current().mesh_rel_length * scale * np.sqrt(len(points)):
+                return False
+    return True
 
 
 def _split_at_shared_edges(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
@@ -176,6 +213,7 @@ def _assembly(
     source: str,
     tol: Tolerance | None,
     precision: Precision | None,
+    warnings: Sequence[str] = (),
 ) -> Assembly:
     file_units = _file_units([p.mesh for p in parts])
     if units is not None:
@@ -185,7 +223,13 @@ def _assembly(
     else:
         unit, how = DEFAULT_UNITS, "default"
     return Assembly(
-        parts, units=unit, units_source=how, source=source, policy=tol, precision=precision
+        parts,
+        units=unit,
+        units_source=how,
+        source=source,
+        policy=tol,
+        precision=precision,
+        warnings=warnings,
     )
 
 
@@ -206,13 +250,14 @@ def load_mesh_folder(
             f"no mesh files ({', '.join(MESH_SUFFIXES)}) in folder", source=str(folder)
         )
     states = _final_states(folder / "config.json")
+    notes: list[str] = []
     parts: list[Part] = []
     measured: list[Precision] = []
     reach: list[float] = []
     for file in files:
         state = states.get(file.stem)
         pose = np.eye(4) if state is None else pose_from_state(state)
-        mesh = read_mesh(file)
+        mesh = read_mesh(file, notes)
         measured.append(coordinate_precision(mesh.vertices))
         rounding = None
         if state is not None:
@@ -224,7 +269,7 @@ def load_mesh_folder(
         parts.append(Part(file.stem, placed(mesh, pose), pose, source=str(file)))
     if settle and any(reach):
         parts = _settled(parts, reach)
-    return _assembly(parts, None, False, str(folder), tol, combined(measured))
+    return _assembly(parts, None, False, str(folder), tol, combined(measured), notes)
 
 
 def _settled(parts: list[Part], reach: Sequence[float]) -> list[Part]:
@@ -343,6 +388,7 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         raise SchemaError("expected a unit name such as mm", source=source, where="units")
     parts: list[Part] = []
     measured: list[Precision] = []
+    notes: list[str] = []
     for i, entry in enumerate(data["parts"]):
         where = f"parts[{i}]"
         if not isinstance(entry, dict) or not isinstance(entry.get("mesh"), str):
@@ -359,7 +405,7 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
             raise SchemaError(f"duplicate part name {name!r}", source=source, where=where)
         pose = pose_from_spec(entry.get("pose"), source=source, where=f"{where}.pose", tol=tol)
         mesh_path = path.parent / entry["mesh"]
-        mesh = read_mesh(mesh_path)
+        mesh = read_mesh(mesh_path, notes)
         measured.append(coordinate_precision(mesh.vertices))
         parts.append(Part(name, placed(mesh, pose), pose, source=str(mesh_path)))
-    return _assembly(parts, units, units is not None, source, tol, combined(measured))
+    return _assembly(parts, units, units is not None, source, tol, combined(measured), notes)
