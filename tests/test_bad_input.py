@@ -372,6 +372,64 @@ CASES: list[Case] = [
         on("blocking", "g.yaml", POLYGONS.replace("[2, 2]", "[2]")),
         "parts.b",
     ),
+    Case("blocking polygons none", on("blocking", "g.yaml", "parts: {}\n"), "g.yaml"),
+    # integers beyond a float, and beyond what Python converts (4,300 digits)
+    Case(
+        "blocking polygon huge",
+        on("blocking", "g.yaml", POLYGONS.replace("[2, 2]", f"[{10**400}, 2]")),
+        "g.yaml",
+    ),
+    Case(
+        "solve task huge radius",
+        on("solve", "t.yaml", TASK.replace("radius: 0.2", f"radius: {10**400}")),
+        "t.yaml",
+    ),
+    Case(
+        "solve task long radius",
+        on("solve", "t.yaml", TASK.replace("radius: 0.2", "radius: " + "9" * 5000)),
+        "t.yaml",
+    ),
+    Case(
+        "solve rapt huge point",
+        on(
+            "solve",
+            "t.rapt",
+            RAPT.replace(
+                "point (0, 0, 0) normal (0, 0, -1)", f"point (0, 0, {10**400}) normal (0, 0, -1)"
+            ),
+        ),
+        "t.rapt",
+    ),
+    Case(
+        "solve rapt long point",
+        on(
+            "solve",
+            "t.rapt",
+            RAPT.replace(
+                "point (0, 0, 0) normal (0, 0, -1)",
+                "point (0, 0, " + "9" * 5000 + ") normal (0, 0, -1)",
+            ),
+        ),
+        "line 6",
+    ),
+    Case(
+        "plan manifest huge pose",
+        on_assembly("plan", text=manifest(f"{{translation: [0, 0, {10**400}]}}")),
+        "asm.yaml",
+    ),
+    Case(
+        "contacts json long number",
+        on("contacts", "c.json", '{"a": ' + "9" * 5000 + "}"),
+        "c.json",
+    ),
+    *(
+        Case(
+            f"batch timeout {value}",
+            lambda folder, value=value: ["batch", str(write_assembly(folder)), "--timeout", value],
+            "--timeout",
+        )
+        for value in ("0", "-1", "nan", "inf")
+    ),
     # COMPAS documents
     Case(
         "contacts compas no graph", on("contacts", "c.json", json.dumps(COMPAS_ASSEMBLY)), "c.json"

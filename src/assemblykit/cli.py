@@ -94,6 +94,8 @@ class _OptionRange(click.FloatRange):
         number = super().convert(value, param, ctx)
         if number != number:  # NaN passes every range comparison
             self.fail(f"{value!r} is not a number", param, ctx)
+        if abs(number) == float("inf"):
+            self.fail(f"{value!r} is not a finite number", param, ctx)
         return number
 
 
@@ -662,7 +664,12 @@ def demo_cmd(out: str, as_json: bool, tolerance: float | None, debug: bool) -> N
     default="plan",
     help="plan or motion.",
 )
-@click.option("--timeout", type=float, default=None, help="Seconds allowed per assembly.")
+@click.option(
+    "--timeout",
+    type=_OptionRange(min=0.0, min_open=True),
+    default=None,
+    help="Seconds allowed per assembly (more than 0).",
+)
 @click.option("--workers", type=click.IntRange(min=1), default=2, help="Assemblies run at once.")
 @json_option
 @tolerance_option

@@ -15,6 +15,8 @@ nest deeper than :data:`MAX_DEPTH` or, through YAML aliases, expand to more than
 from __future__ import annotations
 
 import json
+import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +33,13 @@ here (a 4x4 pose in a part of a manifest) nests 5 levels; recursive code downstr
 MAX_NODES = 1_000_000
 """Most values a document may hold once its YAML aliases are expanded: ten times the
 largest bundled example, and small enough to count in well under a second."""
+
+FLOAT_MAX = sys.float_info.max
+"""The largest number a document may hold: every number is computed with as a float."""
+
+FLOAT_DIGITS = len(str(int(FLOAT_MAX)))
+"""Digits of the integer part of :data:`FLOAT_MAX` (309): a number written with more is
+beyond it, told before Python converts it (which it refuses beyond 4,300 digits)."""
 
 _ALIAS_LIMITS = yaml_rs.AliasLimits(
     max_total_replayed_events=MAX_NODES, max_replay_stack_depth=MAX_DEPTH
@@ -86,8 +95,9 @@ def read_text(path: str | Path, what: str = "file") -> str:
 
 
 def checked_shape(data: Any, source: str | None = None) -> Any:
-    """``data`` when it nests at most :data:`MAX_DEPTH` levels and holds at most
-    :data:`MAX_NODES` values counting every alias again; else :class:`SchemaError`.
+    """``data`` when it nests at most :data:`MAX_DEPTH` levels, holds at most
+    :data:`MAX_NODES` values counting every alias again and no integer beyond the range
+    of a float (every number is computed with as one); else :class:`SchemaError`.
 
     The walk uses its own stack (no recursion) and stops at the first limit exceeded, so
     an alias bomb costs at most :data:`MAX_NODES` steps."""
@@ -99,6 +109,13 @@ def checked_shape(data: Any, source: str | None = None) -> Any:
         if count > MAX_NODES:
             raise SchemaError(
                 f"document expands to more than {MAX_NODES} values (YAML aliases?)",
+                source=source,
+            )
+        if isinstance(value, int) and not isinstance(value, bool) and abs(value) > FLOAT_MAX:
+            digits = int(value.bit_length() * math.log10(2)) + 1
+            raise SchemaError(
+                f"a number of about {digits} digits is beyond the range of a float "
+                f"({FLOAT_MAX:.4g})",
                 source=source,
             )
         if isinstance(value, dict | list):
@@ -168,3 +185,5 @@ def read_json(text: str, source: str | None = None) -> Any:
             source=source,
             where=f"line {error.lineno}, column {error.colno}",
         ) from None
+    except ValueError as error:  # an integer of more digits than Python converts
+        raise SchemaError(f"a number too long to read: {error}", source=source) from None

@@ -31,7 +31,7 @@ def _points(value: object) -> NDArray[np.float64]:
         return np.zeros(0)
     try:
         return np.asarray(value, dtype=np.float64)
-    except ValueError:  # ragged rows
+    except (ValueError, OverflowError):  # ragged rows, an integer beyond a float
         return np.zeros(0)
 
 
@@ -43,6 +43,8 @@ def load_polygons(path: str | Path) -> PolygonAssembly:
         raise SchemaError(
             "expected a mapping 'parts: {name: [[x, y], ...]}'", source=str(path), where="parts"
         )
+    if not data["parts"]:
+        raise SchemaError("expected at least one polygon", source=str(path), where="parts")
     polygons = {}
     for name, pts in data["parts"].items():
         arr = _points(pts)

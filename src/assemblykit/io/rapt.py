@@ -27,6 +27,7 @@ from lark.exceptions import (
 )
 
 from assemblykit.errors import SchemaError, TaskSyntaxError
+from assemblykit.io.documents import FLOAT_DIGITS, FLOAT_MAX
 from assemblykit.io.spec import parse_task, task_to_dict
 from assemblykit.model.task import ActionKind, Task
 
@@ -203,7 +204,15 @@ class _Builder(Transformer[Token, tuple[dict[str, Any], dict[str, str]]]):
 
     def number(self, token: Token, unit: Token | None = None) -> int | float:
         text = str(token)
+        where = f"line {token.line}, column {token.column}"
+        digits = len(text.lstrip("+-").split(".")[0].split("e")[0].split("E")[0])
+        if digits > FLOAT_DIGITS:
+            raise SchemaError(
+                f"a number of {digits} digits is beyond the range of a float", where=where
+            )
         value: int | float = float(text) if any(c in text for c in ".eE") else int(text)
+        if not math.isfinite(value) or abs(value) > FLOAT_MAX:
+            raise SchemaError(f"{text[:40]} is beyond the range of a float", where=where)
         if unit is not None:
             value = math.radians(value) if unit == "deg" else float(value)
         return value
