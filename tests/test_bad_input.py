@@ -373,6 +373,20 @@ CASES: list[Case] = [
         "parts.b",
     ),
     Case("blocking polygons none", on("blocking", "g.yaml", "parts: {}\n"), "g.yaml"),
+    Case(
+        "solve relation option number",
+        on(
+            "solve",
+            "t.yaml",
+            TASK.replace(
+                "[against, block.bottom, table.top]", "[against, block.bottom, table.top, {5: 1}]"
+            ),
+        ),
+        "no option 5",
+    ),
+    # usage errors are one line too, naming the help to read
+    Case("plan unknown option", on_assembly("plan", "--nosuch"), "'assemblykit plan --help'"),
+    Case("no such command", lambda folder: ["nosuch"], "'assemblykit --help'"),
     # integers beyond a float, and beyond what Python converts (4,300 digits)
     Case(
         "blocking polygon huge",

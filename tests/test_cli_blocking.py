@@ -57,8 +57,9 @@ def test_bad_input_is_one_line_exit_2(tmp_path, capsys):
     assert code == 2
     assert err.count("\n") == 1 and "bad.yaml" in err
     code, _, err = run(["blocking", str(path), "--motion", "sideways"], capsys)
-    # a usage error: the usage, then what was wrong with which option
-    assert code == 2 and err.startswith("Usage: assemblykit blocking") and "'--motion'" in err
+    # a usage error: one line, what was wrong with which option and the help to read
+    assert code == 2 and err.count("\n") == 1 and "'--motion'" in err
+    assert err.startswith("assemblykit: ") and "'assemblykit blocking --help'" in err
 
 
 def test_extended_on_the_compas_stack(capsys):

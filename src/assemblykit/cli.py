@@ -210,7 +210,8 @@ def _direction_values(args: list[str]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the console script: maps errors to one line and an exit code
-    (usage errors print the usage and exit 2, like bad input; Ctrl-C prints
+    (a usage error is one line naming the help to read and exits 2, like bad input;
+    Ctrl-C prints
     "assemblykit: interrupted" and exits ``INTERRUPTED``). Without ``--debug``,
     RuntimeWarnings are not shown."""
     args = _direction_values(sys.argv[1:] if argv is None else argv)
@@ -225,8 +226,10 @@ def main(argv: list[str] | None = None) -> None:
     except click.exceptions.Exit as done:
         raise SystemExit(done.exit_code) from None
     except click.UsageError as usage:
-        usage.show()
-        raise SystemExit(2) from None
+        if debug:
+            raise
+        path = usage.ctx.command_path if usage.ctx is not None else "assemblykit"
+        _fail(f"{usage.format_message()} (see '{path} --help')", 2)
     except click.ClickException as bad:
         if debug:
             raise

@@ -190,7 +190,7 @@ class RelationType(ABC):
     def values(self, options: Mapping[str, Any], where: str | None = None) -> dict[str, float]:
         """Validated option values (``offset`` 0 unless given): unknown or missing names
         and non-numbers are schema errors; ``angle`` accepts ``"30 deg"``."""
-        if unknown := sorted(set(options) - self.options):
+        if unknown := sorted(map(str, set(options) - self.options)):
             allowed = ", ".join(sorted(self.options)) or "none"
             raise SchemaError(
                 f"{self.kind} has no option {', '.join(unknown)} (allowed: {allowed})", where=where
