@@ -133,6 +133,13 @@ def on(command: str, name: str, content: str | bytes, *extra: str) -> Callable[[
     return lambda folder: [command, str(make(folder)), *extra]
 
 
+def _loop(folder: Path, command: str) -> list[str]:
+    """``command --out`` into a folder behind two symbolic links naming each other."""
+    (folder / "one").symlink_to(folder / "two")
+    (folder / "two").symlink_to(folder / "one")
+    return [command, "--out", str(folder / "one" / "report")]
+
+
 def on_assembly(
     command: str, *extra: str, b_obj: str | None = None, text: str | None = None
 ) -> Callable[[Path], list[str]]:
@@ -384,6 +391,7 @@ CASES: list[Case] = [
         ),
         "no option 5",
     ),
+    Case("demo out in a symbolic link loop", lambda folder: _loop(folder, "demo"), "--out"),
     # usage errors are one line too, naming the help to read
     Case("plan unknown option", on_assembly("plan", "--nosuch"), "'assemblykit plan --help'"),
     Case("no such command", lambda folder: ["nosuch"], "'assemblykit --help'"),

@@ -222,6 +222,12 @@ def test_bad_engine_is_an_input_error(tmp_path):
         run_batch([str(DEMO)], tmp_path / "r.jsonl", engine="spark")  # type: ignore[arg-type]
 
 
+def test_a_scheduler_address_that_is_none_is_an_input_error(tmp_path):
+    pytest.importorskip("dask.distributed")
+    with pytest.raises(InputError, match=r"notanaddress.*--scheduler.*no Dask scheduler"):
+        run_batch([str(DEMO)], tmp_path / "r.jsonl", engine="dask", scheduler="notanaddress")
+
+
 @pytest.mark.slow
 def test_local_and_dask_engines_agree(tmp_path):
     pytest.importorskip("dask.distributed")

@@ -340,6 +340,10 @@ def _local(jobs: Sequence[Job], workers: int) -> Iterator[Iterator[dict[str, Any
             pool.shutdown(cancel_futures=True)
 
 
+SCHEDULER_TIMEOUT = 10
+"""Seconds to wait for a remote Dask scheduler to answer before saying it is not there."""
+
+
 @contextlib.contextmanager
 def _dask(
     jobs: Sequence[Job], workers: int, scheduler: str | None
@@ -358,7 +362,14 @@ def _dask(
         client = Client(cluster)
     else:
         cluster = None
-        client = Client(scheduler)
+        try:
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
+        except (OSError, ValueError, TypeError) as error:  # unreachable, or no address
+            raise InputError(
+                f"no Dask scheduler there ({' '.join(str(error).split()) or type(error).__name__})",
+                source=scheduler,
+                where="--scheduler",
+            ) from None
     try:
         yield _answers(dask_completed([client.submit(run_job, j, pure=False) for j in jobs]))
     finally:

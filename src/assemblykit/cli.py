@@ -637,8 +637,15 @@ def demo_cmd(out: str, as_json: bool, tolerance: float | None, debug: bool) -> N
         raise InputError(
             "is a file; --out names the folder of the report", source=out, where="--out"
         )
-    if folder.is_dir():
-        checked_output(folder / REPORT_NAME, "--out")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise InputError(
+            f"cannot make the folder ({error.strerror or type(error).__name__})",
+            source=out,
+            where="--out",
+        ) from None
+    checked_output(folder / REPORT_NAME, "--out")
     with _progress_bar() as bar:
         result = run_demo(out, tol=tolerance_from(tolerance), progress=_updater(bar))
     if as_json:
