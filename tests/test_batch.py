@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from assemblykit import batch
 from assemblykit.batch import finished_inputs, run_batch
 from assemblykit.errors import InputError
 from datasets import dataset
@@ -241,3 +242,24 @@ def test_local_and_dask_engines_agree(tmp_path):
         assert by_local[name]["status"] == by_dask[name]["status"] == "ok"
         assert by_local[name]["result"] == by_dask[name]["result"]
     assert run_batch(inputs, dask, engine="dask", workers=2).skipped == len(inputs)
+
+
+def test_a_fault_of_assemblykit_is_recorded_as_one_not_as_bad_input(tmp_path, monkeypatch, capsys):
+    # bad input: the loader's message, as the command prints it
+    assert batch._child(["plan", str(tmp_path / "none.yaml")]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["status"] == "error" and "none.yaml" in record["error"]
+    assert "internal" not in record
+
+    # a fault of the computation: said to be one
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("division by zero")
+
+    monkeypatch.setattr(batch, "compute", broken)
+    assert batch._child(["plan", str(DEMO)]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record == {
+        "status": "error",
+        "error": "internal error: ZeroDivisionError: division by zero",
+        "internal": True,
+    }

@@ -11,7 +11,9 @@ The output is JSON Lines, one line per assembly, appended as soon as it is known
 ``input`` (as given), ``status`` (``ok``, ``error`` or ``timeout``), ``result`` (the
 command's JSON) or ``error`` (one line), ``seconds``, and what identifies the work done:
 ``command``, ``path`` (absolute) and ``sha256`` (of the file, or of every file in a
-folder). A line is written whole, by one write followed by ``fsync``, so a run that is
+folder). An error that is a fault of assemblykit rather than of the input (the command
+would exit 1) says ``internal error: ...`` and carries ``"internal": true``. A line is
+written whole, by one write followed by ``fsync``, so a run that is
 killed leaves at most its last line cut short; the next run drops that line (saying so)
 before appending.
 
@@ -473,10 +475,16 @@ def _child(argv: Sequence[str]) -> int:
             "status": "ok",
             "result": compute(command, path, rel_tolerance),  # type: ignore[arg-type]
         }
-    except AssemblyKitError as failure:
-        outcome = {"status": "error", "error": str(failure)}
+    except (InputError, MissingExtraError) as bad:
+        outcome = {"status": "error", "error": str(bad)}
+    except AssemblyKitError as failure:  # a fault of the computation, not of the input
+        outcome = {"status": "error", "error": f"internal error: {failure}", "internal": True}
     except Exception as bug:  # recorded, never fatal to the batch
-        outcome = {"status": "error", "error": f"{type(bug).__name__}: {bug}"}
+        outcome = {
+            "status": "error",
+            "error": f"internal error: {type(bug).__name__}: {bug}",
+            "internal": True,
+        }
     except KeyboardInterrupt:  # Ctrl-C reaches the whole process group; the batch stops
         return INTERRUPTED_CODES[0]
     sys.stdout.write(json.dumps(outcome) + "\n")
