@@ -121,6 +121,11 @@ as_written_option = click.option(
     is_flag=True,
     help="Keep rounded mesh-folder poses as written (do not settle thin overlaps).",
 )
+partial_option = click.option(
+    "--partial",
+    is_flag=True,
+    help="Work on the parts of a damaged STEP file that could be read (they are listed).",
+)
 assembly_argument = click.argument("assembly", metavar="ASSEMBLY")
 ASSEMBLY_HELP = "ASSEMBLY: mesh folder, .yaml manifest, .step or COMPAS .json."
 
@@ -138,25 +143,35 @@ def tolerance_from(option: float | None, angle: float | None = None) -> Toleranc
     return Tolerance.relative(option, angle)
 
 
-def loaded_assembly(path: str, tol: Tolerance, as_written: bool) -> Assembly:
+def loaded_assembly(path: str, tol: Tolerance, as_written: bool, partial: bool = False) -> Assembly:
     """The assembly at ``path`` with the command line's tolerance, settled unless
-    ``--as-written``; what the loader skipped is said on stderr."""
+    ``--as-written``; what the loader skipped is said on stderr. A file damaged where
+    solids should be (:attr:`Skipped.unreadable`) is bad input unless ``--partial``."""
     from assemblykit.io.assembly import load_assembly
 
     loaded = load_assembly(path, tol, settle=not as_written)
+    damaged = [item for item in loaded.skipped if item.unreadable]
+    if damaged and not partial:
+        first = damaged[0]
+        raise InputError(
+            f"damaged: {first.item}: {first.reason}"
+            + (f" (and {len(damaged) - 1} more)" if len(damaged) > 1 else "")
+            + f"; --partial works on the {len(loaded.parts)} parts read",
+            source=path,
+        )
     for item in loaded.skipped:
         note(f"{path}: skipped {item.item}: {item.reason}")
     return loaded
 
 
-def assembly_or_polygons(path: str, tol: Tolerance, as_written: bool) -> Any:
+def assembly_or_polygons(path: str, tol: Tolerance, as_written: bool, partial: bool = False) -> Any:
     """A YAML file of 2D polygons (``parts: {name: [[x, y], ...]}``) as a polygon
     assembly, anything else as :func:`loaded_assembly`."""
     from assemblykit.io.polygons import is_polygon_file, load_polygons
 
     if is_polygon_file(path):
         return load_polygons(path)
-    return loaded_assembly(path, tol, as_written)
+    return loaded_assembly(path, tol, as_written, partial)
 
 
 def emit(result: Result, as_json: bool, rounding: Tolerance | None = None) -> None:
@@ -335,14 +350,16 @@ def _updater(bar: Any) -> Callable[[str, int, int], None]:
     return update
 
 
-def _plan_input(path: str, tol: Tolerance, as_written: bool, problem: int, solution: int) -> Any:
+def _plan_input(
+    path: str, tol: Tolerance, as_written: bool, problem: int, solution: int, partial: bool
+) -> Any:
     """What ``plan`` reads: a BurrTools puzzle placed as ``solution`` of ``problem``, or
     :func:`assembly_or_polygons`."""
     if path.lower().endswith(".xmpuzzle"):
         from assemblykit.io.burrtools import load_burrtools
 
         return load_burrtools(path, tol, problem, solution)
-    return assembly_or_polygons(path, tol, as_written)
+    return assembly_or_polygons(path, tol, as_written, partial)
 
 
 def _multi_move_plan(
@@ -497,6 +514,7 @@ def _gravity(
 @json_option
 @tolerance_option
 @as_written_option
+@partial_option
 @debug_option
 def plan_cmd(
     assembly: str,
@@ -523,6 +541,7 @@ def plan_cmd(
     as_json: bool,
     tolerance: float | None,
     as_written: bool,
+    partial: bool,
     debug: bool,
 ) -> None:
     """Disassembly (and assembly) sequence by extended translations (Wilson & Latombe
@@ -556,7 +575,7 @@ def plan_cmd(
     tol = tolerance_from(tolerance)
     with _progress_bar() as bar:
         update = _updater(bar)
-        loaded = _plan_input(assembly, tol, as_written, problem, solution)
+        loaded = _plan_input(assembly, tol, as_written, problem, solution, partial)
         from assemblykit.io.burrtools import VoxelAssembly
         from assemblykit.model.assembly import Assembly
 
@@ -765,6 +784,7 @@ def _task_motion(path: str, tol: Tolerance, as_json: bool) -> None:
 @tolerance_option
 @angle_tolerance_option
 @as_written_option
+@partial_option
 @debug_option
 def motion_cmd(
     assembly: str,
@@ -774,6 +794,7 @@ def motion_cmd(
     tolerance: float | None,
     angle_tolerance: float | None,
     as_written: bool,
+    partial: bool,
     debug: bool,
 ) -> None:
     """Motion of each part and subassembly relative to the rest, gear trains (Liu 1997);
@@ -792,7 +813,7 @@ def motion_cmd(
             raise InputError("--subassembly and --html apply to assemblies, not tasks")
         _task_motion(assembly, tol, as_json)
         return
-    loaded = loaded_assembly(assembly, tol, as_written)
+    loaded = loaded_assembly(assembly, tol, as_written, partial)
     sets = [
         loaded.groups.get(spec.strip()) or [n.strip() for n in spec.split(",") if n.strip()]
         for spec in subassembly
@@ -813,6 +834,7 @@ def motion_cmd(
 @json_option
 @tolerance_option
 @as_written_option
+@partial_option
 @debug_option
 def contacts_cmd(
     assembly: str,
@@ -820,6 +842,7 @@ def contacts_cmd(
     as_json: bool,
     tolerance: float | None,
     as_written: bool,
+    partial: bool,
     debug: bool,
 ) -> None:
     """Parts, contact patches (areas, normals), surface features and interferences.
@@ -831,7 +854,7 @@ def contacts_cmd(
     if png is not None:
         checked_output(png, "--png", PNG_SUFFIXES)
     tol = tolerance_from(tolerance)
-    result = contact_report(loaded_assembly(assembly, tol, as_written), tol)
+    result = contact_report(loaded_assembly(assembly, tol, as_written, partial), tol)
     if png is not None:
         from assemblykit.viz.plots import plot_contacts
 
@@ -854,6 +877,7 @@ BLOCKING_MOTIONS = ("infinitesimal", "extended", "rigid")
 @json_option
 @tolerance_option
 @as_written_option
+@partial_option
 @debug_option
 def blocking_cmd(
     assembly: str,
@@ -862,6 +886,7 @@ def blocking_cmd(
     as_json: bool,
     tolerance: float | None,
     as_written: bool,
+    partial: bool,
     debug: bool,
 ) -> None:
     """Non-directional blocking graph: regions of directions, removable subassemblies.
@@ -877,7 +902,7 @@ def blocking_cmd(
             raise InputError("--png draws the direction sphere: not for --motion rigid")
         checked_output(png, "--png", PNG_SUFFIXES)
     tol = tolerance_from(tolerance)
-    model = assembly_or_polygons(assembly, tol, as_written)
+    model = assembly_or_polygons(assembly, tol, as_written, partial)
     result = blocking_graph(model, motion, tol=tol)
     if png is not None and isinstance(result, NonDirectionalBlockingGraph):
         from assemblykit.viz.plots import plot_ndbg

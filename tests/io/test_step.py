@@ -126,7 +126,7 @@ def test_a_damaged_solid_is_listed_as_skipped(damaged_step):
     assert all("\x1b" not in w for w in asm.warnings)
 
 
-def test_a_damaged_step_still_gives_json_that_parses_and_says_what_was_skipped(damaged_step):
+def test_a_damaged_step_is_refused_and_with_partial_gives_what_was_read(damaged_step):
     import json
     import subprocess
     import sys
@@ -135,8 +135,16 @@ def test_a_damaged_step_still_gives_json_that_parses_and_says_what_was_skipped(d
     # a child process: OCP writes on the process's descriptor 1, which only a real
     # stdout shows
     entry = "from assemblykit.cli import main; main()"
-    done = subprocess.run(
+    refused = subprocess.run(
         [sys.executable, "-c", entry, "contacts", str(path), "--json"],
+        capture_output=True,
+        text=True,
+    )
+    assert refused.returncode == 2 and refused.stdout == ""
+    (line,) = refused.stderr.strip().splitlines()
+    assert str(path) in line and f"{label} MANIFOLD_SOLID_BREP" in line and "--partial" in line
+    done = subprocess.run(
+        [sys.executable, "-c", entry, "contacts", str(path), "--json", "--partial"],
         capture_output=True,
         text=True,
         check=True,

@@ -680,13 +680,16 @@ def _skipped_solids(
         for (label, kind, name), entity in zip(declared, entities, strict=True):
             if not _readable(entity):
                 item = f"{label} {kind}" + (f" '{name}'" if name else "")
-                skipped.append(Skipped(item, "its shell could not be read; the solid is left out"))
+                skipped.append(
+                    Skipped(item, "its shell could not be read; the solid is left out", True)
+                )
     missing = len(declared) - transferred
     if missing > len(skipped):
         skipped.append(
             Skipped(
                 f"{missing - len(skipped)} of {len(declared)} declared solids",
                 "not transferred by the STEP reader; they are left out",
+                True,
             )
         )
     return skipped

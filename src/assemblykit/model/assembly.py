@@ -48,11 +48,15 @@ class Derived(Protocol):
 @dataclass(frozen=True)
 class Skipped:
     """An item of the input the loader could not use: ``item`` names it (e.g. a STEP
-    entity ``#386 MANIFOLD_SOLID_BREP``) and ``reason`` says why. Answers about the
-    assembly list these, so that a dropped part is never silent."""
+    entity ``#386 MANIFOLD_SOLID_BREP``) and ``reason`` says why; ``unreadable`` when the
+    file itself is damaged there (a misspelled entity, a shell with no faces), where
+    the command line refuses the file unless ``--partial`` (a solid read but not meshed
+    is not). Answers about the assembly list these, so that a dropped part is never
+    silent."""
 
     item: str
     reason: str
+    unreadable: bool = False
 
     def to_dict(self) -> dict[str, str]:
         """JSON form: ``item`` and ``reason``."""
