@@ -381,6 +381,11 @@ CASES: list[Case] = [
     ),
     Case("blocking polygons none", on("blocking", "g.yaml", "parts: {}\n"), "g.yaml"),
     Case(
+        "plan polygon far",
+        on("plan", "g.yaml", POLYGONS.replace("[2, 2]", "[2, 1.0e300]")),
+        "coordinates beyond",
+    ),
+    Case(
         "solve relation option number",
         on(
             "solve",

@@ -37,6 +37,11 @@ largest bundled example, and small enough to count in well under a second."""
 FLOAT_MAX = sys.float_info.max
 """The largest number a document may hold: every number is computed with as a float."""
 
+MAX_COORDINATE = 1e10
+"""Largest coordinate of a mesh vertex or polygon point accepted: trimesh merges vertices
+by hashing coordinates scaled by 1e8 as 64-bit integers (at most 9.2e18), which
+overflows beyond about 9e10, and a model's size sets every tolerance."""
+
 FLOAT_DIGITS = len(str(int(FLOAT_MAX)))
 """Digits of the integer part of :data:`FLOAT_MAX` (309): a number written with more is
 beyond it, told before Python converts it (which it refuses beyond 4,300 digits)."""

@@ -45,16 +45,15 @@ from assemblykit.geometry.contacts import candidate_pairs
 from assemblykit.geometry.precision import combined, coordinate_precision, pose_precision
 from assemblykit.geometry.settling import settle as settle_parts
 from assemblykit.geometry.solids import placed
-from assemblykit.io.documents import read_json, read_text, read_yaml
+from assemblykit.io.documents import MAX_COORDINATE, read_json, read_text, read_yaml
 from assemblykit.model.assembly import Assembly, Part, Precision
 from assemblykit.tolerance import Tolerance, current
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".glb")
 DEFAULT_UNITS = "mm"
 
-MAX_MESH_COORDINATE = 1e10
-"""Largest mesh coordinate accepted: trimesh merges vertices by hashing coordinates scaled
-by 1e8 as 64-bit integers (at most 9.2e18), which overflows beyond about 9e10."""
+MAX_MESH_COORDINATE = MAX_COORDINATE
+"""Largest mesh coordinate accepted (:data:`~assemblykit.io.documents.MAX_COORDINATE`)."""
 
 
 def read_mesh(path: str | Path, notes: list[str] | None = None) -> trimesh.Trimesh:

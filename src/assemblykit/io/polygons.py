@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from assemblykit.blocking.polygons import PolygonAssembly, counter_clockwise
 from assemblykit.errors import InputError, SchemaError
-from assemblykit.io.documents import read_text, read_yaml
+from assemblykit.io.documents import MAX_COORDINATE, read_text, read_yaml
 
 
 def _points(value: object) -> NDArray[np.float64]:
@@ -51,6 +51,12 @@ def load_polygons(path: str | Path) -> PolygonAssembly:
         if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3 or not np.isfinite(arr).all():
             raise SchemaError(
                 "a polygon is a list of at least three [x, y] points of finite numbers",
+                source=str(path),
+                where=f"parts.{name}",
+            )
+        if np.abs(arr).max() > MAX_COORDINATE:
+            raise SchemaError(
+                f"coordinates beyond {MAX_COORDINATE:g}",
                 source=str(path),
                 where=f"parts.{name}",
             )
