@@ -128,7 +128,11 @@ class Sweep:
             self.hull = manifold3d.Manifold.hull_points(np.vstack([vertices, vertices + shift]))
             return
         self.ends = [solid(mesh), solid(mesh).translate(tuple(shift))]
-        triangles = vertices[np.asarray(mesh.faces)[np.asarray(mesh.face_normals) @ shift > 0]]
+        # the prisms with a volume (a sliver's is none: the two ends cover it, and a
+        # flat hull is no solid for manifold3d to intersect)
+        volume = np.asarray(mesh.area_faces) * (np.asarray(mesh.face_normals) @ shift)
+        length = float(np.linalg.norm(shift))
+        triangles = vertices[np.asarray(mesh.faces)[volume > 1e-12 * length * mesh.scale**2]]
         self.triangles = triangles
         self.low = np.minimum(triangles.min(axis=1), (triangles + shift).min(axis=1))
         self.high = np.maximum(triangles.max(axis=1), (triangles + shift).max(axis=1))
