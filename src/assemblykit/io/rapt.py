@@ -205,7 +205,7 @@ class _Builder(Transformer[Token, tuple[dict[str, Any], dict[str, str]]]):
     def number(self, token: Token, unit: Token | None = None) -> int | float:
         text = str(token)
         where = f"line {token.line}, column {token.column}"
-        digits = len(text.lstrip("+-").split(".")[0].split("e")[0].split("E")[0])
+        digits = len(text.lstrip("+-").partition(".")[0].lower().partition("e")[0])
         if digits > FLOAT_DIGITS:
             raise SchemaError(
                 f"a number of {digits} digits is beyond the range of a float", where=where
