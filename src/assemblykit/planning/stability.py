@@ -417,7 +417,7 @@ def _balances(matrix: sp.csc_matrix, rhs: NDArray[np.float64], forces: NDArray[n
 def _proves_none(matrix: sp.csc_matrix, rhs: NDArray[np.float64], ray: NDArray[np.float64]) -> bool:
     """Whether ``ray`` is a Farkas certificate that ``matrix @ x = rhs`` has no
     ``x >= 0``: ``rhs @ ray < 0`` while no column loses by it (``matrix.T @ ray >= 0``, to
-    :data:`LP_FEASIBILITY` of ``rhs @ ray``), as :meth:`EquilibriumModel._certifies`
+    :data:`LP_FEASIBILITY` of ``rhs @ ray``), as :meth:`EquilibriumModel._first_certifying`
     reads a kept one: an answer the solver calls almost infeasible, checked."""
     share = float(rhs @ ray)
     return share < 0 and bool((matrix.T @ ray).min(initial=0.0) >= LP_FEASIBILITY * share)
@@ -689,28 +689,26 @@ class EquilibriumModel:
         error = np.abs(-self.load - wrench).reshape(-1, 6).max(axis=1)
         return free & (error > LP_FEASIBILITY)
 
-    def _certifies(
-        self,
-        certificate: NDArray[np.float64],
-        free: NDArray[np.bool_],
-        selected: NDArray[np.bool_],
-        mu: float,
-    ) -> bool:
-        """Whether ``certificate`` (its ``y``), restricted to the equations
-        of the ``free`` parts, proves that they have no balance over the ``selected``
-        points at ``mu``: no generator gains from it (``matrix.T @ y >= 0``, to
-        :data:`LP_FEASIBILITY` of the loads' share) while the loads do (``rhs @ y <
-        0``). A part removed takes its generators away and a part held its equations:
-        either can spoil it, which the test sees."""
-        y = certificate * np.repeat(free, 6)
-        share = float(-self.load @ y)
-        if share >= 0:
-            return False
+    def _first_certifying(
+        self, free: NDArray[np.bool_], selected: NDArray[np.bool_], mu: float
+    ) -> int | None:
+        """The index of the first certificate kept (its ``y``) that, restricted to the
+        equations of the ``free`` parts, proves that they have no balance over the
+        ``selected`` points at ``mu`` (``None`` when none does): no generator gains
+        from it (``matrix.T @ y >= 0``, to :data:`LP_FEASIBILITY` of the loads' share)
+        while the loads do (``rhs @ y < 0``). A part removed takes its generators away
+        and a part held its equations: either can spoil one, which the test sees. Every
+        certificate is tested in one product with each matrix."""
+        if not self._certificates:
+            return None
+        kept = np.stack(self._certificates, axis=1) * np.repeat(free, 6)[:, None]
+        shares = -self.load @ kept
+        generators = np.repeat(selected, CONE_SIDES)
         normal, tangent = self._transposed
-        gain = normal @ y + mu * (tangent @ y)
-        return bool(
-            gain[np.repeat(selected, CONE_SIDES)].min(initial=0.0) >= LP_FEASIBILITY * share
-        )
+        gains = normal[generators] @ kept + mu * (tangent[generators] @ kept)
+        worst = gains.min(axis=0, initial=0.0)
+        proven = (shares < 0) & (worst >= LP_FEASIBILITY * shares)
+        return int(np.argmax(proven)) if proven.any() else None
 
     def _local_verdict(
         self,
@@ -725,7 +723,7 @@ class EquilibriumModel:
         * *stands* when a balance kept, without the forces on parts absent from this
           state, still balances every free part with forces that ``mu``'s pyramids
           hold (a balance at one friction coefficient is one at every larger one);
-        * *falls* when a certificate kept still proves it (:meth:`_certifies`), or when
+        * *falls* when a certificate kept still proves it (:meth:`_first_certifying`), or when
           the parts the last balance leaves unbalanced, or pushes on with more friction
           than ``mu`` allows, grown by contacts (:data:`LOCAL_HOPS`), cannot balance
           even with every part around them immobile (pushing on them however it must):
@@ -743,10 +741,10 @@ class EquilibriumModel:
                 del self._balances[index]
                 self._balances.insert(0, (kept, gauge * selected))
                 return True
-        for index, certificate in enumerate(self._certificates):
-            if self._certifies(certificate, free, selected, mu):
-                self._certificates.insert(0, self._certificates.pop(index))
-                return False
+        index = self._first_certifying(free, selected, mu)
+        if index is not None:
+            self._certificates.insert(0, self._certificates.pop(index))
+            return False
         if not self._balances:
             return None
         forces, gauge = self._balances[0]
