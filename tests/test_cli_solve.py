@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -158,6 +159,46 @@ def test_four_bar_is_a_one_dof_mechanism(capsys):
     assert (bodies["coupler@s1"]["dof"], bodies["coupler@s1"]["motion"]) == (1, "mechanism")
     np.testing.assert_allclose(bodies["crank@s1"]["invariants"]["point"][:2], [0, 0], atol=1e-9)
     np.testing.assert_allclose(bodies["rocker@s1"]["invariants"]["point"][:2], [40, 0], atol=1e-9)
+
+
+@needs_engine
+def test_four_bar_yaml_closes_where_it_is_drawn(capsys):
+    """The four-bar is drawn closed: every body stays at its pose as written, the crank
+    turning about A = (0, 0) and the rocker about D = (40, 0)."""
+    bodies = underconstrained_bodies("four_bar.yaml", capsys)
+    for body in bodies.values():
+        np.testing.assert_allclose(body["pose"], np.eye(4), atol=1e-9)
+    assert (bodies["coupler@s1"]["dof"], bodies["coupler@s1"]["motion"]) == (1, "mechanism")
+    np.testing.assert_allclose(bodies["crank@s1"]["invariants"]["point"][:2], [0, 0], atol=1e-9)
+    np.testing.assert_allclose(bodies["rocker@s1"]["invariants"]["point"][:2], [40, 0], atol=1e-9)
+
+
+@needs_engine
+def test_four_bar_out_of_reach_is_inconsistent_by_how_far_it_stays_open(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+):
+    """The ground pivot D and the rocker moved to x = 100: crank 10, coupler √1700 and
+    rocker 20 reach 71.23 of the 100 between the pivots, so the loop stays open by
+    100 - 10 - √1700 - 20 ≈ 28.77, reported without a numeric search."""
+    text = (EXAMPLES / "four_bar.yaml").read_text()
+    for old, new in (
+        ("pin_d: {type: shaft, point: [40, 0, 0]", "pin_d: {type: shaft, point: [100, 0, 0]"),
+        ("hole_d: {type: hole, point: [40, 0, 0]", "hole_d: {type: hole, point: [100, 0, 0]"),
+        ("pin_c:  {type: shaft, point: [40, 20, 1]", "pin_c:  {type: shaft, point: [100, 20, 1]"),
+    ):
+        assert text.count(old) == 1
+        text = text.replace(old, new)
+    path = tmp_path / "far_four_bar.yaml"
+    path.write_text(text)
+    started = time.process_time()
+    assert run(["solve", str(path), "--json"]) == 0
+    assert time.process_time() - started < 6.0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "inconsistent"
+    (conflict,) = out["conflicts"]
+    assert conflict["kind"] == "loop"
+    assert conflict["value"] == pytest.approx(100 - 10 - math.sqrt(1700) - 20, abs=1e-9)
+    assert "cannot close" in conflict["message"]
 
 
 @needs_engine

@@ -5,6 +5,7 @@ branch found is checked against its relations written out by hand in the test.""
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -20,6 +21,7 @@ from assemblykit.inference.loops import (
     circle_meets,
     circle_plane,
     circle_sphere,
+    loop_reach,
     point_loop,
 )
 from assemblykit.model.relations import Relation, relation_residual
@@ -552,3 +554,136 @@ def test_circle_gap_is_the_least_distance_found_by_brute_force(kind, seed):
         assert gap == pytest.approx(brute, abs=1e-10)
     else:  # a crossing: the samples straddle it, 2π/1e6 of the radius apart at most
         assert gap <= 1e-9
+
+
+# ------------------------------------------------------------ the reach of a planar loop
+
+
+def test_loop_reach_spans_the_distances_between_each_bodys_axes():
+    """Body 0 holds both of its joints on the z axis through the origin, body 1 holds
+    its two 3 apart, body 2 its two 4 apart: the joint between 1 and 2 would have to be 3
+    and 4 from the origin at once. The spans are (0, 3, 4): open by 4 - 3 - 0 = 1."""
+    links = [
+        Coset(SymmetryGroup.revolute((0, 0, 0), Z), np.eye(4)),
+        Coset(SymmetryGroup.revolute((3, 0, 0), Z), shift(3)),
+        Coset(SymmetryGroup.revolute((4, 0, 0), (0, 0, -1)), shift(4) @ se3.rot_x(math.pi)),
+    ]
+    reach = loop_reach(links, TOL)
+    assert reach is not None
+    assert reach.spans == pytest.approx((0.0, 3.0, 4.0), abs=1e-12)
+    assert (reach.longest, reach.gap) == (2, pytest.approx(1.0, abs=1e-12))
+    # a cylindrical joint keeps its axis too; a joint turned off the others' direction
+    # (body 2's axis tilted about x) leaves no planar polygon
+    sliding = [*links[:2], Coset(SymmetryGroup.cylindrical((4, 0, 0), Z), shift(4))]
+    assert loop_reach(sliding, TOL) is not None
+    tilted = [*links[:2], Coset(SymmetryGroup.revolute((4, 0, 0), Z), se3.rot_x(0.3))]
+    assert loop_reach(tilted, TOL) is None
+    slide = [*links[:2], Coset(SymmetryGroup.prismatic((1, 0, 0)), shift(4))]
+    assert loop_reach(slide, TOL) is None
+
+
+def planar_four_bar(pivot: float, rocker_pin: tuple[float, float] = (40.0, 20.0)):
+    """The bundled four-bar (examples/tasks/four_bar.yaml) with the ground pivot D and
+    the rocker's hole at (pivot, 0) and the rocker's pin C at ``rocker_pin``: crank A-B
+    of 10 (A = (0, 0), B = (0, 10)), coupler B-C of √1700 (C = (40, 20)), rocker D-C.
+    Links are 1 thick: crank and rocker on the ground, the coupler on the crank."""
+    r = 1.0
+    ground = body(
+        "ground",
+        fixed=True,
+        top=Plane((0, 0, 0), Z),
+        pin_a=Shaft((0, 0, 0), Z, r),
+        pin_d=Shaft((pivot, 0, 0), Z, r),
+    )
+    crank = body(
+        "crank",
+        bottom=Plane((0, 0, 0), (0, 0, -1)),
+        top=Plane((0, 0, 1), Z),
+        hole_a=Hole((0, 0, 0), Z, r),
+        pin_b=Shaft((0, 10, 1), Z, r),
+    )
+    coupler = body(
+        "coupler",
+        bottom=Plane((0, 0, 1), (0, 0, -1)),
+        hole_b=Hole((0, 10, 1), Z, r),
+        hole_c=Hole((40, 20, 1), Z, r),
+    )
+    rocker = body(
+        "rocker",
+        bottom=Plane((0, 0, 0), (0, 0, -1)),
+        hole_d=Hole((pivot, 0, 0), Z, r),
+        pin_c=Shaft((*rocker_pin, 1), Z, r),
+    )
+    return solve(
+        [ground, crank, coupler, rocker],
+        rel("against", "crank.bottom", "ground.top"),
+        rel("fits", "crank.hole_a", "ground.pin_a"),
+        rel("against", "rocker.bottom", "ground.top"),
+        rel("fits", "rocker.hole_d", "ground.pin_d"),
+        rel("against", "coupler.bottom", "crank.top"),
+        rel("fits", "coupler.hole_b", "crank.pin_b"),
+        rel("fits", "coupler.hole_c", "rocker.pin_c"),
+        explain=True,
+    )
+
+
+COUPLER = math.sqrt(40**2 + 10**2)
+
+
+def test_four_bar_out_of_reach_is_a_loop_conflict_found_at_once():
+    """Ground pivots 100 apart, crank 10, coupler √1700 ≈ 41.23 and rocker 20: the three
+    moving links stretched in one line reach 71.23 of the 100, so the loop stays open by
+    100 - 10 - √1700 - 20 ≈ 28.77 whatever the angles. That is an answer, not a search."""
+    started = time.process_time()
+    out = planar_four_bar(100.0, (100.0, 20.0))
+    assert time.process_time() - started < 6.0
+    assert out["status"] == "inconsistent"
+    (conflict,) = out["conflicts"]
+    assert conflict["kind"] == "loop"
+    assert conflict["value"] == pytest.approx(100 - 10 - COUPLER - 20, abs=1e-9)
+    assert "cannot close" in conflict["message"] and "world spans 100 " in conflict["message"]
+    assert "fits coupler.hole_c rocker.pin_c @s1" in conflict["relations"]
+    assert conflict["needed_tolerance"] is None
+    assert "residue" not in rules(out)
+
+
+def test_four_bar_with_a_rocker_too_long_names_the_rocker():
+    """The rocker's pin 120 from its pivot: more than 10 + √1700 + 40 together."""
+    out = planar_four_bar(40.0, (40.0, 120.0))
+    assert out["status"] == "inconsistent"
+    (conflict,) = out["conflicts"]
+    assert conflict["kind"] == "loop"
+    assert conflict["value"] == pytest.approx(120 - 10 - COUPLER - 40, abs=1e-9)
+    assert "rocker@s1 spans 120 " in conflict["message"]
+
+
+def test_four_bar_missing_by_a_hair_says_how_far_to_loosen():
+    """Open by 1e-6 of a model about 104 across: within 1000 times the default tolerance,
+    so the conflict says which tolerance would accept it."""
+    pivot = 10 + COUPLER + 20 + 1e-6
+    out = planar_four_bar(pivot, (pivot, 20.0))
+    (conflict,) = out["conflicts"]
+    assert conflict["kind"] == "loop"
+    assert conflict["value"] == pytest.approx(1e-6, abs=1e-9)
+    assert conflict["needed_tolerance"] is not None
+    assert 1e-9 < conflict["needed_tolerance"] < 1e-7
+
+
+def test_four_bar_within_reach_closes_on_its_joints():
+    """Ground pivots 60 apart (less than 10 + √1700 + 20): the loop closes. Checked by
+    hand on the answer: each body keeps its joints where its partners keep theirs."""
+    out = planar_four_bar(60.0, (60.0, 20.0))
+    assert out["status"] == "underconstrained" and out["conflicts"] == []
+    pose = {key: np.asarray(b["pose"]) for key, b in out["bodies"].items()}
+    a, b = np.array([0.0, 0, 0]), se3.apply(pose["crank@s1"], np.array([0.0, 10, 1]))
+    c = se3.apply(pose["rocker@s1"], np.array([60.0, 20, 1]))
+    np.testing.assert_allclose(se3.apply(pose["crank@s1"], a), a, atol=1e-6)
+    np.testing.assert_allclose(se3.apply(pose["rocker@s1"], [60.0, 0, 0]), [60, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(se3.apply(pose["coupler@s1"], np.array([0.0, 10, 1])), b, atol=1e-6)
+    np.testing.assert_allclose(se3.apply(pose["coupler@s1"], np.array([40.0, 20, 1])), c, atol=1e-6)
+    assert b[2] == pytest.approx(1.0, abs=1e-6) and c[2] == pytest.approx(1.0, abs=1e-6)
+    assert {k: out["bodies"][k]["dof"] for k in ("crank@s1", "coupler@s1", "rocker@s1")} == {
+        "crank@s1": 1,
+        "coupler@s1": 1,
+        "rocker@s1": 1,
+    }

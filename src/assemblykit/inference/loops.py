@@ -249,3 +249,63 @@ def point_loop(first: Any, second: Any, closing: Any, tol: Tolerance) -> LoopPos
         gap = 0.0 if poses else circle_gap(circle, locus)
         return LoopPoses(f"circle-{locus.kind}", poses, gap)
     return None
+
+
+_AXIAL = (Kind.REVOLUTE, Kind.CYLINDRICAL, Kind.HELICAL)
+"""Joints that keep a line of both bodies in place (their axis) and turn about it."""
+
+
+@dataclass(frozen=True)
+class Reach:
+    """The reach bound of a loop of joints with parallel axes: the span of each body of
+    the loop between its two joint axes, in loop order."""
+
+    spans: tuple[float, ...]
+
+    @property
+    def longest(self) -> int:
+        """The position in the loop of the body with the longest span."""
+        return int(np.argmax(self.spans))
+
+    @property
+    def gap(self) -> float:
+        """How far the loop stays open at best: the longest span less the sum of the others
+        (zero or negative when the loop can close). With the other bodies stretched in one
+        line, the ends of the longest span are this far from theirs."""
+        return 2 * max(self.spans) - sum(self.spans)
+
+
+def _axis_ends(link: Any) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """A point and the unit direction of a joint's axis (the group origin and ``+z``) in
+    the frame of the link's source and in that of its target. Every pose ``h·x0`` of the
+    coset carries the target's copy of the axis onto the source's (``h`` keeps the axis
+    line), so the target's copy is the source's moved by ``x0⁻¹``."""
+    point, axis = link.group.origin, link.group.axis
+    back = se3.inverse(link.rep)
+    return (point, axis), (se3.apply(back, point), back[:3, :3] @ axis)
+
+
+def loop_reach(links: list[Any], tol: Tolerance) -> Reach | None:
+    """The reach bound of a loop of revolute, cylindrical or helical joints with parallel
+    axes (ALGEBRA.md §5.2 rule 4, "R·R vs R·R with all four axes parallel (planar 4-bar
+    loop)"), a necessary condition for the loop to close.
+
+    ``links[i]`` is the coset of body ``i + 1`` relative to body ``i`` (indices modulo
+    the loop's length, the last link closing on body 0). When each body's two joint axes
+    are parallel, every turn in the loop is about that one direction, and the loop
+    projects onto the plane normal to it as a closed polygon whose sides are the
+    distances between each body's two axes (a planar four-bar: crank, coupler, rocker
+    and the ground between its pivots). A closed polygon has no side longer than the
+    others together, so a positive :attr:`Reach.gap` proves the loop cannot close.
+    Returns None when the pattern does not apply (another joint, a discrete or lattice
+    part, axes that are not parallel)."""
+    if not all(_single(link, _AXIAL) for link in links):
+        return None
+    ends = [_axis_ends(link) for link in links]
+    spans = []
+    for (p, u), (q, w) in ((ends[i - 1][1], ends[i][0]) for i in range(len(links))):
+        if np.linalg.norm(np.cross(u, w)) > tol.angle:
+            return None
+        d = q - p
+        spans.append(float(np.linalg.norm(d - np.dot(d, w) * w)))
+    return Reach(tuple(spans))

@@ -15,7 +15,9 @@ The rules, in the seed's order:
    cycle but one are chained (``Coset.product``) and intersected with the last; a result
    with fewer dof replaces it. A revolute-revolute chain closing on a revolute link (the
    planar four-bar with its crank stopped, two revolutes closing a loop) is solved in
-   closed form by circle-circle intersection (0, 1 or 2 points).
+   closed form by circle-circle intersection (0, 1 or 2 points). A cycle of joints with
+   parallel axes that no rule closes is checked against its reach: one body spanning
+   more between its axes than the others together is a conflict (the loop cannot close).
 5. **Termination**: each remaining instance gets its pose set relative to the world:
    a coset (product along a tree path from the world), a finite set, or, for what the
    rules cannot express (non-coset relations, unresolved cycles, chains that are not
@@ -58,6 +60,7 @@ from assemblykit.inference.loops import (
     circle_circle,
     circle_gap,
     foot,
+    loop_reach,
     point_loop,
     rotation_about,
 )
@@ -416,7 +419,7 @@ class Reducer:
                     )
                     if solved is not None:
                         return self._apply_point_loop(closing, way, solved, labels)
-        return False
+        return self._check_reach(cycle)
 
     def _chain(self, path: list[Node]) -> Any:
         """The product of the links along ``path`` (a Coset, or a Chain when not a coset)."""
@@ -507,6 +510,37 @@ class Reducer:
             )
         )
         self.loops.append([[(first_key, path[0], p)] for p in solved.poses])
+        return True
+
+    def _check_reach(self, cycle: list[Node]) -> bool:
+        """The reach bound of a cycle no rule closes (:func:`loop_reach`): when one body
+        spans more between its parallel joint axes than the others together, by more than
+        the length tolerance, the loop cannot close and the cycle is a ``loop`` conflict
+        whose value is by how much it stays open. True on a conflict."""
+        keys = [frozenset((cycle[i], cycle[(i + 1) % len(cycle)])) for i in range(len(cycle))]
+        reach = loop_reach(
+            [self.edges[key].oriented(node) for key, node in zip(keys, cycle, strict=True)],
+            self.tol,
+        )
+        if reach is None or reach.gap <= self.tol.length:
+            return False
+        widest = reach.longest
+        spans = ", ".join(
+            f"{instance_key(node)} {span:.6g}"
+            for node, span in zip(cycle, reach.spans, strict=True)
+        )
+        self.conflicts.append(
+            Conflict.measured(
+                tuple(dict.fromkeys(label for key in keys for label in self.edges[key].labels)),
+                "loop",
+                reach.gap,
+                "the loop cannot close (its joint axes are parallel and"
+                f" {instance_key(cycle[widest])} spans {reach.spans[widest]:.6g} between"
+                f" its joints, more than the others together by {reach.gap:.6g}; spans:"
+                f" {spans})",
+                self.tol,
+            )
+        )
         return True
 
     def run(self) -> None:
