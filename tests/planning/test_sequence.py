@@ -221,6 +221,43 @@ def test_pairs_tested_for_one_subassembly_serve_the_others():
     assert fresh.evaluated == {0}
 
 
+def test_parts_leaving_and_groups_along_directions_visited_in_turn_are_the_extended_dbgs():
+    # one search visits direction after direction, trying first the parts that blocked
+    # each part along the others: who leaves and which groups close are those of the
+    # DBG computed from scratch along each direction, for the whole gearbox and a subset
+    assembly = load_assembly(DEMO)
+    names = tuple(assembly.names)
+    tol = assembly.tolerance()
+    translations = translation_table(assembly, tol)
+    volumes = tuple(assembly.parts[n].volume for n in names)
+    extended = ExtendedDirections(assembly, translations.directions, tol)
+    rng = np.random.default_rng(11)
+    everything = (1 << len(names)) - 1
+    subset = everything & ~(1 << names.index("cover"))
+    visited = rng.permutation(len(translations.directions))[:6].tolist()
+    blocked_somewhere = False
+    for members in (everything, subset):
+        base = base_part(members, volumes)
+        chosen = tuple(n for i, n in enumerate(names) if members >> i & 1)
+        for k in visited:
+            arcs = extended_dbg(assembly, translations.directions[k], chosen, tol).arcs
+            held = {names.index(a) for a, _ in arcs}
+            leaving = mask_of(i for i in range(len(names)) if members >> i & 1 and i not in held)
+            assert extended.leaving(k, members, members) == leaving
+            blocked_somewhere |= bool(held)
+            union = DirectionTable.from_arcs(
+                translations.names,
+                translations.directions[[k]],
+                [
+                    list(translations.graph(k, members).edges)
+                    + [(names.index(a), names.index(b)) for a, b in arcs]
+                ],
+            )
+            whole = sorted(_removal(_sinks(union, 0, members), members, volumes))
+            assert _free_closures(translations, extended, k, members, base) == whole
+    assert blocked_somewhere
+
+
 def test_gearbox_plan_lifts_pins_and_cover_first():
     assembly = load_assembly(DEMO)
     result = plan(assembly)

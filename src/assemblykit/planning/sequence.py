@@ -77,6 +77,9 @@ gravity) before the search for groups stops, and the next narrower is asked (und
 gravity: the removal leaving the fewest parts falling). A large vault, where no single
 block may go, has more than ten thousand candidate directions, each with its groups to
 close under extended blocking."""
+RECENT_BLOCKERS = 4
+"""How many of the parts found last blocking a part are tried first, alone, along a new
+direction (:meth:`ExtendedDirections.leaving`)."""
 MotionKind = Literal["translation", "rigid"]
 
 
@@ -123,6 +126,8 @@ class ExtendedDirections:
         self._blocking: dict[tuple[int, int], int] = {}
         self._first: dict[tuple[int, ...], int] = {}
         self._witness: dict[tuple[int, int], int] = {}
+        self._recent: dict[int, list[int]] = {}
+        self._hinted: set[tuple[int, int]] = set()
         self._clear: dict[tuple[int, int], int] = {}
 
     def same_as(self, k: int) -> int:
@@ -170,6 +175,7 @@ class ExtendedDirections:
             for a, b in arcs:
                 key = (k, self.index[a])
                 self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
+                self._remember(key[1], self.index[b])
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
 
     def leaving(self, k: int, movers: int, among: int) -> int:
@@ -190,25 +196,82 @@ class ExtendedDirections:
                 if witness is None or not among >> witness & 1:
                     unknown.append(i)
         if unknown:
-            arcs = extended_arcs(
-                self.assembly,
-                self.directions[k],
-                [self.names[i] for i in unknown],
-                [self.names[j] for j in bits(among)],
-                self.tol,
-                first_only=True,
-            )
-            found: dict[int, int] = {}
-            for a, b in arcs:
-                i, j = self.index[a], self.index[b]
-                found[i] = min(j, found.get(i, j))
+            unknown = self._blocked_as_before(k, unknown, among)
+        if unknown:
+            found = self._first_blockers(k, unknown, bits(among))
+            self._witness.update(((k, i), j) for i, j in found.items())
             for i in unknown:
-                if i in found:
-                    self._witness[(k, i)] = found[i]
-                else:
+                if i not in found:
                     self._clear[(k, i)] = among
                     free |= 1 << i
         return free
+
+    def _first_blockers(self, k: int, movers: list[int], blockers: Iterable[int]) -> dict[int, int]:
+        """Per part of ``movers`` that some part of ``blockers`` blocks along ``k``, one
+        such blocker (the lowest index found), which is kept among the part's
+        :data:`RECENT_BLOCKERS` last ones."""
+        arcs = extended_arcs(
+            self.assembly,
+            self.directions[k],
+            [self.names[i] for i in movers],
+            [self.names[j] for j in blockers],
+            self.tol,
+            first_only=True,
+        )
+        found: dict[int, int] = {}
+        for a, b in arcs:
+            i, j = self.index[a], self.index[b]
+            found[i] = min(j, found.get(i, j))
+        for i, j in found.items():
+            self._remember(i, j)
+        return found
+
+    def _remember(self, i: int, j: int) -> None:
+        """Keep ``j`` first among the :data:`RECENT_BLOCKERS` last blockers of ``i``."""
+        recent = self._recent.setdefault(i, [])
+        if j in recent:
+            recent.remove(j)
+        recent.insert(0, j)
+        del recent[RECENT_BLOCKERS:]
+
+    def known_blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
+        """Per part of ``movers``, some of its blockers in ``among`` along ``k`` (every
+        one where it was tested along ``k``): besides those, the parts that blocked it
+        last along other directions are tested along ``k``, alone (a few projected
+        meshes). A closure under these arcs is within the closure under all of them
+        (:func:`_free_closures`)."""
+        k = self.same_as(k)
+        asked = [
+            i for i in bits(movers) if (k, i) not in self._tested and (k, i) not in self._hinted
+        ]
+        hints = sorted({j for i in asked for j in self._recent.get(i, ()) if among >> j & 1})
+        if asked and hints:
+            arcs = extended_arcs(
+                self.assembly,
+                self.directions[k],
+                [self.names[i] for i in asked],
+                [self.names[j] for j in hints],
+                self.tol,
+            )
+            for a, b in arcs:
+                key = (k, self.index[a])
+                self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
+        self._hinted.update((k, i) for i in asked)
+        return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
+
+    def _blocked_as_before(self, k: int, movers: list[int], among: int) -> list[int]:
+        """The parts of ``movers`` not shown blocked along ``k`` by a part of ``among``
+        that blocked them along another direction (:data:`RECENT_BLOCKERS` each, tested
+        alone: a few projected meshes, where the whole test projects every part near
+        the sweep). A part blocked along one direction mostly is along its neighbours by
+        the same part, as the search visits them."""
+        hinted = [i for i in movers if any(among >> j & 1 for j in self._recent.get(i, ()))]
+        if not hinted:
+            return movers
+        hints = sorted({j for i in hinted for j in self._recent[i] if among >> j & 1})
+        found = self._first_blockers(k, hinted, hints)
+        self._witness.update(((k, i), j) for i, j in found.items())
+        return [i for i in movers if i not in found]
 
     def arcs(self, k: int, members: int | None = None) -> list[tuple[int, int]]:
         """The arcs ``(i, j)``, "j blocks i", of the DBG along direction ``k`` among
@@ -607,18 +670,29 @@ def _free_closures(
     (everything its parts' blockers, and theirs, reach), and the sinks of the union are
     the least of these closures. A closure stops as soon as it reaches the base, so only
     the Γ_e blockers of parts in the sets found, and of those on the way to the base,
-    are computed. (Γ_t's arcs are Γ_e's but where a direction grazes a contact, within
-    the tolerances: there the part stays, as a single part Γ_t holds does.)"""
+    are computed. Before that, a closure under the arcs already known (and the parts
+    that blocked each part last along other directions, tested along ``k`` alone:
+    :meth:`ExtendedDirections.known_blockers`) that reaches the base rules its start
+    out: it lies within the whole closure. (Γ_t's arcs are Γ_e's but where a direction
+    grazes a contact, within the tolerances: there the part stays, as a single part Γ_t
+    holds does.)"""
     necessary = translations.masks(k)
-    closures = set()
-    for start in _sinks(translations, k, members):
+
+    def closure(start: int, blockers: Callable[[int], dict[int, int]]) -> int:
         closed = frontier = start
         while frontier and not closed >> base & 1:
             blocked = 0
-            for i, mask in extended.blockers(k, frontier, members, whole=True).items():
+            for i, mask in blockers(frontier).items():
                 blocked |= mask | necessary[i] & members
             frontier = blocked & ~closed
             closed |= frontier
+        return closed
+
+    closures = set()
+    for start in _sinks(translations, k, members):
+        if closure(start, lambda parts: extended.known_blockers(k, parts, members)) >> base & 1:
+            continue
+        closed = closure(start, lambda parts: extended.blockers(k, parts, members, whole=True))
         if not closed >> base & 1:
             closures.add(closed)
     return sorted(s for s in closures if not any(o != s and o & s == o for o in closures))
