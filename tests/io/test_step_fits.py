@@ -459,3 +459,45 @@ def test_a_trimmed_screw_keeps_its_surfaces_and_fits_its_pilot_hole(self_tapping
         "axis": [0.0, 0.0, 1.0],
         "holes": [PLATE],
     }
+
+
+@pytest.fixture(scope="module")
+def screwed_stack(tmp_path_factory) -> Read:
+    """Three 20 x 20 x 4 plates at z in [0, 4], [6, 10] and [12, 16], each with a pilot
+    hole of radius 1.45 whose seam is turned another way (so each is faceted at its own
+    angles), and a self-tapping screw of radius 1.5 from z = -2 to 16 through all three,
+    a head of radius 2.8 on the top plate up to z = 18."""
+    plates = [
+        cut(box((-10, -10, z), (20, 20, 4)), cylinder((0, 0, z - 1), 1.45, 6.0, turn=turn))
+        for z, turn in ((0.0, 0.0), (6.0, 7.0), (12.0, 19.0))
+    ]
+    screw = fuse(cylinder((0, 0, -2), 1.5, 18.0, turn=4), cylinder((0, 0, 16), 2.8, 2.0))
+    return read(tmp_path_factory.mktemp("stack") / "stack.step", *plates, screw)
+
+
+def test_a_screw_tapped_through_plates_faceted_apart_leaves_along_its_axis(screwed_stack):
+    # each plate's hole takes off the screw's thread to its own facets; the screw must
+    # be inside all of them to pass, and a fitter turns it out through all three: its
+    # shank is cut to within 1% of the holes' exact radius along its whole length
+    from assemblykit.geometry.overlaps import THREAD_CLEARANCE_SHARE, resolve_overlaps
+
+    asm = screwed_stack.assembly
+    screw = "solid4"
+    found = interferences(asm)
+    assert sorted(a if b == screw else b for a, b, _ in found) == ["solid1", "solid2", "solid3"]
+    prepared = resolve_overlaps(asm)
+    assert interferences(prepared) == []
+    shank = prepared[screw].mesh
+    radius = np.linalg.norm(shank.vertices[:, :2], axis=1)
+    below_head = shank.vertices[:, 2] < 16 - 1e-6
+    assert radius[below_head].max() <= 1.45 + 1e-9
+    assert radius[below_head].max() >= 1.45 * (1 - THREAD_CLEARANCE_SHARE) - 1e-9
+    # the head still bears on the top plate
+    assert shank.bounds[1][2] == pytest.approx(18.0) and radius.max() == pytest.approx(2.8, 1e-3)
+    found = plan(prepared, max_and_or_parts=0)
+    assert found.feasible
+    first = found.steps[0]
+    assert first.parts == (screw,) and float(first.direction @ Z) == pytest.approx(1.0)
+    assert max(sweep_overlaps(prepared, found.steps)) <= 1e-6
+    # pushed the other way the head runs into the top plate
+    assert max(sweep_overlaps(prepared, found.steps[:1], reverse=True)) > 1.0

@@ -24,6 +24,7 @@ otherwise, and :func:`resolve_overlaps` does the same, saying what it did for ea
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
 
@@ -163,10 +164,74 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part:
     shared = mesh_of(_bodies(common))
     size = float(np.linalg.norm(np.ptp(np.vstack([part.mesh.bounds, other.mesh.bounds]), axis=0)))
     axis = insertion_axis(shared)
-    cut = _bodies(mine - _extruded_shadow(shared, axis, 2 * size))
+    removed = _extruded_shadow(shared, axis, 2 * size)
+    hole = _hole_along(other, shared, axis, tol)
+    if hole is not None:
+        removed = removed + _thread_tube(hole, shared, 2 * size)
+    cut = _bodies(mine - removed)
     mesh, source = traced_mesh(cut, original_id)
     surfaces = _cut_surfaces(part, other, mesh, source, axis, tol) if part.surfaces else ()
     return replace(part, mesh=mesh, surfaces=surfaces)
+
+
+THREAD_CLEARANCE_SHARE = 0.01
+"""How far inside a threaded hole's exact cylinder, as a share of its radius, a screw
+trimmed in it is cut along its whole shank (:func:`_thread_tube`): every tessellation
+of the hole (its chords lie within the angular deflection of the cylinder, 0.5% of the
+radius at 0.2 rad, io/step.py) then lies outside the shank, so that holes of one
+radius in several plates, faceted each at its own angles, all let it through."""
+
+SEGMENTS = 256
+"""Sides of the polygons that stand for exact circles in :func:`_thread_tube` (their
+chords within 0.01% of the radius)."""
+
+
+def _hole_along(
+    other: Part, shared: trimesh.Trimesh, axis: NDArray[np.float64], tol: Tolerance
+) -> Surface | None:
+    """The hole (a cylinder of ``other`` with its material outside) along ``axis`` that
+    the volume ``shared`` with it surrounds, its inner side on the cylinder and its
+    centre of mass on the axis (within ``CUT_RADIUS_SHARE`` of the radius): a thread's
+    ring in its pilot hole (``None`` when there is none)."""
+    for surface in other.surfaces:
+        if surface.kind != "cylinder" or surface.convex or surface.axis is None:
+            continue
+        if abs(float(surface.axis @ axis)) < 1.0 - tol.mesh_angle:
+            continue
+        points = np.vstack([np.asarray(shared.vertices), shared.center_mass])
+        offset = points - surface.point
+        across = np.linalg.norm(offset - np.outer(offset @ surface.axis, surface.axis), axis=1)
+        near = CUT_RADIUS_SHARE * surface.radius
+        if abs(float(across[:-1].min()) - surface.radius) <= near and across[-1] <= near:
+            return surface
+    return None
+
+
+def _thread_tube(hole: Surface, shared: trimesh.Trimesh, length: float) -> manifold3d.Manifold:
+    """The tube about ``hole``'s axis from ``THREAD_CLEARANCE_SHARE`` inside its exact
+    radius out to as far outside the outer radius of the ring of the volume and height
+    of ``shared`` (faces that only touch leave sheets of no volume in a boolean, so
+    the volume measures it, not the vertices), ``length`` long each way: cut from a
+    screw trimmed in that hole, it leaves the shank inside every faceting of the hole
+    and of holes of the same radius on the axis, so that it leaves along it through
+    them all (the cut of the shared volume's shadow alone follows this hole's facets)."""
+    assert hole.axis is not None
+    axis = hole.axis
+    along = (np.asarray(shared.vertices) - hole.point) @ axis
+    height = max(float(np.ptp(along)), 1e-12)
+    ring = math.sqrt(abs(float(shared.volume)) / (math.pi * height) + hole.radius**2)
+    outer = ring * (1.0 + THREAD_CLEARANCE_SHARE)
+    inner = hole.radius * (1.0 - THREAD_CLEARANCE_SHARE)
+    ring = manifold3d.CrossSection.circle(outer, SEGMENTS) - manifold3d.CrossSection.circle(
+        inner, SEGMENTS
+    )
+    u = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
+    u /= np.linalg.norm(u)
+    v = np.cross(axis, u)
+    start = hole.point - length * axis
+    return manifold3d.Manifold.extrude(ring, 2 * length).transform(
+        np.column_stack([u, v, axis, start])
+    )
 
 
 CUT_RADIUS_SHARE = 0.05
