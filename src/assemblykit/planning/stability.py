@@ -741,9 +741,9 @@ class EquilibriumModel:
                 del self._balances[index]
                 self._balances.insert(0, (kept, gauge * selected))
                 return True
-        index = self._first_certifying(free, selected, mu)
-        if index is not None:
-            self._certificates.insert(0, self._certificates.pop(index))
+        proof = self._first_certifying(free, selected, mu)
+        if proof is not None:
+            self._certificates.insert(0, self._certificates.pop(proof))
             return False
         if not self._balances:
             return None
