@@ -5,13 +5,14 @@ meets.py; ALGEBRA.md §2.1-§2.4, W14, W16, W21)."""
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from assemblykit.algebra import Kind, Locus, SymmetryGroup, intersect_groups, se3
+from assemblykit.algebra import Coset, Kind, Locus, SymmetryGroup, intersect_groups, se3
 from assemblykit.algebra.connected_meets import connected_meet
 from assemblykit.algebra.groups import classify_algebra
 from assemblykit.algebra.subspaces import psd_solve
@@ -303,6 +304,154 @@ def test_extended_by_generates_the_dihedral_group():
     assert d4.contains(se3.rot_z(math.pi / 2) @ se3.rot_x(math.pi))
     flipped = G.cylindrical(ORIGIN, Z).extended_by([se3.rot_x(math.pi)])
     assert flipped.n_components == 2 and flipped.contains(se3.rot_y(math.pi) @ tr(0, 0, 3))
+
+
+# ----------------------------------------------------------------------------- many components
+
+
+def prism_group(n: int, phase: float = 0.0) -> SymmetryGroup:
+    """T(z) ⋊ Cₙ about the z axis as a prism feature lists it: I and the n - 1 turns (the
+    frame's x axis, through a vertex, at ``phase``)."""
+    turns = tuple(se3.rot_z(math.tau * k / n) for k in range(1, n))
+    return SymmetryGroup(Kind.PRISMATIC, se3.rot_z(phase), 0.0, (np.eye(4), *turns))
+
+
+def test_a_1000_sided_prism_in_its_hole_against_a_face_has_1000_positions_quickly():
+    """W14 with 1000 sides: the prism fit (T(z) ⋊ C₁₀₀₀) meets the face contact G(z) in
+    the 1000 turns Rz(2πk/1000), no more (not the half steps), in well under 5 s."""
+    start = time.process_time()
+    met = Coset(prism_group(1000), np.eye(4)).intersect(Coset(G.planar(Z), np.eye(4)))
+    assert isinstance(met, Coset)
+    assert (met.dof, met.n_components) == (0, 1000)
+    assert met.group.equals(G.cyclic(ORIGIN, Z, 1000))
+    step = math.tau / 1000
+    assert met.contains(se3.rot_z(417 * step)) and met.contains(se3.rot_z(-step))
+    assert not met.contains(se3.rot_z(417.5 * step)) and not met.contains(tr(0, 0, 1e-3))
+    assert time.process_time() - start < 5.0
+
+
+def test_meets_of_large_cyclic_parts_keep_the_common_turns_quickly():
+    """C₁₀₀₀ ∩ C₁₅₀₀ = C₅₀₀ (gcd), and the same turns with the slide of two coaxial
+    prisms of 1000 and 1500 sides: T(z) ⋊ C₅₀₀, in well under 5 s."""
+    start = time.process_time()
+    met = intersect_groups(G.cyclic(ORIGIN, Z, 1000), G.cyclic(ORIGIN, Z, 1500))
+    assert met.kind is Kind.FIXED and met.equals(G.cyclic(ORIGIN, Z, 500))
+    slid = intersect_groups(prism_group(1000), prism_group(1500))
+    assert slid.kind is Kind.PRISMATIC and slid.n_components == 500
+    assert slid.contains(se3.rot_z(math.tau * 3 / 500) @ tr(0, 0, 7))
+    assert not slid.contains(se3.rot_z(math.tau / 1000))
+    assert time.process_time() - start < 5.0
+
+
+def test_with_discrete_checks_the_closure_of_1000_components_quickly():
+    """The 999 turns of C₁₀₀₀ over T(z) close into 1000 components; without one of them
+    they do not, in well under 5 s."""
+    turns = [se3.rot_z(math.tau * k / 1000) for k in range(1, 1000)]
+    start = time.process_time()
+    group = G.prismatic(Z).with_discrete(reps=tuple(turns))
+    assert group.n_components == 1000 and group.equals(prism_group(1000))
+    with pytest.raises(GroupError, match="not closed"):
+        G.prismatic(Z).with_discrete(reps=tuple(turns[:500] + turns[501:]))
+    assert time.process_time() - start < 5.0
+
+
+def all_pairs_meet(a: SymmetryGroup, b: SymmetryGroup) -> SymmetryGroup:
+    """A ∩ B from the meets A0 α ∩ B0 β of every pair of components (§2.4, the definition)."""
+    a0, b0 = a.connected_part, b.connected_part
+    found = [
+        met.rep
+        for x in a.reps
+        for y in b.reps
+        if isinstance(met := Coset(a0, x).intersect(Coset(b0, y)), Coset)
+    ]
+    return connected_meet(a0, b0, Tolerance()).with_known_discrete(reps=tuple(found))
+
+
+FLIP = se3.rot_x(math.pi)
+MEET_CASES = {
+    "coaxial prisms": (prism_group(12), prism_group(18), 6),
+    "prism and turns": (prism_group(12), G.cyclic(ORIGIN, Z, 8), 4),
+    "turns and prism": (G.cyclic(ORIGIN, Z, 8), prism_group(12, phase=math.pi / 12), 4),
+    "dihedral and flipped prism": (
+        G.cyclic(ORIGIN, Z, 4).extended_by([FLIP]),
+        prism_group(6).extended_by([FLIP]),
+        4,
+    ),
+    "turns about parallel axes": (G.cyclic((1.0, 0.0, 0.0), Z, 6), G.cyclic(ORIGIN, Z, 6), 1),
+    "flipped cylinder and turns": (
+        G.cylindrical(ORIGIN, Z).extended_by([FLIP]),
+        G.cyclic(ORIGIN, Z, 6).extended_by([FLIP]),
+        12,
+    ),
+    "crossed prisms": (prism_group(4), prism_group(6).conjugate(se3.rot_y(math.pi / 2)), 1),
+}
+
+
+@pytest.mark.parametrize("case", MEET_CASES)
+def test_meets_pair_only_the_components_that_can_meet(case):
+    """When one connected part contains the other, a component meets only those of the
+    other group near it: the same components, in the same order, as meeting every pair."""
+    a, b, components = MEET_CASES[case]
+    met, expected = intersect_groups(a, b), all_pairs_meet(a, b)
+    assert met.kind is expected.kind and np.array_equal(met.frame, expected.frame)
+    assert len(met.reps) == len(expected.reps) == components
+    assert all(np.array_equal(x, y) for x, y in zip(met.reps, expected.reps, strict=True))
+
+
+KINDS_WITH_PITCH = [
+    (kind, 0.7 if kind in (Kind.HELICAL, Kind.PSEUDO_PLANAR) else 0.0) for kind in Kind
+]
+
+
+def scan_dedupe(g0: SymmetryGroup, elements: list, tol: Tolerance) -> list:
+    """One element per G0-coset by testing every kept one (the definition)."""
+    kept: list = []
+    for g in elements:
+        if not any(g0.contains(g @ se3.inverse(f), tol) for f in kept):
+            kept.append(g)
+    return kept
+
+
+def near_copies(rng: np.random.Generator, g0: SymmetryGroup, g, tol: Tolerance) -> list:
+    """``g`` moved by elements of G0 and by perturbations of 0.3 to 4 tolerances."""
+    out = []
+    for size in (0.0, 0.3, 0.8, 1.5, 4.0):
+        params = rng.uniform(-1.0, 1.0, g0.dof) * np.where(g0.angle_parameters(), math.pi, 5.0)
+        axis = se3.unit(rng.normal(size=3))
+        nudge = se3.rotation(axis, size * tol.angle) @ se3.translation(
+            size * tol.length * se3.unit(rng.normal(size=3))
+        )
+        out.append(nudge @ g0.element(params) @ g)
+    return out
+
+
+@pytest.mark.parametrize(("kind", "pitch"), KINDS_WITH_PITCH)
+@pytest.mark.parametrize("tol", [Tolerance(), Tolerance(scale=50.0, rel_length=1e-6, angle=1e-6)])
+@settings(max_examples=8, deadline=None)
+@given(seed=seeds)
+def test_keyed_components_answer_as_a_scan_of_all_components(kind, pitch, tol, seed):
+    """Merging components and membership test only the components with nearby coset keys;
+    the answers are those of testing every component, for every family, also for
+    elements within and just beyond the tolerance of each other."""
+    rng = np.random.default_rng(seed)
+    g0 = G.connected(kind, se3.random_transform(rng), pitch)
+    elements = [
+        copy for _ in range(6) for copy in near_copies(rng, g0, se3.random_transform(rng), tol)
+    ]
+    order = rng.permutation(len(elements))
+    elements = [elements[i] for i in order]
+    group = g0.with_known_discrete(reps=tuple(elements), tol=tol)
+    expected = scan_dedupe(g0, [np.eye(4), *elements], tol)
+    assert len(group.reps) == len(expected)
+    assert all(np.array_equal(a, b) for a, b in zip(group.reps[1:], expected[1:], strict=True))
+    queries = [
+        copy
+        for g in (*elements[:8], se3.random_transform(rng))
+        for copy in near_copies(rng, g0, g, tol)
+    ]
+    for q in queries:
+        scan = any(g0.contains(q @ se3.inverse(r), tol) for r in group.reps)
+        assert group.contains(q, tol) is scan
 
 
 # ----------------------------------------------------------------------------- orbits W21

@@ -4,6 +4,8 @@ G0 is one of Hervé's 12 connected families (§2.1, :mod:`assemblykit.algebra.li
 placed by a frame F (G0 = F K F^-1 with K canonical: axis/normal +z through the
 origin); Gamma is a finite transversal ``reps`` (always containing I) and optional
 ``lattice`` generators of an infinite discrete quotient (helical lattices, §2.2).
+Components are looked up by coset keys (§2.3 "Discrete parts"), so the operations on
+Gamma cost about |Gamma|, not |Gamma|^2.
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ from assemblykit.tolerance import Tolerance, current
 __all__ = [
     "IDENTITY_MATRIX",
     "MAX_FINITE_ORDER",
+    "MEET_SPREAD",
     "SymmetryGroup",
     "classify_algebra",
     "lattice_parameter",
@@ -48,6 +51,10 @@ __all__ = [
 
 #: Largest finite group built by closure (``extended_by``); beyond it the group is not finite.
 MAX_FINITE_ORDER = 1_000
+
+#: How far, in multiples of the bound on a tolerance's effect on coset keys, the meet of
+#: two discrete groups looks for the components that may meet (:meth:`components_near`).
+MEET_SPREAD = 16.0
 
 #: The identity transform that stands first in every group's ``reps`` (shared, read-only:
 #: membership tests skip it by identity).
@@ -297,15 +304,46 @@ class SymmetryGroup:
 
     def contains(self, t: NDArray[np.float64], tol: Tolerance | None = None) -> bool:
         """Whether ``t`` is in G (ALGEBRA.md §2.3, with reps and lattice projection)."""
-        tol = tol or current()
-        for gamma in self.reps:
+        return self._component(t, tol or current()) is not None
+
+    def _component(self, t: NDArray[np.float64], tol: Tolerance) -> int | None:
+        """The first index i with t in G0 . Lambda . reps[i], or ``None`` when t is not in G.
+
+        Without a lattice the candidates are the components whose coset keys are near that
+        of t (:class:`_CosetTable`, ALGEBRA.md §2.3 "Discrete parts"), so the cost does not
+        grow with the number of components."""
+        if not self.lattice:
+            if len(self.reps) == 1:
+                return 0 if self._in_connected(t, tol) else None
+            return self._rep_table(tol).find(t)
+        for i, gamma in enumerate(self.reps):
             g = t @ se3.inverse(gamma) if gamma is not IDENTITY_MATRIX else t
-            if not self.lattice:
-                if self._in_connected(g, tol):
-                    return True
-            elif self._in_lattice_coset(g, tol):
-                return True
-        return False
+            if self._in_lattice_coset(g, tol):
+                return i
+        return None
+
+    def components_near(self, t: NDArray[np.float64], tol: Tolerance | None = None) -> list[int]:
+        """The indices i, in order, of the components G0 . reps[i] that may hold ``t``: all of
+        them with a lattice, else those whose coset keys are within :data:`MEET_SPREAD`
+        times the tolerance bound of the key of t (:class:`_CosetTable`), a superset of
+        the components holding t. Meets of discrete groups pair only these (§2.4)."""
+        if self.lattice or len(self.reps) == 1:
+            return list(range(len(self.reps)))
+        return self._rep_table(tol or current()).near(t, MEET_SPREAD)
+
+    @cached
+    def _rep_tables(self) -> dict[Tolerance, _CosetTable]:
+        """The coset tables of ``reps``, one per tolerance used (filled by :meth:`_rep_table`)."""
+        return {}
+
+    def _rep_table(self, tol: Tolerance) -> _CosetTable:
+        """``reps`` keyed by their G0-cosets under ``tol`` (built on first use, then kept)."""
+        table = self._rep_tables.get(tol)
+        if table is None:
+            table = _CosetTable(self.connected_part, tol)
+            table.extend(self.reps, distinct=True)
+            self._rep_tables[tol] = table
+        return table
 
     @cached
     def _lattice_projection(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -408,11 +446,35 @@ class SymmetryGroup:
         )
         if lattice:
             group._check_lattice(tol)
-        for a in unique:
-            for b in unique:
-                if not group.contains(a @ b, tol):
-                    raise GroupError("the discrete part is not closed under composition")
+        group._check_closed(tol)
         return group
+
+    def _check_closed(self, tol: Tolerance) -> None:
+        """Raise unless reps . reps is in G, i.e. Gamma is closed under composition.
+
+        Generators B are taken from reps greedily (each one not yet reached) and every
+        reached component is multiplied by each of them: reps . B in G with every rep a
+        product of generators is the same condition as reps . reps in G. Each new generator
+        at least doubles the subgroup reached (Lagrange), so |B| <= log2 |reps| + 1 and
+        the test costs O(|reps| log |reps|) memberships instead of |reps|^2.
+        """
+        gens: list[NDArray[np.float64]] = []
+        used: dict[int, int] = {0: 0}
+        for i, rep in enumerate(self.reps):
+            if i in used:
+                continue
+            gens.append(rep)
+            work = list(used)
+            while work:
+                m = work.pop()
+                for g in gens[used[m] :]:
+                    j = self._component(self.reps[m] @ g, tol)
+                    if j is None:
+                        raise GroupError("the discrete part is not closed under composition")
+                    if j not in used:
+                        used[j] = 0
+                        work.append(j)
+                used[m] = len(gens)
 
     def with_known_discrete(
         self,
@@ -423,7 +485,7 @@ class SymmetryGroup:
         """G0 . Gamma for a discrete part known to form a group with G0 (components of an
         intersection of groups, flips of a stabiliser): duplicates are merged, the
         rigidity, normaliser and closure checks of :meth:`with_discrete` are skipped
-        (they cost O(n^3) membership tests for n components)."""
+        (n normaliser tests and O(n log n) memberships for n components)."""
         g0 = self.connected_part
         unique = _dedupe(g0, [IDENTITY_MATRIX, *reps], tol or current())
         return SymmetryGroup(g0.kind, g0.frame, g0.pitch, tuple(unique), tuple(lattice))
@@ -441,21 +503,22 @@ class SymmetryGroup:
         for g in extra:
             if not g0.conjugate(g).equals(g0, tol):
                 raise GroupError(f"an element does not normalise the {g0.kind.value} part")
-        found = _dedupe(g0, [*self.reps, *extra], tol)
-        frontier = list(found)
+        table = _CosetTable(g0, tol)
+        table.extend([*self.reps, *extra])
+        frontier = list(table.members)
         gens = [*self.reps[1:], *extra]
         while frontier:
             new = []
             for a in frontier:
                 for b in gens:
                     c = a @ b
-                    if not any(g0.contains(c @ se3.inverse(f), tol) for f in found):
-                        found.append(c)
+                    if table.find(c) is None:
+                        table.add(c)
                         new.append(c)
-            if len(found) > MAX_FINITE_ORDER:
+            if len(table.members) > MAX_FINITE_ORDER:
                 raise GroupError("the generated discrete group is not finite")
             frontier = new
-        return SymmetryGroup(g0.kind, g0.frame, g0.pitch, tuple(found), self.lattice)
+        return SymmetryGroup(g0.kind, g0.frame, g0.pitch, tuple(table.members), self.lattice)
 
     # ------------------------------------------------------------------ orbits
 
@@ -552,11 +615,163 @@ def _dedupe(
     g0: SymmetryGroup, elements: list[NDArray[np.float64]], tol: Tolerance
 ) -> list[NDArray[np.float64]]:
     """One representative per G0-coset, in order of first appearance."""
-    out: list[NDArray[np.float64]] = []
-    for g in elements:
-        if not any(g0.contains(g @ se3.inverse(f), tol) for f in out):
-            out.append(g)
-    return out
+    table = _CosetTable(g0, tol)
+    table.extend(elements)
+    return table.members
+
+
+#: Points (model units, canonical frame) whose images under an element key its G0-coset.
+_KEY_POINTS = np.array([[0.6, -0.2, 0.3], [0.3, 0.7, -0.5], [0.7, 0.4, 0.8]])
+
+#: Fixed generic weights that fold the invariant features of a coset into one number.
+_KEY_WEIGHTS = np.random.default_rng(20_240_601).uniform(0.5, 1.0, 9)
+
+#: The smallest angle tolerance the bound on key differences assumes: it also covers the
+#: rounding of F^-1 g F, about 1e-16 of the reach, when a user asks for down to 1e-15.
+_KEY_ROUNDING = 1e-12
+
+
+def _coset_features(
+    g0: SymmetryGroup, elements: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Features of the G0-cosets G0 . g of ``elements`` (n x 4 x 4), invariant under left
+    multiplication by G0 (ALGEBRA.md §2.3 "Discrete parts"): with c = F^-1 g F in the
+    canonical frame, the K-invariant coordinates of the images c(p) of three points p
+    (e.g. radius and height for R, x and y for T, all three for E) and the rotation rows
+    K leaves unchanged (all of R without rotations, the z row with rotations about z).
+
+    Returns (point features n x a, rotation features n x b, reach n): reach bounds the
+    images c(p) and the magnitudes rounding acts on, which sets how far a tolerance
+    moves the point features (:meth:`_CosetTable.width`).
+    """
+    c = g0.frame_inverse @ elements @ g0.frame
+    r = c[:, :3, :3]
+    x = r @ _KEY_POINTS + c[:, :3, 3:]
+    n = len(elements)
+    rotation = ROTATIONS[g0.kind]
+    if rotation is RotationPart.NONE:
+        turned = r.reshape(n, 9)
+    elif rotation is RotationPart.LINE:
+        turned = r[:, 2, :]
+    else:
+        turned = np.zeros((n, 0))
+    kind = g0.kind
+    rho = np.hypot(x[:, 0], x[:, 1])
+    if kind is Kind.FIXED:
+        placed = x.reshape(n, 9)
+    elif kind is Kind.PRISMATIC:
+        placed = x[:, :2].reshape(n, 6)
+    elif kind in (Kind.TRANSLATION2, Kind.PLANAR):
+        placed = x[:, 2]
+    elif kind is Kind.REVOLUTE:
+        placed = np.hstack((rho, x[:, 2]))
+    elif kind in (Kind.HELICAL, Kind.CYLINDRICAL):
+        placed = rho
+    elif kind is Kind.SPHERICAL:
+        placed = np.linalg.norm(x, axis=1)
+    else:
+        placed = np.zeros((n, 0))
+    reach = (
+        np.max(np.linalg.norm(x, axis=1), axis=1)
+        + np.linalg.norm(elements[:, :3, 3], axis=1)
+        + se3.norm(g0.origin)
+    )
+    return placed, turned, reach
+
+
+class _CosetTable:
+    """Elements of distinct G0-cosets with a lookup of the member whose coset holds a
+    given element (ALGEBRA.md §2.3 "Discrete parts").
+
+    Each element has a scalar key, a fixed weighted sum of :func:`_coset_features`. When
+    g f^-1 passes the membership predicate of G0, the keys of g and f differ by less than
+    :meth:`width` (each feature is 1-Lipschitz in the image points, and the predicate
+    bounds the part of g f^-1 outside K by the length and angle tolerances), so only
+    members in the neighbouring buckets of that width are tested, with the same predicate
+    as a scan of all members: the answers are those of the scan, in the same order.
+    """
+
+    def __init__(self, g0: SymmetryGroup, tol: Tolerance) -> None:
+        self.g0 = g0
+        self.tol = tol
+        self.members: list[NDArray[np.float64]] = []
+        self._keys: list[float] = []
+        self._reach = 0.0
+        self._width = 1.0
+        self._buckets: dict[int, list[int]] = {}
+        placed, turned, _ = _coset_features(g0, IDENTITY_MATRIX[None])
+        self._weights = (_KEY_WEIGHTS[: placed.shape[1]], _KEY_WEIGHTS[: turned.shape[1]])
+
+    def _keys_of(
+        self, elements: list[NDArray[np.float64]] | tuple[NDArray[np.float64], ...]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The keys and reaches of ``elements``."""
+        placed, turned, reach = _coset_features(self.g0, np.asarray(elements, dtype=np.float64))
+        return placed @ self._weights[0] + turned @ self._weights[1], reach
+
+    def width(self, reach: float) -> float:
+        """A bound, with a factor 4 to spare, on the key difference of two elements of one
+        G0-coset whose images c(p) are within ``reach``: a point feature moves by at most
+        3 angle . reach + 2 length, a rotation-row feature by at most 3 angle."""
+        tol = self.tol
+        angle = max(tol.angle, _KEY_ROUNDING)
+        placed, turned = (float(np.sum(w)) for w in self._weights)
+        return 4.0 * (
+            2.0 * tol.length
+            + placed * (3.0 * angle * reach + 2.0 * tol.length)
+            + turned * 3.0 * angle
+        )
+
+    def near(self, g: NDArray[np.float64], spread: float, key: float | None = None) -> list[int]:
+        """The indices, in order, of the members whose keys are within ``spread`` times
+        :meth:`width` of the key of ``g`` (and maybe a little further)."""
+        if key is None:
+            key = float(self._keys_of([g])[0][0])
+        bucket, steps = math.floor(key / self._width), math.ceil(spread)
+        return sorted(
+            i for b in range(bucket - steps, bucket + steps + 1) for i in self._buckets.get(b, ())
+        )
+
+    def find(self, g: NDArray[np.float64], key: float | None = None) -> int | None:
+        """The index of the first member f with g f^-1 in G0, else ``None``."""
+        for i in self.near(g, 1.0, key):
+            f = self.members[i]
+            if self.g0._in_connected(g if f is IDENTITY_MATRIX else g @ se3.inverse(f), self.tol):
+                return i
+        return None
+
+    def add(
+        self, g: NDArray[np.float64], key: float | None = None, reach: float | None = None
+    ) -> None:
+        """Append ``g`` as a new member. The buckets are sized for twice the largest reach
+        so far, and rebuilt when a member reaches beyond that."""
+        if key is None or reach is None:
+            keys, reaches = self._keys_of([g])
+            key, reach = float(keys[0]), float(reaches[0])
+        self.members.append(g)
+        self._keys.append(key)
+        if reach > self._reach:
+            self._reach = 2.0 * reach
+            self._width = self.width(self._reach)
+            self._buckets = {}
+            for i, k in enumerate(self._keys):
+                self._buckets.setdefault(math.floor(k / self._width), []).append(i)
+        else:
+            bucket = math.floor(key / self._width)
+            self._buckets.setdefault(bucket, []).append(len(self._keys) - 1)
+
+    def extend(
+        self,
+        elements: list[NDArray[np.float64]] | tuple[NDArray[np.float64], ...],
+        distinct: bool = False,
+    ) -> None:
+        """Add the elements not in a member's coset (all of them when ``distinct``)."""
+        if not elements:
+            return
+        keys, reaches = self._keys_of(elements)
+        for g, key, reach in zip(elements, keys.tolist(), reaches.tolist(), strict=True):
+            if distinct or self.find(g, key) is None:
+                self.add(g, key, reach)
 
 
 def classify_algebra(basis: NDArray[np.float64], tol: Tolerance | None = None) -> SymmetryGroup:
