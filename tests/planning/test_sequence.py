@@ -29,6 +29,7 @@ from assemblykit.planning.sequence import (
     _sinks,
     and_or_graph,
     base_part,
+    least_interlocked,
     minimal_interlocked,
     separable,
 )
@@ -322,6 +323,38 @@ def test_interlocked_rings_are_stuck():
     assert lock.translation_locked is False
     assert lock.rigid_may_free is True
     assert result.and_or is not None and result.and_or.plans == 0
+
+
+def test_the_interlock_reported_is_the_least_one_the_whole_dbgs_give():
+    # a chain of three links and a block lying on the table: the search stops on the
+    # chain; the interlock named, found from Γ_t and Γ_e along the directions where Γ_t
+    # separates, is the one the whole Γ_e DBGs of every direction give (the first two
+    # links: dropping the first leaves the last two, still linked, dropping either then
+    # frees the other)
+    first = ring(10.0, 2.0, np.eye(4))
+    turn = trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0])
+    turn[:3, 3] = [10.0, 0.0, 0.0]
+    third = np.eye(4)
+    third[:3, 3] = [20.0, 0.0, 0.0]
+    block = trimesh.creation.box((4.0, 4.0, 4.0))
+    block.apply_translation([-30.0, 0.0, 0.0])
+    parts = [
+        Part("ring_a", first),
+        Part("ring_b", ring(10.0, 2.0, turn)),
+        Part("ring_c", ring(10.0, 2.0, third)),
+        Part("block", block),
+    ]
+    assembly = Assembly(parts)
+    tol = assembly.tolerance()
+    translations = translation_table(assembly, tol)
+    members = mask_of(range(4))
+    whole = ExtendedDirections(assembly, translations.directions, tol)
+    expected = minimal_interlocked(whole.table(translations.incomplete(members), members), members)
+    lazy = ExtendedDirections(assembly, translations.directions, tol)
+    found = least_interlocked(translations, lazy, members)
+    assert found == expected == mask_of([1, 2])
+    (lock,) = plan(assembly).interlocked
+    assert lock.parts == ("ring_b", "ring_c") and lock.held == ("ring_a",)
 
 
 @pytest.mark.slow

@@ -34,7 +34,7 @@ from assemblykit.planning.sequence import (
     base_part,
     distinct_directions,
     exact_candidates,
-    minimal_interlocked,
+    least_interlocked,
     one_set,
     separable,
 )
@@ -206,7 +206,7 @@ def finish_plan(
         _interlock(
             assembly,
             names,
-            minimal_interlocked(extended.table(translations.incomplete(members), members), members),
+            least_interlocked(translations, extended, members),
             members,
             translations,
             tol,

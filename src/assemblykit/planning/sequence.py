@@ -974,6 +974,34 @@ def minimal_interlocked(table: DirectionTable, members: int) -> int:
     return members
 
 
+def least_interlocked(translations: DirectionTable, extended: Any, members: int) -> int:
+    """A minimal subset of ``members`` that no direction separates under Γ_e
+    (``extended``: :class:`ExtendedDirections`, or its counterpart for polygons), found
+    without Γ_e's whole DBGs. Γ_e blocks at least where Γ_t does (``translations``), so
+    a set Γ_t cannot separate is interlocked: parts are first dropped while Γ_t alone
+    cannot separate the rest (:func:`minimal_interlocked` on Γ_t: a pair drawn
+    interfering, a pin in a blind hole), then while Γ_e cannot, asked only along the
+    directions where Γ_t separates the rest, and only until one separates it."""
+    core = members
+    if not separable(translations, members):
+        core = minimal_interlocked(translations, members)
+
+    def separates(subset: int) -> bool:
+        return any(
+            separable(extended.table([k], subset), subset)
+            for k in np.flatnonzero(translations.separating(subset)).tolist()
+        )
+
+    def drop(subset: int) -> int:
+        for i in list(bits(subset)):
+            smaller = subset & ~(1 << i)
+            if several(smaller) and not separates(smaller):
+                return drop(smaller)
+        return subset
+
+    return drop(core)
+
+
 def and_or_graph(table: DirectionTable) -> AndOrGraph:
     """The AND/OR graph of every two-handed partition of the whole set that ``table``
     (Γ_e) accepts, and the number of disassembly trees it holds (seed 004, "order").
