@@ -427,7 +427,7 @@ def near_copies(rng: np.random.Generator, g0: SymmetryGroup, g, tol: Tolerance) 
 
 @pytest.mark.parametrize(("kind", "pitch"), KINDS_WITH_PITCH)
 @pytest.mark.parametrize("tol", [Tolerance(), Tolerance(scale=50.0, rel_length=1e-6, angle=1e-6)])
-@settings(max_examples=8, deadline=None)
+@settings(max_examples=3, deadline=None)
 @given(seed=seeds)
 def test_keyed_components_answer_as_a_scan_of_all_components(kind, pitch, tol, seed):
     """Merging components and membership test only the components with nearby coset keys;
