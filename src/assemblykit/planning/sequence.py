@@ -164,18 +164,10 @@ class ExtendedDirections:
                 if self._projected[i] and (k, i) not in self._tested and i not in asked
             ]
         if untested:
-            arcs = extended_arcs(
-                self.assembly,
-                self.directions[k],
-                [self.names[i] for i in untested],
-                self.names,
-                self.tol,
-            )
             self._tested.update((k, i) for i in untested)
-            for a, b in arcs:
-                key = (k, self.index[a])
-                self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
-                self._remember(key[1], self.index[b])
+            for i, j in self._extended(k, untested, range(len(self.names))):
+                self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
+                self._remember(i, j)
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
 
     def leaving(self, k: int, movers: int, among: int) -> int:
@@ -210,21 +202,28 @@ class ExtendedDirections:
         """Per part of ``movers`` that some part of ``blockers`` blocks along ``k``, one
         such blocker (the lowest index found), which is kept among the part's
         :data:`RECENT_BLOCKERS` last ones."""
+        found: dict[int, int] = {}
+        for i, j in self._extended(k, movers, blockers, first_only=True):
+            found[i] = min(j, found.get(i, j))
+        for i, j in found.items():
+            self._remember(i, j)
+        return found
+
+    def _extended(
+        self, k: int, movers: Iterable[int], blockers: Iterable[int], *, first_only: bool = False
+    ) -> list[tuple[int, int]]:
+        """The arcs ``(i, j)`` of Γ_e along ``k`` from ``movers`` to ``blockers``, as
+        indices (:func:`~assemblykit.blocking.extended.extended_arcs`, with ``first_only``
+        one blocker at least of each blocked mover)."""
         arcs = extended_arcs(
             self.assembly,
             self.directions[k],
             [self.names[i] for i in movers],
             [self.names[j] for j in blockers],
             self.tol,
-            first_only=True,
+            first_only=first_only,
         )
-        found: dict[int, int] = {}
-        for a, b in arcs:
-            i, j = self.index[a], self.index[b]
-            found[i] = min(j, found.get(i, j))
-        for i, j in found.items():
-            self._remember(i, j)
-        return found
+        return [(self.index[a], self.index[b]) for a, b in arcs]
 
     def _remember(self, i: int, j: int) -> None:
         """Keep ``j`` first among the :data:`RECENT_BLOCKERS` last blockers of ``i``."""
@@ -246,16 +245,8 @@ class ExtendedDirections:
         ]
         hints = sorted({j for i in asked for j in self._recent.get(i, ()) if among >> j & 1})
         if asked and hints:
-            arcs = extended_arcs(
-                self.assembly,
-                self.directions[k],
-                [self.names[i] for i in asked],
-                [self.names[j] for j in hints],
-                self.tol,
-            )
-            for a, b in arcs:
-                key = (k, self.index[a])
-                self._blocking[key] = self._blocking.get(key, 0) | 1 << self.index[b]
+            for i, j in self._extended(k, asked, hints):
+                self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
         self._hinted.update((k, i) for i in asked)
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
 
