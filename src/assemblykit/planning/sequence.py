@@ -106,9 +106,11 @@ class ExtendedDirections:
     asks for them, and kept: per direction, the moving parts already tested and the
     parts that block each of them.
 
-    A part is tested along a direction once, against every other part: blocking is
-    pairwise, so its blockers among any set of parts are read off. Parts that are not
-    unions of convex bodies go to the projection test
+    A part is tested along a direction against the set of parts asked about (the parts
+    still together, as the search takes them apart), and again only if asked about a
+    set holding others: blocking is pairwise, so its blockers among any subset are read
+    off, and late in a plan the few parts left are projected, not all of them. Parts
+    that are not unions of convex bodies go to the projection test
     (:mod:`assemblykit.geometry.occlusion`), whose cost is projecting the meshes around
     them: a closure (:func:`_free_closures`) asks about a few more parts at a time,
     dozens of times along one direction, so it has all such parts of the set tested
@@ -122,7 +124,7 @@ class ExtendedDirections:
         self.index = {name: i for i, name in enumerate(self.names)}
         self.directions = directions
         self.tol = tol
-        self._tested: set[tuple[int, int]] = set()
+        self._tested: dict[tuple[int, int], int] = {}
         self._blocking: dict[tuple[int, int], int] = {}
         self._first: dict[tuple[int, ...], int] = {}
         self._witness: dict[tuple[int, int], int] = {}
@@ -155,20 +157,26 @@ class ExtendedDirections:
         untested part of ``among`` that goes to the projection test when ``whole``
         (class docstring)."""
         k = self.same_as(k)
-        untested = [i for i in bits(movers) if (k, i) not in self._tested]
+        untested = [i for i in bits(movers) if not self._knows(k, i, among)]
         if whole and any(self._projected[i] for i in untested):
             asked = set(untested)
             untested += [
                 i
                 for i in bits(among)
-                if self._projected[i] and (k, i) not in self._tested and i not in asked
+                if self._projected[i] and not self._knows(k, i, among) and i not in asked
             ]
         if untested:
-            self._tested.update((k, i) for i in untested)
-            for i, j in self._extended(k, untested, range(len(self.names))):
+            for i in untested:
+                self._tested[(k, i)] = self._tested.get((k, i), 0) | among
+            for i, j in self._extended(k, untested, bits(among)):
                 self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
                 self._remember(i, j)
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
+
+    def _knows(self, k: int, i: int, among: int) -> bool:
+        """Whether every blocker of part ``i`` in ``among`` along ``k`` is known: it was
+        tested against a set holding ``among``."""
+        return among & ~self._tested.get((k, i), 0) == 0
 
     def leaving(self, k: int, movers: int, among: int) -> int:
         """The parts of ``movers`` that no part of ``among`` blocks along ``k``, as a
@@ -179,7 +187,7 @@ class ExtendedDirections:
         k = self.same_as(k)
         free, unknown = 0, []
         for i in bits(movers):
-            if (k, i) in self._tested:
+            if self._knows(k, i, among):
                 free |= 0 if self._blocking.get((k, i), 0) & among & ~(1 << i) else 1 << i
             elif among & ~self._clear.get((k, i), 0) == 0:
                 free |= 1 << i
@@ -241,7 +249,7 @@ class ExtendedDirections:
         (:func:`_free_closures`)."""
         k = self.same_as(k)
         asked = [
-            i for i in bits(movers) if (k, i) not in self._tested and (k, i) not in self._hinted
+            i for i in bits(movers) if not self._knows(k, i, among) and (k, i) not in self._hinted
         ]
         hints = sorted({j for i in asked for j in self._recent.get(i, ()) if among >> j & 1})
         if asked and hints:
