@@ -8,8 +8,8 @@ Printed per file: parts, the loader's warnings and skipped items, the interferin
 and what was done about them, the plan (feasible or the stuck parts, steps), the CPU
 seconds of each stage and the peak resident memory of the process so far, next to the
 targets: a file of up to 34 parts loaded, contacts and plan in <= 10 CPU s and <= 1 GB,
-144 parts in <= 30 CPU s. The gripper is planned for its first ``--gripper-steps``
-steps (default 8; 0: to the end), the parts not yet taken apart counted as unfinished.
+144 parts in <= 30 CPU s. The gripper is planned to the end, or for its first
+``--gripper-steps`` steps, the parts not yet taken apart counted as unfinished.
 
 Run: python benchmarks/bench_step.py [--gripper-steps N]
 """
@@ -73,6 +73,8 @@ def bench(path: Path, max_steps: int | None = None) -> None:
     )
     print(f"  interfering pairs: {len(prepared.overlaps)} {dict(resolutions)}")
     print(f"  plan: {verdict}, {len(result.steps)} steps")
+    for lock in result.interlocked:
+        print(f"    {', '.join(lock.parts)}: {lock.reason}; holding {', '.join(lock.held) or '-'}")
     stages = ", ".join(f"{k} {v:.1f}" for k, v in times.items())
     print(
         f"  CPU s: {stages}; total {total:.1f} (target <= {target:.0f}); "
@@ -82,7 +84,7 @@ def bench(path: Path, max_steps: int | None = None) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--gripper-steps", type=int, default=8)
+    parser.add_argument("--gripper-steps", type=int, default=0)
     steps = parser.parse_args().gripper_steps
     for path in sorted(EXAMPLES.rglob("*.step")):
         bench(path)

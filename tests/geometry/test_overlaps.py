@@ -6,12 +6,15 @@ cut checked by manifold3d and the plans' directions known by hand."""
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
+import manifold3d
 import numpy as np
 import pytest
 import trimesh
 
-from assemblykit.geometry.interference import overlap_volume
+from assemblykit.geometry import overlaps
+from assemblykit.geometry.interference import interferences, overlap_volume
 from assemblykit.geometry.overlaps import DESIGNED_SHARE, joined, resolve_overlaps
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.planner import plan
@@ -160,3 +163,33 @@ def test_a_screw_through_two_plates_is_cut_once_along_its_whole_shank():
     result = plan(prepared, max_and_or_parts=0)
     assert result.feasible and result.steps[0].parts == ("screw",)
     np.testing.assert_allclose(result.steps[0].direction, [0, 0, 1], atol=1e-9)
+
+
+def test_designed_interference_far_from_the_origin_is_cut():
+    # the cup and peg 100 up the peg's insertion axis (z), 20 times the assemblies'
+    # size away: the shadow of the 0.1 x 0.2 x 1 they share is cut all the same
+    far = Assembly(
+        [
+            replace(part, mesh=part.mesh.copy().apply_translation([0, 0, 100]))
+            for part in cup_and_peg()
+        ]
+    )
+    prepared = resolve_overlaps(far)
+    ((volume, resolution),) = [(o.volume, o.resolution) for o in prepared.overlaps]
+    assert volume == pytest.approx(0.02, rel=1e-9) and resolution == "trimmed from peg"
+    peg, cup = prepared.parts["peg"].mesh, prepared.parts["cup"].mesh
+    assert peg.volume == pytest.approx(0.22 - 0.02, rel=1e-8)
+    assert overlap_volume(peg, cup) == pytest.approx(0.0, abs=1e-9)
+    assert interferences(prepared) == []
+
+
+def test_a_cut_that_leaves_the_pair_interfering_leaves_it_as_it_is(monkeypatch):
+    # a shadow that removes nothing leaves the peg sharing its 0.02 with the cup: the
+    # pair is an obstacle, not "trimmed", and the peg is whole
+    monkeypatch.setattr(overlaps, "_extruded_shadow", lambda *_: manifold3d.Manifold())
+    prepared = resolve_overlaps(cup_and_peg())
+    (overlap,) = prepared.overlaps
+    assert overlap.resolution == "" and overlap.volume == pytest.approx(0.02, rel=1e-9)
+    assert prepared.parts["peg"].mesh.volume == pytest.approx(0.22, rel=1e-9)
+    ((_, _, left),) = interferences(prepared)
+    assert left == pytest.approx(0.02, rel=1e-9)

@@ -18,7 +18,9 @@ otherwise, and :func:`resolve_overlaps` does the same, saying what it did for ea
   whole shank, the pin its press fit, so it touches the other and leaves the way it went
   in (unscrewing, for a screw: its helical motion follows the same axis);
 * any other pair is left as it is, an obstacle in every direction, and named with its
-  volume wherever it stops a plan.
+  volume wherever it stops a plan; so is a pair of designed interference whose cut
+  would leave the smaller part still sharing more than the interference threshold
+  with the other.
 """
 
 from __future__ import annotations
@@ -125,7 +127,8 @@ def insertion_axis(shared: trimesh.Trimesh) -> NDArray[np.float64]:
 def _extruded_shadow(
     shared: trimesh.Trimesh, axis: NDArray[np.float64], length: float
 ) -> manifold3d.Manifold:
-    """The prism of the shadow of ``shared`` along ``axis``, ``length`` long each way."""
+    """The prism of the shadow of ``shared`` along ``axis``, ``length`` long each way
+    from the centre of ``shared``'s bounding box."""
     u = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
     u /= np.linalg.norm(u)
     v = np.cross(axis, u)
@@ -139,18 +142,21 @@ def _extruded_shadow(
         manifold3d.FillRule.Positive,
     )
     prism = manifold3d.Manifold.extrude(shadow, 2 * length)
-    frame = np.column_stack([u, v, axis, -length * axis])
+    middle = float(np.mean(shared.bounds, axis=0) @ axis)
+    frame = np.column_stack([u, v, axis, (middle - length) * axis])
     return prism.transform(frame)
 
 
-def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part:
+def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
     """``part`` without what it shares with ``other``, and without the rest of ``part``
     in that shared volume's shadow along its :func:`insertion_axis`: a screw loses its
     thread's ring along the whole shank, so that it leaves along its axis through the
     hole it is screwed into. Its exact surfaces keep the triangles that remain of them
     (:func:`_cut_surfaces`). A part that an earlier cut already took out of ``other``
     (a screw through two plates, trimmed along its whole shank by the first) is left
-    as it is: what it still shares is rounding, whose shadow means nothing."""
+    as it is: what it still shares is rounding, whose shadow means nothing. ``None``
+    when what the cut leaves of ``part`` still shares more than the interference
+    threshold with ``other`` (a cut that cannot be made)."""
     # the triangles of surface k numbered k, the others each their own number after them
     count = len(part.surfaces)
     ids = count + np.arange(len(part.mesh.faces))
@@ -158,7 +164,8 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part:
         ids[surface.faces] = k
     original_id = manifold3d.Manifold.reserve_ids(1)
     mine = solid(part.mesh, part.name, original_id=original_id, face_ids=ids)
-    common = mine ^ solid(other.mesh, other.name)
+    theirs = solid(other.mesh, other.name)
+    common = mine ^ theirs
     if common.volume() <= interference_threshold(part.mesh, other.mesh, tol):
         return part
     shared = mesh_of(_bodies(common))
@@ -170,6 +177,8 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part:
         removed = removed + _thread_tube(hole, shared, 2 * size)
     cut = _bodies(mine - removed)
     mesh, source = traced_mesh(cut, original_id)
+    if (cut ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
+        return None
     surfaces = _cut_surfaces(part, other, mesh, source, axis, tol) if part.surfaces else ()
     return replace(part, mesh=mesh, surfaces=surfaces)
 
@@ -327,10 +336,11 @@ def resolve_overlaps(
     for a, b, volume in pending:
         small, large = sorted((whole[a], whole[b]), key=lambda p: p.volume)
         limit = DESIGNED_SHARE * small.volume if ignore_overlap is None else ignore_overlap
-        if volume > limit:
+        trimmed = None if volume > limit else _trimmed(result.parts[small.name], large, tol)
+        if trimmed is None:
             overlaps.append(Overlap(a, b, volume))
             continue
-        result = result.with_part(_trimmed(result.parts[small.name], large, tol))
+        result = result.with_part(trimmed)
         overlaps.append(Overlap(a, b, volume, f"trimmed from {small.name}"))
     prepared = type(result).like(result, scale=result.scale)
     prepared.overlaps = tuple(overlaps)
