@@ -225,7 +225,8 @@ class Coset:
 
         TR groups: transporter of the characteristic invariants (closed form, with the
         failed congruence test when empty). Helical groups: the exact group meet and a
-        common point from the numeric fallback. Finite parts: pairs of components.
+        common point from the numeric fallback. Finite parts: the pairs of components that
+        may meet (:func:`_component_pairs`), with the result of meeting every pair.
         """
         tol = tol or current()
         if isinstance(other, Chain):
@@ -234,12 +235,12 @@ class Coset:
             return _lattice_coset_meet(self, other, tol)
         if self.group.is_connected and other.group.is_connected:
             return _connected_meet(self, other, tol)
-        pieces: list[Coset | EmptySet] = []
-        a0, b0 = self.group.connected_part, other.group.connected_part
-        for alpha, beta in itertools.product(self.group.reps, other.group.reps):
-            pieces.append(
-                _connected_meet(Coset(a0, alpha @ self.rep), Coset(b0, beta @ other.rep), tol)
-            )
+        a, b = self.group, other.group
+        a0, b0 = a.connected_part, b.connected_part
+        pieces = [
+            _connected_meet(Coset(a0, a.reps[i] @ self.rep), Coset(b0, b.reps[j] @ other.rep), tol)
+            for i, j in _component_pairs(self, other, tol)
+        ]
         found = [p for p in pieces if isinstance(p, Coset)]
         if not found:
             empties = [p for p in pieces if isinstance(p, EmptySet)]
@@ -264,6 +265,35 @@ class Coset:
             return Coset(k_grp, rep)
         group = _group_product(a_grp, k_grp, tol)
         return Chain((self, other)) if group is None else Coset(group, rep)
+
+
+def _component_pairs(p: Coset, q: Coset, tol: Tolerance) -> list[tuple[int, int]]:
+    """The pairs (i, j) of components A0 alpha_i a of P = A a and B0 beta_j b of Q = B b
+    that may meet, in the order of all pairs and with (0, 0) first (ALGEBRA.md §2.5
+    "Finite parts").
+
+    When B0 ⊂ A0, A0 alpha a ∩ B0 beta b is B0 beta b if beta b a^-1 is in A0 alpha and
+    empty otherwise, so each beta needs only the components of A near beta b a^-1
+    (:meth:`SymmetryGroup.components_near`); likewise when A0 ⊂ B0. The pairs are cut
+    only when the meets of components are in closed form (both groups TR, or one of
+    them of dof 0): their empty answers are all proven, so when no pair meets, the
+    answer of the pair (0, 0) is the result, as with every pair met. Otherwise every pair.
+    """
+    a, b = p.group, q.group
+    closed_form = (a.is_tr and b.is_tr) or a.dof == 0 or b.dof == 0
+    if closed_form and a.connected_part.includes(b.connected_part, tol):
+        shift = q.rep @ p.rep_inverse
+        near = [
+            (i, j) for j, beta in enumerate(b.reps) for i in a.components_near(beta @ shift, tol)
+        ]
+    elif closed_form and b.connected_part.includes(a.connected_part, tol):
+        shift = p.rep @ q.rep_inverse
+        near = [
+            (i, j) for i, alpha in enumerate(a.reps) for j in b.components_near(alpha @ shift, tol)
+        ]
+    else:
+        return list(itertools.product(range(len(a.reps)), range(len(b.reps))))
+    return sorted({(0, 0), *near})
 
 
 def _lattice_steps(bound: int) -> list[int]:
