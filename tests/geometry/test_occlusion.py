@@ -142,3 +142,49 @@ def test_triangle_overlaps_match_shapely_intersections():
     # the same polygons, vertices in order around them
     found = [shapely.Polygon(points[k, corner[k]]) for k in np.flatnonzero(solid)]
     assert shapely.area(shapely.symmetric_difference(found, overlap[solid])).max() < 1e-12
+
+
+def hull_test(meshes, direction) -> set[tuple[int, int]]:
+    """The pairs the convex-hull outlines leave possible along ``direction``."""
+    hulls = [occlusion.hull_vertices(m) for m in meshes]
+    pairs = np.array([(i, j) for i in range(len(meshes)) for j in range(len(meshes)) if i != j])
+    keep = occlusion.hulls_may_block(hulls, pairs, direction, TOL)
+    return {(int(i), int(j)) for (i, j), k in zip(pairs, keep, strict=True) if k}
+
+
+def test_hull_outlines_rule_out_sliding_and_neighbours_and_keep_what_blocks():
+    below, above = mesh_of(cube([0, 0, 0], [1, 1, 1])), mesh_of(cube([0, 0, 1], [1, 1, 2]))
+    # sliding along the face they share: the outlines meet on a segment only
+    assert hull_test([below, above], EAST) == set()
+    # lifting: only the lower block runs into the upper one
+    assert hull_test([below, above], UP) == {(0, 1)}
+    beside = mesh_of(cube([3, 0, 0], [4, 1, 1]))
+    assert hull_test([below, beside], UP) == set()
+    assert hull_test([below, beside], EAST) == {(0, 1)}
+
+
+def test_hull_outlines_of_a_tessellated_cylinder_hold_it():
+    rod = trimesh.creation.cylinder(radius=2.0, height=10.0, sections=256)
+    corners = occlusion.hull_vertices(rod)
+    assert len(corners) < len(rod.convex_hull.vertices) / 4
+    outer = trimesh.convex.convex_hull(corners)
+    assert outer.volume >= rod.volume
+    assert outer.volume < 1.1 * rod.volume
+    # every vertex of the rod inside the polytope (up to rounding)
+    normals, offsets = (
+        outer.face_normals,
+        np.einsum("ij,ij->i", outer.face_normals, outer.triangles[:, 0]),
+    )
+    assert np.all(rod.vertices @ normals.T <= offsets + 1e-9)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_hull_outlines_never_rule_out_a_block_the_meshes_show(seed):
+    # a hook and a wall placed at random, along random directions: every pair the
+    # projection test finds blocking is kept by the hull test
+    rng = np.random.default_rng(seed)
+    hook = cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4])
+    wall = cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1])
+    meshes = [mesh_of(hook), mesh_of(wall.translate(tuple(rng.uniform(-2, 2, 3))))]
+    for d in [UP, DOWN, EAST, *rng.normal(size=(12, 3))]:
+        assert blocked(meshes, d) <= hull_test(meshes, d), d

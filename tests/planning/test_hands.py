@@ -1,4 +1,4 @@
-"""Tests of the hands analysis (seed 004, "Conclusion": how many hands an assembly
+"""Tests of the hands analysis (Wilson & Latombe 1992, "Conclusion": how many hands an assembly
 needs) on the bundled planar assemblies, with an independent check of the sweeps by
 manifold3d (prisms over the polygons)."""
 
@@ -9,10 +9,12 @@ from pathlib import Path
 import manifold3d as m3
 import numpy as np
 import pytest
+import trimesh
 
 from assemblykit.blocking.planar import convex_pieces
 from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.io.polygons import load_polygons
+from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.hands import hands_needed, partitions
 from assemblykit.planning.planner import plan
 
@@ -104,3 +106,31 @@ def test_a_plan_two_hands_finish_needs_two_hands():
     assert result.hands is not None and result.hands.needed == 2
     assert result.hands.moves == ()
     assert hands_needed(load_polygons(PLANAR / "hook.yaml")).needed == 2
+
+
+def test_three_handed_move_of_meshes_between_a_floor_and_a_ceiling():
+    # the planar three-hands joint as prisms, the base's floor and ceiling holding the
+    # bar and block in their plane: the base is not convex, so Γ_e is sampled and
+    # computed by projection, and the same three-handed move separates the parts
+    model = load_polygons(PLANAR / "three_hands.yaml")
+    slab = m3.Manifold.cube([10.0, 7.0, 1.0]).translate([0.0, -1.0, 0.0])
+    base = prism(model.polygons["base"]) + slab.translate([0, 0, -1]) + slab.translate([0, 0, 1])
+
+    def mesh(body: m3.Manifold) -> trimesh.Trimesh:
+        out = body.to_mesh()
+        return trimesh.Trimesh(np.asarray(out.vert_properties)[:, :3], np.asarray(out.tri_verts))
+
+    bodies = {"base": base, **{n: prism(model.polygons[n]) for n in ("bar", "block")}}
+    assembly = Assembly([Part(name, mesh(body)) for name, body in bodies.items()])
+    hands = hands_needed(assembly)
+    assert hands.needed == 3
+    (move,) = hands.moves
+    assert move.groups == (("base",), ("bar",), ("block",))
+    velocity = {group[0]: v for group, v in zip(move.groups, move.velocities, strict=True)}
+    # in the plane of the joint: the floor and ceiling are never crossed
+    assert np.allclose([v[2] for v in velocity.values()], 0.0)
+    for moving in ("bar", "block"):
+        for still in ("base", "bar", "block"):
+            if still != moving:
+                relative = (velocity[moving] - velocity[still])[:2]
+                assert swept_overlap(model, moving, still, relative) == pytest.approx(0, abs=1e-9)

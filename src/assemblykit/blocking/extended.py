@@ -41,10 +41,11 @@ from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph
 from assemblykit.geometry.minkowski import blocks_along
-from assemblykit.geometry.occlusion import occluded_pairs, shadows
+from assemblykit.geometry.occlusion import hulls_may_block, occluded_pairs, shadows
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
+    from assemblykit.blocking.obstacles import Obstacles
     from assemblykit.model.assembly import Assembly
 
 
@@ -115,7 +116,9 @@ def extended_arcs(
                 projected.append((moving, blocker))
             elif any(blocks_along(c, d)[0] for c in cache.cones_of(moving, blocker, tol)):
                 arcs.add((moving, blocker))
-    plain = [pair for pair in projected if not cache.backout(*pair, tol).any()]
+    plain = _may_block(
+        cache, d, [pair for pair in projected if not cache.backout(*pair, tol).any()], tol
+    )
     if first_only:
         blocked = {moving for moving, _ in arcs}
         plain = [pair for pair in plain if pair[0] not in blocked]
@@ -127,6 +130,21 @@ def extended_arcs(
         if shift.any():
             arcs |= _occluded(assembly, d, [(moving, blocker)], {moving: shift}, tol)
     return arcs
+
+
+def _may_block(
+    cache: Obstacles, direction: NDArray[np.float64], pairs: list[tuple[str, str]], tol: Tolerance
+) -> list[tuple[str, str]]:
+    """The pairs (moving, blocker) of ``pairs`` whose convex hulls allow a block along
+    ``direction`` (:func:`~assemblykit.geometry.occlusion.hulls_may_block`): the others
+    need no projection of their meshes."""
+    if not pairs:
+        return pairs
+    names = sorted({name for pair in pairs for name in pair})
+    index = {name: k for k, name in enumerate(names)}
+    rows = np.array([(index[a], index[b]) for a, b in pairs], dtype=np.int64)
+    keep = hulls_may_block([cache.hull(n) for n in names], rows, direction, tol)
+    return [pair for pair, kept in zip(pairs, keep.tolist(), strict=True) if kept]
 
 
 def _occluded(

@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from assemblykit.geometry.interference import interference_threshold, shared_volume, solid
 from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
+from assemblykit.geometry.occlusion import hull_vertices
 from assemblykit.geometry.settling import settle
 from assemblykit.model.assembly import Assembly
 from assemblykit.tolerance import Tolerance
@@ -44,6 +45,7 @@ class Obstacles:
         self.cones: dict[tuple[str, str, Tolerance], list[NDArray[np.float64]]] = {}
         self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
         self.solids: dict[str, manifold3d.Manifold] = {}
+        self.hulls: dict[str, NDArray[np.float64]] = {}
         names = list(assembly.names)
         self.names = names
         bounds = np.array([assembly.parts[n].mesh.bounds for n in names]).reshape(-1, 2, 3)
@@ -61,6 +63,13 @@ class Obstacles:
     def convex(self, name: str) -> bool:
         """Whether the part is a union of convex bodies (cones are exact for it)."""
         return self.of(name) is not None
+
+    def hull(self, name: str) -> NDArray[np.float64]:
+        """The vertices of a part's convex hull (all its vertices where the hull is
+        degenerate: a flat part), found once."""
+        if name not in self.hulls:
+            self.hulls[name] = hull_vertices(self.assembly.parts[name].mesh)
+        return self.hulls[name]
 
     def solid(self, name: str) -> manifold3d.Manifold:
         """The manifold3d solid of a part's mesh, made once."""

@@ -36,6 +36,7 @@ import numpy as np
 import shapely
 import trimesh
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import HalfspaceIntersection
 
 from assemblykit.tolerance import Tolerance, current
 
@@ -97,6 +98,80 @@ class Shadows:
         p = self.plane[triangles]
         z = p[:, 0] * uv[:, 0] + p[:, 1] * uv[:, 1] + p[:, 2]
         return np.clip(z, self.low[triangles], self.high[triangles])
+
+
+_CUBE_DIRECTIONS = np.array(
+    [(x, y, z) for x in (-1, 0, 1) for y in (-1, 0, 1) for z in (-1, 0, 1) if x or y or z],
+    dtype=np.float64,
+)
+_DOP_AXES = _CUBE_DIRECTIONS / np.linalg.norm(_CUBE_DIRECTIONS, axis=1)[:, None]
+"""The 26 outward normals of a discrete-orientation polytope (the axes, the face and
+the corner diagonals of a cube)."""
+
+_LARGEST_FACES = 8
+"""How many of a hull's largest faces bound its outer polytope besides those normals."""
+
+
+def hull_vertices(mesh: trimesh.Trimesh) -> NDArray[np.float64]:
+    """The corners of a polytope holding ``mesh``: its convex hull (qhull, through
+    trimesh) cut down to the planes of the 26 :data:`_DOP_AXES` touching it and of its
+    :data:`_LARGEST_FACES` largest faces (scipy's half-space intersection), a few dozen
+    corners where a tessellated cylinder's hull has hundreds; all the mesh's vertices
+    where the hull is degenerate (a flat part). Projected along any direction, the
+    polytope's outline holds the mesh's: where two outlines do not overlap, neither do
+    the meshes (:func:`hulls_may_block`)."""
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    try:
+        hull = mesh.convex_hull
+        corners = np.asarray(hull.vertices, dtype=np.float64)
+        if len(corners) <= len(_DOP_AXES) + _LARGEST_FACES:
+            return corners
+        largest = np.argsort(-hull.area_faces, kind="stable")[:_LARGEST_FACES]
+        normals = np.vstack([_DOP_AXES, hull.face_normals[largest]])
+        offsets = (corners @ normals.T).max(axis=0)
+        planes = np.column_stack([normals, -offsets])
+        cut = HalfspaceIntersection(planes, corners.mean(axis=0)).intersections
+    except Exception:  # qhull refuses flat and degenerate point sets
+        return vertices
+    return np.asarray(cut, dtype=np.float64) if np.all(np.isfinite(cut)) else corners
+
+
+def hulls_may_block(
+    hulls: Sequence[NDArray[np.float64]],
+    pairs: NDArray[np.int64],
+    direction: ArrayLike,
+    tol: Tolerance | None = None,
+) -> NDArray[np.bool_]:
+    """Per pair ``(i, j)`` of ``pairs`` (rows of indices into ``hulls``, each the points
+    of a part's convex hull), whether ``j`` may block the extended translation of ``i``
+    along ``direction``: the projections of their hulls on the plane ``⟂ d`` meet over
+    an area and some point of ``j`` lies deeper than every point of ``i`` by more than
+    the length tolerance. Where either fails, no two triangles of the parts can show a
+    block (module docstring): the overlaps of their projections lie in the hulls'
+    overlap, so their inradius is at most that of the hulls' overlap, and an overlap of
+    area ``A`` and perimeter ``P`` has an inradius of at most ``2 A / P``; so an overlap
+    of the hulls with ``A <= P tol / 2`` holds no triangle overlap that counts
+    (``A > P tol``, as :func:`occluded_pairs` counts them). All pairs at once (shapely's
+    vectorised hulls and intersections)."""
+    tol = tol or current()
+    if not len(pairs):
+        return np.zeros(0, dtype=bool)
+    frame = view_frame(direction)
+    used = np.unique(pairs)
+    seen = [np.asarray(hulls[k], dtype=np.float64) @ frame.T for k in used]
+    owner = np.repeat(np.arange(len(used)), [len(s) for s in seen])
+    points = np.concatenate(seen)
+    outlines = shapely.convex_hull(shapely.multipoints(points[:, :2], indices=owner))
+    deepest = np.full(len(used), -np.inf)
+    lowest = np.full(len(used), np.inf)
+    np.maximum.at(deepest, owner, points[:, 2])
+    np.minimum.at(lowest, owner, points[:, 2])
+    place = np.searchsorted(used, pairs)
+    moving, blocker = place[:, 0], place[:, 1]
+    ahead = deepest[blocker] - lowest[moving] > tol.length
+    shared = shapely.intersection(outlines[moving], outlines[blocker])
+    wide = shapely.area(shared) > 0.5 * tol.length * shapely.length(shared)
+    return np.asarray(ahead & wide, dtype=bool)
 
 
 def _shadow_width(flat: NDArray[np.float64]) -> NDArray[np.float64]:

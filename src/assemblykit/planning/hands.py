@@ -31,7 +31,7 @@ used, ``None`` when ``max_hands`` do not suffice.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -39,10 +39,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.blocking.directions import DirectionTable, bits, mask_of, several
+from assemblykit.blocking.extended import all_convex, extended_arcs
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 from assemblykit.blocking.polygons import PolygonAssembly
-from assemblykit.planning.sequence import Hands, HandsMove, Search
+from assemblykit.planning.sequence import ExtendedDirections, Hands, HandsMove, Search
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -87,27 +88,37 @@ def partitions(items: Sequence[int], k: int) -> Iterator[tuple[tuple[int, ...], 
 
 @dataclass
 class _HandsSearch:
-    ndbg: NonDirectionalBlockingGraph
-    table: DirectionTable
+    """The search of :func:`hands_needed` over candidate directions: Γ_t along them
+    (``translations``) is necessary for a group to leave, Γ_e (``extended``: a table,
+    or computed part by part as asked) decides; ``leaves(group, others, d)`` decides
+    exactly along any direction ``d`` (the relative directions of two moving groups)."""
+
+    translations: DirectionTable
+    extended: DirectionTable | ExtendedDirections
+    leaves: Callable[[int, int, NDArray[np.float64]], bool]
+    circles: NDArray[np.float64]
     sizes: tuple[float, ...]
     max_hands: int
     tol: Tolerance
 
     def __post_init__(self) -> None:
-        self.masks = [self.table.masks(k) for k in range(len(self.table.directions))]
-        self.circles = np.asarray(self.ndbg.arrangement.normals, dtype=np.float64)
+        self.necessary = [self.translations.masks(k) for k in range(len(self.directions))]
+
+    @property
+    def directions(self) -> NDArray[np.float64]:
+        return self.translations.directions
 
     def free(self, group: int, others: int, k: int) -> bool:
-        """Whether ``group`` leaves ``others`` along candidate direction ``k``."""
-        return all(self.masks[k][i] & others == 0 for i in bits(group))
+        """Whether ``group`` leaves ``others`` along candidate direction ``k``: no part
+        of ``others`` blocks one of ``group`` in Γ_t, then in Γ_e."""
+        if any(self.necessary[k][i] & others for i in bits(group)):
+            return False
+        held = self.extended.blockers(k, group, group | others)
+        return not any(mask & others for mask in held.values())
 
     def free_along(self, group: int, others: int, direction: NDArray[np.float64]) -> bool:
         """Whether ``group`` leaves ``others`` along any ``direction`` (exact)."""
-        names = self.table.names
-        dbg = self.ndbg.dbg(direction)
-        inside = {names[i] for i in bits(group)}
-        outside = {names[j] for j in bits(others)}
-        return not any(i in inside and j in outside for i, j in dbg.arcs)
+        return self.leaves(group, others, direction)
 
     def ratios(self, d_g: NDArray[np.float64], d_h: NDArray[np.float64]) -> list[float]:
         """Speed ratios ``r`` at which ``r d_g − d_h`` meets each region of the
@@ -135,7 +146,7 @@ class _HandsSearch:
         group at unit speed along one of its free directions, each other moving group
         along one of its own with a speed ratio against the last (module docstring),
         every two moving groups checked."""
-        directions = self.table.directions
+        directions = self.directions
         options = []
         for g in groups[1:]:
             ks = [k for k in range(len(directions)) if self.free(g, groups[0], k)]
@@ -159,7 +170,7 @@ class _HandsSearch:
         if g == last:
             return chosen
         for k in options[g - 1]:
-            d = self.table.directions[k]
+            d = self.directions[k]
             for r in self.ratios(d, d_last):
                 v = r * d
                 if not self.relative_ok(groups[g], groups[last], v, d_last):
@@ -179,7 +190,7 @@ class _HandsSearch:
         parts = sorted(bits(members), key=lambda i: (-self.sizes[i], i))
         if len(parts) > HANDS_MAX_PARTS:
             return None
-        names = self.table.names
+        names = self.translations.names
         for k in range(3, self.max_hands + 1):
             for split in partitions(parts, k):
                 groups = tuple(mask_of(g) for g in split)
@@ -189,18 +200,22 @@ class _HandsSearch:
                     return HandsMove(labels, velocities)
         return None
 
-    def take_apart(self, members: int) -> tuple[int | None, list[HandsMove]]:
+    def take_apart(self, members: int, locked: bool = False) -> tuple[int | None, list[HandsMove]]:
         """Hands needed for ``members`` and the operations with more than two, taking
-        it apart with two hands wherever the planner's search can."""
+        it apart with two hands wherever the planner's search can (``locked``: it is
+        known that it cannot, ``members`` goes straight to the split)."""
         if not several(members):
             return 1, []
-        search = Search(self.table, self.table, self.sizes, lambda *_: None, [], [])
-        search.disassemble(members)
+        stopped = [members]
+        if not locked:
+            search = Search(self.translations, self.extended, self.sizes, lambda *_: None, [], [])
+            search.disassemble(members)
+            stopped = search.locked
         needed = 2
         moves: list[HandsMove] = []
-        index = {name: i for i, name in enumerate(self.table.names)}
-        for locked in search.locked:
-            move = self.split(locked)
+        index = {name: i for i, name in enumerate(self.translations.names)}
+        for locked_set in stopped:
+            move = self.split(locked_set)
             if move is None:
                 return None, moves
             moves.append(move)
@@ -219,16 +234,64 @@ def hands_needed(
     parts: Sequence[str] | None = None,
     max_hands: int = MAX_HANDS,
     tol: Tolerance | None = None,
+    *,
+    locked: bool = False,
 ) -> Hands:
     """How many hands (up to ``max_hands``) take ``parts`` (default: all) of
     ``assembly`` apart by translations, and the operations with more than two hands
-    (module docstring). Works for 3D assemblies and polygon assemblies alike."""
+    (module docstring). Works for 3D assemblies and polygon assemblies alike.
+    ``locked``: the parts are known not to come apart with two hands (a set where the
+    planner stopped), so no two-handed search is made of them first."""
     tol = assembly.tolerance(tol)
     names = tuple(assembly.names if parts is None else parts)
+    if isinstance(assembly, PolygonAssembly) or all_convex(assembly, names):
+        search = _exact_search(assembly, names, max_hands, tol)
+    else:
+        search = _sampled_search(assembly, names, max_hands, tol)
+    needed, moves = search.take_apart(mask_of(range(len(search.translations.names))), locked)
+    return Hands(needed, max_hands, tuple(moves))
+
+
+def _exact_search(
+    assembly: Assembly | PolygonAssembly, names: tuple[str, ...], max_hands: int, tol: Tolerance
+) -> _HandsSearch:
+    """The search over the exact Γ_e NDBG (polygons, convex parts): its regions'
+    DBGs serve as both tables, its terms decide any direction."""
     ndbg = blocking_graph(assembly, "extended", parts=names, tol=tol)
     assert isinstance(ndbg, NonDirectionalBlockingGraph)
     table = ndbg.direction_table()
+
+    def leaves(group: int, others: int, direction: NDArray[np.float64]) -> bool:
+        arcs = ndbg.dbg(direction).arcs
+        inside = {table.names[i] for i in bits(group)}
+        outside = {table.names[j] for j in bits(others)}
+        return not any(i in inside and j in outside for i, j in arcs)
+
     sizes = _sizes(assembly)
-    search = _HandsSearch(ndbg, table, tuple(sizes[n] for n in table.names), max_hands, tol)
-    needed, moves = search.take_apart(mask_of(range(len(table.names))))
-    return Hands(needed, max_hands, tuple(moves))
+    circles = np.asarray(ndbg.arrangement.normals, dtype=np.float64)
+    parts = tuple(sizes[n] for n in table.names)
+    return _HandsSearch(table, table, leaves, circles, parts, max_hands, tol)
+
+
+def _sampled_search(
+    assembly: Assembly, names: tuple[str, ...], max_hands: int, tol: Tolerance
+) -> _HandsSearch:
+    """The search for parts that are not all convex, as the planner searches: the
+    regions of Γ_t of ``names`` give the candidate directions, Γ_e is computed exactly
+    along them only where Γ_t lets a group leave, and along any relative direction by
+    the projection test (:func:`~assemblykit.blocking.extended.extended_arcs`)."""
+    local = blocking_graph(assembly, "infinitesimal", parts=names, tol=tol)
+    translations = local.direction_table()
+    parts = assembly.subset(names)
+    extended = ExtendedDirections(parts, translations.directions, tol)
+    order = translations.names
+
+    def leaves(group: int, others: int, direction: NDArray[np.float64]) -> bool:
+        moving = [order[i] for i in bits(group)]
+        still = [order[j] for j in bits(others)]
+        return not extended_arcs(parts, direction, moving, still, tol)
+
+    sizes = _sizes(assembly)
+    circles = np.asarray(local.arrangement.normals, dtype=np.float64)
+    volumes = tuple(sizes[n] for n in order)
+    return _HandsSearch(translations, extended, leaves, circles, volumes, max_hands, tol)

@@ -223,7 +223,7 @@ def finish_plan(
         report("hands", 0, len(search.locked))
         # each stopped set on its own: its groups never need the parts already removed
         found = [
-            hands_needed(assembly, [names[i] for i in bits(members)], max_hands, tol)
+            hands_needed(assembly, [names[i] for i in bits(members)], max_hands, tol, locked=True)
             for members in search.locked
         ]
         needed = [h.needed for h in found]
