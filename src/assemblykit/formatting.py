@@ -2,9 +2,11 @@
 (the HTML report, notebook tables, ``repr``s, CSV exports).
 
 A value within the tolerance of zero prints as ``0`` (``6.1e-17`` from ``cos(pi/2)`` is
-noise, not information); others keep ``DIGITS`` significant digits. A unit vector along a
-coordinate axis prints as ``+Z`` or ``-X``; any other vector as ``(0.7071, 0, 0.7071)``.
-Column headers carry the model's length unit when one is known (``offset (mm)``).
+noise, not information); others keep ``DIGITS`` significant digits. A direction within
+the angle tolerance of a coordinate axis prints as ``+Z`` or ``-X``; any other as its
+components to ``DIGITS`` decimals of its length, ``(0.7071, 0, 0.7071)``: never an
+exponent, never ``-0`` (docs/architecture.md, "Numbers for people"). Column headers
+carry the model's length unit when one is known (``offset (mm)``).
 
 >>> number(6.123233995736766e-17)
 '0'
@@ -14,6 +16,10 @@ Column headers carry the model's length unit when one is known (``offset (mm)``)
 '-Y'
 >>> direction([0.6, 0.0, 0.8])
 '(0.6, 0, 0.8)'
+>>> direction([1.0, 2.952e-05, -6.795e-06])  # 3e-5 rad from +X: not within 1e-9 rad
+'(1, 0, 0)'
+>>> direction([1.0, 2.952e-05, -6.795e-06], Tolerance(angle=1e-4))
+'+X'
 >>> header("distance", "mm")
 'distance (mm)'
 >>> name_list(["a", "b", "c", "d", "e", "f"], limit=3)
@@ -23,7 +29,9 @@ Column headers carry the model's length unit when one is known (``offset (mm)``)
 from __future__ import annotations
 
 import html
+import math
 from collections.abc import Iterable, Sequence
+from decimal import Decimal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -61,16 +69,83 @@ def vector(values: ArrayLike, tol: Tolerance | None = None, digits: int = DIGITS
     return "(" + ", ".join(number(x, tol, digits) for x in np.ravel(values)) + ")"
 
 
-def direction(values: ArrayLike, tol: Tolerance | None = None, digits: int = DIGITS) -> str:
-    """A direction as a signed coordinate axis (``+Z``, ``-X``) when every other
-    component is within the angle tolerance of zero, else as :func:`vector`."""
+def axis_angle(values: ArrayLike) -> tuple[int, float]:
+    """The coordinate axis nearest the vector ``values`` (its largest component's index)
+    and the angle to it in radians (``atan2`` of the other components' length over that
+    component's size); ``(-1, nan)`` for a zero or non-finite vector."""
     v = np.asarray(values, dtype=np.float64).ravel()
+    if not len(v) or not np.all(np.isfinite(v)) or not np.any(v):
+        return -1, math.nan
+    i = int(np.argmax(np.abs(v)))
+    rest = float(np.linalg.norm(np.delete(v, i)))
+    return i, math.atan2(rest, abs(float(v[i])))
+
+
+def axis_name(values: ArrayLike, tol: Tolerance | None = None) -> str | None:
+    """``+X``, ``-Y``, ... when the direction ``values`` (2 or 3 components) lies within
+    the angle tolerance (``tol.angle``, tolerance.py) of that axis, else ``None``."""
     tol = current() if tol is None else tol
-    big = np.flatnonzero(np.abs(v) > tol.angle)
-    if len(big) == 1 and len(v) <= len(AXES):
-        i = int(big[0])
-        return ("+" if v[i] > 0 else "-") + AXES[i]
-    return vector(v, tol, digits)
+    v = np.asarray(values, dtype=np.float64).ravel()
+    i, angle = axis_angle(v)
+    if i < 0 or len(v) > len(AXES) or not angle <= tol.angle:
+        return None
+    return ("+" if v[i] > 0 else "-") + AXES[i]
+
+
+def fixed(value: int, decimals: int) -> str:
+    """The number ``value x 10**-decimals`` written out in full (no exponent, no trailing
+    zeros, ``0`` never signed), computed exactly from the integer ``value``.
+
+    >>> fixed(-70710, 5), fixed(0, 4), fixed(123, -2)
+    ('-0.7071', '0', '12300')
+    """
+    if value == 0:
+        return "0"
+    text = format(Decimal(value).scaleb(-decimals).normalize(), "f")
+    return text.rstrip("0").rstrip(".") if "." in text else text
+
+
+def length(values: ArrayLike) -> float:
+    """The Euclidean length of a finite vector, without overflow for huge components."""
+    v = np.asarray(values, dtype=np.float64).ravel()
+    largest = float(np.max(np.abs(v))) if len(v) else 0.0
+    return largest * float(np.linalg.norm(v / largest)) if largest > 0 else 0.0
+
+
+def components(values: ArrayLike, digits: int = DIGITS, size: float | None = None) -> str:
+    """A vector as ``(x, y, z)``, each component rounded to ``digits`` decimals of
+    ``size`` (default: the vector's length; ``1e-4`` of a unit vector): a component far
+    below the others prints as ``0``, not as an exponent, and never as ``-0``."""
+    v = np.asarray(values, dtype=np.float64).ravel()
+    if not np.all(np.isfinite(v)):
+        return vector(v)
+    size = length(v) if size is None else size
+    if not size > 0:
+        return "(" + ", ".join("0" for _ in v) + ")"
+    decimals = digits - math.floor(math.log10(size))
+    scaled = (Decimal(float(x)).scaleb(decimals).to_integral_value() for x in v)
+    return "(" + ", ".join(fixed(int(k), decimals) for k in scaled) + ")"
+
+
+def direction(values: ArrayLike, tol: Tolerance | None = None, digits: int = DIGITS) -> str:
+    """A direction for people: a signed coordinate axis (``+Z``, ``-X``) when it lies
+    within the angle tolerance of one (:func:`axis_name`), else its :func:`components`
+    (docs/architecture.md, "Numbers for people"). JSON keeps the exact vector."""
+    return axis_name(values, tol) or components(values, digits)
+
+
+def twist(values: ArrayLike, digits: int = DIGITS) -> str:
+    """An infinitesimal rigid motion ``(omega; v)`` (six components, Wilson & Latombe
+    1992; docs/architecture.md, "Conventions") as ``(wx, wy, wz; vx, vy, vz)``, both
+    halves by :func:`components` to ``digits`` decimals of the whole twist's length.
+
+    >>> twist([0.0, 0.0, 1.0, 2e-17, -0.5, 0.0])
+    '(0, 0, 1; 0, -0.5, 0)'
+    """
+    v = np.asarray(values, dtype=np.float64).ravel()
+    half, size = len(v) // 2, length(v) if np.all(np.isfinite(v)) else None
+    first, second = components(v[:half], digits, size), components(v[half:], digits, size)
+    return f"{first[:-1]}; {second[1:]}"
 
 
 def header(name: str, units: str | None = None) -> str:

@@ -1,11 +1,11 @@
 """The readable form of every result: the rich tables and lines of text the commands print
 without ``--json``.
 
-The algorithms return data (``to_dict()`` gives the JSON of DESIGN.md §5.3); :func:`render`
-turns any of their results into a rich renderable, dispatched on the result's type
-(:func:`functools.singledispatch`). The renderers of a package's results are registered
-the first time one of its results is rendered, so that printing a solution does not
-import the planners.
+The algorithms return data (``to_dict()`` gives the JSON of docs/architecture.md,
+"Results and errors"); :func:`render` turns any of their results into a rich renderable,
+dispatched on the result's type (:func:`functools.singledispatch`). The renderers of a
+package's results are registered the first time one of its results is rendered, so that
+printing a solution does not import the planners.
 
 >>> from pathlib import Path
 >>> import assemblykit
@@ -35,6 +35,8 @@ from rich.text import Text
 from assemblykit import formatting as fmt
 
 if TYPE_CHECKING:
+    from numpy.typing import NDArray
+
     from assemblykit.batch import BatchSummary
     from assemblykit.blocking.dbg import Removal
     from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
@@ -199,19 +201,21 @@ def _mating(result: MatingResult) -> Group:
     return Group(*lines)
 
 
-def _removals(title: str, kind: str, example: str, removals: list[Removal]) -> Table:
+def _removals(
+    title: str,
+    kind: str,
+    example: str,
+    removals: list[Removal],
+    shown: Callable[[NDArray[np.float64]], str],
+) -> Table:
     """The removable subassemblies (Wilson & Latombe 1992): parts, how many ``kind`` free
-    them, and the first one as an ``example``."""
+    them, and the first one as an ``example``, written by ``shown``."""
     table = Table(title=title)
     table.add_column("removable parts")
     table.add_column(kind)
     table.add_column(example)
     for r in removals:
-        table.add_row(
-            ", ".join(sorted(r.parts)),
-            str(len(r.directions)),
-            np.array2string(r.directions[0], precision=3),
-        )
+        table.add_row(", ".join(sorted(r.parts)), str(len(r.directions)), shown(r.directions[0]))
     return table
 
 
@@ -225,6 +229,7 @@ def _ndbg(result: NonDirectionalBlockingGraph) -> Table:
         "directions",
         "e.g.",
         result.removable(),
+        lambda d: fmt.direction(d, result.tol),
     )
 
 
@@ -237,6 +242,7 @@ def _rigid(result: RigidBlockingGraph) -> Table:
         "twists",
         "e.g. (omega; v)",
         result.removable(),
+        fmt.twist,
     )
 
 
@@ -396,25 +402,19 @@ def _screw(result: ScrewPlan) -> Table:
     for k, stage in enumerate(result.stages):
         for step in stage.steps:
             number += 1
-            direction = ", ".join(f"{x:.3g}" for x in step.direction)
+            direction = fmt.direction(step.direction)
             table.add_row(str(number), ", ".join(step.parts), step.motion, "-", direction)
         if k < len(result.screws):
             turn = result.screws[k]
             number += 1
-            axis = (
-                "("
-                + ", ".join(f"{x:.3g}" for x in turn.point)
-                + "; "
-                + ", ".join(f"{x:.3g}" for x in turn.axis)
-                + ")"
-            )
+            axis = f"({fmt.vector(turn.point)[1:-1]}; {fmt.direction(turn.axis)})"
             table.add_row(
                 str(number),
                 ", ".join(turn.parts),
                 f"turn {math.degrees(turn.angle):.1f} deg"
                 + (f", pitch {turn.pitch:.4g} per rad" if turn.pitch else ""),
                 axis,
-                ", ".join(f"{x:.3g}" for x in turn.exit),
+                fmt.direction(turn.exit),
             )
     if not result.feasible:
         table.caption = "stuck: " + ", ".join(result.stages[-1].stuck)
@@ -434,8 +434,9 @@ def _contacts(result: ContactReport) -> Group:
     contacts = Table(title=f"{len(result.contacts)} contacts")
     for column in ("a", "b", "planar area", "normals", "curved"):
         contacts.add_column(column)
+    working = asm.tolerance(result.policy)
     for c in result.contacts:
-        normals = "; ".join("(" + ", ".join(f"{x:.3g}" for x in p.normal) + ")" for p in c.planar)
+        normals = "; ".join(fmt.direction(p.normal, working) for p in c.planar)
         curved = ", ".join(f"{p.kind} r={p.radius:.6g} inner={p.inner}" for p in c.curved)
         contacts.add_row(c.a, c.b, f"{c.area:.6g}", normals, curved)
     clashes = (

@@ -13,6 +13,7 @@ import trimesh
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.exports import CSV_COLUMNS, write_gltf, write_plan
 from assemblykit.planning.sequence import Plan, Step
+from assemblykit.viz.viewer import part_colors
 from cli_runs import run
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -66,8 +67,29 @@ def test_json_export_is_the_plan_json_and_gltf_text_reads_back(tmp_path):
     plan = Plan(tuple(assembly.names), (step,), (), None, 2)
     data = json.loads(write_plan(plan, tmp_path / "p.json").read_text(encoding="utf-8"))
     assert data["steps"][0]["direction"] == [1.0, 0.0, 0.0]
+    assert data["steps"][0]["direction_label"] == "+X"  # beside the vector, in words
+    assert data["assembly_steps"][0]["direction_label"] == "-X"
     assert data["order"] == [["plug"]] and data["feasible"] is True
     loaded = trimesh.load(write_gltf(assembly, plan, tmp_path / "x.gltf"))
     assert len(loaded.geometry) == 14
     # the plug leaves along +x by 1.25 x its length (x from 60 to 70)
     assert np.allclose(loaded.graph["plug"][0][:3, 3], [12.5, 0, 0])
+
+
+def test_each_part_of_the_gltf_scene_has_the_colour_of_the_report_legend(tmp_path):
+    assembly = load_assembly(DEMO)
+    step = Step(("cover",), UP, ("base", "housing"), ())
+    plan = Plan(tuple(assembly.names), (step,), (), None, 2)
+    legend = part_colors(assembly.names)
+    assert (legend["cover"], legend["gear_a"], legend["housing"]) == (
+        "#00CC96",  # green
+        "#FECB52",  # yellow
+        "#EF553B",  # red
+    )
+    for suffix in (".glb", ".gltf"):
+        loaded = trimesh.load(write_gltf(assembly, plan, tmp_path / f"x{suffix}"))
+        for name, color in legend.items():
+            material = loaded.geometry[name].visual.material
+            red, green, blue = (int(color[i : i + 2], 16) for i in (1, 3, 5))
+            assert list(material.baseColorFactor) == [red, green, blue, 255], (suffix, name)
+            assert material.metallicFactor == 0.0

@@ -1,8 +1,10 @@
 """The HTML report in a real browser: headless Chromium with the network off opens the
-file, draws the assembled model large, highlights the parts of the shown step with an
-arrow along its direction, and plays the steps; the same on the 184-block crossvault
+file, draws the assembled model large in the colours of its part list, highlights the
+parts of the shown step (every other part one grey) with an arrow that starts on them,
+along the step's direction, and plays the steps; the same on the 184-block crossvault
 (bundled) and the 527-block dome (when ``$ASSEMBLYKIT_DATA`` holds it), whose reports are
-written in under 5 s and 25 MB.
+written in under 5 s and 25 MB. Colours are measured on screenshots: by hue where the
+view is shaded, exactly where the test switches the shading off.
 
 Driven through Chromium's DevTools protocol (``--remote-debugging-port``) with the
 ``websocket-client`` package. Without Chromium or that package a test is skipped, or
@@ -28,12 +30,13 @@ from typing import Any, NoReturn, TypeVar
 
 import numpy as np
 import pytest
+import trimesh
 from PIL import Image
 
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.sequence import Plan, Step
-from assemblykit.viz.viewer import ARROW_FRACTION, PALETTE, write_report
+from assemblykit.viz.viewer import ARROW_FRACTION, DIM_COLOR, PALETTE, write_report
 from datasets import dataset
 
 pytestmark = pytest.mark.browser
@@ -58,6 +61,9 @@ DEADLINE = 30.0
 """Seconds to wait for the browser, the page or the drawing before failing."""
 POLL = 0.1
 UP = np.array([0.0, 0.0, 1.0])
+ON_THE_PARTS = 1e-3
+"""Largest distance, as a fraction of the assembly's size, from the back of a step's arrow
+to the nearest moved part (the page rounds the arrow's vertices)."""
 LIFTED = ("cover", "pin_1", "pin_2", "pin_3", "pin_4")
 
 T = TypeVar("T")
@@ -278,38 +284,124 @@ def gearbox_report(tmp_path: Path) -> Path:
     return write_report(assembly, plan, tmp_path / "report.html")
 
 
-def show_step_one(browser: DevTools) -> dict[str, Any]:
-    """Move the slider to step 1; what the page then draws: the face colour slots, the
-    arrow trace, the caption and the highlighted table rows."""
+def show_step(browser: DevTools, number: int) -> dict[str, Any]:
+    """Move the slider to step ``number``; what the page then draws: the face colours,
+    the arrow trace, how far the step's parts moved and along which direction, the
+    caption and the highlighted table rows."""
     browser.evaluate(
-        "(() => { const s = document.getElementById('step-slider'); s.value = 1;"
-        " s.dispatchEvent(new Event('input')); })()"
+        "(() => { const s = document.getElementById('step-slider');"
+        f" s.value = {number}; s.dispatchEvent(new Event('input')); }})()"
     )
     return browser.wait_for(
-        "(() => { const gd = document.getElementById('assembly-view');"
-        " if (gd.dataset.step !== '1') return null;"
-        " return {intensity: Array.from(gd.data[0].intensity), arrow: gd.data[1].visible,"
+        "(() => { const gd = document.getElementById('assembly-view'),"
+        " P = window.assemblyReport.data;"
+        f" if (gd.dataset.step !== '{number}') return null;"
+        " return {facecolor: Array.from(gd.data[0].facecolor), arrow: gd.data[1].visible,"
         " x: Array.from(gd.data[1].x), y: Array.from(gd.data[1].y),"
         " z: Array.from(gd.data[1].z),"
+        f" moved: P.travel[{number}] - P.travel[{number - 1}],"
+        f" direction: P.directions[{number - 1}],"
         " caption: document.getElementById('caption').textContent,"
         " current: Array.from(document.querySelectorAll('tr.current'), r => r.dataset.step)};"
         " })()"
     )
 
 
+def show_step_one(browser: DevTools) -> dict[str, Any]:
+    """:func:`show_step` 1."""
+    return show_step(browser, 1)
+
+
+def legend(browser: DevTools) -> dict[str, np.ndarray]:
+    """The colour of each part in the report's part list, as the page draws it."""
+    swatches = browser.evaluate(
+        "Array.from(document.querySelectorAll('.swatch'), s =>"
+        " [s.parentElement.textContent, getComputedStyle(s).backgroundColor])"
+    )
+    return {
+        name: np.array([int(c) for c in color[color.index("(") + 1 : -1].split(",")[:3]])
+        for name, color in swatches
+    }
+
+
+def arrow_gap(shown: dict[str, Any], assembly: Assembly, moved: Sequence[str]) -> float:
+    """How far the back end of the shown arrow (the centre of its shaft's end) is from
+    the nearest of the ``moved`` parts, where the step has moved them; as a fraction of
+    the assembly's size."""
+    arrow = np.column_stack([shown["x"], shown["y"], shown["z"]])
+    d = np.asarray(shown["direction"], dtype=np.float64)
+    heights = arrow @ d
+    tail = arrow[heights < heights.min() + 1e-4 * assembly.scale].mean(axis=0)
+    shift = d * shown["moved"]
+    gaps = [
+        trimesh.proximity.closest_point(
+            assembly.parts[n].mesh.copy().apply_translation(shift), [tail]
+        )[1][0]
+        for n in moved
+    ]
+    return float(min(gaps)) / assembly.scale
+
+
+def chromaticity(pixels: np.ndarray) -> np.ndarray:
+    """Each colour's share of red, green and blue (what shading leaves of its hue)."""
+    rgb = np.asarray(pixels, dtype=np.float64).reshape(-1, 3)
+    return rgb / np.maximum(rgb.sum(axis=1, keepdims=True), 1)
+
+
+NEUTRAL = 12
+"""A pixel whose red, green and blue differ by at most this much is grey."""
+HUE = 0.05
+"""A shaded pixel shows a colour when their chromaticities differ by at most this much."""
+
+
+def colored_pixels(image: np.ndarray) -> np.ndarray:
+    """The painted pixels that are not grey (nor dark, where hues blur)."""
+    spread = image.max(axis=2) - image.min(axis=2)
+    return image[painted(image) & (spread > NEUTRAL) & (image.sum(axis=2) > 120)]
+
+
+def showing(pixels: np.ndarray, color: np.ndarray) -> np.ndarray:
+    """Which of ``pixels`` show ``color`` under the view's lighting."""
+    return np.abs(chromaticity(pixels) - chromaticity(color)).max(axis=1) <= HUE
+
+
+FLAT = (
+    "Plotly.restyle(document.getElementById('assembly-view'), {lighting: {ambient: 1,"
+    " diffuse: 0, specular: 0, fresnel: 0, roughness: 1}}, [0])"
+)
+"""Switch the parts' shading off: each pixel then shows its face's colour as it is."""
+HIDE_AXES = "Plotly.restyle(document.getElementById('assembly-view'), {visible: false}, [2, 3])"
+"""Hide the axis triad and its labels (their colours are not the parts')."""
+EXACT = 3
+"""A pixel drawn without shading shows a colour when no channel differs by more."""
+
+
+def check_dimmed_grey(image: np.ndarray, colors: Sequence[np.ndarray]) -> None:
+    """Every part but the step's drawn (without shading) in the one neutral grey: nearly
+    all painted pixels are grey, and most of the others show one of ``colors`` (the
+    moved parts'; the rest are their anti-aliased edges)."""
+    coloured = colored_pixels(image)
+    assert len(coloured) < 0.2 * painted(image).sum(), "the parts left are not grey"
+    exact = np.zeros(len(coloured), dtype=bool)
+    for color in colors:
+        exact |= np.abs(coloured - color).max(axis=1) <= EXACT
+    assert exact.mean() > 0.5, f"{exact.mean():.0%} of the coloured pixels in the step's colours"
+
+
 def check_step_one(shown: dict[str, Any], assembly: Assembly, moved: Sequence[str]) -> None:
     """The parts ``moved`` in step 1 (along +z) in their own colours, every other part
-    dimmed; a visible arrow along +z, ``ARROW_FRACTION`` of the assembly's diagonal long,
-    starting above the moved parts; the step's table row marked."""
+    in the one neutral grey; a visible arrow along +z, ``ARROW_FRACTION`` of the
+    assembly's diagonal long, starting on the moved parts, above them; the step's table
+    row marked."""
     faces = np.cumsum([0] + [len(p.mesh.faces) for p in assembly])
-    slots = np.asarray(shown["intensity"])
-    assert len(slots) == faces[-1]
+    colors = np.asarray(shown["facecolor"])
+    assert len(colors) == faces[-1]
     for index, name in enumerate(assembly.names):
-        own = slots[faces[index] : faces[index + 1]]
+        own = colors[faces[index] : faces[index + 1]]
         if name in moved:  # in its own colour
-            assert np.all(own == index % len(PALETTE)), name
+            assert np.all(own == PALETTE[index % len(PALETTE)]), name
         else:  # dimmed
-            assert np.all(own == index % len(PALETTE) + len(PALETTE)), name
+            assert np.all(own == DIM_COLOR), name
     assert shown["arrow"] is True
     arrow = np.column_stack([shown["x"], shown["y"], shown["z"]])
     spread = arrow.max(axis=0) - arrow.min(axis=0)
@@ -318,6 +410,7 @@ def check_step_one(shown: dict[str, Any], assembly: Assembly, moved: Sequence[st
     assert spread[2] > 2.5 * max(spread[0], spread[1])
     top = max(assembly.parts[n].mesh.bounds[1][2] for n in moved)
     assert arrow[:, 2].min() > top  # above the lifted parts
+    assert arrow_gap(shown, assembly, moved) < ON_THE_PARTS  # starting on them
     assert shown["current"] == ["1"]
 
 
@@ -330,6 +423,11 @@ def test_the_gearbox_fills_the_view_step_one_is_highlighted_and_play_walks_on(
     before = browser.drawn(scene)
     width, height = painted_box(before)
     assert width > 1 / 3 and height > 1 / 3  # the assembled state fills the view
+    # the parts in the colours of the legend: the cover green, the housing red and the
+    # base blue, each a good part of the picture (shaded, so compared by hue)
+    colors, coloured = legend(browser), colored_pixels(before)
+    for name in ("cover", "housing", "base"):
+        assert showing(coloured, colors[name]).sum() > 0.15 * painted(before).sum(), name
 
     shown = show_step_one(browser)
     check_step_one(shown, load_assembly(DEMO), LIFTED)
@@ -368,13 +466,31 @@ def test_a_large_report_is_small_large_on_screen_and_highlights_step_one(
     scene = browser.open(page)
     width, height = painted_box(browser.drawn(scene))
     assert width > 1 / 3 and height > 1 / 3
-    legend = browser.evaluate("document.querySelectorAll('#assembly-view .legend').length")
-    assert legend == 0
+    legends = browser.evaluate("document.querySelectorAll('#assembly-view .legend').length")
+    assert legends == 0
     # long lists are folded: 39 steps of hundreds of parts fit in a few screens
     assert browser.evaluate("document.body.scrollHeight") < 6000
+    before = browser.drawn(scene)
     shown = show_step_one(browser)
     check_step_one(shown, assembly, plan.steps[0].parts)
     assert shown["caption"].startswith(f"Step 1 of {len(plan.steps)}: ")
+    # the parts still assembled all in one grey: the moved ones the only colours (drawn
+    # without shading, the axis triad hidden)
+    browser.evaluate(FLAT)
+    browser.evaluate(HIDE_AXES)
+    until(
+        lambda: np.any(np.abs(browser.screenshot(scene) - before) > 30, axis=2).mean() > 0.001,
+        "step 1 drawn",
+    )
+    colors = legend(browser)
+    check_dimmed_grey(browser.drawn(scene), [colors[n] for n in plan.steps[0].parts])
+    # the last layer: blocks on the feet, far apart; the arrow starts on one of them,
+    # not in the air between them
+    last = plan.steps[-1].parts
+    shown = show_step(browser, len(plan.steps))
+    assert arrow_gap(shown, assembly, last) < ON_THE_PARTS
+    centres = np.array([assembly.parts[n].mesh.bounds.mean(axis=0) for n in last])
+    assert np.ptp(centres[:, :2], axis=0).max() > 0.3 * assembly.scale  # spread out
 
 
 def test_on_a_phone_the_report_fits_the_screen_and_still_shows_the_model(
@@ -399,3 +515,44 @@ def test_on_a_phone_the_report_fits_the_screen_and_still_shows_the_model(
         check_step_one(show_step_one(browser), load_assembly(DEMO), LIFTED)
     finally:
         browser.send("Emulation.clearDeviceMetricsOverride")
+
+
+@pytest.mark.slow
+def test_every_part_is_drawn_in_the_colour_of_the_legend(chromium: Chromium, tmp_path: Path):
+    """The demo gearbox taken apart one part per step, drawn without shading: in each
+    step the only coloured pixels are the moved part's, in its colour in the part list
+    (the commonest colour not grey is exactly that colour; the others are the part's
+    anti-aliased edges)."""
+    assembly = load_assembly(DEMO)
+    order = [
+        *LIFTED,
+        *("shaft_a", "gear_a", "shaft_b", "gear_b", "spacer_a", "spacer_b"),
+        *("plug", "housing", "base"),
+    ]
+    assert sorted(order) == sorted(assembly.names)
+    x = np.array([1.0, 0.0, 0.0])
+    steps = tuple(
+        Step((name,), x if name in ("plug", "housing") else UP, tuple(order[k + 1 :]), ())
+        for k, name in enumerate(order)
+    )
+    page = write_report(
+        assembly, Plan(tuple(assembly.names), steps, (), None, 2), tmp_path / "r.html"
+    )
+    browser = chromium.devtools()
+    scene = browser.open(page)
+    browser.evaluate(FLAT)
+    browser.evaluate(HIDE_AXES)
+    colors = legend(browser)
+    assert sorted(colors) == sorted(assembly.names)
+    for number, name in enumerate(order, start=1):
+        show_step(browser, number)
+        until(
+            lambda: len(colored_pixels(browser.screenshot(scene))) > 0,
+            f"step {number} drawn",
+        )
+        coloured = colored_pixels(browser.drawn(scene))
+        assert len(coloured) > 30, f"{name} not in view"
+        values, counts = np.unique(coloured, axis=0, return_counts=True)
+        assert np.abs(values[np.argmax(counts)] - colors[name]).max() <= EXACT, name
+        exact = np.abs(coloured - colors[name]).max(axis=1) <= EXACT
+        assert exact.mean() > 0.6, f"{name}: {exact.mean():.0%} of its pixels in its colour"

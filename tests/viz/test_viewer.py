@@ -15,10 +15,21 @@ from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.sequence import Interlock, Plan, Step
 from assemblykit.viz.viewer import (
     ARROW_FRACTION,
+    DIM_COLOR,
     PALETTE,
+    TRIAD_COLORS,
+    TRIAD_FRACTION,
     ReportTable,
+    face_colors,
     figure,
+    frame_colors,
+    part_colors,
+    ray_exit,
     report_html,
+    scene,
+    triad,
+    triad_labels,
+    triad_origin,
     view_box,
     write_report,
 )
@@ -45,16 +56,113 @@ def page_data(page: str) -> dict:
     return json.loads(re.search(r"const P = (\{.*?\});\n", page).group(1))
 
 
-def test_one_trace_holds_every_part_and_one_the_arrow():
+def test_one_trace_holds_every_part_one_the_arrow_and_two_the_axes():
     assembly = two_boxes()
     fig = figure(assembly, lifted(assembly))
-    assert [t.type for t in fig.data] == ["mesh3d", "mesh3d"]
-    parts, arrow = fig.data
+    assert [t.type for t in fig.data] == ["mesh3d", "mesh3d", "mesh3d", "scatter3d"]
+    parts, arrow, axes, names = fig.data
     assert len(parts.i) == 24 and len(parts.x) == 16  # two boxes: 12 triangles, 8 corners
-    assert list(parts.intensity) == [0] * 12 + [1] * 12  # colour slot per face
-    assert parts.intensitymode == "cell"
+    # each face in its part's colour, the colour of the legend
+    legend = part_colors(assembly.names)
+    assert list(parts.facecolor) == [legend["base"]] * 12 + [legend["lid<1>"]] * 12
+    assert parts.intensity is None
     assert arrow.visible is False and fig.frames == ()
     assert fig.layout.showlegend is False
+    assert list(names.text) == ["X", "Y", "Z"] and list(names.textfont.color) == list(TRIAD_COLORS)
+    assert set(axes.facecolor) == set(TRIAD_COLORS)
+
+
+def test_the_step_parts_keep_their_colour_and_every_other_part_turns_one_grey():
+    assembly = row_of_blocks(5)
+    step = Step(("b1", "b3"), UP, ("b0", "b2", "b4"), ())
+    plan = Plan(tuple(assembly.names), (step,), (), None, 1)
+    drawn = scene(assembly, plan)
+    legend = part_colors(assembly.names)
+    assert face_colors(assembly, drawn, 0) == [legend[n] for n in assembly.names for _ in range(12)]
+    shown = face_colors(assembly, drawn, 1)
+    expected = [legend[n] if n in step.parts else DIM_COLOR for n in assembly.names]
+    assert shown == [c for c in expected for _ in range(12)]
+    data = page_data(report_html(assembly, plan))
+    assert data["colors"] == [legend[n] for n in assembly.names] and data["dim"] == DIM_COLOR
+    assert frame_colors(["#ff0000"], [0], 1) == [DIM_COLOR]  # never moved: grey in a step
+
+
+def row_of_blocks(n: int, gap: float = 0.0) -> Assembly:
+    """``n`` unit cubes along y, ``gap`` apart."""
+    return Assembly(
+        [
+            Part(
+                f"b{i}",
+                trimesh.creation.box(extents=(1, 1, 1)).apply_translation((0, i * (1 + gap), 0)),
+            )
+            for i in range(n)
+        ]
+    )
+
+
+def test_a_ray_leaves_a_closed_mesh_where_it_crosses_it_last():
+    box = trimesh.creation.box(extents=(2, 2, 2))
+    triangles = np.asarray(box.triangles)
+    centre, up = np.zeros(3), np.array([0.0, 0.0, 1.0])
+    assert ray_exit(centre, up, triangles) == pytest.approx(1.0)
+    diagonal = np.array([1.0, 1.0, 1.0]) / np.sqrt(3)  # through a corner: an edge of six
+    assert ray_exit(centre, diagonal, triangles) == pytest.approx(np.sqrt(3))
+    assert ray_exit(np.array([5.0, 0.0, 0.0]), up, triangles) is None  # beside it
+    assert ray_exit(np.array([0.0, 0.0, 5.0]), up, triangles) is None  # behind the ray
+    assert ray_exit(centre, up, np.zeros((0, 3, 3))) is None
+
+
+def arrow_tail(arrow: trimesh.Trimesh, d: np.ndarray) -> np.ndarray:
+    """The centre of the arrow's back end: its vertices furthest back along ``d``."""
+    heights = np.asarray(arrow.vertices) @ d
+    return np.asarray(arrow.vertices)[heights < heights.min() + 1e-9].mean(axis=0)
+
+
+def test_the_arrow_starts_on_the_moved_parts_even_when_they_stand_apart():
+    # the two outer blocks of a row leave along +x: the centre of their bounding box is
+    # in the middle block, which stays; the arrow starts on one of the moved blocks
+    assembly = row_of_blocks(3, gap=4.0)
+    d = np.array([1.0, 3.011e-05, -6.204e-06])
+    d /= np.linalg.norm(d)
+    step = Step(("b0", "b2"), d, ("b1",), ())
+    plan = Plan(tuple(assembly.names), (step,), (), None, 1)
+    drawn = scene(assembly, plan)
+    tail = arrow_tail(drawn.arrows[0], d)
+    distances = [
+        float(
+            np.linalg.norm(
+                tail
+                - trimesh.proximity.closest_point(
+                    assembly.parts[n].mesh.copy().apply_translation(drawn.frames.offset(n, 1)),
+                    [tail],
+                )[0][0]
+            )
+        )
+        for n in step.parts
+    ]
+    assert min(distances) < 1e-6 * assembly.scale
+    # on the face it leaves by, level with the block's centre
+    assert tail[0] == pytest.approx(0.5 + drawn.frames.distance(1), abs=1e-6)
+    assert abs(tail[2]) < 1e-3
+    # a group that holds its centre: the arrow leaves it from there
+    lid = scene(two_boxes(), lifted(two_boxes()))
+    assert arrow_tail(lid.arrows[0], UP)[:2] == pytest.approx([0, 0], abs=1e-9)
+
+
+def test_the_axis_triad_stands_beside_the_assembly_inside_the_view():
+    assembly = two_boxes()
+    mesh, colors = triad(assembly)
+    lo, hi = view_box(assembly)
+    assert np.all(mesh.bounds[0] >= lo) and np.all(mesh.bounds[1] <= hi)
+    labels = triad_labels(assembly)
+    assert np.all(labels >= lo) and np.all(labels <= hi)
+    origin = triad_origin(assembly)
+    assert np.all(origin < assembly.bounds[0])  # below, left of and before the assembly
+    # each arrow along its axis, in its colour
+    for axis, color in enumerate(TRIAD_COLORS):
+        faces = np.asarray(mesh.faces)[np.asarray(colors) == color]
+        reach = mesh.vertices[np.unique(faces)] - origin
+        assert reach[:, axis].max() == pytest.approx(TRIAD_FRACTION * assembly.scale)
 
 
 def test_the_camera_box_is_fitted_to_the_assembled_state():
@@ -136,6 +244,4 @@ def test_a_report_of_hundreds_of_parts_carries_the_geometry_once():
     plotly_js = 4_000_000
     assert len(page) - plotly_js < 3_000_000  # not 400 steps x 400 traces
     assert len(set(page_data(page)["arrows"][0][0])) > 1
-    assert max(int(s) for s in re.findall(r'"slot":\[([0-9,]+)\]', page)[0].split(",")) < len(
-        PALETTE
-    )
+    assert set(page_data(page)["colors"]) == set(PALETTE)  # the palette, repeated

@@ -96,6 +96,24 @@ def storyboard_frames(steps: int, panels: int = STORYBOARD_PANELS) -> list[int]:
     return sorted(set(np.rint(np.linspace(0, steps, panels)).astype(int).tolist()))
 
 
+def _draw_triad(axes: Any, assembly: Assembly) -> None:
+    """The report's axis triad (:func:`~assemblykit.viz.viewer.triad_origin`): X, Y and Z
+    arrows in their colours, each with its label."""
+    from assemblykit.viz.viewer import (
+        AXES_NAMES,
+        TRIAD_COLORS,
+        TRIAD_FRACTION,
+        triad_labels,
+        triad_origin,
+    )
+
+    origin, length = triad_origin(assembly), TRIAD_FRACTION * assembly.scale
+    labels = triad_labels(assembly)
+    for axis, name, color, label in zip(np.eye(3), AXES_NAMES, TRIAD_COLORS, labels, strict=True):
+        axes.quiver(*origin, *(axis * length), color=color, linewidth=1.5, zorder=9)
+        axes.text(*label, name, color=color, fontsize=8, ha="center", va="center", zorder=9)
+
+
 def exploded_view_png(
     assembly: Assembly,
     plan: Plan,
@@ -107,13 +125,15 @@ def exploded_view_png(
     """A storyboard of a disassembly plan (matplotlib Agg): the assembly, then steps
     spread evenly over the plan, each panel fitted to the assembled state as in the HTML
     report (:func:`~assemblykit.viz.viewer.view_box`): the parts of the step in their
-    colours, moved along its direction with an arrow, the parts still assembled dimmed,
-    the parts removed earlier gone. Returns the PNG's path."""
+    colours (those of the report's legend), moved along its direction with an arrow
+    starting on them, the parts still assembled in one neutral grey, the parts removed
+    earlier gone, and the axis triad of the report (docs/planning.md, "The HTML
+    report"). Returns the PNG's path."""
     from assemblykit.viz.viewer import (
         ARROW_COLOR,
         ARROW_FRACTION,
+        DIM_COLOR,
         VIEW_DIRECTION,
-        dimmed,
         part_colors,
         scene,
         view_box,
@@ -140,11 +160,12 @@ def exploded_view_png(
             mesh = assembly.parts[name].mesh
             moving = k == 0 or step == k
             triangles.append(np.asarray(mesh.triangles, dtype=np.float64) + frames.offset(name, k))
-            color = colors[name] if moving else dimmed(colors[name])
+            color = colors[name] if moving else DIM_COLOR
             faces += [color] * len(mesh.faces)
         axes.add_collection3d(
             Poly3DCollection(np.concatenate(triangles), facecolor=faces, edgecolor="none")
         )
+        _draw_triad(axes, assembly)
         if k == 0:
             title = f"assembled: {fmt.count(len(assembly.names), 'part')}"
         else:

@@ -2,17 +2,20 @@
 
 One file holds everything: plotly's JavaScript is embedded by default (about 5 MB, opens
 offline; ``plotlyjs="cdn"`` links it instead for a small file that needs the network).
-The 3D view is one ``mesh3d`` trace holding every part (per-face colours) and one for the
-arrow of the shown step; a slider and a play button walk through the steps. A few lines
-of JavaScript move the vertices and recolour the faces for each step, so the file carries
-the geometry once whatever the number of steps. The camera is fitted to the assembled
-state (:func:`view_box`). Step k shows the parts still assembled, dimmed, and the parts
-of step k in their colours, moved along the step's direction (:mod:`.explode`, as far
-as the view allows) with an arrow and a caption in words; parts removed in earlier steps
-have left the view. Below the view: the steps as a table (the parts the moved ones leave
-are counted, the list behind a toggle), the parts grouped by step, and the blocking
-relations of the step's direction (Wilson & Latombe 1992, §3: which of the remaining
-parts the moved ones were holding in place).
+The 3D view is one ``mesh3d`` trace holding every part (each face in its part's colour,
+the colour of the part list below: :func:`part_colors`), one for the arrow of the shown
+step and an axis triad (X, Y, Z, labelled) beside the assembly; a slider and a play
+button walk through the steps. A few lines of JavaScript move the vertices and recolour
+the faces for each step, so the file carries the geometry once whatever the number of
+steps. The camera is fitted to the assembled state (:func:`view_box`). Step k shows the
+parts still assembled in one neutral grey and the parts of step k in their colours,
+moved along the step's direction (:mod:`.explode`, as far as the view allows) with an
+arrow that starts on them (:func:`arrow_anchor`) and a caption in words; parts removed
+in earlier steps have left the view (docs/planning.md, "The HTML report"). Below the
+view: the steps as a table (the parts the moved ones leave are counted, the list behind
+a toggle), the parts grouped by step, and the blocking relations of the step's direction
+(Wilson & Latombe 1992, §3: which of the remaining parts the moved ones were holding in
+place).
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ import plotly.graph_objects as go
 import plotly.io as pio
 import trimesh
 from numpy.typing import NDArray
-from plotly.colors import hex_to_rgb, qualitative
+from plotly.colors import qualitative
 
 from assemblykit import formatting as fmt
 from assemblykit.algebra import se3
@@ -43,14 +46,25 @@ if TYPE_CHECKING:
     from assemblykit.tolerance import Tolerance
 
 PALETTE = qualitative.Plotly + qualitative.Dark24  # hex strings: valid for matplotlib too
-DIM_TOWARDS = (0.88, 0.88, 0.88)
-"""Parts that do not move in the shown step are blended this far towards light grey."""
-DIM_AMOUNT = 0.75
+DIM_COLOR = "#c8c8c8"
+"""Every part that does not move in the shown step, whatever its own colour: one neutral
+grey, so that the parts of the step are the only colours in the view."""
 ARROW_COLOR = "#111111"
 ARROW_FRACTION = 0.12
 """Length of the arrow of a step, as a fraction of the assembly's size."""
 ARROW_RADIUS_FRACTION = 0.008
 ARROW_SECTIONS = 12
+LIGHTING = {"ambient": 0.6, "diffuse": 0.55, "specular": 0.05, "fresnel": 0.1}
+"""The parts' shading: faces towards the light a little brighter than their colour,
+faces away from it darker, never far from the colour of the legend."""
+LIGHT_POSITION = {"x": 40_000, "y": -60_000, "z": 100_000}
+"""The light comes from above the camera (front right, high up), so the faces the view
+shows are lit (plotly's default light is level, from the back left of this view)."""
+TRIAD_COLORS = ("#d62728", "#2ca02c", "#1f77b4")
+"""The X, Y and Z arrows of the axis triad (red, green, blue, as CAD programs draw them)."""
+TRIAD_FRACTION = 0.1
+"""Length of each arrow of the axis triad, as a fraction of the assembly's size."""
+AXES_NAMES = ("X", "Y", "Z")
 LIST_OPEN_PARTS = 30
 """Part lists and "away from" cells longer than this start folded."""
 SHOWN_NAMES = 6
@@ -118,8 +132,8 @@ SCRIPT = """
       x[v] = base[3 * v] + o[0]; y[v] = base[3 * v + 1] + o[1]; z[v] = base[3 * v + 2] + o[2];
     }
     const colour = Array.from(partOfFace, (p) =>
-      k === 0 || P.stepOf[p] === k ? P.slot[p] : P.slot[p] + P.palette);
-    Plotly.restyle(gd, {x: [x], y: [y], z: [z], intensity: [colour], text: [hover]}, [0]);
+      k === 0 || P.stepOf[p] === k ? P.colors[p] : P.dim);
+    Plotly.restyle(gd, {x: [x], y: [y], z: [z], facecolor: [colour], text: [hover]}, [0]);
     const arrow = k === 0 ? null : P.arrows[k - 1];
     Plotly.restyle(gd, arrow === null ? {visible: false} :
       {visible: true, x: [arrow[0]], y: [arrow[1]], z: [arrow[2]]}, [1]);
@@ -164,26 +178,24 @@ class ReportTable:
 
 
 def part_colors(names: Sequence[str]) -> dict[str, str]:
-    """A colour per part, cycling through plotly's qualitative palettes."""
+    """A colour per part, cycling through plotly's qualitative palettes: the one colour
+    of the part in the report's legend, its 3D view, the PNG storyboard and the glTF
+    scene (docs/planning.md, "The HTML report")."""
     return {name: PALETTE[i % len(PALETTE)] for i, name in enumerate(names)}
 
 
-def dimmed(color: str) -> str:
-    """``color`` blended towards light grey: a part that does not move in this step."""
-    rgb = np.asarray(hex_to_rgb(color), dtype=np.float64) / 255
-    mixed = (1 - DIM_AMOUNT) * rgb + DIM_AMOUNT * np.asarray(DIM_TOWARDS)
-    return "#" + "".join(f"{round(255 * c):02x}" for c in mixed)
+def frame_colors(colors: Sequence[str], step_of: Sequence[int], frame: int) -> list[str]:
+    """Each part's colour in ``frame`` (0 is the assembly): its own colour (``colors``)
+    in the assembled state and when its step (``step_of``, 0 for a part no step moves)
+    is the one shown, else ``DIM_COLOR``.
 
-
-def _colorscale() -> list[list[Any]]:
-    """A discrete colour scale: slot i < len(PALETTE) is palette colour i, slot
-    len(PALETTE) + i its dimmed version (face intensities are slot numbers)."""
-    colors = [*PALETTE, *(dimmed(c) for c in PALETTE)]
-    n = len(colors)
-    scale: list[list[Any]] = []
-    for i, color in enumerate(colors):
-        scale += [[i / n, color], [(i + 1) / n, color]]
-    return scale
+    >>> frame_colors(["#ff0000", "#00ff00"], [1, 2], 2)
+    ['#c8c8c8', '#00ff00']
+    """
+    return [
+        color if frame == 0 or step == frame else DIM_COLOR
+        for color, step in zip(colors, step_of, strict=True)
+    ]
 
 
 @dataclass(frozen=True)
@@ -223,15 +235,66 @@ def scene(assembly: Assembly, plan: Plan) -> Scene:
     )
 
 
-def _moved_bounds(assembly: Assembly, names: Sequence[str]) -> NDArray[np.float64]:
-    boxes = np.array([assembly.parts[n].mesh.bounds for n in names], dtype=np.float64)
-    return np.array([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
+def ray_exit(
+    origin: NDArray[np.float64], direction: NDArray[np.float64], triangles: NDArray[np.float64]
+) -> float | None:
+    """How far along ``direction`` from ``origin`` the ray last crosses ``triangles``
+    (``n x 3 x 3``): the largest ``t >= 0`` with ``origin + t direction`` on one of them
+    (Möller & Trumbore 1997), where the ray leaves a closed mesh it starts inside; None
+    when it meets none. Points on a triangle's edge count as on it.
+
+    >>> square = np.array([[[0, 0, 1], [1, 0, 1], [0, 1, 1]], [[1, 0, 1], [1, 1, 1], [0, 1, 1]]])
+    >>> ray_exit(np.array([0.5, 0.5, 0.0]), np.array([0.0, 0.0, 1.0]), square.astype(float))
+    1.0
+    """
+    corners = np.asarray(triangles, dtype=np.float64).reshape(-1, 3, 3)
+    if not len(corners):
+        return None
+    first, second = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    normal = np.cross(direction, second)
+    det = np.einsum("ij,ij->i", first, normal)
+    crossed = det != 0  # the ray is not parallel to the triangle's plane
+    first, second, normal = first[crossed], second[crossed], normal[crossed]
+    offset = origin - corners[crossed, 0]
+    q = np.cross(offset, first)
+    with np.errstate(over="ignore", invalid="ignore"):  # nearly parallel: huge, then dropped
+        inverse = 1.0 / det[crossed]
+        u = np.einsum("ij,ij->i", offset, normal) * inverse
+        v = (q @ direction) * inverse
+        t = np.einsum("ij,ij->i", second, q) * inverse
+    slack = 1e-9  # barycentric: a ray through an edge meets the triangles on both sides
+    hit = (u >= -slack) & (v >= -slack) & (u + v <= 1 + slack) & (t >= 0) & np.isfinite(t)
+    return float(t[hit].max()) if hit.any() else None
 
 
-def _arrow_mesh(
-    start: NDArray[np.float64], direction: NDArray[np.float64], length: float, radius: float
-) -> trimesh.Trimesh:
-    """A shaft and a cone from ``start`` along the unit ``direction``."""
+def arrow_anchor(
+    meshes: Sequence[trimesh.Trimesh], direction: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Where the arrow of a step starts: on the surface of the moved parts (``meshes``,
+    in place), where the ray from the centre of their bounding box along the unit
+    ``direction`` leaves them. When that ray misses them (parts apart from one another,
+    the centre between them), the ray from the centre of the part nearest it; when that
+    misses too (an open mesh), that part's furthest point along the direction, level
+    with its centre (docs/planning.md, "The HTML report")."""
+    d = np.asarray(direction, dtype=np.float64)
+    boxes = np.array([m.bounds for m in meshes], dtype=np.float64)
+    centre = (boxes[:, 0].min(axis=0) + boxes[:, 1].max(axis=0)) / 2
+    out = ray_exit(centre, d, np.concatenate([m.triangles for m in meshes]))
+    if out is not None:
+        return centre + out * d
+    centres = boxes.mean(axis=1)
+    nearest = int(np.argmin(np.linalg.norm(centres - centre, axis=1)))
+    own = centres[nearest]
+    mesh = meshes[nearest]
+    out = ray_exit(own, d, np.asarray(mesh.triangles, dtype=np.float64))
+    if out is None:
+        out = max(float(((np.asarray(mesh.vertices) - own) @ d).max()), 0.0)
+    return own + out * d
+
+
+def arrow_shape(length: float, radius: float) -> trimesh.Trimesh:
+    """An arrow from the origin along +z: a shaft of ``radius`` and a cone, ``length``
+    long in all."""
     head = min(0.35 * length, 6 * radius)
     shaft = trimesh.creation.cylinder(radius=radius, height=length - head, sections=ARROW_SECTIONS)
     shaft.apply_translation((0, 0, (length - head) / 2))
@@ -239,24 +302,63 @@ def _arrow_mesh(
     cone.apply_translation((0, 0, length - head))
     arrow = trimesh.util.concatenate([shaft, cone])
     assert isinstance(arrow, trimesh.Trimesh)  # meshes concatenate to a mesh
-    arrow.apply_transform(se3.frame(start, direction))
     return arrow
 
 
+def placed(
+    shape: trimesh.Trimesh, start: NDArray[np.float64], direction: NDArray[np.float64]
+) -> trimesh.Trimesh:
+    """``shape`` (an :func:`arrow_shape`) moved to start at ``start`` along the unit
+    ``direction``."""
+    frame = se3.frame(start, direction)
+    vertices = np.asarray(shape.vertices) @ frame[:3, :3].T + frame[:3, 3]
+    return trimesh.Trimesh(vertices, np.asarray(shape.faces), process=False)
+
+
+def _arrow_mesh(
+    start: NDArray[np.float64], direction: NDArray[np.float64], length: float, radius: float
+) -> trimesh.Trimesh:
+    """A shaft and a cone from ``start`` along the unit ``direction``."""
+    return placed(arrow_shape(length, radius), start, direction)
+
+
 def step_arrows(assembly: Assembly, plan: Plan, frames: Explosion) -> list[trimesh.Trimesh]:
-    """One arrow per step, from the leading face of the moved parts (where they are in
-    the step's frame) along the step's direction, ``ARROW_FRACTION`` of the assembly's
-    size long."""
+    """One arrow per step, ``ARROW_FRACTION`` of the assembly's size long, from the moved
+    parts' surface (:func:`arrow_anchor`, where they are in the step's frame) along the
+    step's direction."""
     arrows = []
-    radius = ARROW_RADIUS_FRACTION * assembly.scale
+    shape = arrow_shape(ARROW_FRACTION * assembly.scale, ARROW_RADIUS_FRACTION * assembly.scale)
     for number, step in enumerate(plan.steps, start=1):
         d = frames.directions[number - 1]
-        lo, hi = _moved_bounds(assembly, step.parts)
-        corners = np.array(np.meshgrid(*zip(lo, hi, strict=True))).reshape(3, -1).T
-        centre = (lo + hi) / 2 + d * frames.distance(number)
-        start = centre + d * ((corners - (lo + hi) / 2) @ d).max()
-        arrows.append(_arrow_mesh(start, d, ARROW_FRACTION * assembly.scale, radius))
+        meshes = [assembly.parts[name].mesh for name in step.parts]
+        arrows.append(placed(shape, arrow_anchor(meshes, d) + d * frames.distance(number), d))
     return arrows
+
+
+def triad_origin(assembly: Assembly) -> NDArray[np.float64]:
+    """Where the axis triad stands: halfway between the assembly's lowest corner and the
+    view box's (:func:`view_box`), outside the assembly and inside the view."""
+    low = np.asarray(assembly.bounds, dtype=np.float64)[0]
+    return (low + view_box(assembly)[0]) / 2
+
+
+def triad(assembly: Assembly) -> tuple[trimesh.Trimesh, list[str]]:
+    """The axis triad: three arrows along +X, +Y and +Z from :func:`triad_origin`,
+    ``TRIAD_FRACTION`` of the assembly's size long, as one mesh, and the colour
+    (``TRIAD_COLORS``) of each of its faces."""
+    origin, length = triad_origin(assembly), TRIAD_FRACTION * assembly.scale
+    radius = ARROW_RADIUS_FRACTION * assembly.scale
+    arrows = [_arrow_mesh(origin, axis, length, radius) for axis in np.eye(3)]
+    colors = [c for arrow, c in zip(arrows, TRIAD_COLORS, strict=True) for _ in arrow.faces]
+    mesh = trimesh.util.concatenate(arrows)
+    assert isinstance(mesh, trimesh.Trimesh)  # meshes concatenate to a mesh
+    return mesh, colors
+
+
+def triad_labels(assembly: Assembly) -> NDArray[np.float64]:
+    """Where the labels ``X``, ``Y`` and ``Z`` of the axis triad stand: a little beyond
+    the tip of each arrow (one row per axis)."""
+    return triad_origin(assembly) + 1.3 * TRIAD_FRACTION * assembly.scale * np.eye(3)
 
 
 def view_box(assembly: Assembly) -> NDArray[np.float64]:
@@ -286,13 +388,53 @@ def _view(assembly: Assembly) -> dict[str, Any]:
     }
 
 
+def face_colors(assembly: Assembly, drawn: Scene, frame: int = 0) -> list[str]:
+    """The colour of every face of the parts' trace in ``frame`` (:func:`frame_colors`,
+    each part's repeated over its faces)."""
+    colors = list(part_colors(assembly.names).values())
+    step_of = [drawn.frames.step_of[name] for name in assembly.names]
+    counts = np.diff(drawn.face_start)
+    shown = frame_colors(colors, step_of, frame)
+    return [color for color, n in zip(shown, counts, strict=True) for _ in range(n)]
+
+
+def _triad_traces(assembly: Assembly) -> list[go.Mesh3d | go.Scatter3d]:
+    """The axis triad (:func:`triad`) as a mesh trace and a trace of its labels."""
+    mesh, colors = triad(assembly)
+    vertices, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    labels = triad_labels(assembly)
+    return [
+        go.Mesh3d(
+            x=vertices[:, 0],
+            y=vertices[:, 1],
+            z=vertices[:, 2],
+            i=faces[:, 0],
+            j=faces[:, 1],
+            k=faces[:, 2],
+            facecolor=colors,
+            flatshading=True,
+            name="axes",
+            hoverinfo="skip",
+        ),
+        go.Scatter3d(
+            x=labels[:, 0],
+            y=labels[:, 1],
+            z=labels[:, 2],
+            mode="text",
+            text=list(AXES_NAMES),
+            textfont={"color": list(TRIAD_COLORS), "size": 15},
+            name="axis names",
+            hoverinfo="skip",
+        ),
+    ]
+
+
 def figure(assembly: Assembly, plan: Plan, drawn: Scene | None = None) -> go.Figure:
-    """The 3D view in its assembled state: trace 0 holds every part (face intensities are
-    colour slots of :func:`_colorscale`), trace 1 the arrow of the shown step (hidden in
-    the assembled state). The page's script moves and recolours them per step."""
+    """The 3D view in its assembled state: trace 0 holds every part (one colour per face,
+    :func:`face_colors`), trace 1 the arrow of the shown step (hidden in the assembled
+    state), traces 2 and 3 the axis triad and its labels. The page's script moves and
+    recolours traces 0 and 1 per step."""
     drawn = scene(assembly, plan) if drawn is None else drawn
-    slots = [i % len(PALETTE) for i in range(len(assembly.names))]
-    face_slots = np.repeat(np.asarray(slots, dtype=np.uint8), np.diff(drawn.face_start))
     vertices, faces = drawn.vertices, drawn.faces
     arrow_faces = np.asarray(drawn.arrows[0].faces) if drawn.arrows else np.zeros((0, 3), np.int32)
     parts = go.Mesh3d(
@@ -302,16 +444,12 @@ def figure(assembly: Assembly, plan: Plan, drawn: Scene | None = None) -> go.Fig
         i=faces[:, 0],
         j=faces[:, 1],
         k=faces[:, 2],
-        intensity=face_slots,
-        intensitymode="cell",
-        colorscale=_colorscale(),
-        cmin=0,
-        cmax=2 * len(PALETTE),
-        showscale=False,
+        facecolor=face_colors(assembly, drawn),
         flatshading=True,
         name="parts",
         hoverinfo="text",
-        lighting={"ambient": 0.55, "diffuse": 0.8, "specular": 0.1},
+        lighting=LIGHTING,
+        lightposition=LIGHT_POSITION,
     )
     arrow = go.Mesh3d(
         x=[],
@@ -326,7 +464,7 @@ def figure(assembly: Assembly, plan: Plan, drawn: Scene | None = None) -> go.Fig
         hoverinfo="name",
         visible=False,
     )
-    fig = go.Figure(data=[parts, arrow])
+    fig = go.Figure(data=[parts, arrow, *_triad_traces(assembly)])
     fig.update_layout(
         scene=_view(assembly),
         height=620,
@@ -474,8 +612,8 @@ def _script(assembly: Assembly, plan: Plan, drawn: Scene, tol: Tolerance | None)
         "vertices": _b64(drawn.vertices),
         "vertexStart": list(drawn.vertex_start),
         "faceStart": list(drawn.face_start),
-        "slot": [i % len(PALETTE) for i in range(len(assembly.names))],
-        "palette": len(PALETTE),
+        "colors": list(part_colors(assembly.names).values()),
+        "dim": DIM_COLOR,
         "stepOf": [frames.step_of[n] for n in assembly.names],
         "directions": np.round(frames.directions, 6).tolist(),
         "travel": [float(f"{t:.6g}") for t in frames.travel],
@@ -567,7 +705,53 @@ def write_report(
     extra: Sequence[ReportTable] = (),
     plotlyjs: PlotlyJs = "inline",
 ) -> Path:
-    """Write :func:`report_html` to ``path`` (UTF-8) and return the path."""
+    """Write the plan's self-contained HTML report (docs/planning.md, "The HTML report";
+    :func:`report_html`): the assembly in 3D, the disassembly animated step by step, the
+    steps, the assembly order and the interlocked sets.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The assembly planned.
+    plan : Plan
+        Its plan (:func:`assemblykit.plan`).
+    path : str or Path
+        The HTML file to write (UTF-8); its folder is made when missing.
+    title : str, optional
+        The page's title (the assembly's file name when ``None``).
+    extra : sequence of ReportTable, default ()
+        More sections (e.g. the motion of each part).
+    plotlyjs : {"inline", "cdn"}, default "inline"
+        Embed plotly.js (the page opens offline) or link it from its CDN (a small file
+        that needs the network).
+
+    Returns
+    -------
+    Path
+        ``path``, written whole: a failed write leaves no partial file.
+
+    Raises
+    ------
+    OSError
+        The file cannot be written.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import trimesh
+    >>> import assemblykit
+    >>> lower = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    >>> upper = trimesh.creation.box(bounds=[[0, 0, 1], [1, 1, 2]])
+    >>> parts = [assemblykit.Part("lower", lower), assemblykit.Part("upper", upper)]
+    >>> boxes = assemblykit.Assembly(parts)
+    >>> plan = assemblykit.plan(boxes)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "boxes.html"
+    ...     page = assemblykit.write_report(boxes, plan, path, plotlyjs="cdn")
+    ...     page.name, "<html" in page.read_text(encoding="utf-8")
+    ('boxes.html', True)
+    """
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
     page = report_html(assembly, plan, title=title, extra=extra, plotlyjs=plotlyjs)
