@@ -1,4 +1,4 @@
-"""Closed-form coset intersections per second (ALGEBRA.md §2.5), one core.
+"""Closed-form coset intersections per second (docs/algebra.md §2.5), one core.
 
 Relation cosets are built with ``transporter`` from plane, line (cylinder) and point
 (sphere) invariants in random placements, each pair holding at one random relative
@@ -7,7 +7,7 @@ rate (CPU time of this process, so other load on the machine does not count) ove
 repeats for each relation pair, for fresh cosets (cold: nothing derived is cached yet)
 and for the same cosets intersected again (warm); the target is >= 10,000 per second.
 The thread rows (a helical coset against a plane or cylinder relation) measure the
-exact helical intersections of ALGEBRA.md §2.4-§2.5, which need no numeric search.
+exact helical intersections of docs/algebra.md §2.4-§2.5, which need no numeric search.
 """
 
 from __future__ import annotations

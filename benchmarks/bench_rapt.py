@@ -7,7 +7,7 @@ residue solver, the "equation solving" system of Corner et al. 1983 §III G) to 
 Shapes: ``stack`` (equal cubes, so reduction reuses the intersections of repeated
 geometry), ``stack~`` (every cube a different size: no reuse), ``tree`` and ``grid``.
 
-Then a task file of 1,000 stacked bodies (YAML, DESIGN.md §5.1) read and solved in one
+Then a task file of 1,000 stacked bodies (YAML, docs/tutorial.md §1) read and solved in one
 process: load time (YAML parsing, by yaml-rs, and validation),
 solve time and their sum.
 

@@ -1,9 +1,10 @@
 """Generate the bundled demo assembly: a small gearbox of 14 parts.
 
 Run ``python examples/make_demo.py`` from the repository root. It writes one OBJ mesh
-per part (in the part's own frame) and the YAML manifest ``gearbox.yaml`` (DESIGN.md
-§5.2: ``parts: [{name, mesh, pose}]``) into ``src/assemblykit/examples/gearbox_demo/``,
-where ``assemblykit demo`` finds them in an installed package.
+per part (in the part's own frame) and the YAML manifest ``gearbox.yaml`` (docs/geometry.md,
+"Loaders and their conventions": ``parts: [{name, mesh, pose}]``) into
+``src/assemblykit/examples/gearbox_demo/``, where ``assemblykit demo`` finds them in an
+installed package.
 
 The parts are exact boxes and faceted cylinders; holes are manifold3d differences with
 the very cylinder that fills them, so pins, shafts and bores touch face to face along

@@ -1,10 +1,11 @@
-"""Generate the bundled motion examples (seed 003): meshes, YAML manifests and STEP files.
+"""Generate the bundled motion examples (Liu 1997): meshes, YAML manifests and STEP files.
 
 Run ``python examples/make_motion_examples.py`` from the repository root. For every
 example it writes, under ``src/assemblykit/examples/motion/<name>/``, one OBJ mesh per
-part in world coordinates, the manifest ``<name>.yaml`` (DESIGN.md §5.2) and, when OCP
-is installed (extra ``cad``), ``<name>.step`` with one named solid per part; then the
-picture of the gearbox's motions for the user guide, ``docs/images/motion.png``.
+part in world coordinates, the manifest ``<name>.yaml`` (docs/geometry.md,
+"Loaders and their conventions") and, when OCP is installed (extra ``cad``), ``<name>.step``
+with one named solid per part; then the picture of the gearbox's motions for the user guide,
+``docs/images/motion.png``.
 
 Each part is a small constructive solid (boxes, vertical cylinders, spheres, unions and
 differences) rendered twice: faceted by manifold3d for the meshes and exactly by
@@ -12,13 +13,13 @@ OpenCascade for STEP, so both inputs describe the same model. A hole is the diff
 with the very cylinder (or sphere) that fills it, so the facets of a pin and of its bore
 coincide and no two parts overlap. Units are millimetres, z points up.
 
-* ``gearbox`` (seed 003 Figs. 7-9): four gear discs on pins of a housing, a cover on
+* ``gearbox`` (Liu 1997, Figs. 7-9): four gear discs on pins of a housing, a cover on
   the housing walls pinned by the four pins. Neighbouring gears have tangent pitch
   circles (radii 10, 20, 5, 25); gears sit on the floor and clear the cover.
 * ``drawer``: a tray resting on two runners of a cabinet, guided by the side walls.
 * ``hinge``: a door whose knuckle turns on a frame's pin and rests on the frame.
 * ``ball_joint``: a ball with a stem resting in a spherical cup (less than a hemisphere).
-* ``interlock`` (seed 003 Fig. 10): two hooked bars filling a channel closed by a keyed
+* ``interlock`` (Liu 1997, Fig. 10): two hooked bars filling a channel closed by a keyed
   lid; every part alone is held, the two bars together slide out along x.
 """
 
@@ -153,7 +154,7 @@ def to_occ(solid: Solid) -> Any:
 
 
 def gearbox() -> dict[str, Solid]:
-    """Housing with four pins, a pinned cover, four gears in a tangent train (seed 003 Fig. 7)."""
+    """Housing with four pins, a pinned cover, four gears in a tangent train (Liu 1997, Fig. 7)."""
     gears = [(0.0, 10.0), (30.0, 20.0), (55.0, 5.0), (85.0, 25.0)]  # (x, radius)
     pin_radius = 3.0
     pins = [Rod(x, 0.0, 0.0, 20.0, pin_radius) for x, _ in gears]
@@ -222,7 +223,7 @@ def ball_joint() -> dict[str, Solid]:
 
 
 def interlock() -> dict[str, Solid]:
-    """Seed 003 Fig. 10: bars A, B hooked into each other fill a 3 x 3 channel (x-z
+    """Liu 1997, Fig. 10: bars A, B hooked into each other fill a 3 x 3 channel (x-z
     section) of the base C, closed by the lid D whose keys sit in notches of C's walls."""
     width = 4.0
     bar_a = Union(

@@ -1,4 +1,4 @@
-"""The ``assemblykit blocking`` command (DESIGN.md §5.3)."""
+"""The ``assemblykit blocking`` command (docs/blocking.md)."""
 
 from __future__ import annotations
 

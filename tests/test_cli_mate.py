@@ -1,4 +1,5 @@
-"""``assemblykit mate``: the seed's answers on the bundled problems; exit 2 on bad input."""
+"""``assemblykit mate``: the answers of Liu & Popplestone 1990 on the bundled problems; exit 2
+on bad input."""
 
 from __future__ import annotations
 

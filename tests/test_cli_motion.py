@@ -1,4 +1,4 @@
-"""The ``assemblykit motion`` command (DESIGN.md §5.3)."""
+"""The ``assemblykit motion`` command (docs/motion.md)."""
 
 from __future__ import annotations
 

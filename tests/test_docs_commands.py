@@ -1,11 +1,16 @@
 """Every ``assemblykit`` command shown in the README and the guides runs as written from
 a clone of the repository: the lines of ```bash blocks that start with ``assemblykit``
-and the ``$ assemblykit`` lines of ```console blocks (which exit 2 when the transcript
-shows an error). Each runs in a fresh folder that sees the repository's ``src``,
-``tests`` and ``examples``, so written files land there."""
+and the ``$ assemblykit`` lines of ```console blocks (which exit 2, printing the error
+line the transcript shows, when it shows one). The tutorial's Python blocks run in
+order, as one session, and print what they show. Each runs in a fresh folder that sees
+the repository's ``src``, ``tests`` and ``examples``, so written files land there."""
 
 from __future__ import annotations
 
+import contextlib
+import doctest
+import io
+import itertools
 import re
 import shlex
 from pathlib import Path
@@ -42,6 +47,20 @@ def documented_commands() -> list[tuple[str, int, str, int]]:
 COMMANDS = documented_commands()
 
 
+def documented_errors() -> dict[str, str]:
+    """The error line each ```console transcript shows under its command, by command."""
+    errors = {}
+    for document in DOCUMENTS:
+        lines = document.read_text().splitlines()
+        for line, after in itertools.pairwise(lines):
+            if line.startswith("$ assemblykit ") and after.startswith("assemblykit: "):
+                errors[line.removeprefix("$ ")] = after
+    return errors
+
+
+ERRORS = documented_errors()
+
+
 # commands that need an optional extra: the module it installs
 EXTRAS = {"--engine dask": "dask.distributed", ".step": "OCP"}
 
@@ -66,7 +85,7 @@ SLOW = ("PelikanBurr.xmpuzzle --moves multi", "SolidSixPieceBurrs.xmpuzzle --mov
     ],
     ids=[f"{d}:{n}" for d, n, _, _ in COMMANDS],
 )
-def test_documented_command_runs(command, expected, tmp_path, monkeypatch):
+def test_documented_command_runs(command, expected, tmp_path, monkeypatch, capsys):
     for marker, module in EXTRAS.items():
         if marker in command:
             pytest.importorskip(module)
@@ -80,3 +99,34 @@ def test_documented_command_runs(command, expected, tmp_path, monkeypatch):
     except SystemExit as done:
         code = int(done.code or 0)
     assert code == expected, command
+    if command in ERRORS:
+        assert capsys.readouterr().err.strip() == ERRORS[command]
+
+
+def python_blocks(document: Path) -> list[str]:
+    """The text of each ```python block of ``document``, in order."""
+    return re.findall(r"^```python\n(.*?)^```", document.read_text(), re.DOTALL | re.MULTILINE)
+
+
+def test_the_tutorial_python_blocks_run_from_the_repository_root(tmp_path, monkeypatch):
+    blocks = python_blocks(ROOT / "docs" / "tutorial.md")
+    assert len(blocks) >= 2
+    for folder in ("src", "tests", "examples"):
+        (tmp_path / folder).symlink_to(ROOT / folder)
+    monkeypatch.chdir(tmp_path)
+    session: dict[str, object] = {}
+    parser = doctest.DocTestParser()
+    runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE)
+    for number, block in enumerate(blocks, start=1):
+        if ">>> " in block:
+            test = parser.get_doctest(block, session, f"tutorial block {number}", None, 0)
+            test.globs = session  # one session: the names of the blocks before
+            report: list[str] = []
+            result = runner.run(test, out=report.append, clear_globs=False)
+            assert result.failed == 0, "".join(report)
+            continue
+        printed = io.StringIO()
+        with contextlib.redirect_stdout(printed):
+            exec(compile(block, f"tutorial block {number}", "exec"), session)
+        shown = re.findall(r"^print\(.*#\s*(.+)$", block, re.MULTILINE)
+        assert printed.getvalue().split() == shown, block

@@ -255,3 +255,51 @@ def test_every_package_export_is_listed() -> None:
     }
     assert "assemblykit.algebra.intersect_groups" in exported
     assert sorted(exported - set(PUBLIC_NAMES)) == []
+
+
+def test_the_top_level_namespace_is_the_public_api() -> None:
+    listed = dir(assemblykit)
+    assert listed == sorted(assemblykit.__all__)
+    for helper in ("Any", "annotations", "importlib", "typing", "errors"):
+        assert helper not in listed
+    star: dict[str, object] = {}
+    exec("from assemblykit import *", star)
+    assert sorted(k for k in star if k != "__builtins__") == sorted(assemblykit.__all__)
+    # submodules still import, as attributes and by name
+    errors = importlib.import_module("assemblykit.errors")
+    assert assemblykit.errors is errors and errors.InputError is assemblykit.InputError
+    exec("from assemblykit import algebra, geometry", star)
+    assert star["algebra"] is importlib.import_module("assemblykit.algebra")
+
+
+def test_the_inputs_and_outputs_users_meet_are_exported() -> None:
+    homes = {
+        "Part": "assemblykit.model.assembly",
+        "Gravity": "assemblykit.planning.stability",
+        "PolygonAssembly": "assemblykit.api.assembly",
+        "Contact": "assemblykit.geometry.contacts",
+        "Contacts": "assemblykit.geometry.contacts",
+        "Solution": "assemblykit.inference.solution",
+        "Motion": "assemblykit.motion.freedom",
+        "MotionReport": "assemblykit.motion.freedom",
+        "Plan": "assemblykit.planning.sequence",
+        "Step": "assemblykit.planning.sequence",
+        "DirectionalBlockingGraph": "assemblykit.blocking.dbg",
+        "NonDirectionalBlockingGraph": "assemblykit.blocking.ndbg",
+        "MatingProblem": "assemblykit.mating.problem",
+        "MatingResult": "assemblykit.mating.search",
+        "InputError": "assemblykit.errors",
+    }
+    for name, module in homes.items():
+        assert name in assemblykit.__all__ and f"assemblykit.{name}" in PUBLIC_NAMES
+        assert getattr(assemblykit, name) is getattr(importlib.import_module(module), name)
+    # what the command line builds, built from the top level
+    boxes = assemblykit.Assembly(
+        [
+            assemblykit.Part("lower", box_mesh([0, 0, 0], [1, 1, 1])),
+            assemblykit.Part("upper", box_mesh([0, 0, 1], [1, 1, 2])),
+        ]
+    )
+    found = assemblykit.plan(boxes, gravity=assemblykit.Gravity(friction=0.5))
+    assert isinstance(found, assemblykit.Plan) and isinstance(found.steps[0], assemblykit.Step)
+    assert isinstance(boxes.contacts(), assemblykit.Contacts)

@@ -1,6 +1,6 @@
 """assemblykit: geometric reasoning about mechanical assemblies.
 
-The public API (DESIGN.md §5.4) is imported lazily so that ``import assemblykit`` stays
+The public API (docs/tutorial.md §4) is imported lazily so that ``import assemblykit`` stays
 cheap and optional extras are only needed by the functions that use them; ``dir()``
 lists it. Results print as one line and show as tables in notebooks; results indexed by
 name behave as mappings.
@@ -74,8 +74,8 @@ SymmetryGroup<revolute about line through (0, 0, 0) along +Z>
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
+import importlib as _importlib
+import typing as _typing
 
 from assemblykit.errors import AssemblyKitError
 
@@ -89,24 +89,46 @@ _PUBLIC = {
     "motion": "assemblykit.motion.freedom",
     "blocking_graph": "assemblykit.blocking.graphs",
     "plan": "assemblykit.planning.planner",
+    "interlocking": "assemblykit.planning.interlocking",
+    "Interlocking": "assemblykit.planning.interlocking",
     "load_problem": "assemblykit.io.problem",
     "mate": "assemblykit.mating.search",
     "Tolerance": "assemblykit.tolerance",
     "write_report": "assemblykit.viz.viewer",
     "write_plan": "assemblykit.io.exports",
     "write_gltf": "assemblykit.io.exports",
+    # what users build inputs from and read outputs as
+    "InputError": "assemblykit.errors",
+    "Part": "assemblykit.model.assembly",
+    "PolygonAssembly": "assemblykit.api.assembly",
+    "Gravity": "assemblykit.planning.stability",
+    "Contact": "assemblykit.geometry.contacts",
+    "Contacts": "assemblykit.geometry.contacts",
+    "Solution": "assemblykit.inference.solution",
+    "Motion": "assemblykit.motion.freedom",
+    "MotionReport": "assemblykit.motion.freedom",
+    "DirectionalBlockingGraph": "assemblykit.blocking.dbg",
+    "NonDirectionalBlockingGraph": "assemblykit.blocking.ndbg",
+    "Plan": "assemblykit.planning.sequence",
+    "Step": "assemblykit.planning.sequence",
+    "MatingProblem": "assemblykit.mating.problem",
+    "MatingResult": "assemblykit.mating.search",
 }
 
 __all__ = ["AssemblyKitError", "__version__", *_PUBLIC]
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> _typing.Any:
+    """A name of the public API, imported from its module when first asked for."""
     module = _PUBLIC.get(name)
     if module is None:
         raise AttributeError(f"module 'assemblykit' has no attribute {name!r}")
-    return getattr(importlib.import_module(module), name)
+    return getattr(_importlib.import_module(module), name)
 
 
 def __dir__() -> list[str]:
-    """The module's names with the lazily imported public API."""
-    return sorted({*globals(), *__all__})
+    """The public API (``__all__``): no helper names and no submodules."""
+    return sorted(__all__)
+
+
+del annotations

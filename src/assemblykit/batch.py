@@ -1,4 +1,4 @@
-"""Many assemblies in parallel: ``assemblykit batch`` (DESIGN.md §5.3).
+"""Many assemblies in parallel: ``assemblykit batch`` (docs/planning.md, "Many assemblies").
 
 Every assembly runs in its own child process (``python -m assemblykit.batch INPUT``), so
 a per-assembly timeout really stops the work and a crash is recorded instead of ending

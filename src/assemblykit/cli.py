@@ -1,4 +1,4 @@
-"""The ``assemblykit`` command (DESIGN.md §5.3).
+"""The ``assemblykit`` command (docs/architecture.md, "Results and errors").
 
 Every command takes ``INPUT``, ``--json`` (the documented JSON on stdout), ``--tolerance``
 (relative length tolerance; ``solve`` and ``motion`` also take ``--angle-tolerance``, which
@@ -174,9 +174,14 @@ def assembly_or_polygons(path: str, tol: Tolerance, as_written: bool, partial: b
     return loaded_assembly(path, tol, as_written, partial)
 
 
-def emit(result: Result, as_json: bool, rounding: Tolerance | None = None) -> None:
+def emit(
+    result: Result, as_json: bool, rounding: Tolerance | None = None, shown: Tolerance | None = None
+) -> None:
     """Print a result: JSON on stdout, its numbers rounded by the model's tolerance
-    ``rounding`` when given (io.report), or its rich rendering."""
+    ``rounding`` when given (io.report), or its rich rendering written with the model's
+    tolerance ``shown`` (else ``rounding``) in force: directions within its angle of an
+    axis print as ``+X``, numbers within its length as 0 (docs/architecture.md, "Numbers
+    for people")."""
     if as_json:
         data: Any = result.to_dict()
         if rounding is not None:
@@ -186,9 +191,11 @@ def emit(result: Result, as_json: bool, rounding: Tolerance | None = None) -> No
         sys.stdout.write(json.dumps(data, indent=2) + "\n")
     else:
         from assemblykit.render import render
+        from assemblykit.tolerance import current, using
 
-        # lines longer than the width (a trace, a path) are wrapped or kept, never cut
-        console().print(render(result), crop=False)
+        with using(shown or rounding or current()):
+            # lines longer than the width (a trace, a path) are wrapped or kept, never cut
+            console().print(render(result), crop=False)
 
 
 def note(message: str) -> None:
@@ -637,7 +644,7 @@ def plan_cmd(
     for written in (html, png, out, gltf):
         if written is not None:
             note(f"wrote {written}")
-    emit(result, as_json)
+    emit(result, as_json, shown=getattr(loaded, "tolerance", lambda: tol)())
 
 
 @command
@@ -743,7 +750,7 @@ def batch_cmd(
 
 def _is_task_file(path: str) -> bool:
     """Whether ``path`` is a task: ``.rapt``, or YAML/JSON whose top level has
-    ``situations`` (DESIGN.md §5.1); anything else is read as an assembly."""
+    ``situations`` (docs/tutorial.md §1); anything else is read as an assembly."""
     from pathlib import Path
 
     from assemblykit.io.documents import read_text, read_yaml
@@ -859,7 +866,7 @@ def contacts_cmd(
         from assemblykit.viz.plots import plot_contacts
 
         plot_contacts(result.assembly, result.contacts, png)
-    emit(result, as_json)
+    emit(result, as_json, shown=result.assembly.tolerance(tol))
 
 
 BLOCKING_MOTIONS = ("infinitesimal", "extended", "rigid")
@@ -908,7 +915,7 @@ def blocking_cmd(
         from assemblykit.viz.plots import plot_ndbg
 
         plot_ndbg(result, png)
-    emit(result, as_json)
+    emit(result, as_json, shown=getattr(model, "tolerance", lambda: tol)())
 
 
 @command
@@ -936,3 +943,177 @@ def mate_cmd(
 
         note(f"wrote {write_mating_png(loaded, result, png)}")
     emit(result, as_json)
+
+
+def _interlock_page(loaded: Assembly, result: Any) -> str:
+    """A self-contained HTML page of an interlocking test: the verdict in words, the 3D
+    view of the assembly (:func:`assemblykit.viz.viewer.figure`) with an arrow per
+    subset that moves, and tables of what moves, the keys in order and the blocking
+    graphs."""
+    import html as markup
+
+    import numpy as np
+    import plotly.graph_objects as go
+    import plotly.io as pio
+
+    from assemblykit import formatting as fmt
+    from assemblykit.planning.sequence import Plan
+    from assemblykit.viz.viewer import ARROW_COLOR, STYLE, ReportTable, figure
+
+    tol = result.tol
+    view = figure(loaded, Plan(tuple(loaded.names), (), (), None, 0))
+    size = 0.15 * loaded.scale
+    for freedom in result.freedoms:
+        d = np.asarray(freedom.direction, dtype=np.float64)
+        if len(d) != 3:
+            continue  # a twist: shown in the table only
+        bounds = np.array([loaded.parts[n].mesh.bounds for n in freedom.parts])
+        centre = (bounds[:, 0].min(axis=0) + bounds[:, 1].max(axis=0)) / 2
+        tip = centre + size * d
+        view.add_trace(
+            go.Scatter3d(
+                x=[centre[0], tip[0]],
+                y=[centre[1], tip[1]],
+                z=[centre[2], tip[2]],
+                mode="lines",
+                line={"color": ARROW_COLOR, "width": 6},
+                name=", ".join(freedom.parts),
+                hoverinfo="name",
+            )
+        )
+        view.add_trace(
+            go.Cone(
+                x=[tip[0]],
+                y=[tip[1]],
+                z=[tip[2]],
+                u=[d[0]],
+                v=[d[1]],
+                w=[d[2]],
+                sizemode="absolute",
+                sizeref=0.3 * size,
+                anchor="tip",
+                showscale=False,
+                colorscale=[[0, ARROW_COLOR], [1, ARROW_COLOR]],
+                name=", ".join(freedom.parts),
+                hoverinfo="name",
+            )
+        )
+    plot = pio.to_html(
+        view,
+        full_html=False,
+        include_plotlyjs=True,
+        div_id="assembly-view",
+        validate=False,
+        config={"displaylogo": False},
+    )
+    moving = ReportTable(
+        "What moves",
+        ("moves", "e.g. along", "free along", "to block it"),
+        tuple(
+            (
+                ", ".join(f.parts),
+                fmt.direction(f.direction, tol),
+                ", ".join(d.words(tol) for d in f.free_along) or "-",
+                f.advice(tol),
+            )
+            for f in result.freedoms
+        ),
+        "Each subset that moves relative to the rest, one direction that frees it, where it "
+        "is free (regions of the blocking graph) and the contacts that would block it.",
+    )
+    order = ReportTable(
+        "Keys in order",
+        ("step", "keys", "along", "rest"),
+        tuple(
+            (str(k), ", ".join(r.keys), fmt.direction(r.direction, tol), fmt.name_list(r.rest, 8))
+            for k, r in enumerate(result.order, start=1)
+        ),
+    )
+    cells = ReportTable(
+        "Blocking graphs",
+        ("direction", "regions", "strong components", "free"),
+        tuple(
+            (
+                fmt.direction(c.direction, tol),
+                str(c.regions),
+                "; ".join(fmt.name_list(g.parts, 6) for g in c.components),
+                "; ".join(fmt.name_list(g.parts, 6) for g in c.components if g.free) or "-",
+            )
+            for c in result.cells
+        ),
+        "One row per distinct directional blocking graph: a subset moves along its directions "
+        "iff it is a union of strong components that no arc leaves.",
+    )
+    name = markup.escape(fmt.file_name(loaded.source) or "assembly")
+    lines = "".join(f"<p>{markup.escape(line)}</p>" for line in result.summary().splitlines())
+    sections = [moving.to_html()] + ([order.to_html()] if result.order else []) + [cells.to_html()]
+    return (
+        '<!DOCTYPE html>\n<html><head><meta charset="utf-8">'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">'
+        f"<title>{name}: {markup.escape(result.verdict)}</title><style>{STYLE}</style>"
+        f"</head><body>\n<h1>{name}: {markup.escape(result.verdict)}</h1>{lines}\n{plot}\n"
+        + "\n".join(sections)
+        + "\n</body></html>\n"
+    )
+
+
+@command
+@assembly_argument
+@click.option(
+    "--key",
+    "keys",
+    multiple=True,
+    metavar="PART",
+    help="A key part; repeat for a set of keys [default: find the key].",
+)
+@click.option(
+    "--motion",
+    type=click.Choice(BLOCKING_MOTIONS),
+    default="infinitesimal",
+    show_default=True,
+    help="infinitesimal, extended or rigid.",
+)
+@click.option(
+    "--html", default=None, help="Also write a self-contained HTML page (verdict, 3D view) here."
+)
+@json_option
+@tolerance_option
+@as_written_option
+@partial_option
+@debug_option
+def interlock_cmd(
+    assembly: str,
+    keys: tuple[str, ...],
+    motion: Motion,
+    html: str | None,
+    as_json: bool,
+    tolerance: float | None,
+    as_written: bool,
+    partial: bool,
+    debug: bool,
+) -> None:
+    """Is the assembly interlocking, and with which key? Every direction of the blocking
+    graphs (Wilson & Latombe 1992), not only the six axes.
+
+    ASSEMBLY: mesh folder, .yaml manifest, .step, COMPAS .json, BurrTools .xmpuzzle, or a
+    YAML file of 2D polygons 'parts: {name: [[x, y], ...]}'.
+    """
+    from assemblykit.outputs import atomic_output
+    from assemblykit.planning.interlocking import interlocking
+
+    if html is not None:
+        checked_output(html, "--html", HTML_SUFFIXES)
+    tol = tolerance_from(tolerance)
+    loaded = _plan_input(assembly, tol, as_written, 0, 0, partial)
+    if html is not None and getattr(loaded, "dimension", 3) == 2:
+        raise InputError("--html draws meshes: not for a 2D polygon assembly")
+    result = interlocking(loaded, keys or None, motion, tol)
+    if html is not None:
+        page = _interlock_page(loaded, result)
+        with atomic_output(html) as temporary:
+            temporary.write_text(page, encoding="utf-8")
+        note(f"wrote {html}")
+    if as_json:
+        emit(result, True, loaded.tolerance(tol))
+    else:
+        console().print(result.summary(), markup=False, highlight=False, crop=False, soft_wrap=True)

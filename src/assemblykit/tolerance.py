@@ -1,4 +1,4 @@
-"""The one tolerance policy of assemblykit (DESIGN.md §4, ALGEBRA.md §1).
+"""The one tolerance policy of assemblykit (docs/architecture.md, "Tolerances"; docs/algebra.md §1).
 
 * **Lengths** are compared relative to the model's size: ``length = rel_length x scale``
   where ``scale`` is the bounding-box diagonal of the model (1 when unknown).

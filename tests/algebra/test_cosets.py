@@ -1,4 +1,4 @@
-"""Relation cosets: the worked examples W1-W21 of ALGEBRA.md §6 at the algebra level
+"""Relation cosets: the worked examples W1-W21 of docs/algebra.md §6 at the algebra level
 (src/assemblykit/algebra/cosets.py). Relations are built with ``transporter`` as §5.1
 prescribes: 'against' maps the body-2 plane with its normal negated onto the body-1 plane."""
 
@@ -372,7 +372,7 @@ def test_w16_lattice_meets_a_third_relation():
 
 
 # ----------------------------------------------------------------------------- helical closed forms
-# ALGEBRA.md §2.4 table and §2.5: a thread coset meets a TR coset in a one-parameter
+# docs/algebra.md §2.4 table and §2.5: a thread coset meets a TR coset in a one-parameter
 # problem in the screw angle, solved exactly (no numeric search).
 
 LEAD = 1.5
@@ -527,7 +527,7 @@ def test_discrete_screw_coset_meets_a_key_every_other_step(no_numeric_search):
 
 
 # ----------------------------------------------------------------------------- many components
-# ALGEBRA.md §2.4 "Finite parts", §2.5: cosets with discrete parts meet only the pairs of
+# docs/algebra.md §2.4 "Finite parts", §2.5: cosets with discrete parts meet only the pairs of
 # components that can meet, with the result of meeting every pair.
 
 

@@ -1,6 +1,6 @@
 """Hervé subgroups, membership, intersection, discrete parts and orbits
 (src/assemblykit/algebra/lie.py, groups.py, loci.py, subspaces.py, connected_meets.py,
-meets.py; ALGEBRA.md §2.1-§2.4, W14, W16, W21)."""
+meets.py; docs/algebra.md §2.1-§2.4, W14, W16, W21)."""
 
 from __future__ import annotations
 

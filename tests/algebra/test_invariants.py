@@ -1,5 +1,5 @@
 """Characteristic invariants, stabilisers and transporters
-(src/assemblykit/algebra/invariants.py; ALGEBRA.md §2.5)."""
+(src/assemblykit/algebra/invariants.py; docs/algebra.md §2.5)."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """One-dimensional lattice arithmetic (src/assemblykit/algebra/lattices.py;
-ALGEBRA.md §2.4 "Finite parts", §7 "Lattice rationality")."""
+docs/algebra.md §2.4 "Finite parts", §7 "Lattice rationality")."""
 
 from __future__ import annotations
 

@@ -28,7 +28,7 @@ def test_rotation_about_offset_line_keeps_the_line_fixed():
 
 
 def test_screw_one_turn_is_a_translation_by_the_lead():
-    # ALGEBRA.md W16: with p = 1/(2 pi), Scr(2 pi k; p) = Tr(0, 0, k).
+    # docs/algebra.md §6, W16: with p = 1/(2 pi), Scr(2 pi k; p) = Tr(0, 0, k).
     for k in (-2, 1, 3):
         t = se3.screw((0, 0, 0), (0, 0, 1), 1 / (2 * math.pi), 2 * math.pi * k)
         np.testing.assert_allclose(t, se3.translation((0, 0, k)), atol=1e-12)

@@ -1,6 +1,6 @@
 """Higher pairs in closed form: a point held in planes and lines, a line lying on a plane
 (a cylinder on a plane, an edge on a face), alone and with a lower pair or a point
-(ALGEBRA.md §3, §5.3; inference/network.py folds the loci, inference/reduction.py solves
+(docs/algebra.md §3, §5.3; inference/network.py folds the loci, inference/reduction.py solves
 them). Every expected pose and invariant is worked out by hand in the comments, and checked
 against the relations' own residuals and the residue solver's Jacobian rank."""
 

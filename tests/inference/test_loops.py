@@ -1,4 +1,4 @@
-"""Loops and coupled joints (ALGEBRA.md §5.2 rule 4): closed-form circle-orbit solvers,
+"""Loops and coupled joints (docs/algebra.md §5.2 rule 4): closed-form circle-orbit solvers,
 closures of up to four bodies with every assembly mode, gears, racks and screws. Each
 branch found is checked against its relations written out by hand in the test."""
 

@@ -1,4 +1,4 @@
-"""The residue solver on hand-built constraint systems (Corner et al. 1983 §III G, ALGEBRA.md
+"""The residue solver on hand-built constraint systems (Corner et al. 1983 §III G, docs/algebra.md
 §2.5)."""
 
 from __future__ import annotations

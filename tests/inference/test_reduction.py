@@ -1,4 +1,4 @@
-"""Network reduction on tasks built from the model (Corner et al. 1983 §III, ALGEBRA.md §5.2,
+"""Network reduction on tasks built from the model (Corner et al. 1983 §III, docs/algebra.md §5.2,
 §6)."""
 
 from __future__ import annotations
@@ -794,7 +794,7 @@ def test_non_coset_relations_that_cannot_hold_report_no_solution_found():
 )
 def test_equivariance_of_the_answer(angles, offset):
     """Re-expressing the moving body's features by g⁻¹ turns its pose X into X·g, and
-    leaves its motion group unchanged (ALGEBRA.md §6, equivariance recipe)."""
+    leaves its motion group unchanged (docs/algebra.md §6, equivariance recipe)."""
     g = shift(*offset) @ se3.rot_z(angles[0]) @ se3.rot_x(angles[1]) @ se3.rot_z(angles[2])
     bodies, relations = plate_and_pin()
     plate, pin = bodies

@@ -1,4 +1,4 @@
-"""The Solution value and its JSON form (DESIGN.md §5.3)."""
+"""The Solution value and its JSON form (docs/tutorial.md, "JSON")."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The YAML/JSON task file (DESIGN.md §5.1): reading, writing and every kind of bad input."""
+"""The YAML/JSON task file (docs/tutorial.md §1): reading, writing and every kind of bad input."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""A relation kind is one class registered in one table (ALGEBRA.md §5.1): a kind defined
+"""A relation kind is one class registered in one table (docs/algebra.md §5.1): a kind defined
 here, outside the package, is read from a task file and solved like the built-in ones."""
 
 from __future__ import annotations

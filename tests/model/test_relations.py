@@ -1,4 +1,4 @@
-"""The relation vocabulary: parsing, checks, cosets (ALGEBRA.md §5.1, §6), residuals."""
+"""The relation vocabulary: parsing, checks, cosets (docs/algebra.md §5.1, §6), residuals."""
 
 from __future__ import annotations
 
@@ -121,7 +121,7 @@ def test_non_coset_kinds_raise_in_relation_coset():
         relation_coset("perpendicular", Plane((0, 0, 0), Z), Plane((0, 0, 0), (1, 0, 0)))
 
 
-# ------------------------------------------------------------------ ALGEBRA.md §6
+# ------------------------------------------------------------------ docs/algebra.md §6
 
 
 def test_w1_single_against_is_planar():
@@ -326,7 +326,7 @@ def test_other_coset_kinds():
     )
 
 
-# ------------------------------------------------------------------ equivariance (ALGEBRA §6)
+# ------------------------------------------------------------ equivariance (docs/algebra.md §6)
 
 rigid = st.builds(
     lambda seed: se3.random_transform(np.random.default_rng(seed), 5.0),

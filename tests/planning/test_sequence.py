@@ -1,4 +1,4 @@
-"""Tests of the disassembly planner (seed 004) on hand-made blocking tables and on
+"""Tests of the disassembly planner (Wilson & Latombe 1992) on hand-made blocking tables and on
 real assemblies (the bundled gearbox, the bundled COMPAS and ASAP data)."""
 
 from __future__ import annotations
@@ -171,7 +171,8 @@ def test_exploded_offsets_push_earlier_parts_further():
 
 def assert_every_step_free(assembly: Assembly, result: Plan) -> None:
     """Each step checked on its own: the moved parts leave the rest by one extended
-    translation (seed 004), each part against each part it leaves."""
+    translation (Wilson & Latombe 1992, "Extended translations"), each part against each
+    part it leaves."""
     assert result.feasible, result.stuck
     # every part but the first base moves at some step (a moved group may split later)
     moved = set().union(*(step.parts for step in result.steps))

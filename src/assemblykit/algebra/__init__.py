@@ -1,5 +1,5 @@
 """The algebra of assemblykit (layer 0): SE(3), Hervé's symmetry subgroups, cosets,
-characteristic invariants and transporters (ALGEBRA.md §1-§2, §5)."""
+characteristic invariants and transporters (docs/algebra.md §1-§2, §5)."""
 
 from assemblykit.algebra.cosets import Chain, Coset, EmptySet, stabilizer, transporter
 from assemblykit.algebra.groups import SymmetryGroup

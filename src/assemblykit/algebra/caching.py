@@ -1,7 +1,7 @@
 """Lazily computed attributes of immutable algebra values.
 
 ``functools.cached_property`` takes a lock on every first access in Python 3.11, which
-costs more than the closed-form coset intersections it caches for (ALGEBRA.md §2.5).
+costs more than the closed-form coset intersections it caches for (docs/algebra.md §2.5).
 The values here are immutable, so a plain descriptor without a lock is enough: a
 concurrent first access at worst computes the same value twice.
 """

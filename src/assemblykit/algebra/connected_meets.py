@@ -1,4 +1,4 @@
-"""Intersections of symmetry groups that need no coset intersection (ALGEBRA.md §2.4):
+"""Intersections of symmetry groups that need no coset intersection (docs/algebra.md §2.4):
 two connected groups, in closed form for TR groups (Liu & Popplestone 1994: the meet
 of their characteristic invariants) and otherwise through the Lie algebras plus the
 helical discrete residue; and a cyclic lattice <tau> with any group, through the

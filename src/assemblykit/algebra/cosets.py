@@ -1,5 +1,5 @@
 """Right cosets H . x0 of symmetry groups, their intersections and products
-(ALGEBRA.md §2.5, §5.2-§5.3).
+(docs/algebra.md §2.5, §5.2-§5.3).
 
 A relation between body 1 and body 2 is the set of relative positions X = L1^-1 L2;
 for lower pairs it is a right coset H . x0 with H in body 1's frame. Intersections
@@ -54,7 +54,7 @@ __all__ = [
     "transporter",
 ]
 
-#: Starts of the deterministic multi-start least squares (ALGEBRA.md §2.5 "Numeric fallback").
+#: Starts of the deterministic multi-start least squares (docs/algebra.md §2.5 "Numeric fallback").
 NUMERIC_STARTS = 24
 
 #: Lattice steps tried on each side when intersecting a lattice coset.
@@ -110,7 +110,7 @@ class EmptySet:
 
 @dataclass(frozen=True, eq=False)
 class Coset:
-    """The right coset H . x0 (``group`` H in body 1's frame, ``rep`` x0), ALGEBRA.md §2.2."""
+    """The right coset H . x0 (``group`` H in body 1's frame, ``rep`` x0), docs/algebra.md §2.2."""
 
     group: SymmetryGroup
     rep: np.ndarray
@@ -221,7 +221,7 @@ class Coset:
         return Coset(self.group.conjugate(t), t @ self.rep @ se3.inverse(t))
 
     def intersect(self, other: Coset, tol: Tolerance | None = None) -> Coset | EmptySet:
-        """(A a) ∩ (B b) = (A ∩ B) . c for any common c, or empty (ALGEBRA.md §2.5).
+        """(A a) ∩ (B b) = (A ∩ B) . c for any common c, or empty (docs/algebra.md §2.5).
 
         TR groups: transporter of the characteristic invariants (closed form, with the
         failed congruence test when empty). Helical groups: the exact group meet and a
@@ -230,7 +230,9 @@ class Coset:
         """
         tol = tol or current()
         if isinstance(other, Chain):
-            raise GroupError("a chain ∩ coset needs the chain solvers (ALGEBRA.md §5.2 rule 4)")
+            raise GroupError(
+                "a chain ∩ coset needs the chain solvers (docs/algebra.md §5.2 rule 4)"
+            )
         if self.group.lattice or other.group.lattice:
             return _lattice_coset_meet(self, other, tol)
         if self.group.is_connected and other.group.is_connected:
@@ -269,7 +271,7 @@ class Coset:
 
 def _component_pairs(p: Coset, q: Coset, tol: Tolerance) -> list[tuple[int, int]]:
     """The pairs (i, j) of components A0 alpha_i a of P = A a and B0 beta_j b of Q = B b
-    that may meet, in the order of all pairs and with (0, 0) first (ALGEBRA.md §2.5
+    that may meet, in the order of all pairs and with (0, 0) first (docs/algebra.md §2.5
     "Finite parts").
 
     When B0 ⊂ A0, A0 alpha a ∩ B0 beta b is B0 beta b if beta b a^-1 is in A0 alpha and
@@ -415,7 +417,7 @@ def _screw_coordinates(group: SymmetryGroup, g: np.ndarray) -> tuple[float, floa
 
 def _helical_meet(p: Coset, q: Coset, tol: Tolerance) -> Coset | EmptySet | None:
     """(H a) ∩ (B b) for a helical or pseudo-planar H and a TR group B, in closed form
-    (ALGEBRA.md §2.4 table, §2.5): a one-parameter problem in the screw angle.
+    (docs/algebra.md §2.4 table, §2.5): a one-parameter problem in the screw angle.
 
     The TR hull C of H (C(N, u) for H(N, u, p), X(u) for Y(u, p)) meets B b a^-1 in a
     TR coset K d (closed form; empty means empty, as H ⊂ C). Within K d the screw
@@ -667,7 +669,7 @@ def transporter(
     sources: tuple[Invariant, ...] | list[Invariant],
     tol: Tolerance | None = None,
 ) -> Coset | EmptySet:
-    """{X in SE(3) : X . sources[i] = targets[i] for all i} (ALGEBRA.md §2.5).
+    """{X in SE(3) : X . sources[i] = targets[i] for all i} (docs/algebra.md §2.5).
 
     ``targets`` are in body-1 coordinates, ``sources`` in body-2 coordinates. Empty when
     the tuples are not congruent (the first failing test is reported); undirected lines

@@ -1,4 +1,4 @@
-"""Symmetry subgroups of SE(3): G = G0 . Gamma (ALGEBRA.md §2.2).
+"""Symmetry subgroups of SE(3): G = G0 . Gamma (docs/algebra.md §2.2).
 
 G0 is one of Hervé's 12 connected families (§2.1, :mod:`assemblykit.algebra.lie`)
 placed by a frame F (G0 = F K F^-1 with K canonical: axis/normal +z through the
@@ -64,7 +64,7 @@ IDENTITY_MATRIX.setflags(write=False)
 
 @dataclass(frozen=True, eq=False)
 class SymmetryGroup:
-    """A subgroup G = G0 . Gamma of SE(3) (ALGEBRA.md §2.2).
+    """A subgroup G = G0 . Gamma of SE(3) (docs/algebra.md §2.2).
 
     ``kind``/``frame``/``pitch`` place the connected part G0 = F K F^-1; ``reps`` is a
     finite transversal of G/G0 (world elements, the first is I) and ``lattice`` the
@@ -188,7 +188,7 @@ class SymmetryGroup:
 
     @property
     def is_tr(self) -> bool:
-        """Whether G0 is a TR group (not helical; ALGEBRA.md §2.4)."""
+        """Whether G0 is a TR group (not helical; docs/algebra.md §2.4)."""
         return self.kind not in HELICAL_KINDS
 
     @cached
@@ -303,14 +303,14 @@ class SymmetryGroup:
         return in_canonical(self.kind, self.pitch, self.frame_inverse @ g @ self.frame, tol)
 
     def contains(self, t: NDArray[np.float64], tol: Tolerance | None = None) -> bool:
-        """Whether ``t`` is in G (ALGEBRA.md §2.3, with reps and lattice projection)."""
+        """Whether ``t`` is in G (docs/algebra.md §2.3, with reps and lattice projection)."""
         return self._component(t, tol or current()) is not None
 
     def _component(self, t: NDArray[np.float64], tol: Tolerance) -> int | None:
         """The first index i with t in G0 . Lambda . reps[i], or ``None`` when t is not in G.
 
         Without a lattice the candidates are the components whose coset keys are near that
-        of t (:class:`_CosetTable`, ALGEBRA.md §2.3 "Discrete parts"), so the cost does not
+        of t (:class:`_CosetTable`, docs/algebra.md §2.3 "Discrete parts"), so the cost does not
         grow with the number of components."""
         if not self.lattice:
             if len(self.reps) == 1:
@@ -418,7 +418,7 @@ class SymmetryGroup:
     # ------------------------------------------------------------------ transforms
 
     def conjugate(self, t: NDArray[np.float64]) -> SymmetryGroup:
-        """T G T^-1 (ALGEBRA.md §2.3 conjugation)."""
+        """T G T^-1 (docs/algebra.md §2.3 conjugation)."""
         ti = se3.inverse(t)
         reps = tuple(IDENTITY_MATRIX if g is IDENTITY_MATRIX else t @ g @ ti for g in self.reps)
         return SymmetryGroup(
@@ -523,7 +523,7 @@ class SymmetryGroup:
     # ------------------------------------------------------------------ orbits
 
     def orbit(self, point: Any, tol: Tolerance | None = None) -> Locus:
-        """The orbit of ``point`` under G (ALGEBRA.md §2.3 orbit table)."""
+        """The orbit of ``point`` under G (docs/algebra.md §2.3 orbit table)."""
         tol = tol or current()
         x = np.asarray(point, dtype=np.float64)
         if any(se3.rotation_angle(g) > tol.angle for g in self.lattice):
@@ -635,7 +635,7 @@ def _coset_features(
     g0: SymmetryGroup, elements: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Features of the G0-cosets G0 . g of ``elements`` (n x 4 x 4), invariant under left
-    multiplication by G0 (ALGEBRA.md §2.3 "Discrete parts"): with c = F^-1 g F in the
+    multiplication by G0 (docs/algebra.md §2.3 "Discrete parts"): with c = F^-1 g F in the
     canonical frame, the K-invariant coordinates of the images c(p) of three points p
     (e.g. radius and height for R, x and y for T, all three for E) and the rotation rows
     K leaves unchanged (all of R without rotations, the z row with rotations about z).
@@ -681,7 +681,7 @@ def _coset_features(
 
 class _CosetTable:
     """Elements of distinct G0-cosets with a lookup of the member whose coset holds a
-    given element (ALGEBRA.md §2.3 "Discrete parts").
+    given element (docs/algebra.md §2.3 "Discrete parts").
 
     Each element has a scalar key, a fixed weighted sum of :func:`_coset_features`. When
     g f^-1 passes the membership predicate of G0, the keys of g and f differ by less than

@@ -1,4 +1,4 @@
-"""Characteristic invariants, their stabilisers and transporters (ALGEBRA.md §2.4-§2.5).
+"""Characteristic invariants, their stabilisers and transporters (docs/algebra.md §2.4-§2.5).
 
 A TR group is the stabiliser of a tuple of geometric objects (points, directed lines,
 oriented planes, free directions). A relation between two bodies is the transporter
@@ -44,7 +44,7 @@ __all__ = [
 
 
 class MismatchKind(StrEnum):
-    """What a failed test measured (ALGEBRA.md §2.5 congruence tests, §4 feature
+    """What a failed test measured (docs/algebra.md §2.5 congruence tests, §4 feature
     parameters, the numeric fallback's residual)."""
 
     ANGLE = "angle"
@@ -273,7 +273,7 @@ def congruence_mismatch(
     tol: Tolerance | None = None,
 ) -> Mismatch | None:
     """The first failing pairwise congruence test (angles, distances, signed moments),
-    or ``None`` when every pair agrees (ALGEBRA.md §2.5)."""
+    or ``None`` when every pair agrees (docs/algebra.md §2.5)."""
     tol = tol or current()
     shape = _shape_mismatch(targets, sources)
     if shape is not None:

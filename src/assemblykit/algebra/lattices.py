@@ -1,5 +1,5 @@
 """Arithmetic of one-dimensional lattices: commensurability and integer points of
-arithmetic progressions (ALGEBRA.md §2.4 "Finite parts", §7 "Lattice rationality").
+arithmetic progressions (docs/algebra.md §2.4 "Finite parts", §7 "Lattice rationality").
 
 A discrete one-parameter family {tau^k} meets another set in the k of a progression
 ``offset + period * Z``; the answer is decided in closed form when ``period`` is
@@ -18,7 +18,7 @@ from assemblykit.tolerance import Tolerance, current
 __all__ = ["MAX_LATTICE_DENOMINATOR", "IntegerPoints", "commensurate", "integer_points"]
 
 #: Largest denominator accepted when deciding that two lattice periods are commensurate
-#: (ALGEBRA.md §2.4, "Finite parts": bounded-denominator continued fraction).
+#: (docs/algebra.md §2.4, "Finite parts": bounded-denominator continued fraction).
 MAX_LATTICE_DENOMINATOR = 10_000
 
 

@@ -1,5 +1,5 @@
 """Hervé's 12 families of connected subgroups of SE(3) and their Lie algebras
-(Hervé 1999; ALGEBRA.md §2.1, §2.3).
+(Hervé 1999; docs/algebra.md §2.1, §2.3).
 
 Each family is a canonical group K (axis or normal +z through the origin) with its Lie
 algebra basis, its elements k(params) and its membership predicate; a connected group
@@ -39,7 +39,7 @@ __all__ = [
 
 
 class Kind(StrEnum):
-    """Hervé's 12 families of connected subgroups of SE(3) (ALGEBRA.md §2.1)."""
+    """Hervé's 12 families of connected subgroups of SE(3) (docs/algebra.md §2.1)."""
 
     FIXED = "fixed"
     REVOLUTE = "revolute"
@@ -78,7 +78,7 @@ HELICAL_KINDS = frozenset({Kind.HELICAL, Kind.PSEUDO_PLANAR})
 
 
 class RotationPart(StrEnum):
-    """The rotations of a TR group (ALGEBRA.md §2.4 characteristic-invariant view): none,
+    """The rotations of a TR group (docs/algebra.md §2.4 characteristic-invariant view): none,
     about lines of one direction, or about a point."""
 
     NONE = "none"
@@ -107,7 +107,7 @@ ROTATIONS = {
 
 
 def canonical_basis(kind: Kind, pitch: float) -> NDArray[np.float64]:
-    """The canonical Lie algebra basis (6 x dim, (omega; v)) of K (ALGEBRA.md §2.1 table)."""
+    """The canonical Lie algebra basis (6 x dim, (omega; v)) of K (docs/algebra.md §2.1 table)."""
     e = np.eye(6)
     rz, tx, ty, tz = e[:, 2], e[:, 3], e[:, 4], e[:, 5]
     sz = rz + pitch * tz
@@ -129,7 +129,7 @@ def canonical_basis(kind: Kind, pitch: float) -> NDArray[np.float64]:
 
 
 def canonical_element(kind: Kind, pitch: float, params: NDArray[np.float64]) -> NDArray[np.float64]:
-    """k(params) of the canonical family (ALGEBRA.md §5.1 normal form).
+    """k(params) of the canonical family (docs/algebra.md §5.1 normal form).
 
     Parameters: R, H (theta); T (s); C (theta, s); T2 (a, b); T3 (a, b, c);
     S (rotation vector); G, Y (a, b, theta); X (a, b, c, theta); D (tx, ty, tz, rotvec).
@@ -177,7 +177,7 @@ def helix_residual(pitch: float, tz: float, theta: float) -> float:
 
 
 def in_canonical(kind: Kind, pitch: float, g: NDArray[np.float64], tol: Tolerance) -> bool:
-    """Membership of a canonical-frame element in K (ALGEBRA.md §2.3 predicate table)."""
+    """Membership of a canonical-frame element in K (docs/algebra.md §2.3 predicate table)."""
     if kind is Kind.FREE:
         return True
     r, t = g[:3, :3], g[:3, 3]
@@ -249,7 +249,7 @@ _ORIGIN = np.zeros(3)
 
 def classify_subalgebra(basis: NDArray[np.float64], tol: Tolerance) -> Placement:
     """The family and frame of the connected group whose Lie algebra is spanned by
-    ``basis`` (6 x k), ALGEBRA.md §2.1 steps 1-5 (Hervé 1999)."""
+    ``basis`` (6 x k), docs/algebra.md §2.1 steps 1-5 (Hervé 1999)."""
     if basis.shape[1] == 0:
         return Placement(Kind.FIXED, np.eye(4))
     thr = rank_threshold(tol)

@@ -1,4 +1,4 @@
-"""Orbits of points under symmetry groups (ALGEBRA.md §2.3 orbit table): points,
+"""Orbits of points under symmetry groups (docs/algebra.md §2.3 orbit table): points,
 circles, lines, helices, cylinders, planes, spheres, all of space, and unions of them
 over the discrete components of a group.
 """
@@ -21,7 +21,7 @@ __all__ = ["Locus", "LocusKind"]
 
 
 class LocusKind(StrEnum):
-    """The shapes an orbit takes (ALGEBRA.md §2.3 orbit table)."""
+    """The shapes an orbit takes (docs/algebra.md §2.3 orbit table)."""
 
     POINT = "point"
     CIRCLE = "circle"
@@ -36,7 +36,7 @@ class LocusKind(StrEnum):
 
 @dataclass(frozen=True, eq=False)
 class Locus:
-    """The orbit of a point under a group (ALGEBRA.md §2.3 orbit table).
+    """The orbit of a point under a group (docs/algebra.md §2.3 orbit table).
 
     ``kind`` is a :class:`LocusKind`. ``point`` is the point itself (point), the centre
     (circle, sphere), a point on the axis (line, helix, cylinder: the axis point) or a

@@ -1,4 +1,4 @@
-"""Intersection of symmetry groups with discrete parts (ALGEBRA.md §2.4 "Finite parts").
+"""Intersection of symmetry groups with discrete parts (docs/algebra.md §2.4 "Finite parts").
 
 The connected parts and cyclic lattices meet in closed form
 (:mod:`assemblykit.algebra.connected_meets`); the finite components of A = A0 . Gamma_A
@@ -24,7 +24,7 @@ __all__ = ["intersect_groups"]
 def intersect_groups(
     a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance | None = None
 ) -> SymmetryGroup:
-    """G ∩ G' (ALGEBRA.md §2.4): the connected part, the helical residue and the finite
+    """G ∩ G' (docs/algebra.md §2.4): the connected part, the helical residue and the finite
     parts, these met as cosets of the connected parts (§2.5)."""
     tol = tol or current()
     if a.is_connected and b.is_connected:
@@ -46,7 +46,7 @@ def intersect_groups(
 
 def _component_pairs(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> list[tuple[int, int]]:
     """The pairs (i, j) of components A0 alpha_i, B0 beta_j that may meet, in the order of
-    all pairs (ALGEBRA.md §2.4 "Finite parts").
+    all pairs (docs/algebra.md §2.4 "Finite parts").
 
     When B0 ⊂ A0, A0 alpha ∩ B0 beta is B0 beta if beta is in A0 alpha and empty
     otherwise, so each beta needs only the components of A near it

@@ -1,4 +1,4 @@
-"""Rigid transforms of SE(3) and twists of se(3) (ALGEBRA.md §1).
+"""Rigid transforms of SE(3) and twists of se(3) (docs/algebra.md §1).
 
 Transforms are 4x4 float64 homogeneous matrices acting on column vectors
 (``p_world = T @ p_body``). Twists are 6-vectors ordered ``(omega; v)`` where ``v`` is
@@ -173,7 +173,7 @@ def screw(
 ) -> NDArray[np.float64]:
     """The screw motion ``Tr(pitch*angle*u) . Rot_L(angle)`` about the line L = (point, axis).
 
-    ALGEBRA.md §1: ``Scr(theta; p) = Tr(0, 0, p theta) Rz(theta)`` placed on L.
+    docs/algebra.md §1: ``Scr(theta; p) = Tr(0, 0, p theta) Rz(theta)`` placed on L.
     """
     u = unit(axis)
     out = rotation(u, angle, point)
@@ -287,7 +287,7 @@ def vee(m: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _left_jacobian(w: NDArray[np.float64], theta: float) -> NDArray[np.float64]:
-    """``V`` with ``exp(hat(w, v)) = (exp(w), V v)`` (closed form, ALGEBRA.md §1)."""
+    """``V`` with ``exp(hat(w, v)) = (exp(w), V v)`` (closed form, docs/algebra.md §1)."""
     k = skew(w)
     if theta < _SERIES_SWITCH:
         # Taylor terms beyond second order are below float64 resolution here.
@@ -349,7 +349,7 @@ def log(t: NDArray[np.float64]) -> NDArray[np.float64]:
     """A twist ``xi`` with ``exp(xi) == t`` and rotation angle in [0, pi].
 
     The logarithm is multivalued (at angle pi and by 2 pi periodicity); it is used for
-    parameterisation and residuals, never to decide membership (ALGEBRA.md §2.3).
+    parameterisation and residuals, never to decide membership (docs/algebra.md §2.3).
     """
     w = rotation_vector(t[:3, :3])
     theta = math.sqrt(float(w @ w))
@@ -434,7 +434,7 @@ def poses_equal(
 def random_starts(
     angles: NDArray[np.bool_], length: float, count: int, seed: int = 0
 ) -> Iterator[NDArray[np.float64]]:
-    """The deterministic starts of a multi-start over group parameters (ALGEBRA.md §2.5
+    """The deterministic starts of a multi-start over group parameters (docs/algebra.md §2.5
     "Numeric fallback"): zero, then ``count - 1`` seeded uniform draws, angles in
     [-pi, pi] and lengths in [-``length``, ``length``]."""
     rng = np.random.default_rng(seed)
@@ -449,7 +449,7 @@ def multistart_least_squares(
     **options: Any,
 ) -> Iterator[Any]:
     """``scipy.optimize.least_squares`` of ``residual`` from each start in turn, yielding
-    each fit (its ``x``, ``fun``, ``jac``): a deterministic multi-start (ALGEBRA.md §2.5
+    each fit (its ``x``, ``fun``, ``jac``): a deterministic multi-start (docs/algebra.md §2.5
     "Numeric fallback") that the caller ends at the first fit it accepts. ``options`` go
     to ``least_squares`` unchanged; ``scipy.optimize`` is imported at the first start, so
     that only numeric cases pay for it."""

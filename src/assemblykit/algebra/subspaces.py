@@ -1,5 +1,5 @@
 """Linear and affine subspaces of R^3 in closed form, and the minimum-norm solution of
-the symmetric positive semi-definite 3x3 systems that meet them (ALGEBRA.md §2.4: the
+the symmetric positive semi-definite 3x3 systems that meet them (docs/algebra.md §2.4: the
 translation parts V of TR groups and the centres of their meets).
 
 A subspace keeps only its dimension and one unit vector (dim 1: its direction, dim 2:

@@ -1,5 +1,5 @@
-"""The objects of the public API (DESIGN.md §5.4): a task that solves itself and an
-assembly that finds its own contacts.
+"""The objects of the public API (docs/tutorial.md §4): a task that solves itself, an
+assembly that finds its own contacts, and a planar assembly of polygons.
 
 :mod:`assemblykit.model` holds plain values and every algorithm is a function of the
 package that implements it (network reduction in :mod:`assemblykit.inference`, contacts

@@ -16,12 +16,13 @@ by its *links*: ``(low, high, circle, sign)`` says that region ``low`` lies in t
 boundary of region ``high`` and that ``high`` is on side ``sign`` of ``circle`` where
 ``low`` is on it (Wilson & Latombe 1992, crossing rule).
 
-Robustness (DESIGN.md §6): normals parallel within the angle tolerance are first snapped
-to one circle; three circles whose determinant is within rounding error of zero are
-snapped to one vertex, and the vertices are closed so that two circles share exactly
-one pair of antipodal vertices (the incidences stay consistent for nearly parallel
-circles, where float signs alone were wrong). The side of a direction with respect to
-a circle uses the angle tolerance, and rationals when that tolerance is below rounding.
+Robustness (the tolerance policy of docs/architecture.md, "Tolerances"): normals parallel
+within the angle tolerance are first snapped to one circle; three circles whose
+determinant is within rounding error of zero are snapped to one vertex, and the vertices
+are closed so that two circles share exactly one pair of antipodal vertices (the
+incidences stay consistent for nearly parallel circles, where float signs alone would be
+wrong). The side of a direction with respect to a circle uses the angle tolerance, and
+rationals when that tolerance is below rounding.
 """
 
 from __future__ import annotations
@@ -91,7 +92,7 @@ def side_signs(
     ``-1``, or ``0`` when the direction is within the angle tolerance of the circle.
 
     Signs whose magnitude is within rounding error (only possible when the angle
-    tolerance is below it) are decided exactly (DESIGN.md §6)."""
+    tolerance is below it) are decided exactly (module docstring, robustness)."""
     tol = tol or current()
     dots = np.atleast_2d(directions) @ np.asarray(normals, dtype=np.float64).T
     signs = np.sign(dots).astype(np.int8)
@@ -191,7 +192,7 @@ def triple_signs(
     """Signs of ``det(n_i, n_j, n_m)`` for every row (i, j) and circle m: on which side
     of circle m the vertex ``n_i x n_j`` lies. Values within rounding error of zero are
     snapped to 0 (circle m passes through the vertex): deciding them exactly would make
-    triangles of 1e-16 rad that float angles cannot order (DESIGN.md §6)."""
+    triangles of 1e-16 rad that float angles cannot order (module docstring, robustness)."""
     cross = np.cross(normals[i], normals[j])
     det = cross @ normals.T
     signs = np.sign(det).astype(np.int8)

@@ -48,7 +48,8 @@ class BlockingTerm:
 
     @property
     def single(self) -> bool:
-        """Whether the term is one half-space (it then adds to the seed's arc weight)."""
+        """Whether the term is one half-space (it then adds to its pair's arc weight: Wilson &
+        Latombe 1992, "Computation of Blocking Graph")."""
         return len(self.normals) == 1
 
 

@@ -112,8 +112,8 @@ class Removal:
     tolerance_dependent: bool = False
 
     def to_dict(self) -> dict[str, object]:
-        """JSON form (DESIGN.md §5.3): sorted part names and direction lists (and
-        ``tolerance_dependent`` when set)."""
+        """JSON form (docs/blocking.md, "Output"): sorted part names and direction lists
+        (and ``tolerance_dependent`` when set)."""
         out: dict[str, object] = {
             "parts": sorted(self.parts),
             "directions": [[float(x) for x in d] for d in self.directions],

@@ -157,8 +157,8 @@ class DirectionTable:
 
     def free_set_sizes(self, members: int, keep: int) -> NDArray[np.int64]:
         """Per direction, how many parts of ``members`` its free sets take away: the
-        parts of the sink strong components of its DBG induced on ``members`` (seed 004,
-        "Directional Blocking Graph"), but for the component holding part ``keep``.
+        parts of the sink strong components of its DBG induced on ``members`` (Wilson &
+        Latombe 1992, "Directional Blocking Graph"), but for the component holding part ``keep``.
         Directions with the same DBG share one computation."""
         place = count_bits(members & ((1 << keep) - 1))
         which, label, sink = self._components(members)
@@ -209,7 +209,8 @@ def local_table(
     names: tuple[str, ...], terms: Sequence[BlockingTerm], tol: Tolerance
 ) -> DirectionTable:
     """Γ_t along the regions of each part's own arrangement (the great circles of the
-    terms that block it; seed 004's arrangement, one part at a time).
+    terms that block it: the arrangement of Wilson & Latombe 1992, "3D case", one part
+    at a time).
 
     A part's blockers are constant over each region of its own arrangement, so every
     way Γ_t lets a single part leave any subassembly is among these directions; groups

@@ -98,13 +98,59 @@ def blocking_graph(
     parts: Iterable[str] | None = None,
     tol: Tolerance | None = None,
 ) -> NonDirectionalBlockingGraph | RigidBlockingGraph:
-    """The NDBG of ``assembly`` (or of the sub-assembly ``parts``) for infinitesimal
-    translations (Γ_t), extended translations (Γ_e) or infinitesimal rigid motions (Γ_g,
-    :class:`~assemblykit.blocking.rigid.RigidBlockingGraph`). Contacts and pairwise
-    obstacles are computed once per assembly; subsets filter them; each NDBG is kept
-    while the assembly lives, and once the whole assembly's is known, a sub-assembly's
-    is derived from it by :meth:`NonDirectionalBlockingGraph.without_parts` (same
-    regions, finer than the sub-assembly needs but still regular)."""
+    """The non-directional blocking graph of ``assembly`` (or of the sub-assembly
+    ``parts``): the directions of motion cut into regions over each of which one
+    directional blocking graph says which part blocks which (Wilson & Latombe 1992,
+    "Non-Directional Blocking Graph"; docs/blocking.md, "Three kinds of motion").
+
+    Contacts and pairwise obstacles are computed once per assembly; subsets filter them;
+    each NDBG is kept while the assembly lives, and once the whole assembly's is known,
+    a sub-assembly's is derived from it by
+    :meth:`NonDirectionalBlockingGraph.without_parts` (same regions, finer than the
+    sub-assembly needs but still regular).
+
+    Parameters
+    ----------
+    assembly : Assembly or PolygonAssembly
+        The parts in assembled position (:func:`assemblykit.load_assembly`); polygons
+        give the graph on the circle of directions S¹.
+    motion : {"infinitesimal", "extended", "rigid"}, default "infinitesimal"
+        Infinitesimal translations (Γ_t: a free set may still be blocked farther along),
+        extended translations (Γ_e: a free set leaves along a straight line to
+        infinity) or infinitesimal rigid motions (Γ_g, a
+        :class:`~assemblykit.blocking.rigid.RigidBlockingGraph`: rotations allowed).
+    parts : iterable of str, optional
+        The sub-assembly whose graph is asked for (the whole assembly when ``None``).
+    tol : Tolerance, optional
+        The tolerance policy (the assembly's own when ``None``).
+
+    Returns
+    -------
+    NonDirectionalBlockingGraph or RigidBlockingGraph
+        The regions and, through ``dbg(direction)``, the directional blocking graph
+        along any direction; ``removable()`` the sets that some direction frees.
+
+    Raises
+    ------
+    ValueError
+        ``motion`` is none of the three.
+    UnknownNameError
+        ``parts`` names a part the assembly does not have.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> import assemblykit
+    >>> lower = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    >>> upper = trimesh.creation.box(bounds=[[0, 0, 1], [1, 1, 2]])
+    >>> parts = [assemblykit.Part("lower", lower), assemblykit.Part("upper", upper)]
+    >>> boxes = assemblykit.Assembly(parts)
+    >>> ndbg = assemblykit.blocking_graph(boxes)
+    >>> ndbg
+    NonDirectionalBlockingGraph(infinitesimal, 2 parts, 1 contact, 3 regions)
+    >>> ndbg.dbg([0, 0, 1]), ndbg.dbg([1, 0, 0])
+    (DirectionalBlockingGraph(+Z, 2 parts, 1 arc), DirectionalBlockingGraph(+X, 2 parts, 0 arcs))
+    """
     if motion not in ("infinitesimal", "extended", "rigid"):
         raise ValueError(f"unknown motion {motion!r}")
     tol = assembly.tolerance(tol)

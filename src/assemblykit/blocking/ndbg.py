@@ -3,10 +3,11 @@ with its DBG, computed by the crossing rule.
 
 The blocking terms (:mod:`assemblykit.blocking.constraints`) are snapped onto great
 circles and become the columns of a :class:`ConstraintTable`: one *weight* column per
-ordered pair of parts for its single half-space terms (the seed's arc weight: the
-number of strictly positive inner products) and one *count* column per cone term
-(extended translations). A pair blocks when its weight is positive or one of its cone
-counts is full. The DBG of the root region is computed directly; every other region
+ordered pair of parts for its single half-space terms (the arc weight of Wilson & Latombe
+1992, "Computation of Blocking Graph": the number of strictly positive inner products)
+and one *count* column per cone term (extended translations). A pair blocks when its
+weight is positive or one of its cone counts is full. The DBG of the root region is
+computed directly; every other region
 is reached by a breadth-first walk over the boundary links of the arrangement and
 obtained by the crossing rule: entering a higher-dimensional region adds the terms
 that become positive on the crossed circles, leaving it for its boundary retracts them
@@ -522,8 +523,8 @@ class NonDirectionalBlockingGraph:
         return fmt.html_summary(repr(self), ("removable", "e.g. along"), rows)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON of DESIGN.md §5.3: ``parts``, ``contacts``, ``regions`` counts and
-        ``removable`` sets with their unit directions."""
+        """JSON of docs/blocking.md, "Output": ``parts``, ``contacts``, ``regions``
+        counts and ``removable`` sets with their unit directions."""
         return {
             "motion": self.motion,
             "parts": list(self.parts),

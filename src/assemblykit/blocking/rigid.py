@@ -1,9 +1,10 @@
 """Blocking for infinitesimal rigid motions, Γ_g (Wilson & Latombe 1992, "Infinitesimal rigid
 motions").
 
-A twist ``(omega; v)`` (DESIGN.md §4: ``v`` is the velocity of the point at the origin)
-moves a point ``p`` of a part with velocity ``v + omega x p``. At a contact point ``p``
-with normal ``n`` pointing from the moving part into the other, the twist is allowed
+A twist ``(omega; v)`` (``v`` is the velocity of the point at the origin:
+docs/architecture.md, "Conventions") moves a point ``p`` of a part with velocity
+``v + omega x p``. At a contact point ``p`` with normal ``n`` pointing from the moving
+part into the other, the twist is allowed
 iff ``n . (v + omega x p) <= 0``, i.e. ``w . (omega; v) <= 0`` with the wrench
 ``w = (p x n; n)``. For planar patches the points are the vertices of the patch's
 convex hull (Wilson & Latombe 1992, "for each vertex v of the convex hull of the contacting area");
@@ -283,7 +284,7 @@ class RigidBlockingGraph:
         return sorted(removals, key=lambda r: (len(r.parts), sorted(r.parts)))
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON of DESIGN.md §5.3: ``regions`` counts only the full-dimensional cells
+        """JSON of docs/blocking.md, "Output": ``regions`` counts only the full-dimensional cells
         (``faces``; ``null`` when the arrangement is not built); lower-dimensional cells
         are not enumerated (``vertices`` and ``edges`` are ``null``); ``arrangement``
         says whether it was built."""

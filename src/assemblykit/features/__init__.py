@@ -1,5 +1,5 @@
 """Oriented primitive features, their pairwise relationships and compound features
-(Liu 1997 §2-§3, ALGEBRA.md §4)."""
+(Liu 1997 §2-§3, docs/algebra.md §4)."""
 
 from assemblykit.features.compound import (
     CompoundFeature,

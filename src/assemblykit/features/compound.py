@@ -3,7 +3,7 @@
 Liu 1997 §3: a compound feature is a set of oriented primitive features (Def. 3.0.1);
 its symmetry group is the intersection of the primitive groups (Props 3.2.6, 3.2.7)
 enlarged by the isometries that swap congruent features (Props 3.2.8, 5.0.9). It is
-computed here by the permutation method of ALGEBRA.md §4.1, which covers all of them:
+computed here by the permutation method of docs/algebra.md §4.1, which covers all of them:
 the union, over the class-preserving permutations π, of the non-empty transporters
 {g : g(Fᵢ) = F_π(i) for all i}.
 """
@@ -98,7 +98,7 @@ def _common_orientation(f1: Feature, f2: Feature) -> tuple[Feature, Feature]:
     """Both features with the axis orientation both of them declare.
 
     ``directed`` is a modelling attribute of an axis, not part of the surface; when only
-    one feature declares it, the pair is judged as undirected (ALGEBRA.md §7)."""
+    one feature declares it, the pair is judged as undirected (docs/algebra.md §7)."""
     if hasattr(f1, "directed") and _directed(f1) != _directed(f2):
         return replace(f1, directed=False), replace(f2, directed=False)  # type: ignore[type-var]
     return f1, f2
@@ -106,14 +106,14 @@ def _common_orientation(f1: Feature, f2: Feature) -> tuple[Feature, Feature]:
 
 def feature_transporter(source: Feature, target: Feature) -> Coset:
     """{g : g(source) = target} for two features with the same canonical surface:
-    ``target.group() · F_target·F_source⁻¹`` (ALGEBRA.md §4.1 step 2, §3)."""
+    ``target.group() · F_target·F_source⁻¹`` (docs/algebra.md §4.1 step 2, §3)."""
     return Coset(target.group(), target.frame() @ se3.inverse(source.frame()))
 
 
 def _swap_exists(f1: Feature, f2: Feature, tol: Tolerance) -> bool:
     """Whether some proper motion maps f1 onto f2 *and* f2 onto f1 (Liu 1997 Def. 3.1.2).
 
-    Closed forms (each a half-turn, derived from the invariants of ALGEBRA.md §2.4):
+    Closed forms (each a half-turn, derived from the invariants of docs/algebra.md §2.4):
 
     * two oriented planes: always, except parallel planes with equal normals and a
       non-zero offset (Liu's (1997) 1-congruent example); the half-turn is about the
@@ -177,7 +177,7 @@ def relationship(f1: Feature, f2: Feature, tol: Tolerance | None = None) -> Rela
 
 def _congruence_classes(features: Sequence[Feature], tol: Tolerance) -> list[int]:
     """A class index per feature: same surface, same side and same ``directed`` flag
-    (ALGEBRA.md §4.1 step 1)."""
+    (docs/algebra.md §4.1 step 1)."""
     shapes = [(_shape(f), _directed(f)) for f in features]
     classes: list[int] = []
     for i, (shape, directed) in enumerate(shapes):
@@ -225,7 +225,7 @@ def _transporters(
     each with its π.
 
     Depth-first over the assignments π(0), π(1), ...; an empty partial intersection
-    prunes every permutation that extends it (ALGEBRA.md §4.1 steps 2-3). Before
+    prunes every permutation that extends it (docs/algebra.md §4.1 steps 2-3). Before
     intersecting, an assignment that changes a pairwise plane invariant
     (:func:`_plane_invariants`) with an earlier one is pruned at once: its intersection
     would be empty, and the invariants cost a comparison where the intersection costs
@@ -264,7 +264,7 @@ def _transporters(
 def compound_group(features: Sequence[Feature], tol: Tolerance | None = None) -> SymmetryGroup:
     """The symmetry group of a compound feature (Liu 1997 Props 3.2.6-3.2.8, 5.0.9).
 
-    ALGEBRA.md §4.1: the union of the non-empty transporters over class-preserving
+    docs/algebra.md §4.1: the union of the non-empty transporters over class-preserving
     permutations. The identity permutation gives G₁ ∩ ... ∩ Gₙ (Props 3.2.6, 3.2.7),
     computed as the meet of the groups (it always holds the identity, also for axes
     just beyond the angle tolerance of parallel, where a meet of cosets may find no

@@ -1,4 +1,4 @@
-"""Oriented primitive features and their symmetry groups (Liu 1997 §2, ALGEBRA.md §4).
+"""Oriented primitive features and their symmetry groups (Liu 1997 §2, docs/algebra.md §4).
 
 A feature is an oriented surface of a body (Liu 1997 Def. 2.1.2: the surface plus its
 outward normals), or an auxiliary datum (point, axis, frame). Every feature has
@@ -7,8 +7,8 @@ outward normals), or an auxiliary datum (point, axis, frame). Every feature has
   normal (planes) or the axis (shafts root→tip, holes opening→inside, cones and threads
   and prisms along their axis);
 * a **symmetry group** ``group()`` = F·Sym·F⁻¹ in body coordinates, Sym the canonical
-  group of ALGEBRA.md §4's table (directed or undirected);
-* **characteristic invariants** (ALGEBRA.md §2.4) used by transporters.
+  group of docs/algebra.md §4's table (directed or undirected);
+* **characteristic invariants** (docs/algebra.md §2.4) used by transporters.
 
 The keyword arguments are exactly the keys of the task file (DESIGN §5.1), so
 ``feature_from_dict`` is a thin schema layer over the constructors.
@@ -122,7 +122,7 @@ def _flag(value: Any, field: str, owner: str) -> bool:
 
 
 def _flip(frame: Matrix) -> Matrix:
-    """The half-turn about the frame's x axis, in body coordinates (ALGEBRA.md §2.2)."""
+    """The half-turn about the frame's x axis, in body coordinates (docs/algebra.md §2.2)."""
     return frame @ se3.rot_x(math.pi) @ se3.inverse(frame)
 
 
@@ -156,7 +156,7 @@ class Feature(ABC):
 
     @abstractmethod
     def group(self) -> SymmetryGroup:
-        """The symmetry group F·Sym·F⁻¹ in body coordinates (ALGEBRA.md §4)."""
+        """The symmetry group F·Sym·F⁻¹ in body coordinates (docs/algebra.md §4)."""
 
     @abstractmethod
     def invariants(self) -> tuple[Invariant, ...]:
@@ -207,7 +207,7 @@ class _Axial(Feature):
 class _Line(_Axial):
     """Shared behaviour of the axial features with a ``directed`` flag: the axis line is
     their invariant, and the half-turn about the frame's x axis joins their group when
-    undirected (ALGEBRA.md §4). By default the group is the line's own, C(z)."""
+    undirected (docs/algebra.md §4). By default the group is the line's own, C(z)."""
 
     directed: bool
 
@@ -225,7 +225,7 @@ class _Line(_Axial):
 class Plane(Feature):
     """A planar face through ``point`` with outward unit ``normal``: Sym = G(z), 3 dof.
 
-    The flip is excluded: it would invert the normal (Liu 1997 §2, ALGEBRA.md §4)."""
+    The flip is excluded: it would invert the normal (Liu 1997 §2, docs/algebra.md §4)."""
 
     point: Vector
     normal: Vector
@@ -333,7 +333,7 @@ class Socket(_Sphere):
 class Cone(_Axial):
     """A single-nappe cone, apex at ``point``, opening along ``axis``: Sym = R(z).
 
-    No flip: it would map the nappe onto the other one (ALGEBRA.md §4)."""
+    No flip: it would map the nappe onto the other one (docs/algebra.md §4)."""
 
     half_angle: float
     male: bool = True
@@ -359,7 +359,7 @@ class Cone(_Axial):
 
 @dataclass(frozen=True, eq=False)
 class Torus(_Axial):
-    """A torus centred at ``point`` about ``axis``: Sym = R(z)⋊⟨Rx(π)⟩ (ALGEBRA.md §4).
+    """A torus centred at ``point`` about ``axis``: Sym = R(z)⋊⟨Rx(π)⟩ (docs/algebra.md §4).
 
     The surface is symmetric under the half-turn across its mid-plane, so it is undirected."""
 
@@ -396,11 +396,11 @@ def _phase_after(frame: Matrix, transform: Matrix) -> float:
 class Thread(_Line):
     """A helical thread of ``radius`` and ``lead`` (axial advance per turn) about the axis.
 
-    Sym = H(z, p) with pitch p = ±lead/2π (+ for a right hand, ALGEBRA.md §1 and §7), or
+    Sym = H(z, p) with pitch p = ±lead/2π (+ for a right hand, docs/algebra.md §1 and §7), or
     H(z, p)⋊⟨Rx(π)⟩ undirected. ``phase`` is the angle of the thread start about the axis
     from the default frame's x axis; the frame's x axis points at the thread start, so the
-    flip axis of an undirected thread is that perpendicular (ALGEBRA.md §4). The helical
-    part is not a TR invariant (ALGEBRA.md §2.4): the invariant is the axis line alone."""
+    flip axis of an undirected thread is that perpendicular (docs/algebra.md §4). The helical
+    part is not a TR invariant (docs/algebra.md §2.4): the invariant is the axis line alone."""
 
     radius: float
     lead: float
@@ -446,7 +446,7 @@ class Prism(_Line):
     ``size`` is the circumradius (axis to vertex) and ``ref`` the direction from the axis
     to one vertex (default: the default frame's x axis). Sym = T(z)⋊Cₙ, or T(z)⋊Dₙ
     undirected, the extra half-turns being about the vertex and mid-edge directions
-    (ALGEBRA.md §4)."""
+    (docs/algebra.md §4)."""
 
     sides: int
     size: float

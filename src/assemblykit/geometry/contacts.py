@@ -91,6 +91,16 @@ class PlanarPatch:
         """Mean of the polygon's vertices (a point on the contact plane)."""
         return np.asarray(self.polygon.mean(axis=0), dtype=np.float64)
 
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        return fmt.summary(
+            "PlanarPatch",
+            f"area {fmt.number(self.area)}",
+            f"normal {fmt.direction(self.normal)}",
+            fmt.count(len(self.polygon), "vertex", "vertices"),
+        )
+
 
 @dataclass(frozen=True, eq=False)
 class CurvedPatch:
@@ -117,6 +127,17 @@ class CurvedPatch:
     half_angle: float = 0.0
     points: NDArray[np.float64] | None = None
     normals: NDArray[np.float64] | None = None
+
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        axis = "" if self.axis is None else f"axis {fmt.direction(self.axis)}"
+        size = (
+            f"half-angle {fmt.number(self.half_angle)}"
+            if self.kind == "conical"
+            else f"radius {fmt.number(self.radius)}"
+        )
+        return fmt.summary("CurvedPatch", self.kind, axis, size, f"inner {self.inner}")
 
     def normal_cone(self) -> NDArray[np.float64]:
         """Unit outward normals of the inner part generating the cone of the patch's
@@ -175,6 +196,66 @@ class Contact:
     def pair(self) -> tuple[str, str]:
         """The two part names, ``(a, b)``."""
         return (self.a, self.b)
+
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        planar = (
+            f"{fmt.count(len(self.planar), 'planar patch', 'planar patches')}, "
+            f"area {fmt.number(self.area)}"
+            if self.planar
+            else ""
+        )
+        curved = (
+            f"{fmt.count(len(self.curved), 'curved patch', 'curved patches')}: "
+            + ", ".join(p.kind for p in self.curved)
+            if self.curved
+            else ""
+        )
+        return fmt.summary("Contact", self.a, self.b, planar, curved)
+
+
+class Contacts(list[Contact]):
+    """The contacts of an assembly, one :class:`Contact` per touching pair (docs/geometry.md,
+    "The contact model"): a list that prints as one line and shows as a table in notebooks,
+    each pair's planar patches with their area and normals (from ``a`` into ``b``), and
+    its curved patches by kind.
+
+    >>> Contacts([Contact("peg", "block")])
+    Contacts(1 touching pair, 0 planar patches, 0 curved patches)
+    >>> Contacts()._repr_html_()[:40]
+    '<p>Contacts(0 touching pairs, 0 planar p'
+    """
+
+    def __repr__(self) -> str:
+        from assemblykit import formatting as fmt
+
+        planar = sum(len(c.planar) for c in self)
+        curved = sum(len(c.curved) for c in self)
+        return fmt.summary(
+            "Contacts",
+            fmt.count(len(self), "touching pair"),
+            fmt.count(planar, "planar patch", "planar patches"),
+            fmt.count(curved, "curved patch", "curved patches"),
+        )
+
+    def _repr_html_(self) -> str:
+        """The touching pairs as a table (notebooks)."""
+        from assemblykit import formatting as fmt
+
+        rows = [
+            (
+                c.a,
+                c.b,
+                str(len(c.planar)),
+                fmt.number(c.area) if c.planar else "",
+                fmt.name_list(sorted({fmt.direction(p.normal) for p in c.planar})),
+                ", ".join(p.kind for p in c.curved),
+            )
+            for c in self
+        ]
+        headers = ("a", "b", "planar patches", "area", "normals (a into b)", "curved")
+        return fmt.html_summary(repr(self), headers, rows)
 
 
 def _expand(starts: NDArray[np.int64], counts: NDArray[np.int64]) -> NDArray[np.int64]:
@@ -754,7 +835,7 @@ class GeometryMemo:
     first, without the planes), and the curved surfaces ``near`` per part, other part
     and tolerance (those contacts ask for: :func:`near_curved_surfaces`)."""
 
-    contacts: dict[Tolerance, tuple[frozenset[str], list[Contact]]] = field(default_factory=dict)
+    contacts: dict[Tolerance, tuple[frozenset[str], Contacts]] = field(default_factory=dict)
     surfaces: dict[tuple[str, Tolerance], tuple[Surface, ...]] = field(default_factory=dict)
     curved: dict[tuple[str, Tolerance], tuple[Surface, ...]] = field(default_factory=dict)
     near: dict[tuple[str, str, Tolerance], tuple[Surface, ...]] = field(default_factory=dict)
@@ -764,7 +845,7 @@ class GeometryMemo:
         their surfaces."""
         return GeometryMemo(
             {
-                key: (covered & names, [c for c in found if c.a in names and c.b in names])
+                key: (covered & names, Contacts(c for c in found if c.a in names and c.b in names))
                 for key, (covered, found) in self.contacts.items()
             },
             {key: found for key, found in self.surfaces.items() if key[0] in names},
@@ -862,19 +943,19 @@ def assembly_contacts(assembly: object, tol: Tolerance | None = None) -> list[Co
 
 
 @assembly_contacts.register
-def _mesh_contacts(assembly: Assembly, tol: Tolerance | None = None) -> list[Contact]:
+def _mesh_contacts(assembly: Assembly, tol: Tolerance | None = None) -> Contacts:
     """The contacts between touching parts, computed once per tolerance
     (:func:`find_contacts`); for parts the memo does not cover yet (one added by
     ``Assembly.with_part``) only their own contacts are found and added."""
     key = assembly.tolerance(tol)
     memo = memo_of(assembly).contacts
-    covered, found = memo.get(key, (frozenset(), []))
+    covered, found = memo.get(key, (frozenset(), Contacts()))
     missing = [name for name in assembly.parts if name not in covered]
     if missing:
         if not covered:
-            found = find_contacts(assembly, tol)
+            found = Contacts(find_contacts(assembly, tol))
         else:
-            found, added = list(found), set[str]()
+            found, added = Contacts(found), set[str]()
             for name in missing:
                 found += [
                     c

@@ -1,10 +1,10 @@
 """Interference between parts: the volume two solids share, by manifold3d booleans.
 
 Touching parts share faces but no volume; interfering parts share a volume. The volume
-of ``A ∩ B`` is computed exactly on the meshes by manifold3d (DESIGN.md §6: trimesh's
-collision distances are wrong for convex parts, so volumes decide). An overlap counts
-as interference when it is thicker than the length tolerance over the smaller part's
-surface, i.e. when ``volume > tol.length x min(area_a, area_b)``.
+of ``A ∩ B`` is computed exactly on the meshes by manifold3d (docs/geometry.md,
+"Interference": trimesh's collision distances are wrong for convex parts, so volumes
+decide). An overlap counts as interference when it is thicker than the length tolerance over
+the smaller part's surface, i.e. when ``volume > tol.length x min(area_a, area_b)``.
 """
 
 from __future__ import annotations

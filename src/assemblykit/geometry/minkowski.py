@@ -3,7 +3,8 @@
 Part ``j`` blocks the extended translation of part ``i`` along ``d`` iff the volume that
 ``i`` sweeps meets the interior of ``j``, i.e. iff the ray ``{t d, t > 0}`` enters the
 interior of the grown obstacle ``P_j ⊕ (−P_i) = {a − b | a ∈ P_j, b ∈ P_i}`` (the
-seed's "Minkowski difference P_j ⊖ P_i", Lozano-Pérez 1983). For convex pieces the
+"Minkowski difference P_j ⊖ P_i" of Wilson & Latombe 1992, "Extended translations",
+after Lozano-Pérez 1983). For convex pieces the
 obstacle is the convex hull of the vertex differences (scipy ``ConvexHull``) and the
 blocked directions form an open polyhedral cone, bounded by the obstacle's facets
 through the origin once the origin is added to the hull.

@@ -1,6 +1,7 @@
 """Solids built from primitives and moved rigidly: boxes and cylinders combined by
 manifold3d booleans (union of the added primitives minus the union of the cut ones),
-and copies of meshes placed by a pose (DESIGN.md §4: ``p_world = L @ p_body``).
+and copies of meshes placed by a pose (``p_world = L @ p_body``: docs/architecture.md,
+"Conventions").
 """
 
 from __future__ import annotations

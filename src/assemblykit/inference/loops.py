@@ -1,8 +1,8 @@
-"""Closed-form chain solvers for short loops (ALGEBRA.md §5.2 rule 4, §5.4).
+"""Closed-form chain solvers for short loops (docs/algebra.md §5.2 rule 4, §5.4).
 
 A loop i→j→k closing on i→k, whose first link is a revolute and whose second link fixes
 a point ``Q`` (a revolute or spherical joint), is solved by intersecting two orbits of
-``Q`` in i's frame (ALGEBRA.md §2.3 orbit table; Kramer's locus-intersection plan
+``Q`` in i's frame (docs/algebra.md §2.3 orbit table; Kramer's locus-intersection plan
 fragments, §5.4): the circle ``Q`` sweeps under the first revolute and the orbit of ``Q``
 under the closing coset (a point, circle, line, plane or sphere). Each common point fixes
 the first joint's angle; what remains of the loop is then a coset intersection (rule 1).
@@ -180,7 +180,7 @@ def circle_sphere(
 
 
 def circle_meets(circle: Circle, locus: Locus, tol: Tolerance) -> list[np.ndarray] | None:
-    """Common points of a circle and an orbit (ALGEBRA.md §2.3): a point, circle, line,
+    """Common points of a circle and an orbit (docs/algebra.md §2.3): a point, circle, line,
     plane or sphere. None for a continuum or a locus without a closed form here."""
     if locus.kind == LocusKind.POINT:
         assert locus.point is not None
@@ -210,7 +210,7 @@ def _single(value: Any, kinds: tuple[Kind, ...]) -> bool:
 
 
 def point_loop(first: Any, second: Any, closing: Any, tol: Tolerance) -> LoopPoses | None:
-    """Closed-form R·(R or S) ∩ coset (ALGEBRA.md §5.2 rule 4): circle against the
+    """Closed-form R·(R or S) ∩ coset (docs/algebra.md §5.2 rule 4): circle against the
     closing orbit.
 
     ``first`` (i→j) is a revolute coset, ``second`` (j→k) fixes a point ``Q`` of j (on
@@ -287,7 +287,7 @@ def _axis_ends(link: Any) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarr
 
 def loop_reach(links: list[Any], tol: Tolerance) -> Reach | None:
     """The reach bound of a loop of revolute, cylindrical or helical joints with parallel
-    axes (ALGEBRA.md §5.2 rule 4, "R·R vs R·R with all four axes parallel (planar 4-bar
+    axes (docs/algebra.md §5.2 rule 4, "R·R vs R·R with all four axes parallel (planar 4-bar
     loop)"), a necessary condition for the loop to close.
 
     ``links[i]`` is the coset of body ``i + 1`` relative to body ``i`` (indices modulo

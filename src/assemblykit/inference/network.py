@@ -1,4 +1,4 @@
-"""The relational network of a RAPT task (Corner et al. 1983 §III, ALGEBRA.md §5.2).
+"""The relational network of a RAPT task (Corner et al. 1983 §III, docs/algebra.md §5.2).
 
 Nodes are **body instances** ``(body, situation)``: the pose of one body in one
 situation. Fixed bodies are the world: all their instances are the one node
@@ -175,8 +175,9 @@ def _axis_residual(
 def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | None:
     """The link ``prev → next`` of one action (Corner et al. 1983 §III B), or None for a free move.
 
-    The feature's frame has +z along its axis or normal (DESIGN.md §4), so moving along it
-    by ``s`` is F·Tr(0,0,s)·F⁻¹ and turning about it by θ is F·Rz(θ)·F⁻¹ in body coordinates.
+    The feature's frame has +z along its axis or normal (docs/architecture.md,
+    "Conventions"), so moving along it by ``s`` is F·Tr(0,0,s)·F⁻¹ and turning about it by θ
+    is F·Rz(θ)·F⁻¹ in body coordinates.
     """
     ref = action.ref
     if ref is None:
@@ -257,7 +258,7 @@ class PointLocus:
 
     The point ``point`` (in ``point_node``'s body frame) satisfies ``rows @ (y - origin)
     = 0`` in ``locus_node``'s body frame: ``rows`` are orthonormal normals, one for a
-    plane, two for a line, three for a single point (ALGEBRA.md §3: the contact set of a
+    plane, two for a line, three for a single point (docs/algebra.md §3: the contact set of a
     point and a plane is Tr(plane)·S(point), not a coset)."""
 
     point_node: Node
@@ -278,7 +279,7 @@ class LineOnPlane:
     along its normal (a cylinder on a plane: ``distance`` between a line and a plane).
 
     ``point`` and ``direction`` are in ``line_node``'s body frame, ``origin`` (already
-    offset by the distance) and ``normal`` in ``plane_node``'s (ALGEBRA.md §3: a double
+    offset by the distance) and ``normal`` in ``plane_node``'s (docs/algebra.md §3: a double
     coset of dimension 3 + 2 − 1 = 4, not a coset)."""
 
     line_node: Node
@@ -329,7 +330,7 @@ def meet_loci(
 def _fold_point_loci(
     constraints: list[Constraint], tol: Tolerance
 ) -> tuple[list[Link], list[Constraint]]:
-    """Higher pairs of one point met together (ALGEBRA.md §3, §5.2 rule 1 for loci).
+    """Higher pairs of one point met together (docs/algebra.md §3, §5.2 rule 1 for loci).
 
     The ``point_on_plane``, ``point_on_line`` and point-plane ``distance`` relations that
     hold the same point of one instance in loci of the same other instance are

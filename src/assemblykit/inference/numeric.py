@@ -3,7 +3,7 @@ G).
 
 Corner et al. 1983 hands "the residue" of the cycle finder to "a more powerful inference system".
 Here that system is a least-squares solve over the world poses of the remaining body
-instances (ALGEBRA.md §2.5, "numeric fallback"):
+instances (docs/algebra.md §2.5, "numeric fallback"):
 
 * every unknown pose is parameterised locally by a twist: ``L = [exp(ω) R0 | t0 + v]``;
 * every constraint is a residual vector over the poses of the instances it links;
@@ -119,7 +119,7 @@ def _local_dof(
     problem: ResidueProblem, jac: Any, tol: Tolerance, residual: float = 0.0
 ) -> tuple[dict[Hashable, int], int]:
     """Per-instance and total dof from the null space of the constraint Jacobian at a
-    solution whose worst residual is ``residual`` (ALGEBRA.md §2.5 step 5), with the rank
+    solution whose worst residual is ``residual`` (docs/algebra.md §2.5 step 5), with the rank
     threshold :meth:`Tolerance.rank`. The local coordinates of each instance differ
     from twists at the solution by an invertible map, which keeps every rank."""
     threshold = tol.rank(residual)
@@ -217,7 +217,7 @@ def solve_residue(
     starts: int = 8,
     seed: int = 0,
 ) -> ResidueResult:
-    """Solve the residue numerically (ALGEBRA.md §2.5 numeric fallback, steps 1-6).
+    """Solve the residue numerically (docs/algebra.md §2.5 numeric fallback, steps 1-6).
 
     Solutions are accepted when every residual entry is within ``tol.length``, the
     tolerance in force (residuals weigh angles by ``tol.arm``, so angles are held to

@@ -1,10 +1,11 @@
-"""Reduction of the relational network to a fixpoint (Corner et al. 1983 §III C-F, ALGEBRA.md §5.2).
+"""Reduction of the relational network to a fixpoint (Corner et al. 1983 §III C-F,
+docs/algebra.md §5.2).
 
-The rules, in the seed's order:
+The rules, in the order of Corner et al. 1983 §III:
 
 1. **Intersection** (standard solutions): two links between the same pair of instances
    are intersected (``Coset.intersect``); an empty result is an inconsistency, recorded
-   with the relations involved and the mismatch (ALGEBRA.md §2.5).
+   with the relations involved and the mismatch (docs/algebra.md §2.5).
 2. **Merge** on a fixed link (a single point ``X``): the target instance is merged into
    the source, and every link of the merged instance is re-expressed
    (``Q ↦ X·Q``, ``P ↦ P·X⁻¹``), which may enable new intersections.
@@ -599,7 +600,7 @@ def _axis(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
 def revolute_loop(
     first: Any, second: Any, closing: Any, tol: Tolerance
 ) -> tuple[list[tuple[np.ndarray, np.ndarray]], float] | None:
-    """Closed-form R·R ∩ R (ALGEBRA.md §5.2 rule 4: "the orbit of a point under two
+    """Closed-form R·R ∩ R (docs/algebra.md §5.2 rule 4: "the orbit of a point under two
     revolutes gives circle-circle intersections").
 
     ``first`` (i→j), ``second`` (j→k) and ``closing`` (i→k) are revolute cosets with
@@ -851,7 +852,7 @@ def _trace_held(
     detail: str,
 ) -> None:
     """Record in the trace a higher pair of ``node`` solved from the world in closed form
-    (ALGEBRA.md §3): dof ``before`` and ``after``."""
+    (docs/algebra.md §3): dof ``before`` and ``after``."""
     reducer.trace.append(
         TraceStep(
             "higher-pair",
@@ -894,7 +895,7 @@ def _point_in_locus(
     subject: str = "point",
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A point held in a world locus (a plane or a line, :class:`PointLocus`), alone or
-    with a planar coset G(m)·x0 from the world, in closed form (ALGEBRA.md §3, §5.3).
+    with a planar coset G(m)·x0 from the world, in closed form (docs/algebra.md §3, §5.3).
 
     The pose kept is the one of least motion: the pose as written (the identity, or the
     coset's representative when the identity is not in it) moved by the shortest
@@ -1025,7 +1026,7 @@ def _line_on_plane(
     tol: Tolerance,
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A line of an instance lying parallel to a world plane at a distance (a cylinder on a
-    plane, an edge on a face: :class:`LineOnPlane`) in closed form (ALGEBRA.md §3).
+    plane, an edge on a face: :class:`LineOnPlane`) in closed form (docs/algebra.md §3).
 
     Alone, the poses form a 4-dof double coset, not a coset: slide in the plane, turn
     about its normal and about the line; the pose kept is :func:`_lay_line`'s. With a
@@ -1054,7 +1055,7 @@ def _line_with_coset(
     labels: tuple[str, ...],
     tol: Tolerance,
 ) -> tuple[_Instance, list[Conflict]] | None:
-    """A line contact met with a lower pair H·x0 from the world, in closed form (ALGEBRA.md
+    """A line contact met with a lower pair H·x0 from the world, in closed form (docs/algebra.md
     §3, §5.3), when every rotation of H keeps the plane's normal n or the line's direction
     a (H in X(n) or in X(a)).
 
@@ -1117,7 +1118,7 @@ def _line_and_point(
     tol: Tolerance,
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A line contact and a point of the same instance held in a parallel world plane (a
-    roller on a table with a lever's tip on the table), in closed form (ALGEBRA.md §3).
+    roller on a table with a lever's tip on the table), in closed form (docs/algebra.md §3).
 
     The line laid by :func:`_lay_line` can still turn about itself: the point c, at a
     distance ρ from the line, then rises by ρ·cos(φ − φ₀) above the line's plane, which
@@ -1185,7 +1186,7 @@ def _coset_meets_locus(
     When every rotation of the group keeps the locus normals' components (the group lies
     in X(n) for a plane of normal n, in T3 for a line), h ↦ N·(h·q − q) is N·t_h, a
     homomorphism: its fibres are cosets of its kernel, the group met with G(n) (a plane)
-    or T(d) (a line along d), ALGEBRA.md §2.4. The fibre reached is K·Tr(t) with t the
+    or T(d) (a line along d), docs/algebra.md §2.4. The fibre reached is K·Tr(t) with t the
     shortest translation of the group onto the locus (least motion); a locus the
     translations cannot reach is missed by that distance (returned as a float). None
     when the group turns the normals or screws (a fibre that is not a coset, or a helical

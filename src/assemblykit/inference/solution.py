@@ -1,4 +1,5 @@
-"""The answer of RAPT inference: a pose set per body instance (DESIGN.md §4, §5.3).
+"""The answer of RAPT inference: a pose set per body instance (docs/architecture.md, "Conventions";
+docs/tutorial.md, "JSON").
 
 A result that is a set is reported as a set: every body instance ``"<body>@<situation>"``
 has a representative pose, its remaining dof and motion group with invariants in world
@@ -22,7 +23,7 @@ from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance
 
 
 class Status(StrEnum):
-    """The answer for the whole task (DESIGN.md §5.3; :func:`status_of`)."""
+    """The answer for the whole task (docs/tutorial.md, "JSON"; :func:`status_of`)."""
 
     SOLVED = "solved"
     AMBIGUOUS = "ambiguous"
@@ -122,7 +123,7 @@ class BodyInstanceResult:
         return fmt.summary("BodyInstanceResult", self.key, self.motion, f"{self.dof} dof")
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON object of DESIGN.md §5.3 for this instance."""
+        """The JSON object of docs/tutorial.md, "JSON" for this instance."""
         return {
             "pose": _plain(np.asarray(self.pose, dtype=np.float64)),
             "dof": int(self.dof),
@@ -424,7 +425,7 @@ class Solution:
         return max(n for n in needed if n is not None)
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``solve`` JSON of DESIGN.md §5.3 (plus ``suggested_tolerance`` when
+        """The ``solve`` JSON of docs/tutorial.md, "JSON" (plus ``suggested_tolerance`` when
         inconsistent and ``trace`` when explaining)."""
         out: dict[str, Any] = {
             "status": self.status,

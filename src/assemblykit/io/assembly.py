@@ -1,4 +1,5 @@
-"""``load_assembly``: read any assembly input of DESIGN.md §5.2, dispatching by kind.
+"""``load_assembly``: read any assembly input (docs/geometry.md, "Loaders and their
+conventions"), dispatching by kind.
 
 * a folder → mesh folder (:func:`assemblykit.io.meshes.load_mesh_folder`);
 * ``.yaml`` / ``.yml``, or ``.json`` with a top-level ``parts`` list → manifest;

@@ -1,5 +1,5 @@
-"""Assemblies from COMPAS JSON (DESIGN.md §5.2): ``compas_assembly`` assemblies and plain
-lists of block meshes.
+"""Assemblies from COMPAS JSON (docs/geometry.md, "Loaders and their conventions"):
+``compas_assembly`` assemblies and plain lists of block meshes.
 
 Accepted layouts (those of the files published with ``compas_assembly``):
 

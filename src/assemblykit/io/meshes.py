@@ -1,4 +1,5 @@
-"""Assemblies from triangle meshes: mesh folders and YAML manifests (DESIGN.md §5.2).
+"""Assemblies from triangle meshes: mesh folders and YAML manifests (docs/geometry.md,
+"Loaders and their conventions").
 
 * A **mesh folder** holds one part per file (``*.obj, *.stl, *.ply, *.glb``), named
   after the file's stem. If the folder has a ``config.json`` with a per-part

@@ -2,7 +2,7 @@
 :class:`~assemblykit.mating.problem.MatingProblem`.
 
 File layout (YAML or JSON, validated with pydantic; features use the task-file YAML of
-DESIGN.md §5.1)::
+docs/tutorial.md §1)::
 
     units: mm
     bodies:
@@ -149,7 +149,37 @@ class ProblemModel(_Model):
 
 
 def load_problem(path: str | Path, tol: Tolerance | None = None) -> MatingProblem:
-    """Read and validate a mating problem (``.yaml``, ``.yml`` or ``.json``)."""
+    """Read and validate a mating problem (docs/mating.md, "The problem file"): bodies with
+    their features, compound features and meshes, and the goals (Liu & Popplestone 1990).
+
+    Parameters
+    ----------
+    path : str or Path
+        The problem file, ``.yaml``, ``.yml`` or ``.json``; mesh paths in it are read
+        relative to its folder.
+    tol : Tolerance, optional
+        The tolerance policy, scaled to the bounding-box diagonal of the feature points and
+        meshes (the current one when ``None``).
+
+    Returns
+    -------
+    MatingProblem
+        The validated problem, for :func:`assemblykit.mate`.
+
+    Raises
+    ------
+    InputError
+        The file is missing, unreadable or of another type, or its content does not
+        validate (the field path is named).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import assemblykit
+    >>> mating = Path(assemblykit.__file__).parent / "examples" / "mating"
+    >>> assemblykit.load_problem(mating / "one_socket.yaml")
+    MatingProblem(3 bodies, 2 goals, mm, one_socket.yaml)
+    """
     path = Path(path)
     text = read_text(path, "problem")
     suffix = path.suffix.lower()
@@ -169,7 +199,8 @@ def parse_problem(
     data: Any, source: str | None = None, folder: Path | None = None, tol: Tolerance | None = None
 ) -> MatingProblem:
     """Build a :class:`MatingProblem` from the file's mapping; the tolerance is scaled to
-    the bounding-box diagonal of the feature points and meshes (DESIGN.md §4)."""
+    the bounding-box diagonal of the feature points and meshes (docs/architecture.md,
+    "Tolerances")."""
     model = validated(
         ProblemModel,
         data,

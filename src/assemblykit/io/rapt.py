@@ -1,7 +1,7 @@
 """The ``.rapt`` task language (Corner et al. 1983 §II), read with lark and written back.
 
-The text maps 1:1 onto the YAML/JSON task file (DESIGN.md §5.1): one statement per line,
-``body ... end`` and ``situation ... end`` blocks, relations written in the seed's
+The text maps 1:1 onto the YAML/JSON task file (docs/tutorial.md §1): one statement per line,
+``body ... end`` and ``situation ... end`` blocks, relations written in RAPT's
 ``against bottom of block, top of table`` form and actions ``move peg parallel shaft of
 peg by 5`` / ``turn peg about shaft of peg by 90 deg``. The grammar is ``rapt.lark`` next
 to this module; docs/tutorial.md describes it. Parsing builds the task-file mapping with

@@ -1,4 +1,5 @@
-"""JSON-ready values for every result type (DESIGN.md §5.3: the ``--json`` output).
+"""JSON-ready values for every result type: the ``--json`` output (docs/architecture.md,
+"Results and errors").
 
 Results hold numpy arrays, numpy scalars, enums, paths, sets and nested dataclasses; the
 command line needs plain lists, numbers, strings and dictionaries. Numbers are rounded so
@@ -80,7 +81,8 @@ def jsonable(obj: Any, tol: Tolerance | None = None) -> JsonValue:
 
 
 def pose_list(pose: Any, tol: Tolerance | None = None) -> list[list[float]]:
-    """A 4x4 homogeneous pose (DESIGN.md §4) as four rows of rounded floats."""
+    """A 4x4 homogeneous pose (docs/architecture.md, "Conventions") as four rows of rounded
+    floats."""
     matrix = np.asarray(pose, dtype=np.float64)
     if matrix.shape != (4, 4):
         raise NumericError(f"a pose must be a 4x4 matrix, got shape {matrix.shape}")

@@ -1,4 +1,4 @@
-"""The task file in YAML or JSON (DESIGN.md §5.1), read into a validated :class:`Task`.
+"""The task file in YAML or JSON (docs/tutorial.md §1), read into a validated :class:`Task`.
 
 The layout is checked with pydantic models; features are built by
 ``assemblykit.features.primitives.feature_from_dict`` and relations by
@@ -54,7 +54,7 @@ class SituationModel(_Model):
 
 
 class TaskModel(_Model):
-    """The whole task file (DESIGN.md §5.1)."""
+    """The whole task file (docs/tutorial.md §1)."""
 
     units: Literal[UNITS] = "mm"  # type: ignore[valid-type]
     bodies: dict[Name, BodyModel]
@@ -159,7 +159,7 @@ def _amount(kind: str, value: Any, where: str) -> float | None:
 
 
 def task_to_dict(task: Task) -> dict[str, Any]:
-    """The task-file mapping of ``task`` (DESIGN.md §5.1); keys equal to their defaults
+    """The task-file mapping of ``task`` (docs/tutorial.md §1); keys equal to their defaults
     are left out, so the output reads like a hand-written file."""
     return {
         "units": task.units,

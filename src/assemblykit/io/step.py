@@ -1,5 +1,5 @@
-r"""Assemblies from STEP files (DESIGN.md §5.2; extra ``cad``: OCP from
-``cadquery-ocp-novtk``, imported only when a STEP file is read).
+r"""Assemblies from STEP files (docs/geometry.md, "Loaders and their conventions"; extra
+``cad``: OCP from ``cadquery-ocp-novtk``, imported only when a STEP file is read).
 
 Each solid is one part, named from the file's product structure (ISO 10303-44: each
 ``PRODUCT`` is placed by ``NEXT_ASSEMBLY_USAGE_OCCURRENCE`` entities in the product that

@@ -1,4 +1,4 @@
-"""Task files by their suffix (DESIGN.md §5.1): ``.yaml``/``.yml`` and ``.json`` read by
+"""Task files by their suffix (docs/tutorial.md §1): ``.yaml``/``.yml`` and ``.json`` read by
 :mod:`assemblykit.io.spec`, ``.rapt`` text by :mod:`assemblykit.io.rapt`; both give the
 same validated :class:`~assemblykit.model.task.Task`.
 """

@@ -131,7 +131,7 @@ def pair_coset(
     tol: Tolerance,
 ) -> Coset | EmptySet:
     """The relative position allowed by all the paired primitives at once: the
-    intersection of their relation cosets (Liu & Popplestone 1990 eq. (3), ALGEBRA.md §2.5)."""
+    intersection of their relation cosets (Liu & Popplestone 1990 eq. (3), docs/algebra.md §2.5)."""
     result: Coset | None = None
     for i, j, kind in pairing:
         step = relation_coset(kind, first[i], second[j], tol=tol)

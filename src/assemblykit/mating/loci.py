@@ -86,7 +86,7 @@ def circle_sphere(
 
 
 def locus_meet(a: Locus, b: Locus, tol: Tolerance) -> list[np.ndarray] | None:
-    """The common points of two loci that are points or circles (ALGEBRA.md §2.3 orbit
+    """The common points of two loci that are points or circles (docs/algebra.md §2.3 orbit
     table): circles in one plane meet in 0, 1 or 2 points, circles in other planes too
     (:func:`circle_sphere` then the other's plane). ``None`` when there is no closed form
     here (coincident circles, other kinds of loci)."""

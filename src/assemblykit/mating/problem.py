@@ -42,7 +42,7 @@ class MatingBody:
 @dataclass(frozen=True)
 class Goal:
     """A required relationship between two bodies (Liu & Popplestone 1990: ``[goal i [fit b1
-    b4]]``); ``number`` counts from 1 as in the seed."""
+    b4]]``); ``number`` counts from 1 as in Liu & Popplestone 1990."""
 
     number: int
     relation: str
@@ -134,7 +134,8 @@ def problem_diagonal(
     features: Mapping[str, Mapping[str, Feature]], meshes: Mapping[str, trimesh.Trimesh | None]
 ) -> float:
     """The bounding-box diagonal of every feature origin and mesh (the model's size for
-    the tolerance policy, DESIGN.md §4); 1 for a problem with a single point."""
+    the tolerance policy, docs/architecture.md, "Tolerances"); 1 for a problem with a single
+    point."""
     points = [f.frame()[:3, 3] for body in features.values() for f in body.values()]
     points += [corner for m in meshes.values() if m is not None for corner in m.bounds]
     if len(points) < 2:

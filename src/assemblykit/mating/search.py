@@ -8,8 +8,8 @@ for small problems, OR-Tools CP-SAT from the ``csp`` extra for large ones), then
 the bodies globally and checks the spatial constraint:
 
 * **global positions**: one body is fixed and the relative cosets are chained around the
-  goal graph; a body reached twice gets the intersection of the two world cosets (seed
-  002 eq. (3)); a body rigidly attached to a moving body moves with it; a loop that
+  goal graph; a body reached twice gets the intersection of the two world cosets (Liu &
+  Popplestone 1990 eq. (3)); a body rigidly attached to a moving body moves with it; a loop that
   chaining leaves open is closed by the representative-point loci of Liu & Popplestone 1990 Figs 4-5
   or, without a closed form, numerically (:mod:`assemblykit.mating.loci`), each
   solution a configuration;
@@ -221,7 +221,35 @@ class MatingResult:
 
 def mate(problem: MatingProblem) -> MatingResult:
     """All assembly configurations satisfying the goals (Liu & Popplestone 1990, steps one to
-    three)."""
+    three; docs/mating.md): candidate feature pairs, pruned by the mandatory request and
+    equivalent feature laws and arc consistency, then searched, placed and checked for
+    interference.
+
+    Parameters
+    ----------
+    problem : MatingProblem
+        The bodies and goals (:func:`assemblykit.load_problem`).
+
+    Returns
+    -------
+    MatingResult
+        The configurations found (feature pairs, each body's pose and remaining motion),
+        the domain sizes after each law, and, when there is none, the goal emptied and the
+        law that emptied it.
+
+    Raises
+    ------
+    MissingExtraError
+        A search too large for the built-in solver without the ``csp`` extra (OR-Tools).
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import assemblykit
+    >>> mating = Path(assemblykit.__file__).parent / "examples" / "mating"
+    >>> assemblykit.mate(assemblykit.load_problem(mating / "one_socket.yaml"))
+    MatingResult(no solution, goal 2 emptied by the mandatory request law)
+    """
     graph = build_graph(problem)
     stages: list[Domains] = [graph.initial, graph.domains]
     stages.append(mandatory_request(stages[-1]))

@@ -1,4 +1,5 @@
-"""An assembly of rigid parts in assembled position (DESIGN.md §2, §5.2).
+"""An assembly of rigid parts in assembled position (docs/geometry.md, "Loaders and their
+conventions").
 
 A :class:`Part` is a triangle mesh already placed in the world, the pose that placed it,
 and, for CAD input, the exact surfaces of its faces. An :class:`Assembly` is an ordered
@@ -107,9 +108,10 @@ class Assembly:
 
     ``units`` is the length unit of the coordinates and ``units_source`` how it was
     known (``declared`` in the file, read from the ``file`` format, or the ``default``
-    mm of DESIGN.md §4). ``exact`` is true when the geometry comes from exact CAD
-    surfaces; otherwise the mesh thresholds of the tolerance policy apply. ``policy``
-    is the tolerance policy given when loading (the current one when ``None``).
+    mm of docs/geometry.md, "Loaders and their conventions"). ``exact`` is true when the
+    geometry comes from exact CAD surfaces; otherwise the mesh thresholds of the tolerance
+    policy apply. ``policy`` is the tolerance policy given when loading (the current one
+    when ``None``).
     ``precision`` is the input's own precision measured by the loader
     (:mod:`assemblykit.geometry.precision`); lengths are never compared more finely.
     ``skipped`` lists what the loader could not read (:class:`Skipped`) and ``warnings``
@@ -222,7 +224,8 @@ class Assembly:
 
     @property
     def scale(self) -> float:
-        """The model's size: the bounding-box diagonal (DESIGN.md §4), 1 when empty.
+        """The model's size: the bounding-box diagonal (docs/architecture.md, "Tolerances"),
+        1 when empty.
 
         A sub-assembly made by :meth:`subset` keeps the scale of the assembly it came
         from, so that its parts are judged with the same tolerance."""

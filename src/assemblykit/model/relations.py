@@ -2,7 +2,7 @@
 
 A relation ``[kind, first, second, {options}]`` between features of two bodies constrains
 X = L₂⁻¹·L₁, the pose of the *first* feature's body in the frame of the *second*
-feature's body (ALGEBRA.md §5.1: the second feature's body is body 1, the "from" side).
+feature's body (docs/algebra.md §5.1: the second feature's body is body 1, the "from" side).
 So ``[against, block.bottom, table.top]`` is the set of block poses in the table frame.
 
 Each kind is a subclass of :class:`RelationType` that holds all the kind means: its
@@ -10,14 +10,14 @@ arity, the feature pairs and options it accepts, its coset, its residual, the do
 removes, whether it couples motions through a third body, and the closed-form geometry
 of the higher pairs. :data:`RELATIONS` maps every kind's name to its class's instance;
 :func:`register_relation` adds a kind, as ``FEATURE_TYPES`` lists the feature classes.
-A task's relations keep the kind's name (the task file of DESIGN.md §5.1) and look the
+A task's relations keep the kind's name (the task file of docs/tutorial.md §1) and look the
 class up in the table.
 
 Lower-pair relations are right cosets H₁·x₀ with x₀ = F₁·σ·F₂⁻¹ and H₁ the common
-symmetry group placed on body 1's feature (ALGEBRA.md §3, §5.1; Liu & Popplestone 1990 eq. (1), seed
-003 eq. (2)). The other relations (perpendicular, angle, point_on_plane, point_on_line,
-distance) are not cosets; they, and all the others, have a residual vector for the
-numeric residue solver (ALGEBRA.md §2.5, numeric fallback). The coupled relations
+symmetry group placed on body 1's feature (docs/algebra.md §3, §5.1; Liu & Popplestone
+1990 eq. (1), Liu 1997 eq. (2)). The other relations (perpendicular, angle, point_on_plane,
+point_on_line, distance) are not cosets; they, and all the others, have a residual vector for the
+numeric residue solver (docs/algebra.md §2.5, numeric fallback). The coupled relations
 (gear, rack, mirror) relate the motions of two bodies relative to a third (Corner et al.
 1983 §III G; Liu 1997 Fig. 9): their residual takes the three world poses.
 
@@ -102,7 +102,7 @@ class FeatureRef:
 class HeldPoint:
     """A point of one body held in an affine locus of the other: ``rows @ (y - origin) =
     0`` in the locus body's frame, ``rows`` orthonormal normals, one for a plane and two
-    for a line (ALGEBRA.md §3: the contact set of a point and a plane is
+    for a line (docs/algebra.md §3: the contact set of a point and a plane is
     Tr(plane)·S(point), not a coset). ``on_first`` says whether the point belongs to the
     first feature's body (the locus then belongs to the second's)."""
 
@@ -115,7 +115,7 @@ class HeldPoint:
 @dataclass(frozen=True)
 class HeldLine:
     """A line of one body kept parallel to a plane of the other, at a signed distance
-    along its normal (a cylinder on a plane, ALGEBRA.md §3: a double coset of dimension
+    along its normal (a cylinder on a plane, docs/algebra.md §3: a double coset of dimension
     3 + 2 − 1 = 4, not a coset). ``point`` and ``direction`` are in the line's body,
     ``origin`` (already offset by the distance) and ``normal`` in the plane's;
     ``on_first`` says whether the line belongs to the first feature's body."""
@@ -153,7 +153,7 @@ def _describe(feature: Feature) -> str:
 
 
 class RelationType(ABC):
-    """One relation kind ``[kind, first, second, {options}]`` (DESIGN.md §5.1).
+    """One relation kind ``[kind, first, second, {options}]`` (docs/tutorial.md §1).
 
     A subclass names the kind (``kind``), the (first, second) feature types it accepts,
     its option names (with the required ones), whether its set of X is a coset
@@ -341,7 +341,7 @@ def relation_coset(
     tol: Tolerance | None = None,
 ) -> Coset | EmptySet:
     """The set of X = L_second⁻¹·L_first allowed by ``[kind, first, second]`` as a right
-    coset H₁·x₀ in the second feature's body (ALGEBRA.md §3, §5.1), or an inconsistency
+    coset H₁·x₀ in the second feature's body (docs/algebra.md §3, §5.1), or an inconsistency
     (:meth:`RelationType.coset` of each kind).
 
     Raises :class:`FeatureError` for a kind that is not a coset or wrong feature types.
@@ -381,7 +381,7 @@ def relation_dof_removed(kind: str, first: Feature, second: Feature) -> int:
 
 def _is_directed(feature: Feature) -> bool:
     """Whether the feature's axis has an orientation: cones always, tori never (their
-    surface has the flip, ALGEBRA.md §4), the others as declared."""
+    surface has the flip, docs/algebra.md §4), the others as declared."""
     if isinstance(feature, Cone | Torus):
         return isinstance(feature, Cone)
     return bool(getattr(feature, "directed", True))
@@ -422,7 +422,7 @@ def _canonical_axis_residual(g: Matrix, scale: float) -> Matrix:
 def _discrete_residual(g: Matrix, feature: Feature) -> Matrix:
     """The helical (thread) or cyclic (prism) part, as a length: zero iff the rotation
     angle θ about z of g satisfies θ ≡ t_z/p (mod 2π) for a thread of pitch p, or
-    θ ≡ 0 (mod 2π/n) for an n-sided prism (ALGEBRA.md §2.3 membership, without a log)."""
+    θ ≡ 0 (mod 2π/n) for an n-sided prism (docs/algebra.md §2.3 membership, without a log)."""
     theta = math.atan2(g[1, 0], g[0, 0])
     if isinstance(feature, Thread):
         lag = g[2, 3] / feature.pitch
@@ -507,7 +507,7 @@ def _mismatch(kind: MismatchKind, first: float, second: float, what: str) -> Emp
 
 
 def _fits_mismatch(first: Feature, second: Feature, tol: Tolerance) -> EmptySet | None:
-    """The precondition of ``fits`` (ALGEBRA.md §4 table): equal radii, half-angle, lead,
+    """The precondition of ``fits`` (docs/algebra.md §4 table): equal radii, half-angle, lead,
     hand, sides and size; the first failing one as an inconsistency."""
     checks: list[tuple[MismatchKind, float, float, str, float]] = []
     match first, second:
@@ -855,7 +855,7 @@ class PointOnLine(RelationType):
 class Distance(RelationType):
     """A ``distance`` d: ‖c₂ − c₁‖ = d (points), n·(c − p) = d (a point and a plane,
     signed along the normal), the line parallel to the plane with n·(o − p) = d (a line
-    and a plane: a cylinder of radius d lying on the plane, ALGEBRA.md §3), planes
+    and a plane: a cylinder of radius d lying on the plane, docs/algebra.md §3), planes
     parallel with n₁·(p₂ − p₁) = d (two planes). Removes 1 dof, 2 between a line and a
     plane, 3 between two planes."""
 

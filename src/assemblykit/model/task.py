@@ -6,7 +6,7 @@ of *situations*. In each situation spatial relations (``against``, ``fits``, ...
 between features of bodies; *actions* say how bodies moved from the previous situation
 (Corner et al. 1983 §II: ``move / body``, ``move / body parallel shaft of body``, optionally by a
 given amount). A body that no action moves keeps its pose into the next situation
-(DESIGN.md §5.1). This module holds the validated model; the file formats live in
+(docs/tutorial.md §1). This module holds the validated model; the file formats live in
 ``assemblykit.io.spec`` (YAML/JSON) and ``assemblykit.io.rapt`` (text).
 """
 
@@ -71,7 +71,7 @@ class Situation:
 
 @dataclass(frozen=True, eq=False)
 class Task:
-    """A validated RAPT task (DESIGN.md §5.1).
+    """A validated RAPT task (docs/tutorial.md §1).
 
     Two tasks are equal when they describe the same model: same units, bodies, features,
     relations and actions, whatever file (and syntax) they were read from. Numbers are

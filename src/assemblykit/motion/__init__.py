@@ -5,7 +5,7 @@
 (:mod:`~assemblykit.motion.articulation`) and the motion of a task's bodies from its
 relations (:mod:`~assemblykit.motion.relational`).
 
-``assemblykit.motion`` is both this package and the public function of DESIGN.md §5.4:
+``assemblykit.motion`` is both this package and the public function of docs/tutorial.md §4:
 once the package is imported its module object is what ``assemblykit.motion`` names,
 so the package itself is callable: on a :class:`~assemblykit.model.task.Task` it forwards
 to :func:`assemblykit.motion.relational.task_motion`, on an assembly to

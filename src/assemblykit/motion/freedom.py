@@ -200,8 +200,8 @@ class GroupMotion:
 class Motion(GroupMotion):
     """The motion of a moving set of parts relative to the rest of its assembly.
 
-    ``group``: the symmetry group of the compound feature of its contact surfaces (seed
-    003 eq. (2)), ``None`` when it touches nothing; ``features``: that compound feature;
+    ``group``: the symmetry group of the compound feature of its contact surfaces (Liu
+    1997 eq. (2)), ``None`` when it touches nothing; ``features``: that compound feature;
     ``touching``: the parts of the rest it touches; ``unilateral``: the push-only reading.
     """
 
@@ -230,7 +230,7 @@ class Motion(GroupMotion):
     def to_dict(self) -> dict[str, Any]:
         """``dof``, ``motion``, ``components``, the invariants (``axis`` {point,
         direction}, ``direction``, ``center``, ``normal``, ``pitch`` as they apply),
-        ``touching`` and ``unilateral`` (DESIGN.md §5.3)."""
+        ``touching`` and ``unilateral`` (docs/motion.md, "Contacts are fits")."""
         out = motion_summary(self.group)
         out["touching"] = list(self.touching)
         out["unilateral"] = self.unilateral.to_dict()
@@ -268,7 +268,7 @@ class MotionSolver:
     """Motions of moving sets of one assembly, sharing its contacts and a cache of
     compound-feature groups.
 
-    Congruent compound features have conjugate groups (ALGEBRA.md §6, equivariance:
+    Congruent compound features have conjugate groups (docs/algebra.md §6, equivariance:
     moving the features by g maps G to g G g⁻¹), so a compound feature that is a
     translate of one already solved (keys of :func:`_feature_key` seen from the lower
     corner of the moving set's bounding box) gets that group conjugated by the
@@ -396,7 +396,8 @@ class MotionReport:
         return fmt.html_summary(repr(self), ("part", "motion", "dof", "touching"), rows)
 
     def to_dict(self) -> dict[str, Any]:
-        """``parts`` keyed by part name (subassemblies by ``a+b``), DESIGN.md §5.3."""
+        """``parts`` keyed by part name (subassemblies by ``a+b``), docs/motion.md,
+        "Contacts are fits"."""
         return {"source": self.source, "parts": {k: m.to_dict() for k, m in self.motions.items()}}
 
 
@@ -405,8 +406,44 @@ def motion(
     subassemblies: Iterable[Sequence[str]] | None = None,
     tol: Tolerance | None = None,
 ) -> MotionReport:
-    """The motion of every part, and of each given subassembly, relative to the rest
-    (Liu 1997 eq. (2)): one compound-feature symmetry group per moving set."""
+    """How each part, and each given subassembly, can still move relative to the rest of
+    ``assembly``: the symmetry group of the compound feature its contacts form (Liu 1997
+    eq. (2); docs/motion.md, "Contacts are fits"), and which way it can lift off
+    (docs/motion.md, "Faces only push").
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The parts in assembled position (:func:`assemblykit.load_assembly`).
+    subassemblies : iterable of sequences of str, optional
+        Sets of parts that move together, each reported under its names joined by
+        ``+``, after the single parts.
+    tol : Tolerance, optional
+        The tolerance policy (the assembly's own when ``None``).
+
+    Returns
+    -------
+    MotionReport
+        One :class:`Motion` per moving set, by name: its kind (``fixed``, ``revolute``,
+        ``prismatic``, ...), dof, invariants and the parts it touches.
+
+    Raises
+    ------
+    UnknownNameError
+        A subassembly names a part the assembly does not have, or no part at all.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> import assemblykit
+    >>> examples = Path(assemblykit.__file__).parent / "examples"
+    >>> hinge = assemblykit.load_assembly(examples / "motion" / "hinge" / "hinge.yaml")
+    >>> report = assemblykit.motion(hinge, [["frame", "door"]])
+    >>> report
+    MotionReport(3 moving sets, 3 with freedom, hinge.yaml)
+    >>> report["door"], report["frame+door"].kind
+    (Motion(door, revolute, 1 dof), 'free')
+    """
     solver = MotionSolver(assembly, tol)
     sets: list[Sequence[str]] = [(name,) for name in assembly.names]
     sets.extend(subassemblies or ())

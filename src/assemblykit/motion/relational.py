@@ -4,7 +4,7 @@ Liu 1997 takes the compound feature of a moving part from its contacts; a task n
 instead: in a situation, the relations a body takes part in pair its features with
 features of other bodies. Each coset relation ``[kind, first, second]`` allows the
 relative poses X = L_second⁻¹·L_first ∈ H·x₀ with H on the second feature's body
-(:func:`assemblykit.model.relations.relation_coset`, ALGEBRA.md §5.1). Holding every
+(:func:`assemblykit.model.relations.relation_coset`, docs/algebra.md §5.1). Holding every
 other body in place, a motion g of the body (L ↦ g·L) keeps the relation iff
 g ∈ L_second·H·L_second⁻¹, whichever side the body is on; so the body's motion group
 relative to the rest (fixed bodies are the world) is the intersection of these placed
@@ -13,7 +13,7 @@ feature meets which, so the swaps of 2-congruent features (Props 3.2.8, 5.0.9) a
 motions here: they would pair a feature with the wrong partner.
 
 A relation keeps holding into later situations as long as no action moves either of its
-bodies (DESIGN.md §5.1: a body no action moves keeps its pose, so the pair's relative
+bodies (docs/tutorial.md §1: a body no action moves keeps its pose, so the pair's relative
 pose is unchanged); a relation of a moved body holds only where it is stated again.
 
 The poses L are the representative poses of RAPT inference (``Task.solve``); a placed

@@ -3,9 +3,9 @@
 Liu 1997 reads every contact as a fit: the surfaces stay coincident and the motions are
 the symmetry group of the compound feature. A real face contact only pushes, so a part
 may also move *away* from an obstacle. To first order, a twist ξ = (ω; v) of the moving
-part (DESIGN.md §4: ``v`` is the velocity of the point at the origin) is allowed at a
-contact point ``p`` with unit normal ``n`` pointing out of the moving part into the
-obstacle iff
+part (docs/architecture.md, "Conventions": ``v`` is the velocity of the point at the
+origin) is allowed at a contact point ``p`` with unit normal ``n`` pointing out of the
+moving part into the obstacle iff
 
     n · (v + ω × p) ≤ 0,    i.e.   a · ξ ≤ 0  with  a = (p × n; n).
 

@@ -8,7 +8,7 @@ inner (shaft) side of a cylindrical contact with a part it leaves
 within the angle tolerance, and a **screw** when it also interferes with one of those
 parts by design (a thread cut into its pilot hole or a nut's insert, resolved by
 :func:`~assemblykit.geometry.overlaps.resolve_overlaps`); otherwise a **pin**. A screw
-comes out by the helical motion of the seeds' screw group about that axis (Liu 1997:
+comes out by the helical motion of the screw group about that axis (Liu 1997:
 the helical pair); its pitch is not read from the model. Bolts and screws drawn at
 their nominal diameter, with no thread modelled and no interference, are reported as
 pins (docs/planning.md, "Fasteners").

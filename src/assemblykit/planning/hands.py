@@ -1,5 +1,5 @@
-"""How many hands an assembly needs (seed 004, "Conclusion": every operation of an NDBG
-plan moves one subassembly relative to the rest, i.e. two hands; an arbitrary device
+"""How many hands an assembly needs (Wilson & Latombe 1992, "Conclusion": every operation
+of an NDBG plan moves one subassembly relative to the rest, i.e. two hands; an arbitrary device
 may need more [Natarajan, 1988]).
 
 A *k-handed* operation splits a set of parts into ``k`` groups: group 0 stays, and each
@@ -7,8 +7,8 @@ other group ``g`` translates with its own constant velocity ``v_g`` to infinity,
 once. Groups ``g`` and ``h`` then move relative to each other along ``v_g − v_h``, a
 straight line, so the operation is collision-free iff for every two groups (the fixed
 one has ``v = 0``) the parts of ``h`` do not block those of ``g`` for the extended
-translation along ``v_g − v_h`` (Γ_e, pairwise as everywhere in seed 004). Two hands
-are the case ``k = 2``.
+translation along ``v_g − v_h`` (Γ_e, pairwise as everywhere in Wilson & Latombe 1992).
+Two hands are the case ``k = 2``.
 
 The search runs where the two-handed planner stops (a set no translation separates):
 

@@ -1,6 +1,6 @@
 """Multi-move disassembly of interlocking voxel pieces: sequences of translations.
 
-Seed 004 plans with one translation per separation (a *monotone* plan) and cites
+Wilson & Latombe 1992 plan with one translation per separation (a *monotone* plan) and cite
 separating parts "by a sequence of translations" [Pollack et al., 1988] as the harder
 problem; interlocking puzzles (burrs) need such sequences, sometimes of a hundred moves.
 On the lattice the problem is exact and finite:
@@ -182,7 +182,7 @@ class MultiMovePlan:
         return total(self.root)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: the plan keys of DESIGN.md §5.3 (``feasible``, ``steps``,
+        """JSON form: the plan keys of docs/planning.md, "JSON" (``feasible``, ``steps``,
         ``stuck``) plus ``moves`` (``multi``), ``level``, ``reference_level``,
         ``first_moves``, ``cut``, ``states``, ``max_states`` and ``separations`` (the
         tree)."""

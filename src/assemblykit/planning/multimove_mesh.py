@@ -1,7 +1,7 @@
 """Multi-move disassembly of mesh assemblies: translations by the distances where
 contacts change.
 
-Seed 004 plans with one translation per separation and cites separating parts "by a
+Wilson & Latombe 1992 plan with one translation per separation and cite separating parts "by a
 sequence of translations" [Pollack et al., 1988] as the harder problem; the lattice
 search (:mod:`assemblykit.planning.multimove`) solves it for voxel pieces. For parts of
 any shape the same breadth-first search runs on these states and moves:

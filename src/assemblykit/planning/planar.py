@@ -1,4 +1,4 @@
-"""Planning for polygon assemblies (seed 004, 2D case): the tables the planner of
+"""Planning for polygon assemblies (Wilson & Latombe 1992, "2D case"): the tables the planner of
 :mod:`assemblykit.planning.sequence` searches, and Γ_g restricted to the plane.
 
 In the plane Γ_e is exact for every polygon (:mod:`assemblykit.blocking.planar`), so
@@ -85,9 +85,10 @@ def planar_search(
 def planar_rigid_may_free(model: PolygonAssembly, parts: Iterable[str], tol: Tolerance) -> bool:
     """Whether some infinitesimal rigid motion of the plane (a turn about z and a
     translation in z = 0) moves a proper part of ``parts`` away from the others without
-    penetration, breaking some contact (Γ_g in 2D, seed 004: "the 2D case is just
-    simpler"). Each candidate set of at most ``RIGID_MAX_SIZE`` parts is decided by
-    the linear program of :meth:`assemblykit.blocking.rigid.RigidBlockingGraph.free_twist`
+    penetration, breaking some contact (Γ_g in 2D, Wilson & Latombe 1992, "Extension and
+    Variant": "the 2D case is just simpler"). Each candidate set of at most
+    ``RIGID_MAX_SIZE`` parts is decided by the linear program of
+    :meth:`assemblykit.blocking.rigid.RigidBlockingGraph.free_twist`
     with the out-of-plane twist components held at zero."""
     names = tuple(parts)
     inside = set(names)

@@ -1,4 +1,4 @@
-"""The disassembly planner (seed 004): the greedy search over the candidate directions
+"""The disassembly planner (Wilson & Latombe 1992): the greedy search over the candidate directions
 of :mod:`assemblykit.planning.sequence`, in the plane for polygons
 (:mod:`assemblykit.planning.planar`), under gravity
 (:mod:`assemblykit.planning.stability`), and the plan it gives: the sets left
@@ -52,8 +52,9 @@ def rigid_may_free(
     assembly: Assembly | PolygonAssembly, parts: Iterable[str], tol: Tolerance | None = None
 ) -> bool:
     """Whether some DBG of Γ_g (infinitesimal rigid motions) of the sub-assembly
-    ``parts`` frees a proper part of it: the necessary condition of seed 004 ("a
-    necessary condition for a subassembly S to be directly removable")."""
+    ``parts`` frees a proper part of it: the necessary condition of Wilson & Latombe
+    1992, "Extension and Variant" ("a necessary condition for a subassembly S to be
+    directly removable")."""
     if isinstance(assembly, PolygonAssembly):
         # polygons move in their plane: lifting off it would free every part
         return planar_rigid_may_free(assembly, parts, assembly.tolerance(tol))
@@ -71,7 +72,10 @@ def plan(
     one_at_a_time: bool = False,
     max_steps: int | None = None,
 ) -> Plan:
-    """Plan the disassembly of ``assembly`` by extended translations (seed 004).
+    """Plan the disassembly of ``assembly`` by extended translations (Wilson & Latombe
+    1992, "Extension and Variant"; docs/planning.md, "How a plan is found"): in what
+    order the parts come apart, along which directions, and which sets are interlocked;
+    read backwards, the assembly order.
 
     ``progress(stage, done, total)`` is called as the work advances. The result is
     feasible when every part is separated; otherwise ``interlocked`` holds the minimal
@@ -90,6 +94,54 @@ def plan(
 
     ``max_steps`` stops the search after that many steps: the parts not yet taken
     apart are the plan's ``unfinished`` ones, and the plan is not feasible.
+
+    Parameters
+    ----------
+    assembly : Assembly or PolygonAssembly
+        The parts in assembled position (:func:`assemblykit.load_assembly`); polygons are
+        planned in their plane.
+    tol : Tolerance, optional
+        The tolerance policy (the assembly's own when ``None``).
+    max_and_or_parts : int, default 8
+        Up to this many parts, every two-handed partition is enumerated (``and_or``).
+    progress : callable, optional
+        Called as ``progress(stage, done, total)``.
+    max_hands : int, default 4
+        How many hands may take a stuck set apart (2: none beyond the two of every step).
+    gravity : Gravity, optional
+        Keep only steps after which everything stands (docs/planning.md, "Under
+        gravity: plans that stand").
+    one_at_a_time : bool, default False
+        Move one free set per step.
+    max_steps : int, optional
+        Stop after this many steps.
+
+    Returns
+    -------
+    Plan
+        ``steps`` (the parts each moves, its direction and the parts it leaves),
+        ``feasible``, ``stuck`` and ``interlocked`` when a set does not come apart,
+        ``order`` and ``assembly_steps`` (the assembly order), and the JSON of
+        docs/planning.md, "JSON" (``to_dict()``).
+
+    Raises
+    ------
+    UnknownNameError
+        ``gravity.fixed`` names a part the assembly does not have.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> import assemblykit
+    >>> lower = trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+    >>> upper = trimesh.creation.box(bounds=[[0, 0, 1], [1, 1, 2]])
+    >>> parts = [assemblykit.Part("lower", lower), assemblykit.Part("upper", upper)]
+    >>> boxes = assemblykit.Assembly(parts)
+    >>> plan = assemblykit.plan(boxes, gravity=assemblykit.Gravity())
+    >>> plan
+    Plan(feasible, 1 step, 2 parts)
+    >>> plan.steps[0], plan.gravity.stable
+    (Step(upper along +Z), True)
     """
     if max_steps is not None and max_steps < 0:
         raise InputError(f"max_steps must be 0 or more, not {max_steps}")
@@ -283,8 +335,8 @@ def separable_by_translations(
     tol: Tolerance | None = None,
 ) -> bool:
     """Whether the assembly comes completely apart with extended translations, one
-    subassembly moving at a time (seed 004, conclusion). Removing parts only removes
-    obstacles, so any removable subassembly can be taken first and a greedy
+    subassembly moving at a time (Wilson & Latombe 1992, "Conclusion"). Removing parts
+    only removes obstacles, so any removable subassembly can be taken first and a greedy
     disassembly decides it: this is the planner's search
     (:func:`plan`), with its candidate directions (Γ_t
     regions, then the faces of the exact free sets), so the two always agree."""

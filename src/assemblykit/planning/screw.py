@@ -1,6 +1,6 @@
 """Rotations in plans: finite screw motions that free what no translation frees.
 
-Seed 004 ("Infinitesimal rigid motions") blocks twists ``xi = (omega; v)`` at each
+Wilson & Latombe 1992 ("Infinitesimal rigid motions") block twists ``xi = (omega; v)`` at each
 contact point ``p`` with normal ``n`` (from the moving set into the rest) unless
 ``w . xi <= 0`` for ``w = (p x n; n)``: Γ_g tells which sets an infinitesimal rigid
 motion may free, a necessary condition only. When the translation planner stops at an
@@ -209,9 +209,10 @@ def screw_removal(
 
 @dataclass(frozen=True, eq=False)
 class ScrewPlan:
-    """A translation plan (seed 004) extended by turns: ``stages[0]`` plans the whole;
-    where it stops, ``screws[k]`` takes one part of the stuck set out by a turn and
-    ``stages[k + 1]`` plans what remains of that set."""
+    """A translation plan (Wilson & Latombe 1992, "Extension and Variant": extended
+    translations) extended by turns: ``stages[0]`` plans the whole; where it stops,
+    ``screws[k]`` takes one part of the stuck set out by a turn and ``stages[k + 1]``
+    plans what remains of that set."""
 
     stages: tuple[Plan, ...]
     screws: tuple[ScrewStep, ...]
@@ -222,8 +223,8 @@ class ScrewPlan:
         return self.stages[-1].feasible
 
     def to_dict(self) -> dict[str, Any]:
-        """The plan keys of DESIGN.md §5.3 (``feasible``, ``steps``, ``stuck``) with the
-        turns among the ``steps`` (``motion``: ``screw``), plus ``screws``."""
+        """The plan keys of docs/planning.md, "JSON" (``feasible``, ``steps``,
+        ``stuck``) with the turns among the ``steps`` (``motion``: ``screw``), plus ``screws``."""
         steps: list[dict[str, Any]] = []
         for k, stage in enumerate(self.stages):
             steps += [s.to_dict() for s in stage.steps]

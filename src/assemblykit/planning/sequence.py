@@ -1,7 +1,9 @@
-"""Assembly planning by disassembly on non-directional blocking graphs (seed 004).
+"""Assembly planning by disassembly on non-directional blocking graphs (Wilson & Latombe
+1992).
 
-The planner answers the questions seed 004 lists for an NDBG: which subassemblies can
-be removed, in what order, and which parts are interlocked. It uses three NDBGs:
+The planner answers the questions Wilson & Latombe 1992 ask of an NDBG ("Introduction"):
+which subassemblies can be removed, in what order, and which parts are interlocked. It
+uses three NDBGs:
 
 * Γ_t (infinitesimal translations) is *necessary*: a set that is not locally free
   along ``d`` cannot be removed along ``d``. Γ_t is cheap (it only needs the contacts),
@@ -331,7 +333,8 @@ class Step:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form (DESIGN.md §5.3): ``parts``, ``direction``, ``motion`` and ``rest``."""
+        """JSON form (docs/planning.md, "JSON"): ``parts``, ``direction``, ``motion``,
+        ``rest``."""
         return {
             "parts": list(self.parts),
             "direction": [float(x) + 0.0 for x in self.direction],
@@ -389,7 +392,8 @@ AndOrNode = frozenset[str] | tuple[str, frozenset[str], frozenset[str]]
 
 @dataclass(frozen=True, eq=False)
 class AndOrGraph:
-    """The AND/OR graph of all feasible two-handed partitions (seed 004, "order").
+    """The AND/OR graph of all feasible two-handed partitions (Wilson & Latombe 1992,
+    "Introduction": the (dis)assembly order).
 
     OR nodes are subassemblies (frozensets of names); an AND node
     ``("split", left, right)`` has arcs to its two halves and an arc from the
@@ -556,7 +560,7 @@ class Plan:
         return tuple(frames)
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form (DESIGN.md §5.3): ``feasible``, ``steps``, ``stuck``, plus
+        """JSON form (docs/planning.md, "JSON"): ``feasible``, ``steps``, ``stuck``, plus
         ``interlocked``, ``order``, ``parts``, ``directions`` and ``and_or``."""
         return {
             "feasible": self.feasible,
@@ -639,7 +643,8 @@ def distinct_directions(table: DirectionTable) -> list[int]:
 
 def separable(table: DirectionTable, members: int) -> bool:
     """True when some direction of ``table`` frees a proper, non-empty part of ``members``
-    (a DBG that is not strongly connected, seed 004)."""
+    (a DBG that is not strongly connected: Wilson & Latombe 1992, "Directional Blocking
+    Graph")."""
     if not several(members):
         return False
     if table.free_parts(members).any():
@@ -649,7 +654,8 @@ def separable(table: DirectionTable, members: int) -> bool:
 
 def _sinks(source: DirectionTable | ExtendedDirections, k: int, members: int) -> list[int]:
     """The minimal free sets of ``members`` along direction ``k``: the sink strong
-    components of its DBG, as bit masks (seed 004, "Directional Blocking Graph")."""
+    components of its DBG, as bit masks (Wilson & Latombe 1992, "Directional Blocking
+    Graph")."""
     condensed = nx.condensation(source.graph(k, members))
     return [
         mask_of(condensed.nodes[c]["members"])
@@ -1003,7 +1009,8 @@ def least_interlocked(translations: DirectionTable, extended: Any, members: int)
 
 def and_or_graph(table: DirectionTable) -> AndOrGraph:
     """The AND/OR graph of every two-handed partition of the whole set that ``table``
-    (Γ_e) accepts, and the number of disassembly trees it holds (seed 004, "order").
+    (Γ_e) accepts, and the number of disassembly trees it holds (Wilson & Latombe 1992,
+    "Introduction": the (dis)assembly order).
     :func:`~assemblykit.planning.planner.plan` gives it one direction per distinct DBG
     of Γ_t plus those its search used, so the count is a lower bound when Γ_e differs
     within a region of Γ_t."""
@@ -1054,7 +1061,8 @@ overlay of every pair's blocked set (single parts always get their free set's)."
 
 def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDArray[np.float64]]:
     """For a set of parts the sampled candidates do not separate: a direction in every
-    face of each part's exact free set among the set (seed 004 §5, checked free), and,
+    face of each part's exact free set among the set (Wilson & Latombe 1992, "Extension
+    and Variant": extended translations; each checked free), and,
     when none leaves alone and the set has at most ``EXACT_GROUP_PARTS`` parts, one in
     every face of the overlay of the pairs' blocked sets (over which every DBG is
     constant, so groups leaving together are found as well)."""

@@ -1,4 +1,4 @@
-"""The self-contained HTML view of a motion report (Liu 1997; DESIGN.md §6).
+"""The self-contained HTML view of a motion report (Liu 1997; docs/motion.md).
 
 Every part is drawn as a ``mesh3d`` trace with its bilateral motion on top: the axis of
 a revolute, cylindrical or helical motion as a line with a turning arc, the direction
