@@ -345,35 +345,47 @@ def facing_groups(
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Usable group pairs ``(g, h)``, ``g`` of the first part of a pair and ``h`` of the
     second, whose bounding boxes overlap each other's part and each other (inflated by
-    ``margin``), in the order of the pairs, then of ``g``, then of ``h``: one bulk R-tree
-    query of every usable group's box against all of them, so the work follows the
-    groups that meet rather than every group of one part times every group of the
-    other (a threaded screw's thousands of facets in a plate's hole)."""
+    ``margin``), in the order of the pairs, then of ``g``, then of ``h``. Per pair of
+    parts, only the groups whose box meets the other part's box are compared, all of
+    one side against all of the other at once: the work follows the groups near the
+    other part (a threaded screw's thousands of facets against a plate's hole), not
+    every group of either part."""
     candidates = np.flatnonzero(usable)
-    lo, hi = seg.lo[candidates], seg.hi[candidates]
-    if not len(candidates) or not len(pairs):
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    tree = index.Index(
-        ((k, tuple(box), None) for k, box in enumerate(np.hstack([lo - margin, hi + margin]))),
-        properties=index.Property(dimension=3),
-    )
-    found, counts = tree.intersection_v(np.ascontiguousarray(lo), np.ascontiguousarray(hi))
-    g = np.repeat(candidates, counts.astype(np.int64))
-    h = candidates[found.astype(np.int64)]
-    # the pair (first part, second part) of each hit, where it is one of ``pairs``
-    size = len(part_lo)
-    keys = pairs[:, 0] * size + pairs[:, 1]
-    order = np.argsort(keys, kind="stable")
-    key = group_part[g] * size + group_part[h]
-    at = np.minimum(np.searchsorted(keys[order], key), len(keys) - 1)
-    listed = keys[order][at] == key
-    g, h, pair = g[listed], h[listed], order[at[listed]]
-    first, second = pairs[pair, 0], pairs[pair, 1]
-    keep = _boxes_overlap(seg.lo[g], seg.hi[g], part_lo[second], part_hi[second], margin)
-    keep &= _boxes_overlap(seg.lo[h], seg.hi[h], part_lo[first], part_hi[first], margin)
-    g, h, pair = g[keep], h[keep], pair[keep]
-    ranked = np.lexsort((h, g, pair))
-    return g[ranked], h[ranked]
+    owners = group_part[candidates]
+    order = np.argsort(owners, kind="stable")
+    candidates, owners = candidates[order], owners[order]
+    count = len(part_lo)
+    starts = np.searchsorted(owners, np.arange(count + 1))
+    firsts, seconds = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
+    for p, q in pairs.tolist():
+        g = _near_box(seg, candidates[starts[p] : starts[p + 1]], part_lo[q], part_hi[q], margin)
+        h = _near_box(seg, candidates[starts[q] : starts[q + 1]], part_lo[p], part_hi[p], margin)
+        if not len(g) or not len(h):
+            continue
+        for lo in range(0, len(g), max(1, _BOX_BLOCK // len(h))):
+            rows = g[lo : lo + max(1, _BOX_BLOCK // len(h))]
+            meets = _boxes_overlap(
+                seg.lo[rows, None], seg.hi[rows, None], seg.lo[None, h], seg.hi[None, h], margin
+            )
+            i, j = np.nonzero(meets)
+            firsts.append(rows[i])
+            seconds.append(h[j])
+    return np.concatenate(firsts), np.concatenate(seconds)
+
+
+_BOX_BLOCK = 1 << 21
+"""How many pairs of group boxes :func:`facing_groups` compares in one array."""
+
+
+def _near_box(
+    seg: Segmentation,
+    groups: NDArray[np.int64],
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+    margin: float,
+) -> NDArray[np.int64]:
+    """The groups whose box (inflated by ``margin``) meets the box ``lo, hi``."""
+    return groups[_boxes_overlap(seg.lo[groups], seg.hi[groups], lo, hi, margin)]
 
 
 def _planar_matches(
