@@ -48,6 +48,7 @@ if TYPE_CHECKING:
     from assemblykit.motion.articulation import Articulation
     from assemblykit.motion.freedom import MotionReport
     from assemblykit.motion.relational import TaskMotionReport
+    from assemblykit.planning.interlocking import Interlocking
     from assemblykit.planning.multimove import MultiMovePlan, Separation
     from assemblykit.planning.screw import ScrewPlan
     from assemblykit.planning.sequence import Hands, Plan
@@ -255,6 +256,29 @@ def _plan(result: Plan) -> Group:
     if result.joined:
         tables.append(_joined_table(result))
     return Group(*tables)
+
+
+def _interlocking(result: Interlocking) -> Group:
+    """The verdict in words, then each subset that moves: one direction that frees it,
+    where it is free and the contacts that would block it (docs/interlocking.md)."""
+    lines = result.summary().splitlines()
+    if result.freedoms:
+        # the table says per subset what the summary's list says
+        lines = [line for line in lines if not line.startswith("- ")]
+    parts: list[RenderableType] = [Text("\n".join(lines))]
+    if result.freedoms:
+        table = Table(title="What moves", title_justify="left")
+        for header in ("moves", "e.g. along", "free along", "to block it"):
+            table.add_column(header, overflow="fold")
+        for freedom in result.freedoms:
+            table.add_row(
+                fmt.name_list(freedom.parts, 8),
+                fmt.direction(freedom.direction, result.tol),
+                "; ".join(d.words(result.tol) for d in freedom.free_along) or "-",
+                freedom.advice(result.tol),
+            )
+        parts.append(table)
+    return Group(*parts)
 
 
 def _joined_table(plan: Plan) -> Table:
@@ -505,11 +529,13 @@ def _register_blocking() -> None:
 
 
 def _register_planning() -> None:
+    from assemblykit.planning.interlocking import Interlocking
     from assemblykit.planning.multimove import MultiMovePlan
     from assemblykit.planning.screw import ScrewPlan
     from assemblykit.planning.sequence import Hands, Plan
 
     render.register(Plan, _plan)
+    render.register(Interlocking, _interlocking)
     render.register(Hands, _hands)
     render.register(MultiMovePlan, _multi_move)
     render.register(ScrewPlan, _screw)
