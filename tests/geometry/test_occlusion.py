@@ -188,3 +188,37 @@ def test_hull_outlines_never_rule_out_a_block_the_meshes_show(seed):
     meshes = [mesh_of(hook), mesh_of(wall.translate(tuple(rng.uniform(-2, 2, 3))))]
     for d in [UP, DOWN, EAST, *rng.normal(size=(12, 3))]:
         assert blocked(meshes, d) <= hull_test(meshes, d), d
+
+
+def test_a_witness_found_along_one_direction_shows_the_block_along_its_neighbours():
+    hook = mesh_of(cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4]))
+    wall = mesh_of(cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1]))
+    meshes = [hook, wall]
+    witnesses = occlusion.blocking_witnesses(shadows(meshes, UP, TOL), BOTH, TOL)
+    face_hook, face_wall = witnesses[(0, 1)]
+    # a backward face of the hook under a forward face of the wall
+    assert hook.face_normals[face_hook] @ UP < 0 < wall.face_normals[face_wall] @ UP
+    tilted = [0.05, 0.02, 1.0]
+    assert occlusion.witnesses_hold(meshes, [(0, 1, face_hook, face_wall)], tilted, TOL).all()
+    # sideways the hook leaves: no witness can show a block there
+    away = [-1.0, 0.0, 0.0]
+    assert not occlusion.witnesses_hold(meshes, [(0, 1, face_hook, face_wall)], away, TOL).any()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_witness_holds_only_where_the_projection_test_blocks(seed):
+    rng = np.random.default_rng(seed)
+    hook = cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4])
+    wall = cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1])
+    meshes = [mesh_of(hook), mesh_of(wall.translate(tuple(rng.uniform(-1, 1, 3))))]
+    found = {}
+    for d in rng.normal(size=(8, 3)):
+        found |= occlusion.blocking_witnesses(shadows(meshes, d, TOL), BOTH, TOL)
+    witnesses = [(i, j, *faces) for (i, j), faces in found.items()]
+    held_somewhere = 0
+    for d in [UP, DOWN, EAST, *rng.normal(size=(10, 3))]:
+        held = occlusion.witnesses_hold(meshes, witnesses, d, TOL)
+        shown = {(w[0], w[1]) for w, h in zip(witnesses, held, strict=True) if h}
+        assert shown <= blocked(meshes, d), d
+        held_somewhere += len(shown)
+    assert held_somewhere > 0

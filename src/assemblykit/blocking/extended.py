@@ -41,7 +41,12 @@ from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph
 from assemblykit.geometry.minkowski import blocks_along
-from assemblykit.geometry.occlusion import hulls_may_block, occluded_pairs, shadows
+from assemblykit.geometry.occlusion import (
+    blocking_witnesses,
+    hulls_may_block,
+    shadows,
+    witnesses_hold,
+)
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -119,6 +124,9 @@ def extended_arcs(
     plain = _may_block(
         cache, d, [pair for pair in projected if not cache.backout(*pair, tol).any()], tol
     )
+    witnessed = _witnessed(assembly, d, plain, tol)
+    arcs |= witnessed
+    plain = [pair for pair in plain if pair not in witnessed]
     if first_only:
         blocked = {moving for moving, _ in arcs}
         plain = [pair for pair in plain if pair[0] not in blocked]
@@ -130,6 +138,24 @@ def extended_arcs(
         if shift.any():
             arcs |= _occluded(assembly, d, [(moving, blocker)], {moving: shift}, tol)
     return arcs
+
+
+def shown_arcs(
+    assembly: Assembly,
+    direction: ArrayLike,
+    movers: Iterable[str],
+    blockers: Iterable[str],
+    tol: Tolerance,
+) -> set[tuple[str, str]]:
+    """Some of the arcs of :func:`extended_arcs`, found without projecting a mesh: the
+    pairs where the two faces that showed a block along another direction show it along
+    this one (:func:`~assemblykit.geometry.occlusion.witnesses_hold`). Every arc
+    returned is an arc of Γ_e; a pair not returned may block all the same."""
+    d = np.asarray(direction, dtype=np.float64).ravel()
+    cache = BlockingCache.of(assembly).obstacles
+    others = list(blockers)
+    pairs = [(m, b) for m in movers for b in others if (m, b) in cache.witnesses]
+    return _witnessed(assembly, d / np.linalg.norm(d), pairs, tol)
 
 
 def _may_block(
@@ -145,6 +171,26 @@ def _may_block(
     rows = np.array([(index[a], index[b]) for a, b in pairs], dtype=np.int64)
     keep = hulls_may_block([cache.hull(n) for n in names], rows, direction, tol)
     return [pair for pair, kept in zip(pairs, keep.tolist(), strict=True) if kept]
+
+
+def _witnessed(
+    assembly: Assembly, direction: NDArray[np.float64], pairs: list[tuple[str, str]], tol: Tolerance
+) -> set[tuple[str, str]]:
+    """The pairs (moving, blocker) of ``pairs`` that block along ``direction`` as shown by
+    the two faces that showed it along another direction (kept in the assembly's
+    :class:`~assemblykit.blocking.obstacles.Obstacles`): two triangles projected instead
+    of two meshes. A part blocked along one direction mostly is along the next ones the
+    search tries, by the same faces."""
+    cache = BlockingCache.of(assembly).obstacles
+    known = [pair for pair in pairs if pair in cache.witnesses]
+    if not known:
+        return set()
+    names = sorted({name for pair in known for name in pair})
+    index = {name: k for k, name in enumerate(names)}
+    witnesses = [(index[a], index[b], *cache.witnesses[(a, b)]) for a, b in known]
+    meshes = [assembly.parts[name].mesh for name in names]
+    holds = witnesses_hold(meshes, witnesses, direction, tol)
+    return {pair for pair, held in zip(known, holds.tolist(), strict=True) if held}
 
 
 def _occluded(
@@ -171,7 +217,10 @@ def _occluded(
         for name, mesh in zip(names, meshes, strict=True)
     ]
     view = shadows(meshes, direction, tol)
-    found = occluded_pairs(view, allowed, tol, first_only=first_only)
+    found = blocking_witnesses(view, allowed, tol, first_only=first_only)
+    if not shifts:
+        cache = BlockingCache.of(assembly).obstacles
+        cache.witnesses.update(((names[i], names[j]), w) for (i, j), w in found.items())
     return {(names[i], names[j]) for i, j in found}
 
 

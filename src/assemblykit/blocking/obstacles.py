@@ -35,9 +35,9 @@ def of_meshes(assembly: object) -> Assembly:
 
 
 class Obstacles:
-    """Convex bodies, solids, bounding spheres and pairwise cones and back-outs of one
-    assembly's parts, each computed when first asked for and kept (one per assembly, in
-    its :class:`~assemblykit.blocking.cache.BlockingCache`)."""
+    """Convex bodies, hulls, solids, bounding spheres and pairwise cones, back-outs and
+    blocking witnesses of one assembly's parts, each computed when first asked for and
+    kept (one per assembly, in its :class:`~assemblykit.blocking.cache.BlockingCache`)."""
 
     def __init__(self, assembly: Assembly) -> None:
         self.assembly = assembly
@@ -46,6 +46,9 @@ class Obstacles:
         self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
         self.solids: dict[str, manifold3d.Manifold] = {}
         self.hulls: dict[str, NDArray[np.float64]] = {}
+        self.witnesses: dict[tuple[str, str], tuple[int, int]] = {}
+        """Per pair (moving, blocker) found blocking by the projection test, the last
+        two faces that showed it (:func:`~assemblykit.geometry.occlusion.witnesses_hold`)."""
         names = list(assembly.names)
         self.names = names
         bounds = np.array([assembly.parts[n].mesh.bounds for n in names]).reshape(-1, 2, 3)

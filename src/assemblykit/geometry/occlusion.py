@@ -62,7 +62,8 @@ class Shadows:
     ``owner`` is the mesh of each triangle; ``facing`` +1 forwards, -1 backwards, 0 both
     (a mesh that bounds no volume); ``flat`` the projected triangles (t x 3 x 2);
     ``plane`` rows ``(a, b, c)`` with depth ``a u + b v + c`` at ``(u, v)``; ``low`` and
-    ``high`` each triangle's depth range and ``box`` its ``(umin, vmin, umax, vmax)``."""
+    ``high`` each triangle's depth range, ``box`` its ``(umin, vmin, umax, vmax)`` and
+    ``face`` its index among its mesh's faces."""
 
     owner: NDArray[np.int64]
     facing: NDArray[np.int8]
@@ -71,6 +72,7 @@ class Shadows:
     low: NDArray[np.float64]
     high: NDArray[np.float64]
     box: NDArray[np.float64]
+    face: NDArray[np.int64]
 
     @property
     def cos(self) -> NDArray[np.float64]:
@@ -184,22 +186,29 @@ def _shadow_width(flat: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def shadows(
-    meshes: Sequence[trimesh.Trimesh], direction: ArrayLike, tol: Tolerance | None = None
+    meshes: Sequence[trimesh.Trimesh],
+    direction: ArrayLike,
+    tol: Tolerance | None = None,
+    faces: Sequence[NDArray[np.int64]] | None = None,
 ) -> Shadows:
-    """Project the meshes' triangles on the plane ``⟂ direction`` (module docstring)."""
+    """Project the meshes' triangles on the plane ``⟂ direction`` (module docstring):
+    all of them, or those listed per mesh in ``faces``."""
     tol = tol or current()
     frame = view_frame(direction)
-    owner, facing, corners, normals = [], [], [], []
+    owner, facing, corners, normals, kept = [], [], [], [], []
     for k, mesh in enumerate(meshes):
-        cos = mesh.face_normals @ frame[2]
+        chosen = np.arange(len(mesh.faces)) if faces is None else np.asarray(faces[k])
+        face_normals = mesh.face_normals[chosen]
+        cos = face_normals @ frame[2]
         # every corner in the view frame once: its first two coordinates on the plane
-        seen = np.asarray(mesh.triangles, dtype=np.float64) @ frame.T
+        seen = np.asarray(mesh.triangles[chosen], dtype=np.float64) @ frame.T
         keep = (np.abs(cos) > tol.mesh_angle) & (_shadow_width(seen[:, :, :2]) > tol.length)
         owner.append(np.full(int(keep.sum()), k, dtype=np.int64))
         # without a consistent outside every triangle may bound the part on either side
         facing.append(np.sign(cos[keep]).astype(np.int8) * np.int8(mesh.is_volume))
         corners.append(seen[keep])
-        normals.append(mesh.face_normals[keep] @ frame.T)
+        normals.append(face_normals[keep] @ frame.T)
+        kept.append(chosen[keep])
     tri = np.concatenate(corners) if corners else np.zeros((0, 3, 3))
     n = np.concatenate(normals) if normals else np.zeros((0, 3))
     # plane n . x = n . p0 solved for the depth coordinate
@@ -218,6 +227,7 @@ def shadows(
         lowest[:, 2],
         highest[:, 2],
         np.column_stack([lowest[:, :2], highest[:, :2]]),
+        np.concatenate(kept) if kept else np.zeros(0, np.int64),
     )
 
 
@@ -339,12 +349,26 @@ def occluded_pairs(
 ) -> set[tuple[int, int]]:
     """The pairs ``(i, j)`` of meshes such that ``j`` blocks the extended translation of
     ``i`` along the view direction, among those with ``allowed[i, j]`` (module
-    docstring). First among the largest projected triangles of each mesh
-    (``_FIRST_TRIANGLES``): most blocking pairs have a pair of triangles that shows it
-    there, and only the others are then examined over all their triangles. With
-    ``first_only``, a mesh found blocked by one is not examined further: each blocked
-    mesh has at least one pair, the others may be missing (whether a part can leave,
-    not all that holds it)."""
+    docstring; :func:`blocking_witnesses` without the witnesses)."""
+    return set(blocking_witnesses(view, allowed, tol, first_only=first_only))
+
+
+def blocking_witnesses(
+    view: Shadows,
+    allowed: NDArray[np.bool_],
+    tol: Tolerance | None = None,
+    *,
+    first_only: bool = False,
+) -> dict[tuple[int, int], tuple[int, int]]:
+    """Per pair ``(i, j)`` of meshes such that ``j`` blocks the extended translation of
+    ``i`` along the view direction, among those with ``allowed[i, j]`` (module
+    docstring), a witness: a backward face of ``i`` and a forward face of ``j`` (their
+    indices among their meshes' faces) whose projections overlap where ``j`` lies deeper.
+    First among the largest projected triangles of each mesh (``_FIRST_TRIANGLES``):
+    most blocking pairs have a pair of triangles that shows it there, and only the
+    others are then examined over all their triangles. With ``first_only``, a mesh
+    found blocked by one is not examined further: each blocked mesh has at least one
+    pair, the others may be missing (whether a part can leave, not all that holds it)."""
     tol = tol or current()
     found = _occluded_among(view, allowed, _largest(view, _FIRST_TRIANGLES), tol, first_only)
     rest = allowed.copy()
@@ -353,7 +377,45 @@ def occluded_pairs(
         if first_only:
             rest[i] = False
     every = np.ones(len(view.owner), dtype=bool)
-    return found | _occluded_among(view, rest, every, tol, first_only)
+    found |= _occluded_among(view, rest, every, tol, first_only)
+    return {pair: (int(view.face[b]), int(view.face[f])) for pair, (b, f) in found.items()}
+
+
+def witnesses_hold(
+    meshes: Sequence[trimesh.Trimesh],
+    witnesses: Sequence[tuple[int, int, int, int]],
+    direction: ArrayLike,
+    tol: Tolerance | None = None,
+) -> NDArray[np.bool_]:
+    """Per witness ``(i, j, face_i, face_j)`` (meshes ``i``, ``j`` of ``meshes`` and a
+    face of each, as :func:`blocking_witnesses` gives them), whether those two faces
+    show that ``j`` blocks ``i`` along ``direction`` too: the test of the module
+    docstring on these two triangles alone. A witness that holds shows the block (a
+    pair of triangles is enough); one that fails shows nothing."""
+    tol = tol or current()
+    chosen = [
+        np.unique([f for w in witnesses for m, f in ((w[0], w[2]), (w[1], w[3])) if m == k])
+        for k in range(len(meshes))
+    ]
+    view = shadows(meshes, direction, tol, [c.astype(np.int64) for c in chosen])
+    # the triangles of the view in mesh order, then face order: one sorted key
+    stride = 1 + max((len(m.faces) for m in meshes), default=0)
+    key = view.owner * stride + view.face
+
+    def place(mesh: int, face: int) -> int:
+        at = int(np.searchsorted(key, mesh * stride + face))
+        return at if at < len(key) and key[at] == mesh * stride + face else -1
+
+    back = np.array([place(w[0], w[2]) for w in witnesses], dtype=np.int64)
+    front = np.array([place(w[1], w[3]) for w in witnesses], dtype=np.int64)
+    present = (back >= 0) & (front >= 0)
+    holds = np.zeros(len(witnesses), dtype=bool)
+    b, f = back[present], front[present]
+    facing = (view.facing[b] <= 0) & (view.facing[f] >= 0)
+    shown = np.zeros(len(b), dtype=bool)
+    shown[facing] = _shows_block(view, b[facing], f[facing], tol)
+    holds[present] = shown
+    return holds
 
 
 def _largest(view: Shadows, count: int) -> NDArray[np.bool_]:
@@ -376,15 +438,16 @@ def _occluded_among(
     among: NDArray[np.bool_],
     tol: Tolerance,
     first_only: bool = False,
-) -> set[tuple[int, int]]:
-    """:func:`occluded_pairs` over the triangles ``among`` alone (a subset shows only
-    pairs that block). Triangle pairs are examined by decreasing :meth:`Shadows.bound`
-    within each pair of meshes, the pairs of meshes in turn, and a pair of meshes stops
-    being examined once it blocks (with ``first_only``, every pair of its moving mesh)."""
+) -> dict[tuple[int, int], tuple[int, int]]:
+    """:func:`blocking_witnesses` over the triangles ``among`` alone (a subset shows only
+    pairs that block), each witness as two triangles of ``view``. Triangle pairs are
+    examined by decreasing :meth:`Shadows.bound` within each pair of meshes, the pairs of
+    meshes in turn, and a pair of meshes stops being examined once it blocks (with
+    ``first_only``, every pair of its moving mesh)."""
     backward = np.flatnonzero(among & (view.facing <= 0) & np.any(allowed, axis=1)[view.owner])
     forward = np.flatnonzero(among & (view.facing >= 0) & np.any(allowed, axis=0)[view.owner])
     if not len(backward) or not len(forward):
-        return set()
+        return {}
     back, front = _box_hits(view, backward, forward, allowed, tol)
     bound = view.bound(back, front) * np.maximum(view.cos[front], view.cos[back])
     keep = bound > tol.length
@@ -401,7 +464,7 @@ def _occluded_among(
     rank[by_pair] = np.arange(len(pairs)) - np.searchsorted(ranked, ranked)
     order = np.argsort(rank, kind="stable")
     back, front = back[order], front[order]
-    found: set[tuple[int, int]] = set()
+    found: dict[tuple[int, int], tuple[int, int]] = {}
     lo, chunk = 0, _FIRST_CHUNK
     while lo < len(back):
         b, f = back[lo : lo + chunk], front[lo : lo + chunk]
@@ -413,10 +476,28 @@ def _occluded_among(
         if first_only:
             fresh &= ~np.isin(view.owner[b], [i for i, _ in found])
         b, f, pair = b[fresh], f[fresh], pair[fresh]
-        points, corner, area, perimeter = triangle_overlaps(view.flat[b], view.flat[f])
-        which, at = np.nonzero(corner & (area > tol.length * perimeter)[:, None])
-        uv = points[which, at]
-        b, f, pair = b[which], f[which], pair[which]
-        excess = (view.depth(f, uv) - view.depth(b, uv)) * np.maximum(view.cos[f], view.cos[b])
-        found |= {(int(p // size), int(p % size)) for p in np.unique(pair[excess > tol.length])}
+        shown = _shows_block(view, b, f, tol)
+        # the first witness of each pair found
+        pair, first = np.unique(pair[shown], return_index=True)
+        witnesses = zip(b[shown][first].tolist(), f[shown][first].tolist(), strict=True)
+        for p, (i, j) in zip(pair.tolist(), witnesses, strict=True):
+            found[(p // size, p % size)] = (i, j)
     return found
+
+
+def _shows_block(
+    view: Shadows, back: NDArray[np.int64], front: NDArray[np.int64], tol: Tolerance
+) -> NDArray[np.bool_]:
+    """Per pair of a backward triangle ``back`` and a forward triangle ``front`` of
+    ``view``, whether their projections overlap over an area (more than the length
+    tolerance times its perimeter) at a vertex of which ``front`` lies deeper than
+    ``back`` by more than the length tolerance, measured across the faces (module
+    docstring)."""
+    points, corner, area, perimeter = triangle_overlaps(view.flat[back], view.flat[front])
+    which, at = np.nonzero(corner & (area > tol.length * perimeter)[:, None])
+    uv = points[which, at]
+    b, f = back[which], front[which]
+    excess = (view.depth(f, uv) - view.depth(b, uv)) * np.maximum(view.cos[f], view.cos[b])
+    shown = np.zeros(len(back), dtype=bool)
+    shown[which[excess > tol.length]] = True
+    return shown

@@ -59,7 +59,7 @@ from assemblykit.blocking.directions import (
     several,
     union_of,
 )
-from assemblykit.blocking.extended import extended_arcs
+from assemblykit.blocking.extended import extended_arcs, shown_arcs
 from assemblykit.deprecation import moved
 from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance, order_key
 
@@ -133,6 +133,7 @@ class ExtendedDirections:
         self._recent: dict[int, list[int]] = {}
         self._hinted: set[tuple[int, int]] = set()
         self._clear: dict[tuple[int, int], int] = {}
+        self._shown: dict[tuple[int, int], int] = {}
 
     def same_as(self, k: int) -> int:
         """The first candidate direction the same as direction ``k`` to the mesh angle
@@ -260,12 +261,47 @@ class ExtendedDirections:
         self._hinted.update((k, i) for i in asked)
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
 
+    def shown_blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
+        """Per part of ``movers``, blockers in ``among`` along ``k`` known without
+        projecting a mesh: those found before, and those shown by the two faces that
+        showed the pair blocking along another direction
+        (:func:`~assemblykit.blocking.extended.shown_arcs`; each pair asked once per
+        direction)."""
+        k = self.same_as(k)
+        asked: dict[int, int] = {}
+        for i in bits(movers):
+            fresh = among & ~self._shown.get((k, i), 0) & ~(1 << i)
+            if fresh and not self._knows(k, i, among):
+                asked[i] = fresh
+        if asked:
+            arcs = shown_arcs(
+                self.assembly,
+                self.directions[k],
+                [self.names[i] for i in asked],
+                [self.names[j] for j in bits(union_of(asked.values()))],
+                self.tol,
+            )
+            for i, mask in asked.items():
+                self._shown[(k, i)] = self._shown.get((k, i), 0) | mask
+            for a, b in arcs:
+                i, j = self.index[a], self.index[b]
+                if asked[i] >> j & 1:
+                    self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
+        return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
+
     def _blocked_as_before(self, k: int, movers: list[int], among: int) -> list[int]:
-        """The parts of ``movers`` not shown blocked along ``k`` by a part of ``among``
-        that blocked them along another direction (:data:`RECENT_BLOCKERS` each, tested
-        alone: a few projected meshes, where the whole test projects every part near
-        the sweep). A part blocked along one direction mostly is along its neighbours by
-        the same part, as the search visits them."""
+        """The parts of ``movers`` not shown blocked along ``k`` by a part of ``among``:
+        first by the faces that showed a pair blocking along another direction
+        (:meth:`shown_blockers`, no mesh projected), then by a part that blocked them
+        along another direction (:data:`RECENT_BLOCKERS` each, tested alone: a few
+        projected meshes, where the whole test projects every part near the sweep). A
+        part blocked along one direction mostly is along its neighbours by the same
+        part, as the search visits them."""
+        shown = self.shown_blockers(k, mask_of(movers), among)
+        for i, mask in shown.items():
+            if mask:
+                self._witness[(k, i)] = (mask & -mask).bit_length() - 1
+        movers = [i for i in movers if not shown[i]]
         hinted = [i for i in movers if any(among >> j & 1 for j in self._recent.get(i, ()))]
         if not hinted:
             return movers
@@ -675,10 +711,11 @@ def _free_closures(
     (everything its parts' blockers, and theirs, reach), and the sinks of the union are
     the least of these closures. A closure stops as soon as it reaches the base, so only
     the Γ_e blockers of parts in the sets found, and of those on the way to the base,
-    are computed. Before that, a closure under the arcs already known (and the parts
-    that blocked each part last along other directions, tested along ``k`` alone:
-    :meth:`ExtendedDirections.known_blockers`) that reaches the base rules its start
-    out: it lies within the whole closure. (Γ_t's arcs are Γ_e's but where a direction
+    are computed. Before that, a closure under the arcs already known that reaches the
+    base rules its start out, as it lies within the whole closure: first the arcs shown
+    without projecting (:meth:`ExtendedDirections.shown_blockers`), then with the parts
+    that blocked each part last along other directions, tested along ``k`` alone
+    (:meth:`ExtendedDirections.known_blockers`). (Γ_t's arcs are Γ_e's but where a direction
     grazes a contact, within the tolerances: there the part stays, as a single part Γ_t
     holds does.)"""
     necessary = translations.masks(k)
@@ -695,6 +732,8 @@ def _free_closures(
 
     closures = set()
     for start in _sinks(translations, k, members):
+        if closure(start, lambda parts: extended.shown_blockers(k, parts, members)) >> base & 1:
+            continue
         if closure(start, lambda parts: extended.known_blockers(k, parts, members)) >> base & 1:
             continue
         closed = closure(start, lambda parts: extended.blockers(k, parts, members, whole=True))
@@ -993,7 +1032,8 @@ def least_interlocked(translations: DirectionTable, extended: Any, members: int)
 
     def separates(subset: int) -> bool:
         return any(
-            separable(extended.table([k], subset), subset)
+            not _connected_as_shown(translations, extended, k, subset)
+            and separable(extended.table([k], subset), subset)
             for k in np.flatnonzero(translations.separating(subset)).tolist()
         )
 
@@ -1005,6 +1045,29 @@ def least_interlocked(translations: DirectionTable, extended: Any, members: int)
         return subset
 
     return drop(core)
+
+
+def _connected_as_shown(translations: DirectionTable, extended: Any, k: int, members: int) -> bool:
+    """Whether the DBG of Γ_e along ``k`` induced on ``members`` is strongly connected as
+    far as arcs known without projecting a mesh show it
+    (:meth:`ExtendedDirections.shown_blockers`, with Γ_t's arcs): a set that leaves
+    along ``k`` is closed under both, so it holds a sink component of Γ_t, whose
+    closure under the arcs shown is within it; when every such closure is ``members``,
+    no proper set leaves. ``False`` says nothing (polygons: nothing is shown)."""
+    if not isinstance(extended, ExtendedDirections):
+        return False
+    necessary = translations.masks(k)
+    for start in _sinks(translations, k, members):
+        closed = frontier = start
+        while frontier and closed != members:
+            blocked = 0
+            for i, mask in extended.shown_blockers(k, frontier, members).items():
+                blocked |= mask | necessary[i] & members
+            frontier = blocked & ~closed
+            closed |= frontier
+        if closed != members:
+            return False
+    return True
 
 
 def and_or_graph(table: DirectionTable) -> AndOrGraph:
