@@ -429,6 +429,33 @@ def test_a_locknut_of_two_solids_is_planned_as_one_part(locknut_step):
     assert not apart.feasible and {"locknut_1", "locknut_2"} <= set(apart.stuck)
 
 
+@cad
+def test_a_joined_locknut_keeps_the_exact_surfaces_left_outside(locknut_step):
+    # the union of nut and insert keeps its members' exact surfaces on its triangles:
+    # the nut's bore (radius 1.5) above and below the insert, the insert's bore (1.2)
+    # between, which the screw passes through
+    asm = load_assembly(locknut_step)
+    nut = resolve_overlaps(asm)["locknut"]
+    assert len(nut.surfaces) == len(asm["locknut_1"].surfaces) + len(asm["locknut_2"].surfaces)
+    bores = [s for s in nut.surfaces if s.kind == "cylinder" and s.radius < 2]
+    assert sorted(round(s.radius, 6) for s in bores) == [1.2, 1.5, 1.5]
+    assert all(not s.convex for s in bores)
+    corners = np.asarray(nut.mesh.triangles)
+    for surface in nut.surfaces:
+        points = corners[surface.faces].reshape(-1, 3) - surface.point
+        if surface.kind == "cylinder":
+            along = points @ surface.axis
+            across = np.linalg.norm(points - np.outer(along, surface.axis), axis=1)
+            # the chords of the tessellation lie within its deflection of the cylinder
+            assert np.allclose(across, surface.radius, atol=0.01 * surface.radius)
+        elif surface.kind == "plane":
+            assert np.allclose(points @ surface.axis, 0.0, atol=1e-9)
+    # the bore of the insert runs between its faces at z 3.5 and 4.5
+    (insert_bore,) = [s for s in bores if s.radius == pytest.approx(1.2)]
+    z = corners[insert_bore.faces][..., 2]
+    assert z.min() == pytest.approx(3.5) and z.max() == pytest.approx(4.5)
+
+
 @pytest.mark.parametrize(
     ("named", "names"),
     [

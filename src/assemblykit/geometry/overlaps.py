@@ -63,23 +63,31 @@ def traced_mesh(
     another solid. The mesh is taken as manifold3d gives it, its vertices already
     shared: merging the ones closer than trimesh's merge distance (a boolean leaves
     edges of 1e-10 where faces nearly meet) would open it."""
+    mesh, originals, face_ids = _traced(body)
+    return mesh, np.where((originals == original_id) & (original_id >= 0), face_ids, -1)
+
+
+def _traced(
+    body: manifold3d.Manifold,
+) -> tuple[trimesh.Trimesh, NDArray[np.int64], NDArray[np.int64]]:
+    """The closed triangle mesh of a manifold3d solid (:func:`traced_mesh`), and per
+    triangle the original id of the solid it comes from and its face id there."""
     out = body.to_mesh64()
     faces = np.array(out.tri_verts, dtype=np.int64)
     vertices = np.array(out.vert_properties[:, :3], dtype=np.float64)
     mesh = trimesh.Trimesh(vertices, faces, process=False)
-    source = np.full(len(faces), -1, dtype=np.int64)
     bounds = np.asarray(out.run_index, dtype=np.int64) // 3
-    for run, original in enumerate(np.asarray(out.run_original_id).tolist()):
-        if original == original_id >= 0:
-            start, stop = bounds[run], bounds[run + 1]
-            source[start:stop] = np.asarray(out.face_id[start:stop], dtype=np.int64)
-    return mesh, source
+    runs = np.asarray(out.run_original_id, dtype=np.int64)
+    originals = np.repeat(runs, np.diff(bounds))
+    return mesh, originals, np.asarray(out.face_id, dtype=np.int64)
 
 
 def joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> Assembly:
     """``assembly`` with each group of parts made one rigid part named by joining its
     members' names with ``+`` (in the assembly's order), its mesh the union of theirs;
-    groups that share a part are one group. The joined part keeps no exact surfaces."""
+    groups that share a part are one group. Where every member has exact surfaces, the
+    joined part keeps them over the triangles of its mesh that lie on them (those inside
+    the union are gone with their triangles: :func:`_joined_surfaces`)."""
     return _joined(assembly, groups)[0]
 
 
@@ -102,16 +110,53 @@ def _joined(
         members = sorted(component, key=order.__getitem__)
         if len(members) < 2:
             continue
+        parts = [assembly.parts[n] for n in members]
+        first_id = manifold3d.Manifold.reserve_ids(len(parts))
         union = manifold3d.Manifold.batch_boolean(
-            [solid(assembly.parts[n].mesh, n) for n in members], manifold3d.OpType.Add
+            [_numbered_solid(part, first_id + k) for k, part in enumerate(parts)],
+            manifold3d.OpType.Add,
         )
-        first = assembly.parts[members[0]]
+        mesh, originals, face_ids = _traced(union)
+        surfaces = _joined_surfaces(parts, mesh, originals - first_id, face_ids)
         name = names_of.get(frozenset(members), "+".join(members))
-        part = Part(name, mesh_of(union), source=first.source)
+        part = Part(name, mesh, surfaces=surfaces, source=parts[0].source)
         rest = [n for n in result.parts if n not in component]
         result = result.subset(rest).with_part(part)
         into.update(dict.fromkeys(members, part.name))
     return result, into
+
+
+def _numbered_solid(part: Part, original_id: int) -> manifold3d.Manifold:
+    """The solid of ``part`` whose triangles carry, under ``original_id``, the number of
+    the exact surface they lie on (its k-th surface k, the others each their own number
+    after them): a boolean's result then tells which surface each triangle lies on."""
+    ids = len(part.surfaces) + np.arange(len(part.mesh.faces))
+    for k, surface in enumerate(part.surfaces):
+        ids[surface.faces] = k
+    return solid(part.mesh, part.name, original_id=original_id, face_ids=ids)
+
+
+def _joined_surfaces(
+    parts: Sequence[Part],
+    mesh: trimesh.Trimesh,
+    member: NDArray[np.int64],
+    face_ids: NDArray[np.int64],
+) -> tuple[Surface, ...]:
+    """The exact surfaces of the union of ``parts`` whose mesh is ``mesh``, each of its
+    triangles from part ``member`` (an index into ``parts``) on the surface numbered
+    ``face_ids`` there (:func:`_numbered_solid`): each part's surfaces over the
+    triangles left of them. None unless every part has exact surfaces (a part without
+    them leaves the union's to recognition)."""
+    if not all(part.surfaces for part in parts):
+        return ()
+    corners = np.asarray(mesh.triangles, dtype=np.float64)
+    kept = []
+    for m, part in enumerate(parts):
+        for k, surface in enumerate(part.surfaces):
+            faces = np.flatnonzero((member == m) & (face_ids == k))
+            if len(faces):
+                kept.append(surface.on_faces(faces, corners[faces]))
+    return tuple(kept)
 
 
 def insertion_axis(shared: trimesh.Trimesh) -> NDArray[np.float64]:
