@@ -178,10 +178,17 @@ def hulls_may_block(
 
 def _shadow_width(flat: NDArray[np.float64]) -> NDArray[np.float64]:
     """The smallest altitude of each projected triangle (t x 3 x 2)."""
-    edges = flat[:, [1, 2, 0]] - flat
-    double_area = np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
-    length = np.sqrt(edges[:, :, 0] * edges[:, :, 0] + edges[:, :, 1] * edges[:, :, 1])
-    longest = np.maximum(np.maximum(length[:, 0], length[:, 1]), length[:, 2])
+    # the edges from each corner to the next, as views of the corners (no gathering)
+    first = flat[:, 1] - flat[:, 0]
+    second = flat[:, 2] - flat[:, 1]
+    third = flat[:, 0] - flat[:, 2]
+    double_area = np.abs(first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0])
+    longest = np.sqrt(
+        np.maximum(
+            np.maximum(np.einsum("ij,ij->i", first, first), np.einsum("ij,ij->i", second, second)),
+            np.einsum("ij,ij->i", third, third),
+        )
+    )
     return double_area / np.where(longest > 0, longest, 1.0)
 
 
@@ -198,10 +205,11 @@ def shadows(
     owner, facing, corners, normals, kept = [], [], [], [], []
     for k, mesh in enumerate(meshes):
         chosen = np.arange(len(mesh.faces)) if faces is None else np.asarray(faces[k])
-        face_normals = mesh.face_normals[chosen]
+        face_normals = mesh.face_normals if faces is None else mesh.face_normals[chosen]
+        triangles = mesh.triangles if faces is None else mesh.triangles[chosen]
         cos = face_normals @ frame[2]
         # every corner in the view frame once: its first two coordinates on the plane
-        seen = np.asarray(mesh.triangles[chosen], dtype=np.float64) @ frame.T
+        seen = np.asarray(triangles, dtype=np.float64) @ frame.T
         keep = (np.abs(cos) > tol.mesh_angle) & (_shadow_width(seen[:, :, :2]) > tol.length)
         owner.append(np.full(int(keep.sum()), k, dtype=np.int64))
         # without a consistent outside every triangle may bound the part on either side
