@@ -13,7 +13,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from assemblykit.io.burrtools import load_puzzle, solution_count
-from assemblykit.planning.multimove import Move, MultiMovePlan, Separation, plan_voxels
+from assemblykit.planning.multimove import (
+    Move,
+    MultiMovePlan,
+    Separation,
+    moving_groups,
+    plan_voxels,
+)
 from assemblykit.render import render
 from cli_runs import run
 from datasets import dataset
@@ -166,8 +172,72 @@ def test_json_has_the_tree_the_level_and_the_plan_keys():
         "parts": ["key"],
         "direction": [0, 0, 1],
         "distance": None,
+        "together": True,
     }
     assert [s["motion"] for s in data["steps"]] == ["translation"] * 3
+    assert all(s["together"] is True and "moves" not in s for s in data["steps"])
+
+
+def lock_and_keys() -> tuple[list[str], list[np.ndarray]]:
+    """A lock bar under two keys in a box (x 0..4, y -1..3, z 0..3). The lock fills
+    ``(1, 0..2, 1)`` and rises +z out of three holes in the lid ``(1, 0..2, 3)``
+    through ``(1, 0..2, 2)``; the keys, two cells long along x, sit on its ends there,
+    ``(1..2, 0, 2)`` and ``(1..2, 2, 2)``. A key is too long for the holes, the box
+    holds it on every side but +x, where one empty cell ``(3, y, 2)`` lets it slide by
+    exactly 1. The keys are side by side: neither is in the other's way."""
+    lock = [(1, 0, 1), (1, 1, 1), (1, 2, 1)]
+    first = [(1, 0, 2), (2, 0, 2)]
+    second = [(1, 2, 2), (2, 2, 2)]
+    empty = [(3, 0, 2), (3, 2, 2), (1, 1, 2), (1, 0, 3), (1, 1, 3), (1, 2, 3)]
+    whole = {(x, y, z) for x in range(5) for y in range(-1, 4) for z in range(4)}
+    box = sorted(whole - {*lock, *first, *second, *empty})
+    return ["box", "lock", "k1", "k2"], [np.array(c) for c in (box, lock, first, second)]
+
+
+def test_keys_that_slide_side_by_side_move_independently_in_one_move():
+    # by hand: the lock leaves only once both keys have slid +x by 1; moving both at once
+    # is one move (BurrTools counts a move of several pieces the same way by the same
+    # distance as one), then the lock leaves +z: two moves. The keys stop each other
+    # nowhere along +x, so the move says they move independently, each by 1 along +x.
+    names, voxels = lock_and_keys()
+    result = plan_voxels(names, voxels, groups=[1, 0, 1, 1])
+    assert result.feasible and result.level == "2"
+    slide, leave = result.root.moves
+    assert (slide.parts, slide.direction, slide.distance) == (("k1", "k2"), (1, 0, 0), 1)
+    assert not slide.together and slide.groups == (("k1",), ("k2",))
+    assert (leave.parts, leave.direction, leave.distance) == (("lock",), (0, 0, 1), None)
+    assert leave.together
+    step = result.to_dict()["steps"][0]
+    assert step["together"] is False
+    assert step["moves"] == [
+        {"parts": ["k1"], "direction": [1.0, 0.0, 0.0], "distance": 1},
+        {"parts": ["k2"], "direction": [1.0, 0.0, 0.0], "distance": 1},
+    ]
+    assert result.to_dict()["steps"][1]["together"] is True
+    replay(result, dict(zip(names, voxels, strict=True)))
+    # the moves listed, one after another, replay too
+    cells = dict(zip(names, voxels, strict=True))
+    offsets = {name: np.zeros(3, dtype=np.int64) for name in names}
+    for move in step["moves"]:
+        for _ in range(move["distance"]):
+            for name in move["parts"]:
+                offsets[name] = offsets[name] + np.array(move["direction"], dtype=np.int64)
+            placed = np.concatenate([cells[n] + offsets[n] for n in names])
+            assert len(np.unique(placed, axis=0)) == len(placed)
+
+
+def test_moving_groups_split_what_does_not_hold_together():
+    # "j blocks i" arcs: a pushes b, which nothing holds back: b goes first, then a;
+    # c and d block each other and move as one
+    assert moving_groups(["a", "b"], [("a", "b")]) == (("b",), ("a",))
+    assert moving_groups(["c", "d"], [("c", "d"), ("d", "c")]) == (("c", "d"),)
+    assert moving_groups(["a", "b", "c"], [("a", "x")]) == (("a",), ("b",), ("c",))
+
+
+def test_move_labels_are_the_projects_directions():
+    assert Move(("key",), (1, 0, 0), 2).label == "+X"
+    assert Move(("key",), (0, 0, -1), None).label == "-Z"
+    assert Move(("key",), (0.6, -0.8, 0.0), None).label == "(0.6, -0.8, 0)"
 
 
 def test_plan_command_moves_multi(capsys):
@@ -175,6 +245,8 @@ def test_plan_command_moves_multi(capsys):
     assert code == 0, err
     data = json.loads(out)
     assert data["feasible"] and data["level"] == "3" and data["moves"] == "multi"
+    # one piece per move: each moves as one rigid group
+    assert [s["together"] for s in data["steps"]] == [True, True, True]
     code, out, _ = run(capsys, "plan", str(STAIRCASE), "--moves", "multi")
     assert code == 0 and "first separation: 3 moves" in out
     code, _, err = run(capsys, "plan", str(STAIRCASE), "--moves", "multi", "--solution", "4")

@@ -166,6 +166,7 @@ def test_exploded_offsets_push_earlier_parts_further():
         "motion": "translation",
         "rest": ["a", "b"],
         "blocking": [["b", "c"]],
+        "together": True,
     }
 
 

@@ -13,12 +13,17 @@ free cone when it has one), then its lower-dimensional regions (isolated directi
 as a pin's axis), then the principal axes of the moving parts and the directions away
 from their contacts that pass the same local test. Each is checked exactly
 (:func:`assemblykit.blocking.extended.extended_free`): a direction reported is truly
-free; free directions strictly between those examined may be missed.
+free. When none of them frees the parts, the exact free set is asked
+(:mod:`assemblykit.blocking.free_cones`): a direction in each of its faces, then in each
+of its arcs and at each of its points, where a part held between two others may only
+slide (a lid clamped on a rim, a drawer between rails). Polygons have an exact NDBG:
+its regions (points and arcs of S¹) are examined instead (docs/blocking.md, "Three
+kinds of motion").
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Collection, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -28,6 +33,7 @@ from numpy.typing import NDArray
 
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import Removal
+from assemblykit.blocking.directions import DirectionTable
 from assemblykit.blocking.extended import extended_arcs, extended_free
 from assemblykit.blocking.free_cones import blocked_sets, exact_free_directions, overlay_faces
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
@@ -38,6 +44,7 @@ from assemblykit.blocking.ndbg import (
     build_ndbg,
 )
 from assemblykit.blocking.obstacles import of_meshes
+from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.deprecation import moved
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import assembly_contacts
@@ -62,14 +69,19 @@ def removable_subassemblies(
 
 
 def _local_graph(
-    assembly: AssemblyLike, subassembly: set[str], tol: Tolerance
+    assembly: AssemblyLike,
+    subassembly: set[str],
+    tol: Tolerance,
+    among: Collection[str] | None = None,
 ) -> NonDirectionalBlockingGraph | None:
-    """Γ_t of the contacts leaving ``subassembly`` only (``None`` when it touches
-    nothing)."""
+    """Γ_t of the contacts leaving ``subassembly`` for the other parts of ``among``
+    (default: all) only (``None`` when it touches none)."""
     terms: list[BlockingTerm] = [
         t
         for t in blocking_terms(assembly, "infinitesimal", tol)
-        if t.moving in subassembly and t.blocker not in subassembly
+        if t.moving in subassembly
+        and t.blocker not in subassembly
+        and (among is None or t.blocker in among)
     ]
     if not terms:
         return None
@@ -78,11 +90,15 @@ def _local_graph(
 
 
 def _local_free_regions(
-    assembly: AssemblyLike, subassembly: set[str], tol: Tolerance
+    assembly: AssemblyLike,
+    subassembly: set[str],
+    tol: Tolerance,
+    among: Collection[str] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
     """Directions and dimensions of the Γ_t regions where ``subassembly`` is locally
-    free, faces first; the six axis directions (as faces) when it touches nothing."""
-    graph = _local_graph(assembly, subassembly, tol)
+    free among ``among`` (default: all parts), faces first; the six axis directions (as
+    faces) when it touches nothing."""
+    graph = _local_graph(assembly, subassembly, tol, among)
     if graph is None:
         return _AXES, np.full(len(_AXES), 2, np.int8)
     dims = graph.arrangement.dims
@@ -92,7 +108,10 @@ def _local_free_regions(
 
 
 def _extra_directions(
-    assembly: AssemblyLike, subassembly: set[str], tol: Tolerance
+    assembly: AssemblyLike,
+    subassembly: set[str],
+    tol: Tolerance,
+    among: Collection[str] | None = None,
 ) -> NDArray[np.float64]:
     """The principal axes (both ways) of the moving parts' meshes and the unit normals
     of their contacts pointing away from the rest, kept where Γ_t leaves them locally
@@ -102,6 +121,8 @@ def _extra_directions(
         mesh = assembly.parts[name].mesh  # type: ignore[attr-defined]
         candidates.extend([*mesh.principal_inertia_vectors, *-mesh.principal_inertia_vectors])
     for c in assembly_contacts(assembly, tol):
+        if among is not None and not (c.a in among and c.b in among):
+            continue
         if (c.a in subassembly) != (c.b in subassembly):
             away = -1.0 if c.a in subassembly else 1.0
             candidates.extend(away * np.asarray(p.normal, dtype=np.float64) for p in c.planar)
@@ -109,7 +130,7 @@ def _extra_directions(
         return np.zeros((0, 3))
     directions = np.array(candidates, dtype=np.float64)
     directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-    graph = _local_graph(assembly, subassembly, tol)
+    graph = _local_graph(assembly, subassembly, tol, among)
     if graph is None:
         return directions
     free: NDArray[np.bool_] = ~np.any(graph.table.direct_arcs(directions, tol), axis=1)
@@ -133,7 +154,14 @@ def can_extract(
     tol: Tolerance | None = None,
 ) -> Removal | None:
     """The directions (or twist) along which ``subassembly`` leaves the rest without
-    removing any other part first, or ``None`` when there is none."""
+    removing any other part first, or ``None`` when there is none.
+
+    Extended translations (docs/blocking.md, "Three kinds of motion"): in 3D the
+    directions of the module docstring, each checked exactly, then those of the exact
+    free set (:func:`assemblykit.blocking.free_cones.exact_free_directions`: its faces,
+    then its arcs and points, for a part that may only slide); for polygons the regions
+    of the exact NDBG (points and arcs of S¹) where the set is free, arcs first, as
+    3-vectors with ``z = 0``."""
     tol = assembly.tolerance(tol)
     names = set(assembly.names)
     moving = set(subassembly)
@@ -144,21 +172,63 @@ def can_extract(
         graph = blocking_graph(assembly, "rigid", tol=tol)
         twist = graph.free_twist(moving)
         return None if twist is None else Removal(chosen, (twist,))
-    directions, dims = _local_free_regions(assembly, moving, tol)
-    if motion == "extended" and len(dims):
-        # the highest dimension first (the open free cone when it has one), then the rest
-        top = dims == dims[0]
-        meshes = of_meshes(assembly)
-        for batch in (directions[top], directions[~top], _extra_directions(assembly, moving, tol)):
-            free = [d for d in batch if extended_free(meshes, moving, d, tol, names)]
-            if free:
-                return Removal(chosen, tuple(free))
-        # none of the sampled directions: a face of the exact free set (a tunnel)
-        exact = exact_free_directions(meshes, moving, tol)
-        if exact.directions:
-            return Removal(chosen, exact.directions, exact.tolerance_dependent)
-        return None
+    if motion == "extended" and isinstance(assembly, PolygonAssembly):
+        exact = _planar_free(assembly, moving, names, tol)
+        return Removal(chosen, tuple(exact)) if len(exact) else None
+    if motion == "extended":
+        return _extended_removal(of_meshes(assembly), moving, names, tol)
+    directions, _ = _local_free_regions(assembly, moving, tol)
     return Removal(chosen, tuple(directions)) if len(directions) else None
+
+
+def _extended_removal(
+    assembly: Assembly, moving: set[str], among: Collection[str], tol: Tolerance
+) -> Removal | None:
+    """:func:`can_extract` by an extended translation among the parts ``among``: none
+    when Γ_t holds it along every direction; else the locally free regions of Γ_t (the
+    highest dimension first, the open free cone when it has one), the other regions,
+    the principal axes and contact normals, each checked exactly; then the exact free
+    set (faces, then arcs and points)."""
+    chosen = frozenset(moving)
+    directions, dims = _local_free_regions(assembly, moving, tol, among)
+    if not len(dims):
+        # Γ_t, a necessary condition, holds it along every direction
+        return None
+    top = dims == dims[0]
+    extra = _extra_directions(assembly, moving, tol, among)
+    for batch in (directions[top], directions[~top], extra):
+        free = [d for d in batch if extended_free(assembly, moving, d, tol, among)]
+        if free:
+            return Removal(chosen, tuple(free))
+    exact = exact_free_directions(assembly, moving, tol, among)
+    if exact.directions:
+        return Removal(chosen, exact.directions, exact.tolerance_dependent)
+    return None
+
+
+def _planar_table(model: PolygonAssembly, among: Collection[str], tol: Tolerance) -> DirectionTable:
+    """Γ_e of the polygons ``among`` over every region of its exact NDBG: the points and
+    open arcs of S¹ (docs/blocking.md, "Three kinds of motion"), arcs first."""
+    graph = blocking_graph(model, "extended", [n for n in model.names if n in among], tol)
+    dims = graph.arrangement.dims
+    table = graph.direction_table()
+    order = np.lexsort((np.arange(len(dims)), -dims))
+    return DirectionTable(
+        table.names, table.directions[order], table.slots[order], table.moving, table.blocker
+    )
+
+
+def _planar_free(
+    model: PolygonAssembly, moving: set[str], among: Collection[str], tol: Tolerance
+) -> NDArray[np.float64]:
+    """The directions of the regions of the exact NDBG of the polygons ``among`` along
+    which ``moving`` leaves the others (:func:`_planar_table`)."""
+    table = _planar_table(model, among, tol)
+    inside = np.array([n in moving for n in table.names])
+    leaving = inside[table.moving] & ~inside[table.blocker]
+    free = ~np.any(table.slots[:, leaving], axis=1)
+    found: NDArray[np.float64] = table.directions[free]
+    return found
 
 
 def removable_parts(
@@ -192,17 +262,25 @@ class Prerequisite:
     minimal: bool
 
 
-def removal_before(assembly: Assembly, part: str, tol: Tolerance | None = None) -> Prerequisite:
+def removal_before(
+    assembly: Assembly | PolygonAssembly, part: str, tol: Tolerance | None = None
+) -> Prerequisite:
     """The fewest parts to remove before ``part`` can leave by an extended translation,
-    over all directions (Wilson & Latombe 1992 §5): the directions are one per face of the overlay
-    of the sets each other part blocks (over a face, the parts blocking ``part`` are
-    constant), so every set of direct blockers is seen; the sets are tried smallest
-    first, and the first whose parts can be taken out one at a time (each along a face
-    of its exact free set) is the answer."""
+    over all directions (Wilson & Latombe 1992 §5): the directions are one per face of
+    the overlay of the sets each other part blocks (over a face, the parts blocking
+    ``part`` are constant) and one per arc and point of the circles where those sets
+    meet without a gap (:func:`assemblykit.blocking.free_cones.overlay_faces`: a part
+    that leaves by sliding between two others, or only after one that slides), so
+    every set of direct blockers is seen; the sets are tried smallest first, and the
+    first whose parts can be taken out one at a time (each by an extended translation,
+    a slide included) is the answer. Polygons: the same over the regions of their
+    exact NDBG (docs/blocking.md, "Questions (Python)")."""
     if part not in assembly.names:
         raise UnknownNameError(f"no part named {part!r}")
     tol = assembly.tolerance(tol)
     names = list(assembly.names)
+    if isinstance(assembly, PolygonAssembly):
+        return _planar_removal_before(assembly, part, names, tol)
     others = [n for n in names if n != part]
     sets = blocked_sets(assembly, [part], names, tol)
     if sets is None:
@@ -212,48 +290,81 @@ def removal_before(assembly: Assembly, part: str, tol: Tolerance | None = None) 
         directions = np.vstack([faces.directions, faces.thin]).reshape(-1, 3)
     options: dict[frozenset[str], NDArray[np.float64]] = {}
     for d in directions:
-        # inside a face the blocked sets say who blocks; the direction kept for each
-        # set is checked exactly below
+        # the blocked sets say who blocks along d; the direction kept for each set is
+        # checked exactly below
         if sets is None:
             blockers = frozenset(j for _, j in extended_arcs(assembly, d, [part], others, tol))
         else:
-            blockers = frozenset(j for j, blocked in sets.items() if blocked.contains(d))
+            blockers = frozenset(j for j, blocked in sets.items() if blocked.contains(d, tol))
         options.setdefault(blockers, d)
     for blockers, d in list(options.items()):
         exact = frozenset(j for _, j in extended_arcs(assembly, d, [part], others, tol))
         if exact != blockers:
             del options[blockers]
             options.setdefault(exact, d)
+    return _first_removable(assembly, part, options, names, tol, sets is not None)
+
+
+def _first_removable(
+    assembly: Assembly | PolygonAssembly,
+    part: str,
+    options: dict[frozenset[str], NDArray[np.float64]],
+    names: list[str],
+    tol: Tolerance,
+    complete: bool,
+) -> Prerequisite:
+    """The smallest set of ``options`` (each with a direction along which ``part`` leaves
+    once it is gone) whose parts can be taken out first; minimal when the options are
+    every set of direct blockers (``complete``) and it is one of the smallest; else
+    every other part, not minimal."""
     smallest = min((len(r) for r in options), default=0)
     for blockers in sorted(options, key=lambda r: (len(r), sorted(r))):
         if _removable_first(assembly, blockers, names, tol):
-            return Prerequisite(
-                part, blockers, options[blockers], len(blockers) == smallest and sets is not None
-            )
-    return Prerequisite(part, frozenset(others), None, False)
+            minimal = complete and len(blockers) == smallest
+            return Prerequisite(part, blockers, options[blockers], minimal)
+    return Prerequisite(part, frozenset(n for n in names if n != part), None, False)
+
+
+def _planar_removal_before(
+    model: PolygonAssembly, part: str, names: list[str], tol: Tolerance
+) -> Prerequisite:
+    """:func:`removal_before` of polygons: the parts blocking ``part`` over each region
+    of the exact NDBG (points and arcs of S¹), so every set of direct blockers is seen."""
+    table = _planar_table(model, names, tol)
+    index = table.names.index(part)
+    mine = table.moving == index
+    options: dict[frozenset[str], NDArray[np.float64]] = {}
+    for d, row in zip(table.directions, table.slots[:, mine], strict=True):
+        blockers = frozenset(table.names[j] for j in table.blocker[mine][row])
+        options.setdefault(blockers, d)
+    return _first_removable(model, part, options, names, tol, True)
 
 
 def _removable_first(
-    assembly: Assembly, chosen: frozenset[str], names: list[str], tol: Tolerance
+    assembly: Assembly | PolygonAssembly, chosen: frozenset[str], names: list[str], tol: Tolerance
 ) -> bool:
     """Whether the parts of ``chosen`` can be taken out of ``names`` one at a time, each
-    along a face of its exact free set among the parts still there (removing parts only
-    removes obstacles, so any part that can leave may leave first)."""
+    by an extended translation among the parts still there (:func:`_extended_removal`,
+    slides included; polygons: :func:`_planar_free`). Removing parts only removes
+    obstacles, so any part that can leave may leave first."""
     remaining, pending = set(names), set(chosen)
     while pending:
-        leaving = next(
-            (
-                r
-                for r in sorted(pending)
-                if exact_free_directions(assembly, [r], tol, remaining, limit=1).directions
-            ),
-            None,
-        )
+        leaving = next((r for r in sorted(pending) if _leaves(assembly, r, remaining, tol)), None)
         if leaving is None:
             return False
         pending.discard(leaving)
         remaining.discard(leaving)
     return True
+
+
+def _leaves(
+    assembly: Assembly | PolygonAssembly, name: str, among: set[str], tol: Tolerance
+) -> bool:
+    """Whether the part ``name`` leaves the other parts of ``among`` by one extended
+    translation."""
+    if isinstance(assembly, PolygonAssembly):
+        return bool(len(_planar_free(assembly, {name}, among, tol)))
+    return _extended_removal(assembly, {name}, among, tol) is not None
 
 
 def parts_to_remove_before(
@@ -269,7 +380,8 @@ def parts_to_remove_before(
     if part not in assembly.names:
         raise UnknownNameError(f"no part named {part!r}")
     if motion == "extended":
-        return removal_before(of_meshes(assembly), part, tol).parts
+        model = assembly if isinstance(assembly, PolygonAssembly) else of_meshes(assembly)
+        return removal_before(model, part, tol).parts
     if motion == "rigid":
         graph = blocking_graph(assembly, "rigid", tol=tol)
         best = min(

@@ -35,8 +35,11 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import networkx as nx
 import numpy as np
 from numpy.typing import NDArray
+
+from assemblykit import formatting as fmt
 
 MAX_STATES = 250_000
 """Default limit of states visited per separation: Pelikan's 98-move first separation
@@ -51,34 +54,76 @@ _INF = 1 << 40  # "never collides": far beyond any offset a search can reach
 Progress = Callable[[str, int, int], None]
 
 
+def moving_groups(
+    parts: Sequence[str], arcs: Iterable[tuple[str, str]]
+) -> tuple[tuple[str, ...], ...]:
+    """The parts a step moves, split into the sets that hold one another: the strongly
+    connected components of the step's DBG restricted to them (an arc ``(i, j)``: ``j``
+    blocks ``i``), each after the sets that block it, so that moved one after another
+    along the step's direction none meets another (docs/planning.md, "JSON"). One set:
+    the parts move as one rigid group; several: each may move on its own."""
+    inside = set(parts)
+    graph: nx.DiGraph[str] = nx.DiGraph()
+    graph.add_nodes_from(parts)
+    graph.add_edges_from((i, j) for i, j in arcs if i in inside and j in inside and i != j)
+    condensed = nx.condensation(graph)
+    rank = {name: k for k, name in enumerate(parts)}
+
+    def first(component: int) -> int:
+        return min(rank[name] for name in condensed.nodes[component]["members"])
+
+    # an arc i -> j asks for j's set to move first: the reverse of a topological order
+    order = list(nx.lexicographical_topological_sort(condensed.reverse(), key=first))
+    return tuple(tuple(sorted(condensed.nodes[c]["members"], key=rank.__getitem__)) for c in order)
+
+
 @dataclass(frozen=True)
 class Move:
     """``parts`` translate by ``distance`` along the unit ``direction`` relative to the
     other parts of the subassembly (on the lattice: a whole number of cells along an
-    axis); ``distance`` None means to infinity (the move that separates)."""
+    axis); ``distance`` None means to infinity (the move that separates). ``groups``,
+    when known, splits ``parts`` into the sets that hold one another, in an order in
+    which they may move one after another (:func:`moving_groups`); empty: one rigid
+    group."""
 
     parts: tuple[str, ...]
     direction: tuple[float, float, float]
     distance: float | None
+    groups: tuple[tuple[str, ...], ...] = ()
 
     @property
     def label(self) -> str:
-        """The direction as ``+x`` / ``-z`` when along an axis, else ``(x, y, z)``."""
-        if sorted(abs(c) for c in self.direction) == [0, 0, 1]:
-            return "".join(
-                ("+" if c > 0 else "-") + axis
-                for c, axis in zip(self.direction, "xyz", strict=True)
-                if c
-            )
-        return "(" + ", ".join(f"{float(c) + 0.0:.3f}" for c in self.direction) + ")"
+        """The direction for people (docs/architecture.md, "Numbers for people")."""
+        return fmt.direction(self.direction)
+
+    @property
+    def together(self) -> bool:
+        """Whether the parts move as one rigid group (they hold one another), not as
+        independent parts."""
+        return len(self.groups) <= 1
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``parts``, ``direction``, ``distance`` (null: to infinity)."""
+        """JSON form: ``parts``, ``direction``, ``distance`` (null: to infinity),
+        ``together`` and, when the parts move independently, ``moves`` (one per set that
+        holds together, in an order they may move one after another: ``parts``,
+        ``direction``, ``distance``)."""
         return {
             "parts": list(self.parts),
             "direction": list(self.direction),
             "distance": self.distance,
+            **self.grouping(list(self.direction)),
         }
+
+    def grouping(self, direction: list[Any]) -> dict[str, Any]:
+        """The JSON keys that say what moves with what (:meth:`to_dict`), each set's
+        direction written as ``direction``."""
+        if self.together:
+            return {"together": True}
+        moves = [
+            {"parts": list(g), "direction": direction, "distance": self.distance}
+            for g in self.groups
+        ]
+        return {"together": False, "moves": moves}
 
 
 @dataclass(frozen=True)
@@ -195,6 +240,7 @@ class MultiMovePlan:
                     "direction": [float(x) for x in m.direction],
                     "motion": "translation",
                     "distance": m.distance,
+                    **m.grouping([float(x) for x in m.direction]),
                 }
                 for m in moves
             ],
@@ -506,40 +552,58 @@ class _Planner(MultiMoveSearch):
         removals, moves = _moves(free)
         if removals:
             group, d = min(removals, key=lambda r: (bin(r[0]).count("1"), r[1], r[0]))
-            return self._separating(members, group, d), ()
+            return self._separating(members, group, d, state), ()
         bits = np.left_shift(1, np.arange(len(members), dtype=np.int64))
         moved = (moves[:, 0:1] & bits) != 0
         step = self.steps[moves[:, 1]] * moves[:, 2:3]
         after = offsets + moved[:, :, None] * step[:, None, :]
         after = after - after[:, :1, :]
         keys = [row.tobytes() for row in after]
-        return None, zip(keys, keys, map(tuple, moves.tolist()), strict=True)
+        # each move keeps the state it starts from, to tell what moves with what
+        raws = [(*row, state) for row in moves.tolist()]
+        return None, zip(keys, keys, raws, strict=True)
 
     def move(self, members: list[int], raw: Any) -> Move:
         # the first piece stays put: a group holding it is reported as the others
         # moving the opposite way (the same relative motion)
-        group, d, k = raw
+        group, d, k, state = raw
         if group & 1:
             group, d = ((1 << len(members)) - 1) ^ group, d ^ 1
-        return self._move(group, d, k, members)
+        return self._move(group, d, k, members, state)
 
     def placement(self, members: list[int], state: Any) -> NDArray[Any]:
         final = np.zeros((self.tables.n, 3), dtype=np.int64)
         final[members] = np.frombuffer(state, dtype=np.int64).reshape(-1, 3)
         return final
 
-    def _separating(self, members: list[int], group: int, d: int) -> Found:
+    def _separating(self, members: list[int], group: int, d: int, state: bytes) -> Found:
         removed = _bits(group, members)
         if 2 * len(removed) > len(members):
             # report the smaller half as the one removed, moving the other way
             removed = [m for m in members if m not in removed]
             d ^= 1
             group = sum(1 << k for k, m in enumerate(members) if m in removed)
-        return removed, self._move(group, d, None, members)
+        return removed, self._move(group, d, None, members, state)
 
-    def _move(self, group: int, d: int, k: int | None, members: list[int]) -> Move:
-        parts = tuple(self.names[m] for m in _bits(group, members))
-        return Move(parts, AXES[d], k)
+    def _move(self, group: int, d: int, k: int | None, members: list[int], state: bytes) -> Move:
+        """The move of the pieces ``group`` (local bits) by ``k`` cells along ``AXES[d]``
+        from ``state``, with the sets of them that hold one another: a piece blocks
+        another of the group when it stands within ``k`` cells ahead of it (anywhere
+        ahead, to infinity) at ``state`` (:func:`moving_groups`)."""
+        moved = _bits(group, members)
+        parts = tuple(self.names[m] for m in moved)
+        whole = np.zeros((self.tables.n, 3), dtype=np.int64)
+        whole[members] = np.frombuffer(state, dtype=np.int64).reshape(-1, 3)
+        entries = self.entries.setdefault(tuple(members), self.tables.subset(members))
+        free = self.tables.free(whole, entries)[d]
+        reach = _INF // 2 if k is None else k
+        arcs = [
+            (self.names[i], self.names[j])
+            for i in moved
+            for j in moved
+            if i != j and free[i, j] < reach
+        ]
+        return Move(parts, AXES[d], k, moving_groups(parts, arcs))
 
 
 def plan_voxels(

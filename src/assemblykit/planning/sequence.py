@@ -61,6 +61,7 @@ from assemblykit.blocking.directions import (
 )
 from assemblykit.blocking.extended import extended_arcs, shown_arcs
 from assemblykit.deprecation import moved
+from assemblykit.planning.multimove import moving_groups
 from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance, order_key
 
 if TYPE_CHECKING:
@@ -370,13 +371,20 @@ class Step:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON form (docs/planning.md, "JSON"): ``parts``, ``direction``, ``motion``,
-        ``rest``."""
+        ``rest``, ``blocking``, ``together`` (the moved parts hold one another: one rigid
+        group) and, when they do not, ``moves`` (the sets that do, in an order they may
+        leave one after another: :func:`~assemblykit.planning.multimove.moving_groups`)."""
+        groups = moving_groups(self.parts, self.blocking)
+        direction = [float(x) + 0.0 for x in self.direction]
+        moves = [{"parts": list(group), "direction": direction} for group in groups]
         return {
             "parts": list(self.parts),
-            "direction": [float(x) + 0.0 for x in self.direction],
+            "direction": direction,
             "motion": self.motion,
             "rest": list(self.rest),
             "blocking": [list(arc) for arc in self.blocking],
+            "together": len(groups) == 1,
+            **({} if len(groups) == 1 else {"moves": moves}),
             **({} if self.stability is None else self.stability.to_dict()),
             **({} if self.fastener is None else {"fastener": self.fastener.to_dict()}),
         }
