@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import manifold3d
 import numpy as np
 import pytest
 import trimesh
@@ -15,6 +16,7 @@ from assemblykit.blocking.free_cones import ChartSet, _distinct_cones, exact_fre
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.geometry.interference import solid
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.packings import box_mesh as box
@@ -231,3 +233,39 @@ def test_one_blocker_each_tells_the_same_parts_apart(example):
         some = extended_arcs(asm, d, names, names, tol, first_only=True)
         assert some <= every
         assert {a for a, _ in some} == {a for a, _ in every}
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_drawer_slides_along_its_rails_in_any_frame(seed):
+    # a drawer on a floor between two rails under a lid, the whole turned at random:
+    # along the rails it slides out (rounding of the turn must not tip the graze into a
+    # block), a hundredth of a radian into the floor or across the rails it is blocked
+    from scipy.spatial.transform import Rotation
+
+    turn = Rotation.random(random_state=seed).as_matrix()
+    frame = np.eye(4)
+    frame[:3, :3] = turn
+    boxes = {
+        "floor": ((-5, -5, -1), (5, 5, 0)),
+        "left": ((-3, -5, 0), (-2, 5, 3)),
+        "right": ((2, -5, 0), (3, 5, 3)),
+        "lid": ((-3, -5, 3), (3, 5, 4)),
+        "drawer": ((-2, -2, 0), (2, 2, 3)),
+    }
+    meshes = {}
+    for name, (lo, hi) in boxes.items():
+        mesh = trimesh.creation.box(bounds=np.array([lo, hi], dtype=float))
+        meshes[name] = mesh.apply_transform(frame)
+    assembly = mesh_assembly(meshes)
+    tol = assembly.tolerance()
+    along = turn @ [0.0, 1.0, 0.0]
+    assert extended_free(assembly, ["drawer"], along, tol)
+    assert extended_free(assembly, ["drawer"], -along, tol)
+    for blocked in ([0.0, 1.0, -0.01], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]):
+        d = turn @ np.asarray(blocked)
+        assert not extended_free(assembly, ["drawer"], d / np.linalg.norm(d), tol)
+    # independently: the drawer swept 20 along the rails shares no volume with the rest
+    corners = meshes["drawer"].vertices
+    swept = manifold3d.Manifold.hull_points(np.vstack([corners, corners + 20 * along]))
+    for name in ("floor", "left", "right", "lid"):
+        assert (swept ^ solid(meshes[name])).volume() < 1e-6, name

@@ -119,7 +119,9 @@ def extended_arcs(
         for blocker in near:
             if not (cache.convex(moving) and cache.convex(blocker)):
                 projected.append((moving, blocker))
-            elif any(blocks_along(c, d)[0] for c in cache.cones_of(moving, blocker, tol)):
+            elif any(
+                blocks_along(c, d, tol.angle)[0] for c in cache.cones_of(moving, blocker, tol)
+            ):
                 arcs.add((moving, blocker))
     plain = _may_block(
         cache, d, [pair for pair in projected if not cache.backout(*pair, tol).any()], tol

@@ -197,9 +197,14 @@ def overlap_depth(first: NDArray[np.float64], second: NDArray[np.float64]) -> fl
     return float(found.x[3]) if found.status == 0 else 0.0
 
 
-def blocks_along(cone: NDArray[np.float64], directions: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """Whether each direction (rows) lies in the open blocking cone."""
-    return np.all(np.atleast_2d(directions) @ cone.T > 0, axis=1)
+def blocks_along(
+    cone: NDArray[np.float64], directions: NDArray[np.float64], margin: float = 0.0
+) -> NDArray[np.bool_]:
+    """Whether each direction (rows, unit) lies in the open blocking cone (rows: its
+    facets' unit inner normals), inside each facet by more than the angle ``margin``: a
+    direction within the angle tolerance of a facet grazes it (a drawer sliding along
+    the plane it rests on, in coordinates rounded by a rotation)."""
+    return np.all(np.atleast_2d(directions) @ cone.T > margin, axis=1)
 
 
 def triangle_cones(
