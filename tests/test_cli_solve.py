@@ -426,3 +426,43 @@ def test_a_bad_png_path_exits_2_before_reading_the_task(
     err = capsys.readouterr().err
     assert "--png" in err and len(err.strip().splitlines()) == 1
     assert not list(tmp_path.rglob("*.png")) and not list(tmp_path.rglob("*.gif"))
+
+
+NEW_TASKS = Path(__file__).parent / "inference" / "tasks"
+
+
+@needs_engine
+def test_a_conflict_through_an_action_names_it_and_the_poses_say_what_they_leave_out(capsys):
+    """The plate lifted 30 into s2 but said to sit on the table there: the seat of s1,
+    the move and the seat of s2 conflict by 30; the pins take no part. The poses printed
+    are those without the three, and the answer says so."""
+    assert run(["solve", str(NEW_TASKS / "plate_lifted_on_the_table.rapt"), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["status"] == "inconsistent"
+    (conflict,) = out["conflicts"]
+    assert [name.split(" @")[0] for name in conflict["relations"]] == [
+        "against plate.bottom table.top",
+        "move plate plate.hole_1 by 30",
+        "against plate.bottom table.top",
+    ]
+    assert conflict["message"] == "distance mismatch 30 between planes 1 and 2"
+    assert out["valid_without"] == conflict["relations"]
+    # without the seats and the move, the pins leave the plate a slide along z in
+    # "stacked", and nothing holds it in "lifted"
+    plate = out["bodies"]["plate@stacked"]
+    assert (plate["dof"], plate["motion"]) == (1, "prismatic")
+    assert out["bodies"]["plate@lifted"]["dof"] == 6
+    assert run(["solve", str(NEW_TASKS / "plate_lifted_on_the_table.rapt")]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "poses and freedoms hold only without: against plate.bottom table.top @stacked" in text
+
+
+@needs_engine
+def test_the_gimbal_head_is_named_spherical(capsys):
+    assert run(["solve", str(NEW_TASKS / "gimbal.rapt"), "--json"]) == 0
+    head = json.loads(capsys.readouterr().out)["bodies"]["head@s1"]
+    assert (head["dof"], head["motion"], head["invariants"]) == (
+        3,
+        "spherical",
+        {"center": [0, 0, 0]},
+    )

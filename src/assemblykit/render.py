@@ -92,6 +92,9 @@ def _solution(result: Solution) -> Group:
             ),
         )
     parts: list[RenderableType] = [table]
+    if result.valid_without:
+        without = ", ".join(result.valid_without)
+        parts.append(Text(f"poses and freedoms hold only without: {without}"))
     if result.cut is not None:
         parts.append(Text(result.cut.message))
     parts.extend(Text(b.freedom) for b in result.bodies.values() if b.freedom)

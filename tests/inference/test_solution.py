@@ -156,7 +156,8 @@ def test_freedom_is_said_in_words_and_only_when_there_is_some():
             "mechanism",
             2,
             {},
-            "keeps 2 dof that no joint names (a closed loop or a relation no coset holds)",
+            "keeps 2 dof that no joint names (a closed loop, a chain of joints whose product is"
+            " no group, or a relation no coset holds)",
         ),
     ],
 )

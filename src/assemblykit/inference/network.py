@@ -26,6 +26,7 @@ residue solver (:mod:`assemblykit.inference.numeric`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Hashable, MutableMapping, Sequence
 from dataclasses import dataclass
 from functools import partial
@@ -37,6 +38,7 @@ import numpy as np
 from assemblykit.algebra import Coset, EmptySet, Mismatch, MismatchKind, SymmetryGroup, se3
 from assemblykit.errors import SchemaError
 from assemblykit.features import Feature
+from assemblykit.inference.joints import PointHold, line_joint, plane_joint
 from assemblykit.inference.numeric import Constraint, Node, Residual
 from assemblykit.model.relations import HeldLine, HeldPoint, Relation, RelationType
 from assemblykit.model.task import Action, ActionKind, Situation, Task
@@ -142,6 +144,29 @@ def relation_label(relation: Relation, situation: str) -> str:
     return f"{relation.kind} {refs} @{situation}{place}"
 
 
+def action_label(action: Action, situation: str) -> str:
+    """A readable name of an action into ``situation`` with its place in the task file
+    when known: ``"move plate plate.hole_1 by 30 @lifted (line 18)"``, a turn's angle in
+    degrees as tasks write it (``"turn plate plate.hole_1 by 90 deg @s2"``)."""
+    label = f"{action.kind} {action.body}"
+    if action.ref is not None:
+        label += f" {action.ref}"
+    if action.by is not None and action.kind == ActionKind.TURN:
+        label += f" by {math.degrees(action.by):.6g} deg"
+    elif action.by is not None:
+        label += f" by {action.by:g}"
+    label += f" @{situation}"
+    if action.where:
+        label += f" ({action.where})"
+    return label
+
+
+def stationary_label(body: str, situation: str) -> str:
+    """The name of the link that keeps a body no action moves into ``situation`` where it
+    was (Corner et al. 1983 §II: a body not moved keeps its pose)."""
+    return f"stationary {body} @{situation}"
+
+
 def _fixed_residual(target: np.ndarray, scale: float) -> Callable[[np.ndarray], np.ndarray]:
     """Residual of ``X == target``: rotation entries (times the length ``scale``, the
     tolerance's arm, so every entry is a length, as in the relations' residuals) and
@@ -182,12 +207,7 @@ def _action_link(task: Task, action: Action, prev: Node, nxt: Node) -> Link | No
     ref = action.ref
     if ref is None:
         return None
-    label = f"{action.kind} {action.body} {ref}"
-    if action.by is not None:
-        label += f" by {action.by:g}"
-    label += f" @{nxt[1]}"
-    if action.where:
-        label += f" ({action.where})"
+    label = action_label(action, nxt[1])
     frame = np.asarray(task.feature(ref, action.where or label).frame(), dtype=np.float64)
     rotate = action.kind == ActionKind.TURN
     if action.by is None:
@@ -327,17 +347,109 @@ def meet_loci(
     return point, np.array(basis).reshape(len(basis), 3)
 
 
+def _incidences(
+    constraint: Constraint, tol: Tolerance
+) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The higher pair as points of the held body in planes of the other: ``(point,
+    origin, normal)``. A point in a locus is its point in each plane of the locus; a line
+    lying parallel to a plane at its distance is two of its points (a model size apart)
+    in the offset plane."""
+    geometry = constraint.geometry
+    if isinstance(geometry, LineOnPlane):
+        far = geometry.point + max(1.0, tol.scale) * geometry.direction
+        return [(p, geometry.origin, geometry.normal) for p in (geometry.point, far)]
+    return [(geometry.point, geometry.origin, row) for row in geometry.rows]
+
+
+def _held_points(group: Sequence[Constraint], tol: Tolerance) -> list[PointHold] | float:
+    """The distinct points a pair's higher pairs hold, each with the locus its planes
+    meet in; or, when two planes of one point are parallel and apart, that distance."""
+    points: list[np.ndarray] = []
+    planes: list[list[tuple[np.ndarray, np.ndarray]]] = []
+    for constraint in group:
+        for point, origin, normal in _incidences(constraint, tol):
+            for index, known in enumerate(points):
+                if np.abs(known - point).max() <= tol.length:
+                    planes[index].append((normal, origin))
+                    break
+            else:
+                points.append(point)
+                planes.append([(normal, origin)])
+    held: list[PointHold] = []
+    for point, its in zip(points, planes, strict=True):
+        met = meet_loci(np.zeros(3), np.zeros((0, 3)), its, tol)
+        if isinstance(met, float):
+            return met
+        held.append(PointHold(point, *met))
+    return held
+
+
+def _joint_link(group: Sequence[Constraint], tol: Tolerance) -> Link | None:
+    """The coset link of the higher pairs between one pair of instances when they make a
+    joint together (:mod:`assemblykit.inference.joints`: points on one line, points on
+    parallel planes), or its conflict; None when they make none."""
+    held = _held_points(group, tol)
+    if isinstance(held, float) or len(held) < 2:
+        return None
+    found = line_joint(held, tol)
+    if found is None and not any(isinstance(c.geometry, LineOnPlane) for c in group):
+        found = plane_joint(held, tol)
+    if found is None:
+        return None
+    pair = _pair_of(group[0])
+    assert pair is not None
+    target, source = pair
+    value = EmptySet(found) if isinstance(found, Mismatch) else found
+    labels = tuple(label for c in group for label in c.labels)
+    return Link(source, target, value, labels, partial(_group_residual, tuple(group), source))
+
+
+def _pair_of(constraint: Constraint) -> tuple[Node, Node] | None:
+    """The (held, locus) instances of a higher pair between two instances, else None."""
+    geometry = constraint.geometry
+    if isinstance(geometry, PointLocus):
+        pair = geometry.point_node, geometry.locus_node
+    elif isinstance(geometry, LineOnPlane):
+        pair = geometry.line_node, geometry.plane_node
+    else:
+        return None
+    return None if pair[0] == pair[1] else pair
+
+
+def _fold_joints(
+    constraints: list[Constraint], tol: Tolerance
+) -> tuple[list[Link], list[Constraint]]:
+    """The higher pairs between each pair of instances that make a joint together,
+    replaced by its coset link (:func:`_joint_link`); the others left as they are."""
+    pairs: dict[tuple[Node, Node], list[Constraint]] = {}
+    for constraint in constraints:
+        pair = _pair_of(constraint)
+        if pair is not None:
+            pairs.setdefault(pair, []).append(constraint)
+    links: list[Link] = []
+    used: set[int] = set()
+    for group in pairs.values():
+        link = _joint_link(group, tol) if len(group) > 1 else None
+        if link is not None:
+            links.append(link)
+            used.update(id(c) for c in group)
+    return links, [c for c in constraints if id(c) not in used]
+
+
 def _fold_point_loci(
     constraints: list[Constraint], tol: Tolerance
 ) -> tuple[list[Link], list[Constraint]]:
     """Higher pairs of one point met together (docs/algebra.md §3, §5.2 rule 1 for loci).
 
-    The ``point_on_plane``, ``point_on_line`` and point-plane ``distance`` relations that
+    First the higher pairs between one pair of instances that make a joint together
+    become its coset link (:func:`_fold_joints`). Then the ``point_on_plane``,
+    ``point_on_line`` and point-plane ``distance`` relations that
     hold the same point of one instance in loci of the same other instance are
     intersected in closed form: loci meeting in one point P make the coset
     S(P)·Tr(P − c) (a spherical link, as ``coincident``); loci missing each other make an
     empty link (a distance mismatch); a line or a plane stays one constraint carrying the
     met locus. Returns the new links and the remaining constraints."""
+    links, constraints = _fold_joints(constraints, tol)
     pairs: dict[tuple[Node, Node], list[list[Constraint]]] = {}
     rest: list[Constraint] = []
     for constraint in constraints:
@@ -352,7 +464,6 @@ def _fold_point_loci(
                 break
         else:
             groups.append([constraint])
-    links: list[Link] = []
     for group in (group for groups in pairs.values() for group in groups):
         head = group[0].geometry
         planes = [(row, c.geometry.origin) for c in group for row in c.geometry.rows]
@@ -500,7 +611,7 @@ def _transition(
                 (body, previous),
                 (body, situation.name),
                 point_coset(np.eye(4)),
-                (f"stationary {body} @{situation.name}",),
+                (stationary_label(body, situation.name),),
                 partial(_fixed_residual, np.eye(4), current().arm),
                 point_key(np.eye(4)),
             )

@@ -46,15 +46,29 @@ import networkx as nx
 import numpy as np
 
 from assemblykit.algebra import (
+    Chain,
     Coset,
     EmptySet,
     Kind,
     Locus,
     LocusKind,
+    Mismatch,
+    MismatchKind,
     SymmetryGroup,
+    congruence_mismatch,
     intersect_groups,
     se3,
+    transform_invariant,
 )
+from assemblykit.algebra.invariants import (
+    DirectionInvariant,
+    Invariant,
+    LineInvariant,
+    PlaneInvariant,
+    PointInvariant,
+    frame_invariants,
+)
+from assemblykit.inference.conflicts import without_conflicts
 from assemblykit.inference.loops import (
     Circle,
     LoopPoses,
@@ -82,6 +96,7 @@ from assemblykit.inference.numeric import (
     ResidueProblem,
     solve_residue,
 )
+from assemblykit.inference.products import chain_product, extend
 from assemblykit.inference.solution import (
     MECHANISM,
     BodyInstanceResult,
@@ -153,6 +168,7 @@ class Reducer:
     merges: deque[frozenset[Node]] = field(default_factory=deque)
     loops: list[list[list[tuple[frozenset[Node], Node, np.ndarray]]]] = field(default_factory=list)
     deferred: set[frozenset[Node]] = field(default_factory=set)
+    merged_by: dict[Node, tuple[Node, tuple[str, ...]]] = field(default_factory=dict)
 
     def copy(self) -> Reducer:
         """An independent copy for branching (link values are immutable)."""
@@ -167,6 +183,7 @@ class Reducer:
             deque(self.merges),
             list(self.loops),
             set(self.deferred),
+            dict(self.merged_by),
         )
 
     def find(self, node: Node) -> tuple[Node, np.ndarray]:
@@ -264,7 +281,7 @@ class Reducer:
             value = value.right(se3.inverse(b))
         if rs == rt:
             if not value.contains(np.eye(4)):
-                check = value.intersect(point_coset(np.eye(4)))
+                check = meet(value, point_coset(np.eye(4)), self.tol)
                 if isinstance(check, EmptySet):
                     self._record_conflict(labels, check)
             return
@@ -283,7 +300,7 @@ class Reducer:
             self.deferred.add(key)
             self.trace.append(TraceStep("lattice", self._edge_text(edge, labels), 0, 0, "kept"))
             return
-        result = edge.value.intersect(incoming)
+        result = meet(edge.value, incoming, self.tol)
         if isinstance(result, EmptySet):
             self._record_conflict(edge.labels + labels, result)
             return
@@ -319,6 +336,7 @@ class Reducer:
         self.adjacency[keep].discard(gone)
         self.adjacency[gone].discard(keep)
         self.parent[gone] = (keep, x)
+        self.merged_by[gone] = (keep, edge.labels)
         offset = np.round(x[:3, 3], 9).tolist()
         self.trace.append(
             TraceStep(
@@ -395,7 +413,7 @@ class Reducer:
                 for label in self.edges[frozenset((path[k], path[k + 1]))].labels
             )
             if isinstance(chained, Coset):
-                result = direct.intersect(chained)
+                result = meet(direct, chained, self.tol)
                 if isinstance(result, EmptySet):
                     self._record_conflict(closing.labels + labels, result)
                     return True
@@ -423,13 +441,13 @@ class Reducer:
         return self._check_reach(cycle)
 
     def _chain(self, path: list[Node]) -> Any:
-        """The product of the links along ``path`` (a Coset, or a Chain when not a coset)."""
-        value = self.edges[frozenset((path[0], path[1]))].oriented(path[0])
-        for k in range(1, len(path) - 1):
-            if not isinstance(value, Coset):
-                return value
-            value = value.product(self.edges[frozenset((path[k], path[k + 1]))].oriented(path[k]))
-        return value
+        """The product of the links along ``path`` (a Coset, or a Chain when not a coset:
+        :func:`chain_product`)."""
+        links = [
+            self.edges[frozenset((path[k], path[k + 1]))].oriented(path[k])
+            for k in range(len(path) - 1)
+        ]
+        return chain_product(links, self.tol)
 
     def _replace(
         self, closing: _Edge, source: Node, value: Any, labels: tuple[str, ...], rule: str
@@ -565,7 +583,7 @@ def _intersect_parallel(values: list[Any], tol: Tolerance) -> tuple[Any, list[Gr
     for index, incoming in enumerate(values[1:], start=1):
         if value.group.lattice:
             return value, events, index
-        result = value.intersect(incoming, tol)
+        result = meet(value, incoming, tol)
         if isinstance(result, EmptySet):
             events.append((index, result))
             continue
@@ -580,6 +598,113 @@ def _parallel_groups(links: Sequence[Link]) -> list[list[Link]]:
     for link in links:
         groups.setdefault(frozenset((link.source, link.target)), []).append(link)
     return list(groups.values())
+
+
+_NOUNS = {
+    PointInvariant: "points",
+    LineInvariant: "axes",
+    PlaneInvariant: "planes",
+    DirectionInvariant: "directions",
+}
+"""What the relations' invariants are called in a conflict's words (docs/algebra.md §2.4,
+the characteristic invariants of each family)."""
+
+
+def _invariant_miss(first: Invariant, second: Invariant, tol: Tolerance) -> Mismatch | None:
+    """The mismatch between two invariants of one type that should coincide: the angle
+    between their directions, else the distance between the planes, axes or points."""
+    noun = _NOUNS[type(first)]
+    ua = getattr(first, "normal", getattr(first, "direction", None))
+    ub = getattr(second, "normal", getattr(second, "direction", None))
+    if ua is not None and ub is not None:
+        angle = math.atan2(float(np.linalg.norm(np.cross(ua, ub))), float(ua @ ub))
+        if angle > tol.angle:
+            text = f"angle mismatch {math.degrees(angle):.6g}° between the {noun}"
+            return Mismatch(MismatchKind.ANGLE, angle, text)
+    if not isinstance(first, PointInvariant | LineInvariant | PlaneInvariant):
+        return None
+    assert isinstance(second, PointInvariant | LineInvariant | PlaneInvariant)
+    gap = second.point - first.point
+    if isinstance(first, PlaneInvariant):
+        distance = abs(float(first.normal @ gap))
+    elif isinstance(first, LineInvariant):
+        distance = float(np.linalg.norm(gap - (gap @ first.direction) * first.direction))
+    else:
+        distance = float(np.linalg.norm(gap))
+    if distance <= tol.length:
+        return None
+    text = f"distance mismatch {distance:.6g} between the {noun}"
+    return Mismatch(MismatchKind.DISTANCE, distance, text)
+
+
+def _point_mismatch(value: Coset, x: np.ndarray, tol: Tolerance) -> Mismatch | None:
+    """Why the pose ``x`` is not in the coset H·x0 of a relation, in the words of the
+    relation's own features: x ∈ H·x0 exactly when x carries the body-2 objects x0⁻¹·I
+    onto the body-1 objects I that H keeps (its characteristic invariants, docs/algebra.md
+    §2.4-§2.5), so the mismatch is between I and x·x0⁻¹·I ("distance mismatch 5 between
+    the planes"). None for a group with no such objects (helical, discrete parts)."""
+    group = value.group
+    if not (group.is_connected and group.is_tr) or group.kind == Kind.FIXED:
+        return None
+    carry = x @ value.rep_inverse
+    for target in frame_invariants(group.kind, group.frame):
+        found = _invariant_miss(target, transform_invariant(carry, target), tol)
+        if found is not None:
+            return found
+    return None
+
+
+_FIRST = {LineInvariant: 0, PlaneInvariant: 1, DirectionInvariant: 2, PointInvariant: 3}
+"""The order in which a conflict's words compare invariants: the axes and planes the
+relations name before the points where they meet (docs/algebra.md §2.4)."""
+
+
+def _features_mismatch(first: Coset, second: Coset, found: Mismatch, tol: Tolerance) -> Mismatch:
+    """The mismatch ``found`` between two cosets of connected TR groups said, when it can
+    be, between the axes or planes of the relations rather than a point where they meet
+    (the marked point of a revolute pair): the congruence tests of docs/algebra.md §2.5
+    taken with the lines and planes first; the same kind and size, or ``found``."""
+    targets: list[Invariant] = []
+    sources: list[Invariant] = []
+    for value in (first, second):
+        group = value.group
+        if not (group.is_connected and group.is_tr) or group.kind == Kind.FIXED:
+            return found
+        own = frame_invariants(group.kind, group.frame)
+        targets.extend(own)
+        sources.extend(transform_invariant(value.rep_inverse, i) for i in own)
+    order = sorted(range(len(targets)), key=lambda i: _FIRST[type(targets[i])])
+    again = congruence_mismatch([targets[i] for i in order], [sources[i] for i in order], tol)
+    if (
+        again is not None
+        and again.kind == found.kind
+        and math.isclose(again.value, found.value, rel_tol=1e-9, abs_tol=tol.length)
+    ):
+        return again
+    return found
+
+
+def meet(first: Any, second: Any, tol: Tolerance) -> Any:
+    """``first ∩ second`` (docs/algebra.md §2.5); when it is empty the mismatch is said in
+    the words of the relations' features: against a single pose (an instance merged, a
+    fixed relation or action) by :func:`_point_mismatch`, else between their axes or
+    planes where it can be (:func:`_features_mismatch`)."""
+    result = first.intersect(second, tol)
+    if not isinstance(result, EmptySet):
+        return result
+    for point, other in ((first, second), (second, first)):
+        if isinstance(point, Coset) and point.is_point and isinstance(other, Coset):
+            said = _point_mismatch(other, point.rep, tol)
+            if said is not None:
+                return EmptySet(said, result.proven)
+    if (
+        isinstance(first, Coset)
+        and isinstance(second, Coset)
+        and "point" in result.mismatch.message
+    ):
+        said = _features_mismatch(first, second, result.mismatch, tol)
+        return EmptySet(said, result.proven)
+    return result
 
 
 def _progress(before: Any, after: Any) -> bool:
@@ -729,10 +854,7 @@ def _tree_sets(
         link = reducer.edges[frozenset((parent, child))].oriented(parent)
         as_written = link.contains(se3.inverse(poses[parent]), reducer.tol)
         poses[child] = np.eye(4) if as_written else poses[parent] @ link.rep
-        above = sets.get(parent)
-        sets[child] = (
-            link if above is None else (above.product(link) if isinstance(above, Coset) else above)
-        )
+        sets[child] = extend(sets.get(parent), link, reducer.tol)
     return poses, sets
 
 
@@ -763,9 +885,10 @@ def _residue_constraints(
 
 
 def _solve_component(
-    network: Network, reducer: Reducer, component: set[Node], tol: Tolerance
+    network: Network, reducer: Reducer, component: set[Node], tol: Tolerance, residue: bool
 ) -> tuple[dict[Node, _Instance], list[Conflict]]:
-    """Rule 5 for one connected group of representatives."""
+    """Rule 5 for one connected group of representatives; without ``residue`` what only
+    the residue solver would answer is left unanswered (a mechanism of unknown dof)."""
     if WORLD not in component:
         root = min(component)
         poses, _ = _tree_sets(reducer, component, root)
@@ -779,10 +902,10 @@ def _solve_component(
         and sum(1 for k in reducer.edges if k <= component) == len(component) - 1
         and not any(k <= component for k in reducer.deferred)
     )
-    if (
-        tree_like and not constrained and all(isinstance(v, Coset) for v in sets.values())
-    ) or reducer.conflicts:
-        # a tree of cosets needs no residue; an inconsistent network is not solved further
+    if (tree_like and not constrained) or reducer.conflicts:
+        # a tree of links needs no residue: each instance moves in the product of the
+        # links from the world (a coset, or a chain of its generic dof); an inconsistent
+        # network is not solved further
         out = {WORLD: _Instance(np.eye(4), 0, Kind.FIXED)}
         for node in component - {WORLD}:
             value = sets.get(node)
@@ -792,11 +915,16 @@ def _solve_component(
                     poses[node], value.dof, motion, _components(value), (), invariants
                 )
             else:
-                out[node] = _Instance(poses.get(node, np.eye(4)), 0, MECHANISM)
+                dof = value.dof if tree_like and isinstance(value, Chain) else 0
+                out[node] = _Instance(poses.get(node, np.eye(4)), dof, MECHANISM)
         return out, []
     closed = _higher_pairs(network, reducer, component, tol)
     if closed is not None:
         return closed
+    if not residue:
+        out = {WORLD: _Instance(np.eye(4), 0, Kind.FIXED)}
+        out.update((n, _Instance(poses.get(n, _EYE), 0, MECHANISM)) for n in component - {WORLD})
+        return out, []
     return _numeric_component(network, reducer, component, poses, tol, candidates=sets)
 
 
@@ -1326,16 +1454,52 @@ def _numeric_component(
     return out, []
 
 
+def _ends(network: Network) -> dict[str, list[Node]]:
+    """The instances each statement's links and constraints join, by label."""
+    ends: dict[str, list[Node]] = {}
+    for link in network.links:
+        for label in link.labels:
+            ends.setdefault(label, []).extend((link.source, link.target))
+    for constraint in network.constraints:
+        for label in constraint.labels:
+            ends.setdefault(label, []).extend(constraint.nodes)
+    return ends
+
+
+def _support(
+    labels: tuple[str, ...], ends: Mapping[str, list[Node]], reducer: Reducer
+) -> tuple[str, ...]:
+    """The statements a conflict between ``labels`` was derived from: those labels, and
+    for every instance they join, the statements of each merge on its way to its
+    representative (a ``fixed`` relation, a body left in place, an action), and so on
+    for the instances those join (docs/inference.md, "Conflicts")."""
+    found = dict.fromkeys(labels)
+    work = list(labels)
+    while work:
+        for node in ends.get(work.pop(), ()):
+            while node in reducer.merged_by:
+                node, why = reducer.merged_by[node]
+                for label in why:
+                    if label not in found:
+                        found[label] = None
+                        work.append(label)
+    return tuple(found)
+
+
 def _leaf_report(
-    network: Network, reducer: Reducer, tol: Tolerance
+    network: Network, reducer: Reducer, tol: Tolerance, residue: bool = True
 ) -> tuple[dict[Node, _Instance], list[Conflict]]:
-    """Rule 5: every representative's pose set, then every instance through its merge."""
+    """Rule 5: every representative's pose set, then every instance through its merge.
+    Each conflict carries the statements it was derived from (:func:`_support`)."""
     reps: dict[Node, _Instance] = {}
     conflicts = list(reducer.conflicts)
     for component in _components_of(network, reducer):
-        found, extra = _solve_component(network, reducer, component, tol)
+        found, extra = _solve_component(network, reducer, component, tol, residue)
         reps.update(found)
         conflicts.extend(extra)
+    if conflicts:
+        ends = _ends(network)
+        conflicts = [replace(c, support=_support(c.relations, ends, reducer)) for c in conflicts]
     out = {}
     for node in network.instances:
         rep, x = reducer.find(node)
@@ -1429,15 +1593,18 @@ def solve_network(
     tol: Tolerance | None = None,
     explain: bool = False,
     max_branches: int = MAX_BRANCHES,
+    residue: bool = True,
 ) -> Solution:
-    """Reduce a network (rules 1-4), then report every instance (rule 5)."""
+    """Reduce a network (rules 1-4), then report every instance (rule 5); without
+    ``residue`` the residue solver is not called (what it would answer stays unknown:
+    the reduction's own conflicts and closed forms only)."""
     tol = tol or current()
     root = Reducer(tol)
     cache: dict[Hashable, tuple[Any, list[GroupEvent], int]] = {}
     for group in _parallel_groups(network.links):
         root.add_parallel(group, cache)
     leaves, skipped = explore(root, max_branches)
-    reports = [_leaf_report(network, leaf, tol) for leaf in leaves]
+    reports = [_leaf_report(network, leaf, tol, residue) for leaf in leaves]
     bodies, conflicts = _combine(network, reports, tol)
     trace = tuple(dict.fromkeys(step for leaf in leaves for step in leaf.trace))
     free = tuple(
@@ -1476,13 +1643,21 @@ def solve_task(
 ) -> Solution:
     """RAPT inference on a task: poses of every body in every situation (Corner et al. 1983 §III).
 
-    ``max_branches`` (default :data:`MAX_BRANCHES`) bounds the finite alternatives
-    followed (rule 3); a cut search is reported in :attr:`Solution.cut`."""
+    A conflict names every statement that takes part and nothing else, and the poses of
+    an inconsistent task are those without its conflicts' statements
+    (:mod:`assemblykit.inference.conflicts`). ``max_branches`` (default
+    :data:`MAX_BRANCHES`) bounds the finite alternatives followed (rule 3); a cut search
+    is reported in :attr:`Solution.cut`."""
     tol = tol or current().with_scale(model_scale(task))
+    branches = max_branches or MAX_BRANCHES
+
+    def solve(part: Task, residue: bool = True) -> Solution:
+        return solve_network(build_network(part), tol, explain, branches, residue)
+
     with using(tol), _collector_paused():
-        solution = solve_network(
-            build_network(task.validate()), tol, explain, max_branches or MAX_BRANCHES
-        )
+        solution = solve(task.validate())
+        if solution.conflicts:
+            solution = without_conflicts(task, solution, solve, tol)
     return replace(solution, units=task.units)
 
 

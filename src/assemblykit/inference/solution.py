@@ -187,7 +187,10 @@ def freedom_words(motion: str, dof: int, invariants: Mapping[str, Any], mechanis
     if dof == 0:
         return ""
     if phrase is None:
-        return f"keeps {dof} dof that no joint names (a closed loop or a relation no coset holds)"
+        return (
+            f"keeps {dof} dof that no joint names (a closed loop, a chain of joints whose"
+            " product is no group, or a relation no coset holds)"
+        )
     try:
         text = phrase.format(**inv)
     except KeyError:
@@ -255,6 +258,10 @@ class Conflict:
     value: float
     message: str
     needed_tolerance: float | None = None
+    support: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    """The statements the conflict was derived from (``relations`` and those that merged
+    their instances), which :mod:`assemblykit.inference.conflicts` narrows to the fewest
+    that still conflict; not part of the JSON."""
 
     @classmethod
     def measured(
@@ -371,7 +378,10 @@ def status_of(
 @dataclass(frozen=True)
 class Solution:
     """Poses of every body instance, the conflicts found, (on request) the trace, and
-    ``cut`` when the search over finite alternatives stopped at its limit."""
+    ``cut`` when the search over finite alternatives stopped at its limit.
+
+    When the task is inconsistent, ``valid_without`` names the statements without which
+    the poses and freedoms hold: those of the conflicts (docs/inference.md, "Conflicts")."""
 
     bodies: Mapping[str, BodyInstanceResult]
     conflicts: tuple[Conflict, ...] = ()
@@ -379,6 +389,7 @@ class Solution:
     explain: bool = False
     cut: BranchCut | None = None
     units: str | None = None
+    valid_without: tuple[str, ...] = ()
 
     @property
     def status(self) -> Status:
@@ -425,8 +436,8 @@ class Solution:
         return max(n for n in needed if n is not None)
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``solve`` JSON of docs/tutorial.md, "JSON" (plus ``suggested_tolerance`` when
-        inconsistent and ``trace`` when explaining)."""
+        """The ``solve`` JSON of docs/tutorial.md, "JSON" (plus ``suggested_tolerance`` and
+        ``valid_without`` when inconsistent and ``trace`` when explaining)."""
         out: dict[str, Any] = {
             "status": self.status,
             "bodies": {key: b.to_dict() for key, b in self.bodies.items()},
@@ -434,6 +445,7 @@ class Solution:
         }
         if self.conflicts:
             out["suggested_tolerance"] = self.suggested_tolerance
+            out["valid_without"] = list(self.valid_without)
         if self.cut is not None:
             out["truncated"] = self.cut.to_dict()
         if self.explain:
