@@ -222,3 +222,23 @@ def test_a_witness_holds_only_where_the_projection_test_blocks(seed):
         assert shown <= blocked(meshes, d), d
         held_somewhere += len(shown)
     assert held_somewhere > 0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_projecting_only_the_faces_near_the_other_outline_finds_the_same_blocks(seed):
+    rng = np.random.default_rng(seed)
+    hook = cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4])
+    wall = cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1])
+    far = cube([20, 20, 20], [21, 21, 21])
+    meshes = [mesh_of(hook), mesh_of(wall.translate(tuple(rng.uniform(-1, 1, 3)))), mesh_of(far)]
+    allowed = ~np.eye(3, dtype=bool)
+    spheres = [occlusion.triangle_spheres(m) for m in meshes]
+    hulls = [occlusion.hull_vertices(m) for m in meshes]
+    dropped = 0
+    for d in [UP, DOWN, EAST, *rng.normal(size=(10, 3))]:
+        faces = occlusion.faces_near_outlines(spheres, hulls, np.argwhere(allowed), d, TOL)
+        every = occluded_pairs(shadows(meshes, d, TOL), allowed, TOL)
+        culled = occluded_pairs(shadows(meshes, d, TOL, faces), allowed, TOL)
+        assert culled == every, d
+        dropped += sum(len(m.faces) - len(f) for m, f in zip(meshes, faces, strict=True))
+    assert dropped > 0

@@ -43,6 +43,7 @@ from assemblykit.blocking.dbg import DirectionalBlockingGraph
 from assemblykit.geometry.minkowski import blocks_along
 from assemblykit.geometry.occlusion import (
     blocking_witnesses,
+    faces_near_outlines,
     hulls_may_block,
     shadows,
     witnesses_hold,
@@ -214,11 +215,23 @@ def _occluded(
     for moving, blocker in pairs:
         allowed[index[moving], index[blocker]] = True
     meshes = [assembly.parts[name].mesh for name in names]
-    meshes = [
-        mesh.copy().apply_translation(shifts[name]) if name in shifts else mesh
-        for name, mesh in zip(names, meshes, strict=True)
-    ]
-    view = shadows(meshes, direction, tol)
+    faces = None
+    if shifts:
+        meshes = [
+            mesh.copy().apply_translation(shifts[name]) if name in shifts else mesh
+            for name, mesh in zip(names, meshes, strict=True)
+        ]
+    else:
+        # only the faces that may meet the other part's outline are projected
+        cache = BlockingCache.of(assembly).obstacles
+        faces = faces_near_outlines(
+            [cache.spheres(name) for name in names],
+            [cache.hull(name) for name in names],
+            np.argwhere(allowed),
+            direction,
+            tol,
+        )
+    view = shadows(meshes, direction, tol, faces)
     found = blocking_witnesses(view, allowed, tol, first_only=first_only)
     if not shifts:
         cache = BlockingCache.of(assembly).obstacles

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from assemblykit.geometry.interference import interference_threshold, shared_volume, solid
 from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
-from assemblykit.geometry.occlusion import hull_vertices
+from assemblykit.geometry.occlusion import hull_vertices, triangle_spheres
 from assemblykit.geometry.settling import settle
 from assemblykit.model.assembly import Assembly
 from assemblykit.tolerance import Tolerance
@@ -46,6 +46,7 @@ class Obstacles:
         self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
         self.solids: dict[str, manifold3d.Manifold] = {}
         self.hulls: dict[str, NDArray[np.float64]] = {}
+        self.balls: dict[str, NDArray[np.float64]] = {}
         self.witnesses: dict[tuple[str, str], tuple[int, int]] = {}
         """Per pair (moving, blocker) found blocking by the projection test, the last
         two faces that showed it (:func:`~assemblykit.geometry.occlusion.witnesses_hold`)."""
@@ -73,6 +74,13 @@ class Obstacles:
         if name not in self.hulls:
             self.hulls[name] = hull_vertices(self.assembly.parts[name].mesh)
         return self.hulls[name]
+
+    def spheres(self, name: str) -> NDArray[np.float64]:
+        """Per triangle of a part's mesh, a ball holding it (centre, radius), found once
+        (:func:`~assemblykit.geometry.occlusion.triangle_spheres`)."""
+        if name not in self.balls:
+            self.balls[name] = triangle_spheres(self.assembly.parts[name].mesh)
+        return self.balls[name]
 
     def solid(self, name: str) -> manifold3d.Manifold:
         """The manifold3d solid of a part's mesh, made once."""

@@ -138,6 +138,57 @@ def hull_vertices(mesh: trimesh.Trimesh) -> NDArray[np.float64]:
     return np.asarray(cut, dtype=np.float64) if np.all(np.isfinite(cut)) else corners
 
 
+def triangle_spheres(mesh: trimesh.Trimesh) -> NDArray[np.float64]:
+    """Per triangle of ``mesh``, its centroid and the distance from it to its farthest
+    corner (rows ``x, y, z, r``): a ball holding the triangle."""
+    corners = np.asarray(mesh.triangles, dtype=np.float64)
+    centre = corners.mean(axis=1)
+    radius = np.linalg.norm(corners - centre[:, None, :], axis=2).max(axis=1)
+    return np.column_stack([centre, radius])
+
+
+def faces_near_outlines(
+    spheres: Sequence[NDArray[np.float64]],
+    hulls: Sequence[NDArray[np.float64]],
+    pairs: NDArray[np.int64],
+    direction: ArrayLike,
+    tol: Tolerance | None = None,
+) -> list[NDArray[np.int64]]:
+    """Per mesh (its :func:`triangle_spheres` and the points of its convex hull), the
+    faces that may take part in a block between the pairs ``(i, j)`` of ``pairs`` along
+    ``direction``: those whose projection on the plane ``⟂ d`` may meet the box around
+    the projection of the other mesh's hull (with the length tolerance). A pair of
+    triangles shows a block only where their projections overlap (module docstring),
+    inside both meshes' outlines, so a face whose ball projects clear of the other
+    outline's box takes part in none."""
+    tol = tol or current()
+    frame = view_frame(direction)[:2]
+    boxes = []
+    for points in hulls:
+        flat = np.asarray(points, dtype=np.float64) @ frame.T
+        boxes.append((flat.min(axis=0), flat.max(axis=0)))
+    partners: dict[int, set[int]] = {}
+    for i, j in np.asarray(pairs).tolist():
+        partners.setdefault(i, set()).add(j)
+        partners.setdefault(j, set()).add(i)
+    chosen = [np.zeros(0, dtype=np.int64) for _ in spheres]
+    for mine, others in partners.items():
+        centre = spheres[mine][:, :3] @ frame.T
+        reach = spheres[mine][:, 3:] + tol.length
+        low, high = centre - reach, centre + reach
+        near = np.zeros(len(centre), dtype=bool)
+        for other in others:
+            lo, hi = boxes[other]
+            near |= (
+                (high[:, 0] >= lo[0])
+                & (low[:, 0] <= hi[0])
+                & (high[:, 1] >= lo[1])
+                & (low[:, 1] <= hi[1])
+            )
+        chosen[mine] = np.flatnonzero(near)
+    return chosen
+
+
 def hulls_may_block(
     hulls: Sequence[NDArray[np.float64]],
     pairs: NDArray[np.int64],
