@@ -101,7 +101,9 @@ class Obstacles:
             else:
                 a, b = self.assembly.parts[moving].mesh, self.assembly.parts[blocker].mesh
                 shift = np.zeros(3)
-                volume = shared_volume(self.solid(moving), self.solid(blocker))
+                # parts whose boxes are apart share no volume: no solid is made for them
+                apart = np.any(a.bounds[0] > b.bounds[1]) or np.any(b.bounds[0] > a.bounds[1])
+                volume = 0.0 if apart else shared_volume(self.solid(moving), self.solid(blocker))
                 if 0 < volume <= interference_threshold(a, b, tol):
                     pair = [self.solid(moving), self.solid(blocker)]
                     shifts = settle([a, b], [(0, 1)], pair).shifts
