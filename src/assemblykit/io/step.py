@@ -196,13 +196,12 @@ def _face_triangles(ocp: Any, face: Any) -> tuple[NDArray[np.float64], NDArray[n
     if triangulation is None:
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     transform = location.Transformation()
-    # the nodes' coordinates as read, then placed by the location's matrix at once
-    nodes = np.array(
-        [triangulation.Node(i).Coord() for i in range(1, triangulation.NbNodes() + 1)],
-        dtype=np.float64,
-    ).reshape(-1, 3)
-    matrix = np.array([[transform.Value(r, c) for c in range(1, 5)] for r in range(1, 4)])
-    points = np.einsum("ij,kj->ik", nodes, matrix[:, :3]) + matrix[:, 3]
+    points = np.array(
+        [
+            _vec(triangulation.Node(i).Transformed(transform))
+            for i in range(1, triangulation.NbNodes() + 1)
+        ]
+    )
     triangles = (
         np.array(
             [triangulation.Triangle(i).Get() for i in range(1, triangulation.NbTriangles() + 1)],
