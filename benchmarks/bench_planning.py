@@ -18,7 +18,10 @@ level each stored and the ``time`` BurrTools recorded for the problem, and all 3
 six-piece burrs (bundled under ``tests/data/burrtools``); then multi-move plans of
 meshes (contact-change distances from the Minkowski sums of convex pieces): the bundled
 key in steps, guillotine packings and a key in a cage too long for it. ``--puzzles``
-runs only these.
+runs only these. Monotone plans of six-piece burrs (``assemblykit plan FILE --solution N
+--max-hands 2``, processor time of ``plan`` after loading): one solvable (solution 0)
+and one stuck (257), next to their targets (0.3 s and 1 s); ``--burrs`` adds all 314
+next to theirs (60 s together).
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ import numpy as np
 import trimesh
 
 from assemblykit.io.assembly import load_assembly
-from assemblykit.io.burrtools import load_puzzle, solution_count
+from assemblykit.io.burrtools import load_burrtools, load_puzzle, solution_count
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.model.packings import box_mesh, guillotine_packing
 from assemblykit.planning.multimove import MultiMovePlan, plan_voxels
@@ -59,6 +62,8 @@ GROWTH_TARGET = 1.5
 END_TO_END_TARGET = 0.64
 """``assemblykit plan`` of the ASAP beam from process start to its JSON, median seconds."""
 DOME = "compas_assembly/dome_assembly.json"
+BURR_TARGETS = {"solvable": 0.3, "stuck": 1.0, "all": 60.0}
+"""Processor seconds of a six-piece burr's monotone plan (``max_hands=2``), and of all 314."""
 PUZZLES = ("CubeInCage", "DraculasDentalDesaster", "PelikanBurr", "AlPackino")
 
 
@@ -220,6 +225,41 @@ def puzzles() -> None:
     )
 
 
+def monotone_burrs(every: bool) -> None:
+    """Monotone plans (``plan(..., max_hands=2)``) of six-piece burrs, processor time
+    after loading: solution 0 (solvable), 257 (stuck: no monotone plan), and with
+    ``every`` all 314, each next to its target (:data:`BURR_TARGETS`)."""
+    path = dataset("burrtools/SolidSixPieceBurrs.xmpuzzle")
+    if path is None:
+        print("six-piece burrs (monotone)   skipped (not found)")
+        return
+
+    def seconds(solution: int) -> tuple[float, bool]:
+        assembly = load_burrtools(path, solution=solution)
+        start = time.process_time()
+        feasible = plan(assembly, max_hands=2).feasible
+        return time.process_time() - start, feasible
+
+    seconds(1)  # imports and first-use caches
+    for kind, solution in (("solvable", 0), ("stuck", 257)):
+        took, feasible = seconds(solution)
+        target = BURR_TARGETS[kind]
+        print(
+            f"six-piece burr {solution:>3} monotone plan ({'feasible' if feasible else 'stuck'}): "
+            f"{took:.3f} CPU s (target {target:g} s: {meets(took <= target)})"
+        )
+    if every:
+        runs = [seconds(s) for s in range(solution_count(path))]
+        total = sum(t for t, _ in runs)
+        stuck = sum(not f for _, f in runs)
+        slowest = max(t for t, _ in runs)
+        target = BURR_TARGETS["all"]
+        print(
+            f"all {len(runs)} six-piece burrs, monotone plans: {stuck} stuck, {total:.1f} CPU s "
+            f"(slowest {slowest:.2f} s; target {target:g} s: {meets(total <= target)})"
+        )
+
+
 def caged_key() -> Assembly:
     """A 2 x 1 x 1 key in a closed cage whose cavity is one unit longer (stuck)."""
     cage = trimesh.boolean.difference(
@@ -256,6 +296,7 @@ def main() -> None:
         return
     print(f"machine: {machine()}; shared with other work, wall times are noisy")
     puzzles()
+    monotone_burrs("--burrs" in sys.argv)
     mesh_puzzles()
     if "--puzzles" in sys.argv:
         return

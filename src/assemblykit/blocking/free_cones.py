@@ -694,3 +694,162 @@ def exact_free_directions(
         return ExactFree(tuple(found), True, False)
     thin = [d for d in faces.thin[:limit] if extended_free(assembly, movers, d, tol, others)]
     return ExactFree(tuple(thin), True, bool(thin))
+
+
+LATTICE_LOCK_PARTS = 8
+"""The most parts a set may have for :func:`lattice_locked` to examine each of its
+subsets (``2^n - 2`` of them, one bit per ordered pair of parts in 64); larger sets
+are left to the faces and cells above."""
+
+_SPREAD = np.array([0.5 + 1e-3 * np.pi, 0.5 + 1e-3 * np.e])
+"""Where in its cell's cross-section a cell is probed (:func:`lattice_cells`): off every
+line through two lattice points of a small model, so no probe lies on an edge."""
+
+
+def lattice_cells(mesh: Any) -> NDArray[np.int64] | None:
+    """The unit cells ``[c, c + 1]`` a closed mesh is the union of, when it is one: every
+    vertex on the integer lattice and every face square to an axis (a BurrTools piece, a
+    part made of voxels); ``None`` otherwise. A cell is inside when a ray from a point of
+    it along ``+z`` crosses the mesh's faces an odd number of times; the cells must make
+    up the mesh's whole volume."""
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    if not len(vertices) or not bool(mesh.is_volume):
+        return None
+    lattice = np.round(vertices)
+    normals = np.abs(np.asarray(mesh.face_normals, dtype=np.float64))
+    if np.abs(vertices - lattice).max() > 1e-9 or np.abs(normals.max(axis=1) - 1.0).max() > 1e-9:
+        return None
+    tris = lattice[np.asarray(mesh.faces)]
+    flat = tris[normals[:, 2] > 0.5]  # faces square to z
+    low, high = lattice.min(axis=0).astype(np.int64), lattice.max(axis=0).astype(np.int64)
+    grid = np.stack(
+        np.meshgrid(*(np.arange(a, b) for a, b in zip(low, high, strict=True)), indexing="ij"),
+        axis=-1,
+    ).reshape(-1, 3)
+    probe = grid[:, :2] + _SPREAD
+    a, b, c = flat[:, 0, :2], flat[:, 1, :2], flat[:, 2, :2]
+
+    def side(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64]:
+        e = (q - p)[None]
+        r = probe[:, None, :] - p[None]
+        out: NDArray[np.float64] = e[..., 0] * r[..., 1] - e[..., 1] * r[..., 0]
+        return out
+
+    s1, s2, s3 = side(a, b), side(b, c), side(c, a)
+    within = ((s1 > 0) & (s2 > 0) & (s3 > 0)) | ((s1 < 0) & (s2 < 0) & (s3 < 0))
+    above = flat[None, :, 0, 2] > grid[:, None, 2] + 0.5
+    cells: NDArray[np.int64] = grid[np.count_nonzero(within & above, axis=1) % 2 == 1]
+    if abs(len(cells) - float(mesh.volume)) > 1e-6:
+        return None
+    return cells
+
+
+def _primitive(vectors: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Nonzero integer vectors divided by their gcd, sign fixed (first nonzero entry
+    positive), each once: one per line through the origin."""
+    kept = vectors[np.any(vectors != 0, axis=1)]
+    kept = kept // np.gcd.reduce(np.abs(kept), axis=1)[:, None]
+    lead = kept[np.arange(len(kept)), np.argmax(kept != 0, axis=1)]
+    return np.unique(kept * np.sign(lead)[:, None], axis=0)
+
+
+def _box_circles(offsets: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The great circles bounding the cones of the open boxes ``(o - 1, o + 1)^3``: the
+    planes through the origin and an edge of a box, an edge along axis ``k`` through the
+    lattice point ``p e_i + q e_j`` giving the normal ``p e_j - q e_i`` (``k, i, j``
+    cyclic). Integer normals, each circle once."""
+    normals = []
+    for k in range(3):
+        i, j = (k + 1) % 3, (k + 2) % 3
+        for si in (-1, 1):
+            for sj in (-1, 1):
+                n = np.zeros((len(offsets), 3), np.int64)
+                n[:, i] = -(offsets[:, j] + sj)
+                n[:, j] = offsets[:, i] + si
+                normals.append(n)
+    return _primitive(np.concatenate(normals))
+
+
+def _vertices(circles: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Every point where two of the circles cross (both antipodes), integer vectors."""
+    first, second = np.triu_indices(len(circles), 1)
+    crossings = _primitive(np.cross(circles[first], circles[second]))
+    return np.unique(np.concatenate([crossings, -crossings]), axis=0)
+
+
+def _near_points(directions: NDArray[np.int64], reach: int) -> NDArray[np.int64]:
+    """``directions x samples x 8 x 3``: lattice points ``o`` with ``|t d - o|_∞ < 1`` for
+    some ``t > 0``, as many as the ray passes near while it stays within ``reach`` of the
+    origin. Between two consecutive ``t`` where a coordinate of ``t d`` is an integer the
+    points within an open unit of ``t d`` do not change (per axis the two integers around
+    a coordinate that is not one, ``0`` along an axis where ``d`` is 0), and at such a
+    ``t`` they are fewer, so one ``t`` per interval, its middle, sees them all."""
+    size = np.abs(directions).astype(np.float64)
+    steps = np.arange(reach + 2, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        times = steps[None, None, :] / size[:, :, None]
+    times = np.sort(times.reshape(len(directions), -1), axis=1)
+    middles = (times[:, :-1] + times[:, 1:]) / 2.0
+    middles = np.where(np.isfinite(middles) & (times[:, 1:] > times[:, :-1]), middles, np.nan)
+    along = middles[:, :, None] * directions[:, None, :]
+    low = np.where(directions[:, None, :] == 0, 0.0, np.floor(along))
+    high = np.where(directions[:, None, :] == 0, 0.0, low + 1.0)
+    corners = np.array([[(c >> k) & 1 for k in range(3)] for c in range(8)], bool)
+    points = np.where(corners[None, None], high[:, :, None, :], low[:, :, None, :])
+    points = np.where(np.isnan(points), reach + 1.0, points)
+    return points.astype(np.int64)
+
+
+def lattice_locked(cells: Sequence[NDArray[np.int64]], chunk: int = 1024) -> bool:
+    """Whether no set of the parts, each a union of unit cells (:func:`lattice_cells`),
+    leaves the others by one extended translation, whatever its direction: a certificate
+    of interlock that needs no overlay of free sets (docs/blocking.md, "Three kinds of
+    motion", parts made of voxels).
+
+    Cell ``a`` of a moving part sweeps into cell ``b`` of a still one along ``d`` iff the
+    ray ``t d`` enters the open box ``(b - a - 1, b - a + 1)^3`` (Wilson & Latombe 1992
+    §5: the grown obstacle of two cubes), so each set's blocked directions are a union of
+    open cones bounded by the circles through the boxes' edges (:func:`_box_circles`).
+    Its free directions, the complement, are closed; each component is bounded by arcs
+    of those circles and so holds a point where two of them cross, its corner (a
+    component without corners is a closed hemisphere or a circle, which another circle
+    crosses). A set is therefore stuck iff every such crossing (:func:`_vertices`) lies
+    in a blocked cone; which boxes a crossing's ray enters is read off the lattice
+    points it passes near (:func:`_near_points`). Sets of more than
+    :data:`LATTICE_LOCK_PARTS` parts are not examined (``False``)."""
+    n = len(cells)
+    if n < 2 or n > LATTICE_LOCK_PARTS:
+        return False
+    every = np.concatenate(cells)
+    reach = int((every.max(axis=0) - every.min(axis=0)).max())  # the farthest offset
+    width = 2 * reach + 1
+    # per lattice offset b - a: bit n i + j when a cell of i and one of j are that far apart
+    table = np.zeros((width, width, width), np.uint64)
+    offsets = []
+    for i in range(n):
+        for j in range(n):
+            if i != j:
+                found = np.unique((cells[j][None] - cells[i][:, None]).reshape(-1, 3), axis=0)
+                x, y, z = (found + reach).T
+                table[x, y, z] |= np.uint64(1 << (n * i + j))
+                offsets.append(found)
+    circles = _box_circles(np.unique(np.concatenate(offsets), axis=0))
+    if len(circles) < 2:
+        return False
+    vertices = _vertices(circles)
+    held = np.zeros(len(vertices), np.uint64)
+    for lo in range(0, len(vertices), chunk):
+        points = _near_points(vertices[lo : lo + chunk], reach)
+        inside = np.all(np.abs(points) <= reach, axis=3)
+        x, y, z = np.moveaxis(np.clip(points + reach, 0, width - 1), 3, 0)
+        bits = np.where(inside, table[x, y, z], np.uint64(0))
+        held[lo : lo + chunk] = np.bitwise_or.reduce(bits.reshape(len(bits), -1), axis=1)
+    everything = (1 << n) - 1
+    for subset in range(1, everything):
+        leaving = 0
+        for i in range(n):
+            if subset >> i & 1:
+                leaving |= (everything & ~subset) << (n * i)
+        if not np.all(held & np.uint64(leaving)):
+            return False
+    return True

@@ -31,10 +31,11 @@ import gzip
 import io
 import re
 import zlib
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, replace
 from functools import cache
 from pathlib import Path
+from typing import Self
 from xml.etree import ElementTree
 
 import numpy as np
@@ -467,6 +468,21 @@ class VoxelAssembly(Assembly):
         ]
         super().__init__(parts, units="unit", units_source="file", source=puzzle.source, policy=tol)
         self.puzzle = puzzle
+
+    @classmethod
+    def like(
+        cls, other: Assembly, parts: Iterable[Part] | None = None, scale: float | None = None
+    ) -> Self:
+        """:meth:`Assembly.like` (a subset of the pieces, as when a stuck set is
+        explained) that keeps the puzzle's pieces among ``parts``."""
+        plain = Assembly.like(other, parts, scale)
+        derived = cls.__new__(cls)
+        vars(derived).update(vars(plain))
+        puzzle = getattr(other, "puzzle", None)
+        if isinstance(puzzle, VoxelPuzzle):
+            kept = tuple(p for p in puzzle.pieces if p.name in plain.parts)
+            derived.puzzle = replace(puzzle, pieces=kept)
+        return derived
 
 
 def load_burrtools(
