@@ -42,7 +42,7 @@ def test_interlock_json_of_a_voxel_puzzle(capsys):
 def test_interlock_prints_the_verdict_in_words(capsys):
     code, out, _ = run(capsys, "interlock", str(PUZZLE))
     assert code == 0
-    assert out.startswith("Recursively interlocking (infinitesimal translations, 4 parts)")
+    assert out.startswith("Recursively interlocking (small straight moves, 4 parts)")
     assert "Keys in order: key along +Z, then slider along +X, then pocket along +Y" in out
 
 

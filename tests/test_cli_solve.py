@@ -315,7 +315,7 @@ def test_explain_text_names_rule_link_places_and_dof(capsys, monkeypatch, column
         " fits coupler.hole_b crank.pin_b @s1 (line 37)] dof 2 -> 1 (revolute)"
     ) in lines
     assert any(
-        line.startswith("residue: coupler@s1, crank@s1, rocker@s1 dof 4 -> 1 (1 solution(s)")
+        line.startswith("residue: coupler@s1, crank@s1, rocker@s1 dof 4 -> 1 (1 solution")
         for line in lines
     )
 

@@ -102,7 +102,7 @@ def group_pairs() -> list[tuple[tuple[Any, ...], str]]:
     return [
         ((cylinder, plane), "revolute about line through (0, 0, 0) along +Z"),
         ((cylinder, plane, Tolerance()), "revolute about line through (0, 0, 0) along +Z"),
-        ((four, six), "fixed, 2 discrete components"),
+        ((four, six), "fixed, 2 symmetric positions"),
         ((four, beside), "fixed"),
     ]
 

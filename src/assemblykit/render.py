@@ -178,26 +178,36 @@ def _task_motion(result: TaskMotionReport) -> Table:
 
 
 def _mating(result: MatingResult) -> Group:
-    """Liu & Popplestone's (1990) Or/And form, then the ranges of motion and the pruning
-    statistics of each law."""
+    """The configurations found, each as its mating pairs in words and the ranges of
+    motion left, then the pruning statistics of each law (docs/mating.md, "Walk-through:
+    Example 1 of Liu & Popplestone 1990"; ``MatingResult.or_and`` gives the paper's
+    Or/And form)."""
     from assemblykit.mating.search import LAWS
 
-    lines = [Text(result.or_and())]
+    found = len(result.configurations)
+    if not found:
+        lines = [Text("no configuration found")]
+    elif result.count == found:
+        lines = [Text(fmt.count(found, "configuration"))]
+    else:
+        lines = [Text(f"{fmt.count(result.count, 'configuration')} ({found} up to symmetry)")]
+    for number, config in enumerate(result.configurations, start=1):
+        lines.append(Text(f"configuration {number}:"))
+        lines.extend(Text(f"  {c.words()} (goal {c.goal.number})") for c in config.pairs)
+        for name, motion in config.motions.items():
+            unit = " rad" if motion.parameter == "angle" else ""
+            spans = ", ".join(f"[{lo:.6g}, {hi:.6g}]{unit}" for lo, hi in motion.intervals)
+            free = f", {motion.parameter} free in {spans}" if motion.intervals else ""
+            lines.append(Text(f"  {name} moves: {motion.kind}{free}"))
     if result.emptied is not None:
-        lines.append(
-            Text(f"goal {result.emptied.goal}: domain emptied by the {result.emptied.law} law")
-        )
+        goal, law = result.emptied.goal, result.emptied.law
+        lines.append(Text(f"goal {goal}: no candidate left after the {law} law"))
         if result.emptied.reason:
             lines.append(Text(f"  {result.emptied.reason}"))
     for rejection in result.rejections:
         lines.append(Text(f"rejected: {rejection.reason}"))
-    lines.append(Text(f"{result.count} configurations ({len(result.configurations)} found)"))
-    for config in result.configurations:
-        for name, motion in config.motions.items():
-            spans = ", ".join(f"[{lo:.6g}, {hi:.6g}]" for lo, hi in motion.intervals)
-            lines.append(Text(f"  {name}: {motion.kind} {motion.parameter} {spans}"))
     header = " -> ".join(LAWS)
-    lines.append(Text(f"domain sizes ({header}):"))
+    lines.append(Text(f"candidates per goal after each law ({header}):"))
     lines.extend(
         Text(f"  goal {g}: {' -> '.join(map(str, s))}") for g, s in result.statistics.items()
     )
@@ -223,13 +233,25 @@ def _removals(
     return table
 
 
+MOTION_WORDS = {
+    "infinitesimal": "a small straight move",
+    "extended": "a straight move all the way out",
+    "rigid": "a small move that may turn",
+}
+"""How each kind of motion of the blocking graphs reads in a title: infinitesimal and
+extended translations, infinitesimal rigid motions (docs/blocking.md, "Three kinds of
+motion")."""
+
+
 def _ndbg(result: NonDirectionalBlockingGraph) -> Table:
     """The NDBG's removable subassemblies with their first direction (Wilson & Latombe
-    1992)."""
-    counts = result.arrangement.counts
+    1992), titled in words (docs/blocking.md, "Output"): the regions of directions are the
+    vertices, edges and faces of its arrangement, counted together."""
+    regions = sum(result.arrangement.counts.values())
     return _removals(
-        f"{result.motion} NDBG: {len(result.parts)} parts, {result.contacts} contacts, "
-        f"{counts['vertices']} vertices, {counts['edges']} edges, {counts['faces']} faces",
+        f"Parts removable by {MOTION_WORDS.get(result.motion, result.motion)}: "
+        f"{fmt.count(len(result.parts), 'part')}, {fmt.count(result.contacts, 'contact')}, "
+        f"{fmt.count(regions, 'region')} of directions",
         "directions",
         "e.g.",
         result.removable(),
@@ -240,9 +262,15 @@ def _ndbg(result: NonDirectionalBlockingGraph) -> Table:
 def _rigid(result: RigidBlockingGraph) -> Table:
     """The subassemblies some rigid twist frees, with their first twist (Wilson & Latombe
     1992)."""
+    arrangement = result.arrangement
+    mapped = (
+        f"{fmt.count(len(arrangement.signs), 'region')} of motions"
+        if arrangement.signs is not None
+        else f"motions not mapped ({fmt.count(len(arrangement.normals), 'contact constraint')})"
+    )
     return _removals(
-        f"rigid NDBG: {len(result.parts)} parts, {len(result.contacts)} contacts, "
-        f"arrangement {result.arrangement.status}",
+        f"Parts removable by {MOTION_WORDS['rigid']}: {fmt.count(len(result.parts), 'part')}, "
+        f"{fmt.count(len(result.contacts), 'contact')}, {mapped}",
         "twists",
         "e.g. (omega; v)",
         result.removable(),
@@ -294,8 +322,9 @@ def _joined_table(plan: Plan) -> Table:
 
 
 def _overlap_table(plan: Plan) -> Table:
+    units = next((o.units for o in plan.overlaps if o.units), None)
     table = Table(title="Interfering parts (shared volume, what was done)")
-    for column in ("parts", "volume", "resolution"):
+    for column in ("parts", fmt.header("volume", f"{units}³" if units else None), "resolution"):
         table.add_column(column)
     for overlap in plan.overlaps:
         table.add_row(
@@ -325,7 +354,8 @@ def _disassembly_table(plan: Plan) -> Table:
     if plan.unfinished:
         title = f"stopped at its step limit, {fmt.count(len(plan.unfinished), 'part')} left"
     if plan.and_or is not None:
-        title += f", {plan.and_or.plans} plan(s) in the AND/OR graph"
+        # the plans of the AND/OR graph (docs/planning.md): the orders it takes apart in
+        title += f", {fmt.count(plan.and_or.plans, 'possible order')}"
     if plan.gravity is not None:
         title += ", " + plan.gravity.summary()
     table = Table(title=f"Disassembly plan ({title})")
@@ -411,8 +441,8 @@ def _multi_move(result: MultiMovePlan) -> Table:
         rows(node.left, f"{label}.l")
 
     rows(result.root, "1")
-    first = "-" if result.first_moves is None else str(result.first_moves)
-    caption = f"first separation: {first} moves"
+    first = "-" if result.first_moves is None else fmt.count(result.first_moves, "move")
+    caption = f"first separation: {first}"
     if result.reference_level is not None:
         caption += f" (stored level {result.reference_level})"
     table.caption = caption
@@ -451,14 +481,16 @@ def _screw(result: ScrewPlan) -> Table:
 def _contacts(result: ContactReport) -> Group:
     """The tolerance used, a table of parts, one of contacts, then the interferences."""
     asm = result.assembly
-    parts = Table(title=f"{asm.source}: {len(asm)} parts ({asm.units}, {asm.units_source})")
-    for column in ("part", "triangles", "volume", "features"):
+    parts = Table(
+        title=f"{asm.source}: {fmt.count(len(asm), 'part')} ({asm.units}, {asm.units_source})"
+    )
+    for column in ("part", "triangles", fmt.header("volume", f"{asm.units}³"), "features"):
         parts.add_column(column)
     for name, part in asm.parts.items():
         kinds = Counter(s.feature().type_name for s in result.surfaces[name])
         listing = ", ".join(f"{n} {k}" for k, n in sorted(kinds.items()))
         parts.add_row(name, str(len(part.mesh.faces)), f"{part.volume:.6g}", listing)
-    contacts = Table(title=f"{len(result.contacts)} contacts")
+    contacts = Table(title=fmt.count(len(result.contacts), "contact"))
     for column in ("a", "b", "planar area", "normals", "curved"):
         contacts.add_column(column)
     working = asm.tolerance(result.policy)
@@ -467,7 +499,10 @@ def _contacts(result: ContactReport) -> Group:
         curved = ", ".join(f"{p.kind} r={p.radius:.6g} inner={p.inner}" for p in c.curved)
         contacts.add_row(c.a, c.b, f"{c.area:.6g}", normals, curved)
     clashes = (
-        "\n".join(f"interference {a} / {b}: volume {v:.6g}" for a, b, v in result.interferences)
+        "\n".join(
+            f"interference {a} / {b}: volume {v:.6g} {asm.units}³"
+            for a, b, v in result.interferences
+        )
         or "no interferences"
     )
     used = asm.tolerance_summary(result.policy)
@@ -492,13 +527,10 @@ def _batch(result: BatchSummary) -> Group:
     return Group(table, *lines)
 
 
-def _demo(result: DemoResult) -> Text:
-    """One line saying what was found and where the report is."""
-    verdict = "feasible" if result.plan.feasible else "infeasible"
-    return Text(
-        f"Gearbox ({len(result.plan.parts)} parts): {verdict} plan in "
-        f"{len(result.plan.steps)} steps.\nReport written to {result.report}"
-    )
+def _demo(result: DemoResult) -> Group:
+    """The plan's tables, then one line saying where the report is to open
+    (docs/planning.md, "The HTML report")."""
+    return Group(_plan(result.plan), Text(f"Open {result.report} in a browser."))
 
 
 def _register_inference() -> None:

@@ -388,7 +388,7 @@ def resolve_overlaps(
         result = result.with_part(trimmed)
         overlaps.append(Overlap(a, b, volume, f"trimmed from {small.name}"))
     prepared = type(result).like(result, scale=result.scale)
-    prepared.overlaps = tuple(overlaps)
+    prepared.overlaps = tuple(replace(o, units=assembly.units) for o in overlaps)
     members: dict[str, list[str]] = {}
     for name, part in into.items():
         members.setdefault(part, []).append(name)

@@ -45,6 +45,7 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
+from assemblykit import formatting as fmt
 from assemblykit.algebra import (
     Chain,
     Coset,
@@ -491,7 +492,7 @@ class Reducer:
                 self._edge_text(closing, labels),
                 closing.value.dof,
                 0,
-                f"revolute-revolute closure, {len(points)} point(s)",
+                f"revolute-revolute closure, {fmt.count(len(points), 'point')}",
             )
         )
         first_key = frozenset((path[0], path[1]))
@@ -525,7 +526,7 @@ class Reducer:
                 self._edge_text(self.edges[first_key], labels + closing.labels),
                 self.edges[first_key].value.dof,
                 0,
-                f"{len(solved.poses)} point(s)",
+                fmt.count(len(solved.poses), "point"),
             )
         )
         self.loops.append([[(first_key, path[0], p)] for p in solved.poses])
@@ -1296,7 +1297,8 @@ def _line_and_point(
         labels,
         6,
         3,
-        f"a line and a point on parallel planes: {count} roll(s) about the line, {motion}",
+        f"a line and a point on parallel planes: {fmt.count(count, 'roll')} about the line,"
+        f" {motion}",
     )
     return _Instance(met.rep, 3, motion, count, (), invariants), []
 
@@ -1412,7 +1414,8 @@ def _numeric_component(
             ", ".join(instance_key(n) for n in unknowns),
             before,
             result.solutions[0].total_dof if result.found else None,
-            f"{len(result.solutions)} solution(s), best residual {result.best_residual:.3g}",
+            f"{fmt.count(len(result.solutions), 'solution')},"
+            f" best residual {result.best_residual:.3g}",
         )
     )
     out = {WORLD: _Instance(np.eye(4), 0, Kind.FIXED)}

@@ -92,6 +92,13 @@ class Candidate:
         g = self.goal
         return f"[{g.relation} [{g.first} {self.first}] [{g.second} {self.second}]]"
 
+    def words(self) -> str:
+        """The pair as the commands print it, ``b1 comp1 fits b4 comp13`` (docs/mating.md,
+        "Walk-through: Example 1 of Liu & Popplestone 1990")."""
+        g = self.goal
+        verb = "fits" if g.relation == "fit" else g.relation
+        return f"{g.first} {self.first} {verb} {g.second} {self.second}"
+
 
 Domains = dict[int, tuple[Candidate, ...]]
 """The domain of each goal (by goal number): its remaining candidates."""

@@ -76,6 +76,8 @@ class Overlap:
     b: str
     volume: float
     resolution: str = ""
+    units: str | None = field(default=None, compare=False)
+    """The model's length unit, for showing ``volume`` with it (``mm³``); not in the JSON."""
 
     def to_dict(self) -> dict[str, str | float]:
         """JSON form: ``a``, ``b``, ``volume`` and ``resolution``."""

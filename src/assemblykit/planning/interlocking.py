@@ -70,10 +70,12 @@ Verdict = Literal["interlocking", "recursively interlocking", "not interlocking"
 FreeKind = Literal["direction", "arc", "circle", "region", "everywhere"]
 
 MOTION_WORDS = {
-    "infinitesimal": "infinitesimal translations",
-    "extended": "extended translations",
-    "rigid": "infinitesimal rigid motions",
+    "infinitesimal": "small straight moves",
+    "extended": "straight moves all the way out",
+    "rigid": "small moves that may turn",
 }
+"""The kinds of motion (infinitesimal and extended translations, infinitesimal rigid
+motions: docs/blocking.md, "Three kinds of motion") in an engineer's words."""
 AXES_3D = ((0, 0, 1), (1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, -1, 0), (0, 0, -1))
 """Directions tried first for a set's one direction, in order (lifting first, as the
 planner's ranking: docs/planning.md, "How a plan is found")."""
@@ -332,7 +334,8 @@ class Interlocking:
             lines.append(
                 f"{head}: only {keys} can move ({which});"
                 " every other part and every subset stays in place along every direction"
-                f" ({fmt.count(len(self.cells), 'distinct blocking graph')})."
+                # one group per distinct blocking graph (docs/interlocking.md)
+                f" ({fmt.count(len(self.cells), 'group')} of directions checked)."
             )
             lines += [f"- {m}" for m in moving]
         elif self.deadlocked:

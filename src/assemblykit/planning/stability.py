@@ -63,6 +63,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linprog
 from scipy.sparse.csgraph import connected_components
 
+from assemblykit import formatting as fmt
 from assemblykit.errors import InputError, NumericError
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.tolerance import MIN_REL_LENGTH, Tolerance, order_key
@@ -1034,9 +1035,11 @@ class StepStability:
         }
 
     def cells(self) -> list[str]:
-        """Table cells: held, would fall, friction needed."""
+        """Table cells: held, would fall, friction needed; long lists of parts cut to
+        their first names and how many more, as the plan's "away from" cells are
+        (docs/planning.md, "Under gravity")."""
         needed = "more than μ" if self.friction_needed is None else f"{self.friction_needed:.3f}"
-        return [", ".join(self.held), ", ".join(self.would_fall) or "-", needed]
+        return [fmt.name_list(self.held), fmt.name_list(self.would_fall) or "-", needed]
 
 
 @dataclass(frozen=True)

@@ -640,7 +640,8 @@ def report_html(
     tol = assembly.tolerance()
     drawn = scene(assembly, plan)
     verdict = (
-        f"feasible in {fmt.count(len(plan.steps), 'step')} by extended translations"
+        # extended translations (docs/planning.md, "How a plan is found"), in words
+        f"feasible in {fmt.count(len(plan.steps), 'step')}, each a straight move"
         if plan.feasible
         else f"infeasible: interlocked parts {', '.join(plan.stuck)}"
     )
@@ -659,7 +660,7 @@ def report_html(
         f"<h1>Disassembly plan: {html.escape(name)}</h1>",
         f'<p class="{"feasible" if plan.feasible else "infeasible"}">'
         f"{fmt.count(len(plan.parts), 'part')}; {html.escape(verdict)}; "
-        f"{fmt.count(plan.directions, 'candidate direction')}{html.escape(units)}.</p>",
+        f"{fmt.count(plan.directions, 'direction')} tried{html.escape(units)}.</p>",
         plot,
         '<div class="controls"><button id="play" type="button">&#9654; play</button>'
         f'<input id="step-slider" type="range" min="0" max="{last}" step="1" value="0"'
