@@ -51,7 +51,8 @@ def test_demo_writes_its_report(capsys, tmp_path):
     assert code == 0, err
     report = tmp_path / "demo" / "gearbox_report.html"
     assert report.stat().st_size > 3_000_000
-    assert "Report written to" in out and "gearbox_report.html" in out
+    assert "Disassembly plan (feasible)" in out
+    assert "in a browser" in out and "gearbox_report.html" in out
     code, out, _ = run(capsys, "demo", "--out", str(tmp_path / "again"), "--json")
     data = json.loads(out)
     assert data["report"] == str((tmp_path / "again" / "gearbox_report.html").resolve())

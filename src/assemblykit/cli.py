@@ -91,6 +91,12 @@ class _OptionRange(click.FloatRange):
         raise InputError(message, where=option)
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if isinstance(value, str):
+            try:
+                float(value)
+            except ValueError:
+                # click's own words ("not a valid float range") name its type, not the value
+                self.fail(f"{value!r} is not a number", param, ctx)
         number = super().convert(value, param, ctx)
         if number != number:  # NaN passes every range comparison
             self.fail(f"{value!r} is not a number", param, ctx)
@@ -375,9 +381,11 @@ def _multi_move_plan(
     tol: Tolerance,
     max_states: int | None,
     progress: Callable[[str, int, int], None],
+    fixed: tuple[str, ...] = (),
 ) -> Result:
     """The multi-move plan of a loaded voxel puzzle, compared with its stored level, or
-    of a mesh assembly."""
+    of a mesh assembly, never moving the ``fixed`` parts (docs/planning.md, "Fixed
+    parts")."""
     from assemblykit.io.burrtools import VoxelAssembly
     from assemblykit.planning.multimove import MAX_STATES, plan_voxels
     from assemblykit.planning.multimove_mesh import plan_meshes
@@ -386,7 +394,7 @@ def _multi_move_plan(
     if getattr(loaded, "dimension", 3) == 2:
         raise InputError("--moves multi moves 3D parts: not for a 2D polygon assembly", source=path)
     if not isinstance(loaded, VoxelAssembly):
-        return plan_meshes(loaded, tol, max_states=limit, progress=progress)
+        return plan_meshes(loaded, tol, max_states=limit, progress=progress, fixed=fixed)
     puzzle = loaded.puzzle
     return plan_voxels(
         puzzle.names,
@@ -395,6 +403,7 @@ def _multi_move_plan(
         max_states=limit,
         reference_level=puzzle.level,
         progress=progress,
+        fixed=fixed,
     )
 
 
@@ -481,8 +490,8 @@ def _gravity(
 @click.option(
     "--fixed",
     multiple=True,
-    help="--gravity: a part that never moves (ground, fixture); repeatable "
-    "[default: the parts touching the lowest plane].",
+    help="A part that never moves (ground, fixture), in every mode; repeatable "
+    "[default under --gravity: the parts touching the lowest plane, taken off last].",
 )
 @click.option("--one-at-a-time", is_flag=True, help="Move one free set (a part) per step.")
 @click.option(
@@ -604,13 +613,13 @@ def plan_cmd(
         if getattr(loaded, "dimension", 3) == 2 and (html is not None or png is not None):
             raise InputError("--html and --png draw meshes: not for a 2D polygon assembly")
         if moves == "multi":
-            result = _multi_move_plan(loaded, assembly, tol, max_states, update)
+            result = _multi_move_plan(loaded, assembly, tol, max_states, update, fixed)
         elif moves == "rigid":
             from assemblykit.planning.screw import plan_with_screws
 
             if getattr(loaded, "dimension", 3) == 2:
                 raise InputError("--moves rigid turns 3D parts: not for a 2D polygon assembly")
-            result = plan_with_screws(loaded, tol)
+            result = plan_with_screws(loaded, tol, fixed=fixed)
         else:
             monotone = plan(
                 loaded,
@@ -620,6 +629,7 @@ def plan_cmd(
                 gravity=_gravity(gravity, friction, holds, fixed),
                 one_at_a_time=one_at_a_time,
                 max_steps=max_steps,
+                fixed=fixed,
             )
             if html is not None:
                 from assemblykit.viz.viewer import write_report

@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
+from assemblykit.errors import UnknownNameError
 
 MAX_STATES = 250_000
 """Default limit of states visited per separation: Pelikan's 98-move first separation
@@ -131,7 +132,8 @@ class Separation:
     """How one subassembly (``parts``) comes apart: ``moves`` up to and including the
     one that takes ``removed`` to infinity, leaving ``left``; each half is a further
     :class:`Separation` when it has several parts. ``status`` is ``separated``,
-    ``group`` (parts meant to stay together: not searched), ``stuck`` (no sequence of
+    ``group`` (parts meant to stay together: not searched), ``fixed`` (fixed parts
+    only, docs/planning.md, "Fixed parts": not searched), ``stuck`` (no sequence of
     moves separates it: every reachable state was visited) or ``cut`` (the search
     stopped at the state limit). ``states`` counts the states visited."""
 
@@ -435,13 +437,41 @@ class MultiMoveSearch(ABC):
     (bytes), so equivalent placements are visited once."""
 
     def __init__(
-        self, names: Sequence[str], groups: Sequence[int], max_states: int, progress: Progress
+        self,
+        names: Sequence[str],
+        groups: Sequence[int],
+        max_states: int,
+        progress: Progress,
+        fixed: Iterable[int] = (),
     ) -> None:
         self.names = list(names)
         self.groups = list(groups)
         self.max_states = max_states
         self.progress = progress
         self.done = 0
+        self.fixed = frozenset(fixed)
+        """The pieces that never move (docs/planning.md, "Fixed parts"): placed first in
+        every subassembly, so that they are the piece that stays put; no move takes some
+        of them and not the others, and no separation removes them."""
+
+    def fixed_bits(self, members: Sequence[int]) -> int:
+        """The fixed pieces of ``members`` as local bits (bit ``i``: ``members[i]``)."""
+        return sum(1 << i for i, m in enumerate(members) if m in self.fixed)
+
+    def keeps_fixed(self, members: Sequence[int], group: int) -> bool:
+        """Whether moving the local bits ``group`` of ``members`` keeps the fixed pieces
+        where they are relative to one another: it holds all of them or none."""
+        anchor = self.fixed_bits(members)
+        return group & anchor in (0, anchor)
+
+    def flipped(self, members: Sequence[int], group: int) -> bool:
+        """Whether the separating ``group`` (local bits) is reported as the others
+        leaving the other way: when it holds the fixed pieces, else when it is the
+        larger half."""
+        anchor = self.fixed_bits(members)
+        if anchor:
+            return bool(group & anchor)
+        return 2 * bin(group).count("1") > len(members)
 
     @abstractmethod
     def origin(self, members: list[int], start: NDArray[Any]) -> tuple[bytes, Any]:
@@ -465,7 +495,10 @@ class MultiMoveSearch(ABC):
     def plan(self, members: list[int], start: NDArray[Any]) -> Separation:
         """The separation tree of ``members`` starting at ``start`` (one row per piece
         of the whole; rows of other pieces are ignored)."""
+        members = sorted(members, key=lambda m: (m not in self.fixed, m))
         parts = tuple(self.names[m] for m in members)
+        if all(m in self.fixed for m in members):
+            return Separation(parts, (), None, None, "fixed", 0)
         shared = {self.groups[m] for m in members}
         if len(shared) == 1 and 0 not in shared:
             return Separation(parts, (), None, None, "group", 0)
@@ -530,8 +563,9 @@ class _Planner(MultiMoveSearch):
         groups: Sequence[int],
         max_states: int,
         progress: Progress,
+        fixed: Iterable[int] = (),
     ) -> None:
-        super().__init__(names, groups, max_states, progress)
+        super().__init__(names, groups, max_states, progress, fixed)
         self.tables = _Tables([np.asarray(v, dtype=np.int64).reshape(-1, 3) for v in voxels])
         self.steps = np.array(AXES, dtype=np.int64)
         self.entries: dict[tuple[int, ...], NDArray[np.bool_]] = {}
@@ -550,6 +584,9 @@ class _Planner(MultiMoveSearch):
         whole[members] = offsets
         free = self.tables.free(whole, entries)[np.ix_(range(6), members, members)]
         removals, moves = _moves(free)
+        anchor = self.fixed_bits(members)
+        removals = [r for r in removals if self.keeps_fixed(members, r[0])]
+        moves = moves[((moves[:, 0] & anchor) == 0) | ((moves[:, 0] & anchor) == anchor)]
         if removals:
             group, d = min(removals, key=lambda r: (bin(r[0]).count("1"), r[1], r[0]))
             return self._separating(members, group, d, state), ()
@@ -578,8 +615,9 @@ class _Planner(MultiMoveSearch):
 
     def _separating(self, members: list[int], group: int, d: int, state: bytes) -> Found:
         removed = _bits(group, members)
-        if 2 * len(removed) > len(members):
-            # report the smaller half as the one removed, moving the other way
+        if self.flipped(members, group):
+            # report the smaller half (the one without the fixed pieces) as the one
+            # removed, moving the other way
             removed = [m for m in members if m not in removed]
             d ^= 1
             group = sum(1 << k for k, m in enumerate(members) if m in removed)
@@ -606,6 +644,17 @@ class _Planner(MultiMoveSearch):
         return Move(parts, AXES[d], k, moving_groups(parts, arcs))
 
 
+def fixed_indices(names: Sequence[str], fixed: Iterable[str]) -> list[int]:
+    """The indices of the ``fixed`` pieces among ``names`` (docs/planning.md, "Fixed
+    parts"); ``UnknownNameError`` for a name not among them."""
+    found = []
+    for name in fixed:
+        if name not in names:
+            raise UnknownNameError(f"no part named {name!r} (parts: {', '.join(names)})")
+        found.append(list(names).index(name))
+    return found
+
+
 def plan_voxels(
     names: Sequence[str],
     voxels: Sequence[NDArray[np.int64]],
@@ -613,16 +662,20 @@ def plan_voxels(
     max_states: int = MAX_STATES,
     reference_level: str | None = None,
     progress: Progress | None = None,
+    fixed: Iterable[str] = (),
 ) -> MultiMovePlan:
     """The multi-move disassembly plan of the voxel pieces ``voxels`` (``(N, 3)`` integer
     cells, pieces in assembled position, none overlapping) named ``names``; pieces
     sharing a nonzero number in ``groups`` may stay together. Each separation's search
     visits at most ``max_states`` states; beyond that its subassembly is reported
-    ``cut`` (module docstring)."""
+    ``cut`` (module docstring). The ``fixed`` pieces never move (docs/planning.md,
+    "Fixed parts")."""
     if len(names) != len(voxels):
         raise ValueError("one name per voxel piece")
     report: Progress = progress or (lambda stage, done, total: None)
-    planner = _Planner(names, voxels, groups or [0] * len(names), max_states, report)
+    planner = _Planner(
+        names, voxels, groups or [0] * len(names), max_states, report, fixed_indices(names, fixed)
+    )
     root = None
     if len(names) > 1:
         root = planner.plan(list(range(len(names))), np.zeros((len(names), 3), dtype=np.int64))

@@ -52,6 +52,7 @@ from assemblykit.planning.multimove import (
     MultiMovePlan,
     MultiMoveSearch,
     Progress,
+    fixed_indices,
 )
 from assemblykit.tolerance import Tolerance
 
@@ -158,10 +159,15 @@ class _MeshSearch(MultiMoveSearch):
     floats), its key those offsets in units of the length tolerance."""
 
     def __init__(
-        self, assembly: Assembly, tol: Tolerance, max_states: int, progress: Progress
+        self,
+        assembly: Assembly,
+        tol: Tolerance,
+        max_states: int,
+        progress: Progress,
+        fixed: Iterable[int] = (),
     ) -> None:
         names = list(assembly.names)
-        super().__init__(names, [0] * len(names), max_states, progress)
+        super().__init__(names, [0] * len(names), max_states, progress, fixed)
         self.tol = tol
         pieces = []
         for k, name in enumerate(names):
@@ -198,10 +204,12 @@ class _MeshSearch(MultiMoveSearch):
                 while len(group) < len(members):
                     free, events, stoppers = self._reach(intervals, among, group, k)
                     mask = sum(1 << i for i, m in enumerate(members) if m in group)
+                    kept = self.keeps_fixed(members, mask)
                     if free == np.inf:
-                        removals.append((len(group), k, mask))
+                        if kept:
+                            removals.append((len(group), k, mask))
                         break
-                    for t in events:
+                    for t in events if kept else ():
                         moves.setdefault((mask, k, t), None)
                     group |= stoppers
         if removals:
@@ -259,8 +267,9 @@ class _MeshSearch(MultiMoveSearch):
         return np.asarray(state, dtype=np.float64)
 
     def _separating(self, members: list[int], mask: int, k: int) -> Found:
-        if 2 * bin(mask).count("1") > len(members):
-            # report the smaller half as the one removed, moving the other way
+        if self.flipped(members, mask):
+            # report the smaller half (the one without the fixed parts) as the one
+            # removed, moving the other way
             mask, k = ((1 << len(members)) - 1) ^ mask, int(self.opposite[k])
         removed = [m for i, m in enumerate(members) if mask >> i & 1]
         return removed, self._move(members, mask, k, None)
@@ -276,15 +285,18 @@ def plan_meshes(
     tol: Tolerance | None = None,
     max_states: int = MAX_STATES,
     progress: Progress | None = None,
+    fixed: Iterable[str] = (),
 ) -> MultiMovePlan:
     """The multi-move disassembly plan of a mesh assembly (module docstring). Each
     separation's search visits at most ``max_states`` states; beyond that its
-    subassembly is reported ``cut``."""
+    subassembly is reported ``cut``. The ``fixed`` parts never move (docs/planning.md,
+    "Fixed parts")."""
     tol = assembly.tolerance(tol)
     report: Progress = progress or (lambda stage, done, total: None)
     names = tuple(assembly.names)
     root = None
     if len(names) > 1:
-        search = _MeshSearch(assembly, tol, max_states, report)
+        anchored = fixed_indices(names, fixed)
+        search = _MeshSearch(assembly, tol, max_states, report, anchored)
         root = search.plan(list(range(len(names))), np.zeros((len(names), 3)))
     return MultiMovePlan(names, root, max_states)

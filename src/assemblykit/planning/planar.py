@@ -12,7 +12,7 @@ some direction leaves along one of them. Γ_t over these directions bounds and e
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -71,13 +71,24 @@ def planar_tables(
 
 
 def planar_search(
-    model: PolygonAssembly, tol: Tolerance, report: Progress, max_steps: int | None = None
+    model: PolygonAssembly,
+    tol: Tolerance,
+    report: Progress,
+    max_steps: int | None = None,
+    fixed: Sequence[str] = (),
 ) -> Search:
     """The planner's search over a polygon assembly, run: Γ_t bounds and Γ_e accepts
     along every region of the common arrangement (:func:`planar_tables`), stopping after
-    ``max_steps`` steps when given."""
+    ``max_steps`` steps when given, never moving the ``fixed`` parts (docs/planning.md,
+    "Fixed parts")."""
     translations, extended, volumes = planar_tables(model, tol)
-    search = Search(translations, extended, volumes, report, [], [], max_steps=max_steps)
+    names = translations.names
+    total = sum(volumes)
+    volumes = tuple(v + total if n in fixed else v for n, v in zip(names, volumes, strict=True))
+    mask = mask_of(k for k, name in enumerate(names) if name in fixed)
+    search = Search(
+        translations, extended, volumes, report, [], [], max_steps=max_steps, fixed=mask
+    )
     search.disassemble(mask_of(range(len(translations.names))))
     return search
 

@@ -16,7 +16,7 @@ from assemblykit.blocking.directions import DirectionTable, bits, mask_of, union
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.tables import translation_slots, translation_table
-from assemblykit.errors import InputError
+from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.geometry.interference import interferences
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.fasteners import step_fastener
@@ -71,6 +71,7 @@ def plan(
     gravity: Gravity | None = None,
     one_at_a_time: bool = False,
     max_steps: int | None = None,
+    fixed: Iterable[str] | None = None,
 ) -> Plan:
     """Plan the disassembly of ``assembly`` by extended translations (Wilson & Latombe
     1992, "Extension and Variant"; docs/planning.md, "How a plan is found"): in what
@@ -95,6 +96,11 @@ def plan(
     ``max_steps`` stops the search after that many steps: the parts not yet taken
     apart are the plan's ``unfinished`` ones, and the plan is not feasible.
 
+    ``fixed`` parts never move, in every mode (docs/planning.md, "Fixed parts"): no
+    step moves a set holding one, they stay together as one immovable base, and the
+    plan stops when only they (and what cannot leave them) are left; ``order`` starts
+    on them. Under gravity they are added to ``gravity.fixed``.
+
     Parameters
     ----------
     assembly : Assembly or PolygonAssembly
@@ -115,6 +121,8 @@ def plan(
         Move one free set per step.
     max_steps : int, optional
         Stop after this many steps.
+    fixed : iterable of str, optional
+        Parts that never move (a fixture, the ground).
 
     Returns
     -------
@@ -127,7 +135,7 @@ def plan(
     Raises
     ------
     UnknownNameError
-        ``gravity.fixed`` names a part the assembly does not have.
+        ``fixed`` or ``gravity.fixed`` names a part the assembly does not have.
 
     Examples
     --------
@@ -147,17 +155,23 @@ def plan(
         raise InputError(f"max_steps must be 0 or more, not {max_steps}")
     tol = assembly.tolerance(tol)
     names = tuple(assembly.names)
+    declared = fixed_parts(assembly, fixed, gravity)
+    if gravity is not None and declared:
+        gravity = replace(gravity, fixed=declared)
     report: Progress = progress or (lambda stage, done, total: None)
     report("blocking graph (infinitesimal translations)", 0, len(names))
     if isinstance(assembly, PolygonAssembly):
         if gravity is not None or one_at_a_time:
             raise InputError("--gravity and --one-at-a-time need 3D parts, not 2D polygons")
 
-        planar = planar_search(assembly, tol, report, max_steps)
-        return finish_plan(assembly, planar, tol, max_and_or_parts, max_hands, report)
+        planar = planar_search(assembly, tol, report, max_steps, declared)
+        result = finish_plan(assembly, planar, tol, max_and_or_parts, max_hands, report)
+        return replace(result, fixed=declared)
     translations = translation_table(assembly, tol)
     extended = ExtendedDirections(assembly, translations.directions, tol)
-    volumes = tuple(assembly.parts[name].volume for name in names)
+    volumes = anchored_volumes(
+        names, tuple(assembly.parts[name].volume for name in names), declared
+    )
     search = Search(
         translations,
         extended,
@@ -169,11 +183,44 @@ def plan(
         translation_slots(assembly, translations, tol),
         (one_set,) if one_at_a_time else (),
         max_steps=max_steps,
+        fixed=mask_of(k for k, name in enumerate(names) if name in declared),
     )
     if gravity is None:
         search.disassemble(mask_of(range(len(names))))
-        return finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
-    return _plan_under_gravity(assembly, search, gravity, tol, max_and_or_parts, max_hands)
+        result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
+    else:
+        result = _plan_under_gravity(assembly, search, gravity, tol, max_and_or_parts, max_hands)
+    return replace(result, fixed=declared)
+
+
+def fixed_parts(
+    assembly: Assembly | PolygonAssembly,
+    fixed: Iterable[str] | None,
+    gravity: Gravity | None,
+) -> tuple[str, ...]:
+    """The declared fixed parts of :func:`plan`: ``fixed`` and ``gravity.fixed``, in the
+    assembly's order (docs/planning.md, "Fixed parts"). Raises ``UnknownNameError`` for
+    a name the assembly does not have."""
+    wanted = {*(fixed or ()), *((gravity.fixed or ()) if gravity is not None else ())}
+    for name in sorted(wanted):
+        if isinstance(assembly, Assembly):
+            assembly.part(name)
+        elif name not in assembly.names:
+            raise UnknownNameError(f"no part named {name!r} (parts: {', '.join(assembly.names)})")
+    return tuple(name for name in assembly.names if name in wanted)
+
+
+def anchored_volumes(
+    names: Sequence[str], volumes: Sequence[float], fixed: Iterable[str]
+) -> tuple[float, ...]:
+    """``volumes`` with every ``fixed`` part's raised by the total, so that the base
+    (:func:`~assemblykit.planning.sequence.base_part`) of a set holding one is a fixed
+    part (docs/planning.md, "Fixed parts")."""
+    anchored = set(fixed)
+    total = sum(volumes)
+    return tuple(
+        v + total if name in anchored else v for name, v in zip(names, volumes, strict=True)
+    )
 
 
 def _plan_under_gravity(
@@ -196,12 +243,8 @@ def _plan_under_gravity(
         dict(gravity.densities),
         tol,
     )
-    fixed = set(model.fixed)
-    total = sum(search.volumes)
-    search.volumes = tuple(
-        v + total if name in fixed else v
-        for name, v in zip(model.names, search.volumes, strict=True)
-    )
+    search.volumes = anchored_volumes(model.names, search.volumes, model.fixed)
+    supports = mask_of(k for k, name in enumerate(model.names) if name in set(model.fixed))
     everything = mask_of(range(len(model.names)))
     judge = StateJudge(
         model,
@@ -217,10 +260,11 @@ def _plan_under_gravity(
     search.judge = judge.judge
     search.up = -gravity_direction(gravity.direction)
     if gravity.fixed is not None:
-        # declared fixed parts (a fixture) never move; the default ones only rest on the
-        # ground, and are taken off it last
-        search.ground = mask_of(k for k, name in enumerate(model.names) if name in fixed)
-    search.disassemble(everything)
+        # declared fixed parts (a fixture) never move
+        search.fixed = search.ground = supports
+        search.disassemble(everything)
+    else:
+        _supports_last(search, everything, supports)
     result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
     whole = model.check()
     present = model.mask(None)
@@ -237,6 +281,28 @@ def _plan_under_gravity(
             and all(step.stability is None or step.stability.stands for step in search.steps),
         ),
     )
+
+
+def _supports_last(search: Search, members: int, supports: int) -> None:
+    """Run ``search`` on ``members`` with the default ``supports`` (the parts on the
+    lowest plane) taken off last (docs/planning.md, "Fixed parts"): first as if they
+    were fixed, then, on what is left (the supports, and any set that could not leave
+    them), with every part free to move."""
+    search.fixed = supports
+    search.disassemble(members)
+    search.fixed = 0
+    if search.unfinished:
+        return
+    moved = mask_of(i for step in search.steps for i in _indices(search, step.parts))
+    left = members & ~moved
+    search.locked[:] = [lock for lock in search.locked if lock != left]
+    search.disassemble(left)
+
+
+def _indices(search: Search, parts: Iterable[str]) -> list[int]:
+    """The indices of the part names ``parts`` in ``search``."""
+    names = search.translations.names
+    return [names.index(name) for name in parts]
 
 
 def finish_plan(

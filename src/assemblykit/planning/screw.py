@@ -239,19 +239,29 @@ class ScrewPlan:
         }
 
 
-def plan_with_screws(assembly: Assembly, tol: Tolerance | None = None) -> ScrewPlan:
+def plan_with_screws(
+    assembly: Assembly, tol: Tolerance | None = None, fixed: Iterable[str] = ()
+) -> ScrewPlan:
     """:func:`~assemblykit.planning.planner.plan`, then, while it stops at a stuck set,
-    a turn (:func:`screw_removal`) of one of its parts and a plan of the others."""
-    stages = [plan(assembly, tol=tol)]
+    a turn (:func:`screw_removal`) of one of its parts and a plan of the others. The
+    ``fixed`` parts are never moved, by a translation or a turn (docs/planning.md,
+    "Fixed parts")."""
+    anchored = tuple(fixed)
+    stages = [plan(assembly, tol=tol, fixed=anchored)]
     screws: list[ScrewStep] = []
     while not stages[-1].feasible:
         stuck = assembly.subset(stages[-1].stuck)
         turn = next(
-            (t for name in stuck.names if (t := screw_removal(stuck, [name], tol)) is not None),
+            (
+                t
+                for name in stuck.names
+                if name not in anchored and (t := screw_removal(stuck, [name], tol)) is not None
+            ),
             None,
         )
         if turn is None:
             break
         screws.append(turn)
-        stages.append(plan(stuck.subset(turn.rest), tol=tol))
+        rest = stuck.subset(turn.rest)
+        stages.append(plan(rest, tol=tol, fixed=[n for n in anchored if n in rest.names]))
     return ScrewPlan(tuple(stages), tuple(screws))

@@ -554,6 +554,9 @@ class Plan:
     """The parts not yet taken apart when the plan stopped at its step limit
     (``max_steps`` of :func:`assemblykit.planning.planner.plan`): neither separated nor
     shown stuck."""
+    fixed: tuple[str, ...] = ()
+    """The parts declared fixed (docs/planning.md, "Fixed parts"): never moved, left
+    in place by the plan, the first set of the assembly ``order``."""
 
     @property
     def feasible(self) -> bool:
@@ -572,8 +575,11 @@ class Plan:
 
     @property
     def order(self) -> tuple[tuple[str, ...], ...]:
-        """Assembly order: the moved sets of the steps, last removed first inserted."""
-        return tuple(step.parts for step in reversed(self.steps))
+        """Assembly order: the moved sets of the steps, last removed first inserted,
+        after the :attr:`fixed` parts when there are any (docs/planning.md, "Fixed
+        parts")."""
+        moved = tuple(step.parts for step in reversed(self.steps))
+        return ((self.fixed,) if self.fixed else ()) + moved
 
     @property
     def assembly_steps(self) -> tuple[AssemblyStep, ...]:
@@ -621,6 +627,7 @@ class Plan:
             "unfinished": list(self.unfinished),
             "overlaps": [overlap.to_dict() for overlap in self.overlaps],
             "joined": {name: list(members) for name, members in self.joined.items()},
+            "fixed": list(self.fixed),
         }
 
     def __repr__(self) -> str:
@@ -709,7 +716,12 @@ def _sinks(source: DirectionTable | ExtendedDirections, k: int, members: int) ->
 
 
 def _free_closures(
-    translations: DirectionTable, extended: ExtendedDirections, k: int, members: int, base: int
+    translations: DirectionTable,
+    extended: ExtendedDirections,
+    k: int,
+    members: int,
+    base: int,
+    fixed: int = 0,
 ) -> list[int]:
     """The minimal sets of ``members`` that leave ``base`` behind along direction ``k``
     with no arc of Γ_t (necessary) or Γ_e (sufficient) leaving them: the sink
@@ -719,18 +731,21 @@ def _free_closures(
     (everything its parts' blockers, and theirs, reach), and the sinks of the union are
     the least of these closures. A closure stops as soon as it reaches the base, so only
     the Γ_e blockers of parts in the sets found, and of those on the way to the base,
-    are computed. Before that, a closure under the arcs already known that reaches the
-    base rules its start out, as it lies within the whole closure: first the arcs shown
-    without projecting (:meth:`ExtendedDirections.shown_blockers`), then with the parts
-    that blocked each part last along other directions, tested along ``k`` alone
+    are computed. The ``fixed`` parts stay with the base part as one immovable body
+    (docs/planning.md, "Fixed parts"). Before that, a closure under the
+    arcs already known that reaches the base rules its start out, as it lies within the
+    whole closure: first the arcs shown without projecting
+    (:meth:`ExtendedDirections.shown_blockers`), then with the parts that blocked each
+    part last along other directions, tested along ``k`` alone
     (:meth:`ExtendedDirections.known_blockers`). (Γ_t's arcs are Γ_e's but where a direction
     grazes a contact, within the tolerances: there the part stays, as a single part Γ_t
     holds does.)"""
     necessary = translations.masks(k)
+    anchor = (1 << base) | fixed
 
     def closure(start: int, blockers: Callable[[int], dict[int, int]]) -> int:
         closed = frontier = start
-        while frontier and not closed >> base & 1:
+        while frontier and not closed & anchor:
             blocked = 0
             for i, mask in blockers(frontier).items():
                 blocked |= mask | necessary[i] & members
@@ -740,12 +755,12 @@ def _free_closures(
 
     closures = set()
     for start in _sinks(translations, k, members):
-        if closure(start, lambda parts: extended.shown_blockers(k, parts, members)) >> base & 1:
+        if closure(start, lambda parts: extended.shown_blockers(k, parts, members)) & anchor:
             continue
-        if closure(start, lambda parts: extended.known_blockers(k, parts, members)) >> base & 1:
+        if closure(start, lambda parts: extended.known_blockers(k, parts, members)) & anchor:
             continue
         closed = closure(start, lambda parts: extended.blockers(k, parts, members, whole=True))
-        if not closed >> base & 1:
+        if not closed & anchor:
             closures.add(closed)
     return sorted(s for s in closures if not any(o != s and o & s == o for o in closures))
 
@@ -758,12 +773,13 @@ def base_part(members: int, volumes: Sequence[float]) -> int:
     return max(bits(members), key=lambda i: (order_key(volumes[i], scale), -i))
 
 
-def _removal(sinks: list[int], members: int, volumes: Sequence[float]) -> list[int]:
-    """The free sets to move: all but the one holding the base (:func:`base_part`). Keeping
-    the base still is no loss: the other side of a partition along ``d`` is free along
-    ``-d``, which is also a candidate (the arrangement is symmetric)."""
-    base = 1 << base_part(members, volumes)
-    return [s for s in sinks if not s & base]
+def _removal(sinks: list[int], members: int, volumes: Sequence[float], fixed: int = 0) -> list[int]:
+    """The free sets to move: all but those holding the base (:func:`base_part`) or a
+    ``fixed`` part (docs/planning.md, "Fixed parts"). Keeping the base still is no loss:
+    the other side of a partition along ``d`` is free along ``-d``, which is also a
+    candidate (the arrangement is symmetric)."""
+    anchor = (1 << base_part(members, volumes)) | fixed
+    return [s for s in sinks if not s & anchor]
 
 
 def _group_bounds(
@@ -784,6 +800,7 @@ def _choose_removal(
     previous: int | None,
     narrow: Narrow | None = None,
     up: NDArray[np.float64] | None = None,
+    fixed: int = 0,
 ) -> tuple[int, list[int]] | None:
     """The direction index and the free sets of Γ_e it removes from ``members``.
 
@@ -793,10 +810,12 @@ def _choose_removal(
     leave together can. ``narrow(members, k, sets)``, when given, picks among the free
     sets of direction ``k`` those to move (one at a time, or only removals that leave
     stable states); once it has rejected the groups of :data:`GROUP_REJECTIONS`
-    directions, no more groups are tried.
+    directions, no more groups are tried. No set holding a ``fixed`` part is moved: with
+    the base, they are one immovable body (docs/planning.md, "Fixed parts").
     """
     base = base_part(members, volumes)
-    free = translations.free_bits(members, members & ~(1 << base))
+    anchor = (1 << base) | (fixed & members)
+    free = translations.free_bits(members, members & ~anchor)
     counts = np.bitwise_count(free).sum(axis=1, dtype=np.int64)
     rejected = 0
 
@@ -818,9 +837,9 @@ def _choose_removal(
         if rejected >= GROUP_REJECTIONS:
             return []
         if isinstance(extended, ExtendedDirections):
-            found = _free_closures(translations, extended, k, members, base)
+            found = _free_closures(translations, extended, k, members, base, anchor)
         else:
-            found = _removal(_sinks(extended, k, members), members, volumes)
+            found = _removal(_sinks(extended, k, members), members, volumes, fixed)
         kept = chosen(k, found)
         rejected += bool(found) and not kept
         return kept
@@ -921,6 +940,10 @@ class Search:
     ground: int = 0
     """Parts that stay where they are (fixed parts declared under gravity): a set holding
     nothing else is not taken apart."""
+    fixed: int = 0
+    """Parts never moved (docs/planning.md, "Fixed parts"): no set holding one leaves,
+    they stay with the base as one body, and a set holding nothing else (with
+    :attr:`ground`) is not taken apart."""
     up: NDArray[np.float64] | None = None
     """Under gravity, the unit vector against it: no direction with a downward component
     is taken, and lifting goes before sliding (:func:`_best_direction`)."""
@@ -946,6 +969,7 @@ class Search:
                     previous,
                     narrow,
                     self.up,
+                    self.fixed,
                 )
                 if choice is not None:
                     return choice
@@ -977,7 +1001,7 @@ class Search:
         pending = [members]
         while pending:
             current = pending.pop()
-            while several(current) and current & ~self.ground:
+            while several(current) and current & ~(self.ground | self.fixed):
                 if self.max_steps is not None and len(self.steps) >= self.max_steps:
                     self.unfinished.append(current)
                     break
@@ -1136,13 +1160,18 @@ def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDAr
     and Variant": extended translations; each checked free), and,
     when none leaves alone and the set has at most ``EXACT_GROUP_PARTS`` parts, one in
     every face of the overlay of the pairs' blocked sets (over which every DBG is
-    constant, so groups leaving together are found as well)."""
+    constant, so groups leaving together are found as well). A set of voxel parts the
+    lattice certificate proves interlocked (:func:`_voxel_lock`) gets none: no direction
+    frees any of its subsets, so none is computed."""
     from assemblykit.blocking.free_cones import blocked_by, exact_free_directions, overlay_faces
 
     names = tuple(assembly.names)
+    locked = _voxel_lock(assembly)
 
     def directions(members: int) -> NDArray[np.float64]:
         among = [names[i] for i in bits(members)]
+        if locked(among):
+            return np.zeros((0, 3))
         found: list[NDArray[np.float64]] = []
         for name in among:
             found.extend(exact_free_directions(assembly, [name], tol, among, limit=2).directions)
@@ -1159,6 +1188,31 @@ def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDAr
         return overlay_faces(sets, tol).directions
 
     return directions
+
+
+def _voxel_lock(assembly: Assembly) -> Callable[[list[str]], bool]:
+    """Whether a set of parts, all made of unit cells, is proved interlocked by
+    :func:`~assemblykit.blocking.free_cones.lattice_locked` (no set of them leaves by one
+    extended translation in any direction, docs/blocking.md, "Three kinds of motion"):
+    then no exact free set needs computing. Each part's cells are found once."""
+    from assemblykit.blocking.free_cones import LATTICE_LOCK_PARTS, lattice_cells, lattice_locked
+
+    cells: dict[str, NDArray[np.int64] | None] = {}
+
+    def locked(among: list[str]) -> bool:
+        if not 1 < len(among) <= LATTICE_LOCK_PARTS:
+            return False
+        found = []
+        for name in among:
+            if name not in cells:
+                cells[name] = lattice_cells(assembly.parts[name].mesh)
+            part = cells[name]
+            if part is None:
+                return False
+            found.append(part)
+        return lattice_locked(found)
+
+    return locked
 
 
 __getattr__ = moved(
