@@ -701,7 +701,7 @@ LATTICE_LOCK_PARTS = 8
 subsets (``2^n - 2`` of them, one bit per ordered pair of parts in 64); larger sets
 are left to the faces and cells above."""
 
-_SPREAD = np.array([0.5 + 1e-3 * np.pi, 0.5 + 1e-3 * np.e])
+_SPREAD = np.array([0.5 + 1e-3 * np.pi, 0.5 + 1e-3 * np.exp(1.0)])
 """Where in its cell's cross-section a cell is probed (:func:`lattice_cells`): off every
 line through two lattice points of a small model, so no probe lies on an edge."""
 
