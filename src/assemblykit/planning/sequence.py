@@ -744,14 +744,7 @@ def _free_closures(
     anchor = (1 << base) | fixed
 
     def closure(start: int, blockers: Callable[[int], dict[int, int]]) -> int:
-        closed = frontier = start
-        while frontier and not closed & anchor:
-            blocked = 0
-            for i, mask in blockers(frontier).items():
-                blocked |= mask | necessary[i] & members
-            frontier = blocked & ~closed
-            closed |= frontier
-        return closed
+        return _closure(start, blockers, necessary, members, lambda closed: closed & anchor)
 
     closures = set()
     for start in _sinks(translations, k, members):
@@ -1089,17 +1082,34 @@ def _connected_as_shown(translations: DirectionTable, extended: Any, k: int, mem
     if not isinstance(extended, ExtendedDirections):
         return False
     necessary = translations.masks(k)
-    for start in _sinks(translations, k, members):
-        closed = frontier = start
-        while frontier and closed != members:
-            blocked = 0
-            for i, mask in extended.shown_blockers(k, frontier, members).items():
-                blocked |= mask | necessary[i] & members
-            frontier = blocked & ~closed
-            closed |= frontier
-        if closed != members:
-            return False
-    return True
+
+    def shown(parts: int) -> dict[int, int]:
+        return extended.shown_blockers(k, parts, members)
+
+    return all(
+        _closure(start, shown, necessary, members, lambda closed: closed == members) == members
+        for start in _sinks(translations, k, members)
+    )
+
+
+def _closure(
+    start: int,
+    blockers: Callable[[int], dict[int, int]],
+    necessary: Sequence[int],
+    members: int,
+    enough: Callable[[int], object],
+) -> int:
+    """``start`` closed under the arcs ``blockers`` gives (per part of a set, the mask of
+    its blockers) and Γ_t's (``necessary``, per part) within ``members``: everything
+    their blockers, and theirs, reach; it stops early once ``enough`` holds of it."""
+    closed = frontier = start
+    while frontier and not enough(closed):
+        blocked = 0
+        for i, mask in blockers(frontier).items():
+            blocked |= mask | necessary[i] & members
+        frontier = blocked & ~closed
+        closed |= frontier
+    return closed
 
 
 def and_or_graph(table: DirectionTable) -> AndOrGraph:
