@@ -96,3 +96,22 @@ def test_a_number_that_does_not_parse_is_one_line(
     assert err.count("\n") == 1
     assert f"{option}: 'abc' is not a number" in err
     assert "float range" not in err and "Usage" not in err
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "said"),
+    [
+        ("--max-steps", "abc", "'abc' is not a whole number"),
+        ("--max-steps", "2.5", "'2.5' is not a whole number"),
+        ("--max-steps", "-3", "-3 must be at least 0"),
+        ("--tolerance", "-1", "-1 must be at least"),
+    ],
+)
+def test_an_option_value_out_of_its_range_is_one_line_in_words(
+    capsys: pytest.CaptureFixture[str], option: str, value: str, said: str
+) -> None:
+    code, out, err = run(capsys, "plan", str(COMPAS / "two-blocks_assembly.json"), option, value)
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1
+    assert f"{option}: {said}" in err
+    assert "range" not in err and "Usage" not in err

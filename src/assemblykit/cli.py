@@ -80,15 +80,31 @@ def console(stderr: bool = False) -> Console:
     return Console(stderr=stderr, width=width)
 
 
+def _option_fault(message: str, param: click.Parameter | None) -> NoReturn:
+    """A bad option value as bad input: one line naming the option and exit 2, like a
+    bad file (click's own faults print the whole usage)."""
+    option = param.opts[0] if param is not None and param.opts else None
+    raise InputError(message, where=option)
+
+
+def _outside(number: float, bounds: click.FloatRange | click.IntRange) -> str | None:
+    """What ``number`` misses of ``bounds``, in words ("must be at least 1"), or
+    ``None`` when it is inside."""
+    low, high = bounds.min, bounds.max
+    if low is not None and (number <= low if bounds.min_open else number < low):
+        return f"must be {'more than' if bounds.min_open else 'at least'} {low:g}"
+    if high is not None and (number >= high if bounds.max_open else number > high):
+        return f"must be {'less than' if bounds.max_open else 'at most'} {high:g}"
+    return None
+
+
 class _OptionRange(click.FloatRange):
-    """A number in a range whose faults are bad input: one line naming the option and
-    exit 2, like a bad file (click's own faults print the whole usage)."""
+    """A number in a range whose faults are bad input (:func:`_option_fault`)."""
 
     def fail(
         self, message: str, param: click.Parameter | None = None, ctx: click.Context | None = None
     ) -> NoReturn:
-        option = param.opts[0] if param is not None and param.opts else None
-        raise InputError(message, where=option)
+        _option_fault(message, param)
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         if isinstance(value, str):
@@ -97,12 +113,36 @@ class _OptionRange(click.FloatRange):
             except ValueError:
                 # click's own words ("not a valid float range") name its type, not the value
                 self.fail(f"{value!r} is not a number", param, ctx)
+            missed = _outside(float(value), self)
+            if missed is not None:
+                self.fail(f"{value} {missed}", param, ctx)
         number = super().convert(value, param, ctx)
         if number != number:  # NaN passes every range comparison
             self.fail(f"{value!r} is not a number", param, ctx)
         if abs(number) == float("inf"):
             self.fail(f"{value!r} is not a finite number", param, ctx)
         return number
+
+
+class _CountRange(click.IntRange):
+    """A whole number in a range whose faults are bad input (:func:`_option_fault`)."""
+
+    def fail(
+        self, message: str, param: click.Parameter | None = None, ctx: click.Context | None = None
+    ) -> NoReturn:
+        _option_fault(message, param)
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if isinstance(value, str):
+            try:
+                int(value)
+            except ValueError:
+                # click's own words ("not a valid integer range") name its type
+                self.fail(f"{value!r} is not a whole number", param, ctx)
+            missed = _outside(int(value), self)
+            if missed is not None:
+                self.fail(f"{value} {missed}", param, ctx)
+        return super().convert(value, param, ctx)
 
 
 json_option = click.option(
@@ -294,7 +334,7 @@ def command(fn: Callable[..., None]) -> click.Command:
 @click.option("--explain", is_flag=True, help="Also print the reduction steps (the trace).")
 @click.option(
     "--max-branches",
-    type=click.IntRange(min=1, max=100_000),
+    type=_CountRange(min=1, max=100_000),
     default=None,
     help="Most finite alternatives (discrete poses, assembly modes) followed to the end "
     "(default 64).",
@@ -434,7 +474,7 @@ def _gravity(
 )
 @click.option(
     "--max-hands",
-    type=click.IntRange(min=2),
+    type=_CountRange(min=2),
     default=4,
     show_default=True,
     help="For parts no two-handed move separates: try up to this many hands.",
@@ -451,16 +491,16 @@ def _gravity(
 )
 @click.option(
     "--max-states",
-    type=click.IntRange(min=1),
+    type=_CountRange(min=1),
     default=None,
     help="--moves multi: states per separation before the search is cut [default: 250000].",
 )
 @click.option(
-    "--problem", type=click.IntRange(min=0), default=0, help=".xmpuzzle: the problem (from 0)."
+    "--problem", type=_CountRange(min=0), default=0, help=".xmpuzzle: the problem (from 0)."
 )
 @click.option(
     "--solution",
-    type=click.IntRange(min=0),
+    type=_CountRange(min=0),
     default=0,
     help=".xmpuzzle: the stored solution giving the assembled position (from 0).",
 )
@@ -482,7 +522,7 @@ def _gravity(
 )
 @click.option(
     "--holds",
-    type=click.IntRange(min=1),
+    type=_CountRange(min=1),
     default=1,
     show_default=True,
     help="--gravity: parts that may be held per step, the moved one included.",
@@ -523,7 +563,7 @@ def _gravity(
 )
 @click.option(
     "--max-steps",
-    type=click.IntRange(min=0),
+    type=_CountRange(min=0),
     default=None,
     help="Stop after this many steps; the parts not yet taken apart are listed as unfinished.",
 )
@@ -716,7 +756,7 @@ def demo_cmd(out: str, as_json: bool, tolerance: float | None, debug: bool) -> N
     default=None,
     help="Seconds allowed per assembly (more than 0).",
 )
-@click.option("--workers", type=click.IntRange(min=1), default=2, help="Assemblies run at once.")
+@click.option("--workers", type=_CountRange(min=1), default=2, help="Assemblies run at once.")
 @json_option
 @tolerance_option
 @debug_option
