@@ -535,6 +535,13 @@ def _gravity(
 )
 @click.option("--one-at-a-time", is_flag=True, help="Move one free set (a part) per step.")
 @click.option(
+    "--floating",
+    is_flag=True,
+    help="Plan free-floating: no ground under an input that stands on one [default: blocks "
+    "declared supports, or resting on the lowest plane of a block assembly, are fixed and "
+    "no part moves down through the plane under them].",
+)
+@click.option(
     "--join",
     nargs=2,
     multiple=True,
@@ -589,6 +596,7 @@ def plan_cmd(
     holds: int,
     fixed: tuple[str, ...],
     one_at_a_time: bool,
+    floating: bool,
     join: tuple[tuple[str, str], ...],
     join_interfering: bool,
     split_products: bool,
@@ -670,6 +678,7 @@ def plan_cmd(
                 one_at_a_time=one_at_a_time,
                 max_steps=max_steps,
                 fixed=fixed,
+                ground=not floating,
             )
             if html is not None:
                 from assemblykit.viz.viewer import write_report

@@ -358,6 +358,8 @@ def _disassembly_table(plan: Plan) -> Table:
         title += f", {fmt.count(plan.and_or.plans, 'possible order')}"
     if plan.gravity is not None:
         title += ", " + plan.gravity.summary()
+    if plan.ground:
+        title += f", on the ground under {fmt.name_list(plan.ground)}"
     table = Table(title=f"Disassembly plan ({title})")
     columns = ["step", "move", "direction", "motion", "away from"]
     if plan.gravity is not None:

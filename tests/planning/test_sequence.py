@@ -175,12 +175,18 @@ def assert_every_step_free(assembly: Assembly, result: Plan) -> None:
     translation (Wilson & Latombe 1992, "Extended translations"), each part against each
     part it leaves."""
     assert result.feasible, result.stuck
-    # every part but the first base moves at some step (a moved group may split later)
+    # every part but the first base, or the fixed parts, moves at some step (a moved
+    # group may split later)
     moved = set().union(*(step.parts for step in result.steps))
-    assert len(moved) == len(assembly.names) - 1
+    if result.fixed:
+        assert moved == set(assembly.names) - set(result.fixed)
+    else:
+        assert len(moved) == len(assembly.names) - 1
     tol = assembly.tolerance()
     for step in result.steps:
         assert np.isclose(np.linalg.norm(step.direction), 1.0)
+        # on the ground, nothing goes down through it
+        assert not result.ground or step.direction[2] >= -tol.angle
         for moving in step.parts:
             for rest in step.rest:
                 assert extended_free(assembly, [moving], step.direction, tol, [moving, rest]), (

@@ -393,4 +393,7 @@ def resolve_overlaps(
     for name, part in into.items():
         members.setdefault(part, []).append(name)
     prepared.joined = {part: tuple(names) for part, names in members.items()}
+    # a part joined to a support stands on the ground as the support did
+    grounded = {into.get(name, name) for name in assembly.supports}
+    prepared.supports = tuple(name for name in prepared.parts if name in grounded)
     return prepared

@@ -13,6 +13,9 @@ Parts are named by node key (assemblies) or list index (lists). COMPAS stores no
 
 The blocks' joints need not match exactly; the assembly records their largest mismatch
 as its measured precision (:func:`assemblykit.geometry.precision.joint_mismatch`).
+The blocks a node declares ``is_support`` are the assembly's supports, the ground it
+stands on; where none is declared, the blocks resting on its lowest plane are
+(:attr:`~assemblykit.model.assembly.Assembly.supports`, docs/planning.md, "The ground").
 """
 
 from __future__ import annotations
@@ -28,8 +31,12 @@ from assemblykit.errors import GeometryError, SchemaError
 from assemblykit.geometry.precision import joint_mismatch
 from assemblykit.io.documents import read_json, read_text
 from assemblykit.io.meshes import DEFAULT_UNITS, repaired
-from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.assembly import Assembly, Part, lowest_parts
 from assemblykit.tolerance import Tolerance
+
+DOWN = (0.0, 0.0, -1.0)
+"""Down for masonry blocks (+Z up, compas_assembly's convention): the ground a block
+assembly stands on, when it declares no support, is its lowest plane across it."""
 
 DTYPES = frozenset(
     {
@@ -100,10 +107,14 @@ def mesh_from_compas(
     return repaired(mesh, f"{source}: {where}", notes)
 
 
-def _blocks(data: Any, source: str) -> list[tuple[str, Any, str]]:
-    """``(name, mesh payload, field path)`` for every block in a COMPAS document."""
+def _blocks(data: Any, source: str) -> list[tuple[str, Any, str, bool]]:
+    """``(name, mesh payload, field path, is_support)`` for every block in a COMPAS
+    document (a list of meshes declares no support)."""
     if isinstance(data, list):
-        return [(str(i), _payload(item, source, f"[{i}]"), f"[{i}]") for i, item in enumerate(data)]
+        return [
+            (str(i), _payload(item, source, f"[{i}]"), f"[{i}]", False)
+            for i, item in enumerate(data)
+        ]
     body = _payload(data, source)
     graph = (
         _payload(body.get("graph"), source, "graph")
@@ -119,7 +130,12 @@ def _blocks(data: Any, source: str) -> list[tuple[str, Any, str]]:
         if block is None:
             raise SchemaError("node has no block", source=source, where=f"node.{key}")
         where = f"node.{key}.block"
-        blocks.append((str(key), _payload(block, source, where), where))
+        support = node.get("is_support")
+        if support is not None and not isinstance(support, bool):
+            raise SchemaError(
+                f"is_support is {support!r}, not true or false", source=source, where=f"node.{key}"
+            )
+        blocks.append((str(key), _payload(block, source, where), where, bool(support)))
     return blocks
 
 
@@ -129,9 +145,10 @@ def load_compas(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     source = str(path)
     data = read_json(read_text(path, "COMPAS file"), source)
     notes: list[str] = []
+    blocks = _blocks(data, source)
     parts = [
         Part(name, mesh_from_compas(mesh, source, where, notes), source=source)
-        for name, mesh, where in _blocks(data, source)
+        for name, mesh, where, _ in blocks
     ]
     if not parts:
         raise GeometryError("no blocks", source=source)
@@ -144,4 +161,6 @@ def load_compas(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         warnings=notes,
     )
     assembly.precision = joint_mismatch(assembly, tol)
+    declared = [name for name, *_, support in blocks if support]
+    assembly.supports = tuple(declared) or lowest_parts(assembly, DOWN, assembly.tolerance())
     return assembly

@@ -124,6 +124,10 @@ class Assembly:
     ``overlaps`` lists the interfering pairs found and what was done about each
     (:class:`Overlap`; empty until :func:`assemblykit.geometry.overlaps.resolve_overlaps`),
     and ``joined`` the parts that were made one, by the name of the part they became.
+    ``supports`` are the parts the input stands on (docs/planning.md, "The ground"):
+    those it declares (COMPAS ``is_support``) or, for a block assembly that declares
+    none, those resting on its lowest plane; a plan keeps them and the ground plane under
+    them, with +Z up.
     ``memo`` is the slot where the geometry layer keeps what it computed from the parts
     (:class:`Derived`; ``None`` until it is asked).
     """
@@ -145,9 +149,12 @@ class Assembly:
         overlaps: Iterable[Overlap] = (),
         products: Mapping[str, Iterable[str]] | None = None,
         joined: Mapping[str, Iterable[str]] | None = None,
+        supports: Iterable[str] = (),
     ) -> None:
         items = parts.values() if isinstance(parts, Mapping) else parts
         self.parts: dict[str, Part] = {p.name: p for p in items}
+        wanted = set(supports)
+        self.supports = tuple(name for name in self.parts if name in wanted)
         self.groups: dict[str, tuple[str, ...]] = {
             group: kept
             for group, names in (groups or {}).items()
@@ -280,8 +287,8 @@ class Assembly:
     ) -> Self:
         """An assembly of ``parts`` (default: those of ``other``) with everything else
         taken from ``other``: units, source, policy, precision, what was skipped, the
-        warnings, groups, products, overlaps and joined parts; ``scale`` as given
-        (``None``: measured from the parts)."""
+        warnings, groups, products, overlaps, joined parts and supports (those among
+        ``parts``); ``scale`` as given (``None``: measured from the parts)."""
         return cls(
             other.parts.values() if parts is None else parts,
             units=other.units,
@@ -297,6 +304,7 @@ class Assembly:
             overlaps=other.overlaps,
             products=other.products,
             joined=other.joined,
+            supports=other.supports,
         )
 
     def _kept(self, parts: Iterable[Part], scale: float | None) -> Self:
@@ -352,4 +360,17 @@ class Assembly:
             },
             "skipped": [item.to_dict() for item in self.skipped],
             "warnings": list(self.warnings),
+            "supports": list(self.supports),
         }
+
+
+def lowest_parts(
+    assembly: Assembly, direction: NDArray[np.float64] | Iterable[float], tol: Tolerance
+) -> tuple[str, ...]:
+    """The parts touching the lowest plane across ``direction`` (gravity, or down): those
+    whose lowest point along it is the assembly's lowest, within the length tolerance."""
+    down = np.asarray(direction, dtype=np.float64)
+    depth = np.array([float((p.mesh.vertices @ down).max()) for p in assembly.parts.values()])
+    return tuple(
+        name for name, d in zip(assembly.names, depth, strict=True) if d >= depth.max() - tol.length
+    )

@@ -12,6 +12,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
+
 from assemblykit.blocking.directions import DirectionTable, bits, mask_of, union_of
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.polygons import PolygonAssembly
@@ -47,6 +49,10 @@ from assemblykit.planning.stability import (
 )
 from assemblykit.tolerance import Tolerance
 
+UP = (0.0, 0.0, 1.0)
+"""Up for an assembly planned on the ground (+Z, the convention of block assemblies):
+no step moves a part along a direction with a component against it."""
+
 
 def rigid_may_free(
     assembly: Assembly | PolygonAssembly, parts: Iterable[str], tol: Tolerance | None = None
@@ -72,6 +78,7 @@ def plan(
     one_at_a_time: bool = False,
     max_steps: int | None = None,
     fixed: Iterable[str] | None = None,
+    ground: bool = True,
 ) -> Plan:
     """Plan the disassembly of ``assembly`` by extended translations (Wilson & Latombe
     1992, "Extension and Variant"; docs/planning.md, "How a plan is found"): in what
@@ -101,6 +108,14 @@ def plan(
     plan stops when only they (and what cannot leave them) are left; ``order`` starts
     on them. Under gravity they are added to ``gravity.fixed``.
 
+    With ``ground``, an assembly that stands on the ground (its
+    :attr:`~assemblykit.model.assembly.Assembly.supports`: blocks declared supports, or
+    resting on the lowest plane of a block assembly) is planned on it (docs/planning.md,
+    "The ground"): the supports are fixed parts, and no step moves a part down through
+    the plane under them (no direction with a component along -Z; sliding along the
+    ground is allowed). Without, the assembly floats free. Under gravity the ground is
+    the lowest plane across gravity whatever this says.
+
     Parameters
     ----------
     assembly : Assembly or PolygonAssembly
@@ -123,6 +138,8 @@ def plan(
         Stop after this many steps.
     fixed : iterable of str, optional
         Parts that never move (a fixture, the ground).
+    ground : bool, default True
+        Plan an assembly that stands on the ground on it; ``False``: free-floating.
 
     Returns
     -------
@@ -155,7 +172,10 @@ def plan(
         raise InputError(f"max_steps must be 0 or more, not {max_steps}")
     tol = assembly.tolerance(tol)
     names = tuple(assembly.names)
-    declared = fixed_parts(assembly, fixed, gravity)
+    supports: tuple[str, ...] = ()
+    if ground and gravity is None and isinstance(assembly, Assembly):
+        supports = assembly.supports
+    declared = fixed_parts(assembly, [*(fixed or ()), *supports], gravity)
     if gravity is not None and declared:
         gravity = replace(gravity, fixed=declared)
     report: Progress = progress or (lambda stage, done, total: None)
@@ -184,13 +204,14 @@ def plan(
         (one_set,) if one_at_a_time else (),
         max_steps=max_steps,
         fixed=mask_of(k for k, name in enumerate(names) if name in declared),
+        up=np.array(UP) if supports else None,
     )
     if gravity is None:
         search.disassemble(mask_of(range(len(names))))
         result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, report)
     else:
         result = _plan_under_gravity(assembly, search, gravity, tol, max_and_or_parts, max_hands)
-    return replace(result, fixed=declared)
+    return replace(result, fixed=declared, ground=supports)
 
 
 def fixed_parts(

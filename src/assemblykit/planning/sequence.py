@@ -557,6 +557,10 @@ class Plan:
     fixed: tuple[str, ...] = ()
     """The parts declared fixed (docs/planning.md, "Fixed parts"): never moved, left
     in place by the plan, the first set of the assembly ``order``."""
+    ground: tuple[str, ...] = ()
+    """The parts the assembly was planned standing on (docs/planning.md, "The ground"):
+    the input's supports, among :attr:`fixed`, with the ground plane under them that no
+    step moves down through."""
 
     @property
     def feasible(self) -> bool:
@@ -628,6 +632,7 @@ class Plan:
             "overlaps": [overlap.to_dict() for overlap in self.overlaps],
             "joined": {name: list(members) for name, members in self.joined.items()},
             "fixed": list(self.fixed),
+            "ground": list(self.ground),
         }
 
     def __repr__(self) -> str:

@@ -66,6 +66,7 @@ from scipy.sparse.csgraph import connected_components
 from assemblykit import formatting as fmt
 from assemblykit.errors import InputError, NumericError
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.model.assembly import lowest_parts
 from assemblykit.tolerance import MIN_REL_LENGTH, Tolerance, order_key
 
 if TYPE_CHECKING:
@@ -206,16 +207,6 @@ class Equilibrium:
             "fixed": list(self.fixed),
             "would_fall": list(self.would_fall),
         }
-
-
-def lowest_parts(assembly: Assembly, direction: ArrayLike, tol: Tolerance) -> tuple[str, ...]:
-    """The parts touching the lowest plane across ``direction`` (gravity): those whose
-    lowest point along it is the assembly's lowest, within the length tolerance."""
-    down = np.asarray(direction, dtype=np.float64)
-    depth = np.array([float((p.mesh.vertices @ down).max()) for p in assembly.parts.values()])
-    return tuple(
-        name for name, d in zip(assembly.names, depth, strict=True) if d >= depth.max() - tol.length
-    )
 
 
 @dataclass(frozen=True, eq=False)
