@@ -47,7 +47,7 @@ def jobs() -> list[tuple[str, list[str]]]:
     arch = DATA / "compas_assembly" / "arch_assembly.json"
     stack = DATA / "compas_assembly" / "stack_assembly.json"
     found.append(("plan_arch", ["plan", str(arch)]))
-    found.append(("plan_arch_gravity_3", ["plan", str(arch), "--gravity", "--holds", "3"]))
+    found.append(("plan_arch_gravity_3", ["plan", str(arch), "--gravity", "--extra-holds", "2"]))
     found.append(("plan_stack_gravity", ["plan", str(stack), "--gravity"]))
     found.append(("plan_beam", ["plan", str(DATA / "asap_beam_assembly")]))
     # the first 20 steps of the cross vault under gravity (its whole plan, 183 steps and

@@ -6,6 +6,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from cli_runs import run
@@ -138,9 +139,21 @@ def test_plan_under_gravity_lists_holds_and_the_assembly_order(capsys, tmp_path)
     manifest = _leaning_pair(tmp_path)
     html = tmp_path / "pair.html"
     code, out, err = run(
-        capsys, "plan", str(manifest), "--json", "--gravity", "--holds", "2", "--html", str(html)
+        capsys,
+        "plan",
+        str(manifest),
+        "--json",
+        "--gravity",
+        "--extra-holds",
+        "1",
+        "--html",
+        str(html),
     )
     assert code == 0, err
+    # the deprecated count of holds, the grip included, gives the same plan and says so
+    code, again, said = run(capsys, "plan", str(manifest), "--json", "--gravity", "--holds", "2")
+    assert code == 0 and json.loads(again) == json.loads(out)
+    assert "--holds 2 is --extra-holds 1" in said
     page = html.read_text()
     assert "<h2>Assembly order</h2>" in page and "<th>stands</th>" in page
     data = json.loads(out)
@@ -150,9 +163,16 @@ def test_plan_under_gravity_lists_holds_and_the_assembly_order(capsys, tmp_path)
     assert {"parts", "direction", "motion", "held", "would_fall", "stability_margin"} <= set(first)
     assert set(first["held"]) == {"corbel_l", "corbel_r"}
     assert all(len(step["parts"]) == 1 for step in data["steps"])
+    assert data["gravity"]["holds"] == 2 and data["gravity"]["extra_holds"] == 1
     last = data["assembly_steps"][-1]
     assert last["parts"] == first["parts"] and set(last["held"]) == set(first["held"])
     assert last["direction"] == [-x + 0.0 for x in first["direction"]]
+    # each assembly step says whether it stands, as the step it reverses does
+    stands = [step["stands"] for step in data["steps"]]
+    assert [step["stands"] for step in data["assembly_steps"]] == stands[::-1]
+    code, out, _ = run(capsys, "plan", str(manifest), "--gravity", "--extra-holds", "1")
+    assert "no extra hold" not in out and "1 extra hold" in " ".join(out.split())
+    assert "unheld" in out
 
     code, out, _ = run(capsys, "plan", str(manifest), "--gravity", "0,0,-1", "--friction", "0.05")
     assert code == 0
@@ -182,8 +202,26 @@ def test_bad_gravity_options_are_one_line_and_exit_2(capsys, tmp_path, option, n
 
 
 def test_no_holds_at_all_is_bad_input(capsys, tmp_path):
-    code, _, err = run(capsys, "plan", str(_leaning_pair(tmp_path)), "--gravity", "--holds", "0")
+    manifest = str(_leaning_pair(tmp_path))
+    code, _, err = run(capsys, "plan", manifest, "--gravity", "--holds", "0")
     assert code == 2 and "--holds" in err
+    code, _, err = run(capsys, "plan", manifest, "--gravity", "--extra-holds", "-1")
+    assert code == 2 and "--extra-holds: -1 must be at least 0" in err
+    code, _, err = run(capsys, "plan", manifest, "--gravity", "--extra-holds", "1", "--holds", "2")
+    assert code == 2 and "give --extra-holds alone" in err
+
+
+def test_a_step_along_an_axis_names_it_and_keeps_the_exact_vector(capsys):
+    code, out, err = run(capsys, "plan", str(DEMO), "--json")
+    assert code == 0, err
+    data = json.loads(out)
+    for step in data["steps"] + data["assembly_steps"]:
+        direction = np.array(step["direction"])
+        axis = np.argmax(np.abs(direction))
+        along = np.abs(direction[axis]) > 1 - 1e-9
+        expected = ("+" if direction[axis] > 0 else "-") + "XYZ"[axis] if along else None
+        assert step["axis"] == expected
+    assert data["steps"][0]["axis"] == "+Z"
 
 
 @pytest.mark.parametrize("limit", [0, 1, 2])
@@ -198,3 +236,25 @@ def test_a_plan_stopped_at_its_step_limit_is_the_whole_plans_prefix(capsys, limi
     assert not prefix["feasible"] and prefix["stuck"] == [] and whole["unfinished"] == []
     left = whole["parts"] if limit == 0 else whole["steps"][limit - 1]["rest"]
     assert sorted(prefix["unfinished"]) == sorted(left)
+
+
+def test_an_assembly_that_does_not_stand_as_given_is_step_0(capsys, tmp_path):
+    # a unit cube on a unit cube, its centre 0.1 beyond the lower one's edge: it tips
+    # over before anything is moved (no friction holds it)
+    import trimesh
+
+    folder = tmp_path / "tipping"
+    folder.mkdir()
+    for name, low in (("bottom", (0.0, 0.0, 0.0)), ("top", (0.6, 0.0, 1.0))):
+        mesh = trimesh.creation.box(extents=(1, 1, 1))
+        mesh.apply_translation([c + 0.5 for c in low])
+        mesh.export(folder / f"{name}.obj")
+    code, out, err = run(capsys, "plan", str(folder), "--gravity", "--json")
+    assert code == 0, err
+    gravity = json.loads(out)["gravity"]
+    assert gravity["stands"] is False and gravity["would_fall"] == ["top"]
+    assert gravity["tips"] is True and gravity["friction_needed"] is None
+    code, out, err = run(capsys, "plan", str(folder), "--gravity")
+    assert code == 0, err
+    first = next(line for line in out.splitlines() if line.startswith("│ 0 "))
+    assert "as given" in first and "top" in first and "tips" in first

@@ -447,6 +447,18 @@ def _multi_move_plan(
     )
 
 
+def _holds(extra: int | None, holds: int | None) -> int:
+    """The holds of a step under gravity, the grip of the moved part included, from
+    ``--extra-holds`` (the others) or the deprecated ``--holds`` (all of them), which
+    says what to write instead."""
+    if holds is None:
+        return 1 + (extra or 0)
+    if extra is not None:
+        raise InputError("--holds and --extra-holds say the same: give --extra-holds alone")
+    note(f"assemblykit: --holds is deprecated; --holds {holds} is --extra-holds {holds - 1}")
+    return holds
+
+
 def _gravity(
     direction: str | None, friction: float, holds: int, fixed: tuple[str, ...]
 ) -> Gravity | None:
@@ -521,11 +533,17 @@ def _gravity(
     help="--gravity: Coulomb friction coefficient of every contact.",
 )
 @click.option(
+    "--extra-holds",
+    type=_CountRange(min=0),
+    default=None,
+    help="--gravity: parts that may be held during a step besides the moved one, which "
+    "its grip holds [default: 0, what remains stands alone].",
+)
+@click.option(
     "--holds",
     type=_CountRange(min=1),
-    default=1,
-    show_default=True,
-    help="--gravity: parts that may be held per step, the moved one included.",
+    default=None,
+    help="Deprecated: the holds counting the grip, --extra-holds K-1.",
 )
 @click.option(
     "--fixed",
@@ -593,7 +611,8 @@ def plan_cmd(
     solution: int,
     gravity: str | None,
     friction: float,
-    holds: int,
+    extra_holds: int | None,
+    holds: int | None,
     fixed: tuple[str, ...],
     one_at_a_time: bool,
     floating: bool,
@@ -674,7 +693,7 @@ def plan_cmd(
                 tol=tol,
                 progress=update,
                 max_hands=max_hands,
-                gravity=_gravity(gravity, friction, holds, fixed),
+                gravity=_gravity(gravity, friction, _holds(extra_holds, holds), fixed),
                 one_at_a_time=one_at_a_time,
                 max_steps=max_steps,
                 fixed=fixed,

@@ -337,15 +337,21 @@ def _overlap_table(plan: Plan) -> Table:
 
 def _assembly_table(plan: Plan) -> Table:
     table = Table(title="Assembly order")
-    for column in ("step", "insert", "direction", "held"):
+    columns = ["step", "insert", "direction", "held"]
+    if plan.gravity is not None:
+        columns.append("stands")
+    for column in columns:
         table.add_column(column)
     for number, step in enumerate(plan.assembly_steps, start=1):
-        table.add_row(
+        cells = [
             str(number),
             ", ".join(step.parts),
             fmt.direction(step.direction),
             fmt.name_list(step.held),
-        )
+        ]
+        if step.stands is not None:
+            cells.append("yes" if step.stands else "no")
+        table.add_row(*cells)
     return table
 
 
@@ -363,9 +369,12 @@ def _disassembly_table(plan: Plan) -> Table:
     table = Table(title=f"Disassembly plan ({title})")
     columns = ["step", "move", "direction", "motion", "away from"]
     if plan.gravity is not None:
-        columns += ["held", "would fall", "friction needed"]
+        columns += ["held", "would fall unheld", "friction needed"]
     for column in columns:
         table.add_column(column)
+    if plan.gravity is not None and not plan.gravity.whole.stands:
+        # the assembly as given does not stand: step 0 says what falls before any move
+        table.add_row("0", "-", "-", "as given", "-", *plan.gravity.cells())
     for number, step in enumerate(plan.steps, start=1):
         cells = [
             str(number),

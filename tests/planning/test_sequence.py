@@ -163,6 +163,7 @@ def test_exploded_offsets_push_earlier_parts_further():
     assert data["steps"][0] == {
         "parts": ["c"],
         "direction": [0.0, 0.0, 1.0],
+        "axis": "+Z",
         "motion": "translation",
         "rest": ["a", "b"],
         "blocking": [["b", "c"]],

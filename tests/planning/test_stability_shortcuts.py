@@ -16,6 +16,7 @@ from assemblykit.io.assembly import load_assembly
 from assemblykit.planning import stability
 from assemblykit.planning.stability import (
     CONE_SIDES,
+    FRICTION_STEPS,
     EquilibriumModel,
     contact_points,
     equilibrium_model,
@@ -60,6 +61,17 @@ def answers(model: EquilibriumModel, states: list[set[str]]) -> list[tuple]:
     return out
 
 
+def assert_same(found: list[tuple], expected: list[tuple]) -> None:
+    """The same parts fall, and the friction needed is the same within the resolution
+    of the search (what a balance needs depends on the points it has: with more, a
+    balance may need less)."""
+    assert [falls for falls, _ in found] == [falls for falls, _ in expected]
+    for (_, need), (_, other) in zip(found, expected, strict=True):
+        assert (need is None) is (other is None)
+        if need is not None:
+            assert abs(need - other) < MU / 2**FRICTION_STEPS
+
+
 CASES = [
     (overhanging_stack(0.4), [{"bottom", "middle", "top"}]),
     (overhanging_stack(0.6), [{"bottom", "middle", "top"}, {"bottom", "middle"}]),
@@ -89,7 +101,7 @@ def test_vertices_between_their_neighbours_are_left_out_with_the_same_answers(
         assert np.array_equal(found.points[found.corners], plain.points)
         model = equilibrium_model(assembly, friction=MU)
         assert model.normal_part.shape[1] == len(found.points) * CONE_SIDES
-        assert answers(model, states) == expected
+        assert_same(answers(model, states), expected)
         # and the programs with every midpoint agree
         patch.setattr(
             stability,
@@ -98,7 +110,7 @@ def test_vertices_between_their_neighbours_are_left_out_with_the_same_answers(
         )
         full = equilibrium_model(assembly, friction=MU)
         assert full.corners.all() and not model.corners.all()
-        assert answers(full, states) == expected
+        assert_same(answers(full, states), expected)
 
 
 def test_a_vertex_off_the_segment_is_kept():

@@ -289,15 +289,15 @@ def _plan_under_gravity(
     result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
     whole = model.check()
     present = model.mask(None)
+    needed = model.friction_needed(present, present & judge.fixed, model.mask(whole.would_fall))
     return replace(
         result,
         gravity=GravityReport(
             settings=gravity,
             fixed=model.fixed,
             whole=whole,
-            friction_needed=model.friction_needed(
-                present, present & judge.fixed, model.mask(whole.would_fall)
-            ),
+            friction_needed=needed,
+            tips=needed is None and model.tips(present, present & judge.fixed),
             stable=whole.stands
             and all(step.stability is None or step.stability.stands for step in search.steps),
         ),

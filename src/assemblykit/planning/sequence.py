@@ -370,8 +370,9 @@ class Step:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form (docs/planning.md, "JSON"): ``parts``, ``direction``, ``motion``,
-        ``rest``, ``blocking``, ``together`` (the moved parts hold one another: one rigid
+        """JSON form (docs/planning.md, "JSON"): ``parts``, ``direction`` (and ``axis``,
+        its name when it lies along a coordinate axis), ``motion``, ``rest``,
+        ``blocking``, ``together`` (the moved parts hold one another: one rigid
         group) and, when they do not, ``moves`` (the sets that do, in an order they may
         leave one after another: :func:`~assemblykit.planning.multimove.moving_groups`)."""
         groups = moving_groups(self.parts, self.blocking)
@@ -380,6 +381,7 @@ class Step:
         return {
             "parts": list(self.parts),
             "direction": direction,
+            "axis": fmt.axis_name(self.direction),
             "motion": self.motion,
             "rest": list(self.rest),
             "blocking": [list(arc) for arc in self.blocking],
@@ -596,6 +598,7 @@ class Plan:
                 onto=step.rest,
                 held=step.parts if step.stability is None else step.stability.held,
                 reverses=len(self.steps) - k,
+                stands=None if step.stability is None else step.stability.stands,
             )
             for k, step in enumerate(reversed(self.steps))
         )
@@ -670,22 +673,28 @@ class AssemblyStep:
     """One assembly step, the disassembly step ``reverses`` (1-based) run backwards:
     ``parts`` are inserted along unit ``direction`` (minus the removal direction) onto
     ``onto`` while ``held`` are held (the inserted parts, and under gravity the parts
-    that would fall otherwise)."""
+    that would fall otherwise); under gravity ``stands`` says whether the states of the
+    step stand with those holds (``None`` otherwise)."""
 
     parts: tuple[str, ...]
     direction: NDArray[np.float64]
     onto: tuple[str, ...]
     held: tuple[str, ...]
     reverses: int
+    stands: bool | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``parts``, ``direction``, ``onto``, ``held``, ``reverses``."""
+        """JSON form: ``parts``, ``direction`` (and ``axis``, its name when it lies along
+        a coordinate axis: :func:`~assemblykit.formatting.axis_name`), ``onto``, ``held``,
+        ``reverses`` and, under gravity, ``stands``."""
         return {
             "parts": list(self.parts),
             "direction": [float(x) + 0.0 for x in self.direction],
+            "axis": fmt.axis_name(self.direction),
             "onto": list(self.onto),
             "held": list(self.held),
             "reverses": self.reverses,
+            **({} if self.stands is None else {"stands": self.stands}),
         }
 
 

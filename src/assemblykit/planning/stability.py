@@ -45,8 +45,10 @@ asks about states that differ by a block, a hold or the friction coefficient fro
 already decided: the balances and Farkas certificates found before answer many of them
 with no program, or from a few parts' equations (:meth:`EquilibriumModel.stands`).
 Loads are homogeneous in rigid-block equilibrium (scaling gravity scales every force),
-so the margin reported is the least friction coefficient with which the state stands,
-to a resolution of ``mu / 32`` (:meth:`EquilibriumModel.friction_needed`).
+so the margin reported is the friction coefficient a balance of the state needs, less
+than ``mu / 32`` above the least one (:meth:`EquilibriumModel.friction_needed`); a state
+that falls is told apart by whether it tips over, falling even with unbounded friction
+(:meth:`EquilibriumModel.tips`), or slides.
 """
 
 from __future__ import annotations
@@ -174,12 +176,19 @@ class Gravity:
     fixed: tuple[str, ...] | None = None
     densities: tuple[tuple[str, float], ...] = ()
 
+    @property
+    def extra_holds(self) -> int:
+        """The holds beyond the grip of the moved parts: ``holds - 1``."""
+        return self.holds - 1
+
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``direction``, ``friction``, ``holds``."""
+        """JSON form: ``direction``, ``friction``, ``holds`` (the grip included) and
+        ``extra_holds`` (beyond it)."""
         return {
             "direction": [float(x) + 0.0 for x in self.direction],
             "friction": self.friction,
             "holds": self.holds,
+            "extra_holds": self.extra_holds,
         }
 
 
@@ -535,8 +544,8 @@ class EquilibriumModel:
     parts and the friction coefficient (at most :data:`KEPT_RESIDUALS`, the oldest
     forgotten first)."""
     _needed: list[int] = field(default_factory=list, repr=False, init=False)
-    """The last answer of :meth:`friction_needed`, in steps of its resolution, where its
-    next search starts (none yet: at ``friction``)."""
+    """The upper end of :meth:`friction_needed`'s last bracket, in steps of its
+    resolution, where its next search starts (none yet: at ``friction``)."""
 
     def __post_init__(self) -> None:
         self._index.update({name: i for i, name in enumerate(self.names)})
@@ -560,7 +569,8 @@ class EquilibriumModel:
 
     @property
     def resolution(self) -> float:
-        """The step of :meth:`friction_needed`'s answers: ``friction / 2**FRICTION_STEPS``."""
+        """The width of :meth:`friction_needed`'s last bracket:
+        ``friction / 2**FRICTION_STEPS``."""
         return self.friction / 2**FRICTION_STEPS
 
     def mask(self, names: Iterable[str] | None) -> NDArray[np.bool_]:
@@ -859,44 +869,157 @@ class EquilibriumModel:
         fixed: NDArray[np.bool_],
         falls: NDArray[np.bool_] | None = None,
     ) -> float | None:
-        """The least friction coefficient, within ``friction / 2**FRICTION_STEPS`` (the
-        upper end of a bisection: one with which the state is shown to stand), with
-        which ``present`` stands; ``None`` when ``friction`` itself does not suffice.
-        ``falls``: :meth:`falling` at ``friction``, when already known.
+        """A friction coefficient with which ``present`` is shown to stand, less than
+        ``friction / 2**FRICTION_STEPS`` (:attr:`resolution`) above the least one and
+        never above the least multiple of the resolution with which it stands; ``None``
+        when ``friction`` itself does not suffice. ``falls``: :meth:`falling` at
+        ``friction``, when already known.
 
         Standing is monotone in the friction coefficient (a larger pyramid holds every
-        force a smaller one does), so the answer is the least multiple ``k`` of the
-        resolution at which the state stands (0 when it stands without friction), what
-        bisection over ``[0, friction]`` finds. The search starts from the answer last
-        found: consecutive states of a plan mostly need the same friction, which two
-        programs then confirm; else it gallops away from it, then bisects."""
+        force a smaller one does), so a bracket of multiples of the resolution holds the
+        least one: a probe that falls raises its lower end; one that stands lowers its
+        upper end to the multiple just above what the balance that showed it needs
+        (:meth:`_carrying`), and keeps that need. The search ends when the bracket is
+        one step wide, and answers what the last balance found needs once its
+        tangential forces are spread (:meth:`_spread_friction`, one more program): a
+        balance stands with it, and the least one is above the lower end; 0 when the
+        state stands without friction. It starts at the upper end of the last bracket:
+        consecutive states of a plan mostly need the same friction, which two programs
+        then confirm (a probe there, mostly decided by the balance the state's own
+        verdict found there, :meth:`stands`, and one a step below what its balance
+        needs); else it gallops away from it, then bisects (docs/planning.md, "Under
+        gravity")."""
         if (self.falling(present, fixed) if falls is None else falls).any():
             return None
-        grid = 2**FRICTION_STEPS
+        free = present & ~fixed
+        if not free.any() or self.friction == 0:
+            return 0.0
+        grid, step = 2**FRICTION_STEPS, self.resolution
+        low, high = -1, grid
+        shown: list[float] = []
 
         def stands(k: int) -> bool:
-            return k == grid or self.stands(present, fixed, k * self.resolution)
+            """Probe ``k`` steps: narrow the bracket, keep what a balance needs, and say
+            whether the state stands. With ``friction`` it stands (``falls`` names no
+            part there) even should the first program find no balance within its
+            tolerance."""
+            nonlocal low, high
+            mu = k * step
+            if self.stands(present, fixed, mu):
+                shown[:] = [min(mu, self._carrying(free)[1])]
+                # the least multiple not below what the balance needs
+                above = math.ceil(shown[0] / step)
+                high = min(high, above + (above * step < shown[0]))
+                return True
+            if k < grid:
+                low = k
+                return False
+            return True
 
-        guess = self._needed[0] if self._needed else grid
         reach = 1
-        if stands(guess):
-            high, low = guess, guess - 1
-            while low >= 0 and stands(low):
-                high, reach = low, 2 * reach
-                low = max(high - reach, -1)
+        if stands(self._needed[0] if self._needed else grid):
+            while high - low > 1 and stands(max(high - reach, 0)):
+                reach *= 2
         else:
-            low, high = guess, min(guess + 1, grid)
-            while not stands(high):
-                low, reach = high, 2 * reach
-                high = min(low + reach, grid)
+            while high - low > 1 and not stands(min(low + reach, grid)):
+                reach *= 2
         while high - low > 1:
-            middle = (low + high) // 2
-            if stands(middle):
-                high = middle
-            else:
-                low = middle
+            stands((low + high) // 2)
         self._needed[:] = [high]
-        return high * self.resolution
+        if not shown:
+            return self.friction
+        return min(shown[0], self._spread_friction(free)) if shown[0] > 0 else 0.0
+
+    def _carrying(self, free: NDArray[np.bool_]) -> tuple[NDArray[np.bool_], float]:
+        """The points of the balance :meth:`stands` found last (the first kept, after it
+        answers that the state stands) that carry force on a ``free`` part (normal
+        force beyond :data:`LP_FEASIBILITY` of the largest), and the friction
+        coefficient that balance needs: the largest ratio of their pyramid gauge to
+        their normal force."""
+        forces, gauge = self._balances[0]
+        normal = forces[:, 0]
+        carrying = self._acting_on(free) & (normal > LP_FEASIBILITY * normal.max(initial=0.0))
+        return carrying, float(np.max(gauge[carrying] / normal[carrying], initial=0.0))
+
+    def _spread_friction(self, free: NDArray[np.bool_]) -> float:
+        """The least friction coefficient of a balance of the ``free`` parts with the
+        normal forces of the one :meth:`stands` found last (:meth:`_carrying`), its
+        tangential forces spread over the points carrying force so that the largest
+        ratio of gauge to normal force is least: with the normal forces fixed, the
+        linear program "minimise ``s`` with every gauge at most ``s N``, the equations
+        of the free parts balanced", solved by Clarabel. Its balance, checked
+        (residuals within :data:`LP_FEASIBILITY`, the ratio read again from its
+        forces), is kept first in place of the one it improves (it fits every
+        coefficient that one fits, and more); should it not check out, what the balance
+        found needs is the answer. A block on a slope of ``tan 20° = 0.364`` balanced
+        with ``mu = 0.5`` needs 0.41 at its lower corners, where the weight presses
+        most; spread evenly, every corner needs 0.364."""
+        import clarabel
+
+        carrying, found = self._carrying(free)
+        if found == 0.0:
+            return found
+        forces = self._balances[0][0]
+        normal = forces[:, 0]
+        rows = self._rows(free)
+        wrench_n, wrench_u, wrench_v = (m[rows] for m in self._point_wrenches)
+        rest = forces * ~carrying[:, None]
+        rhs = -self.load[rows] - wrench_n @ normal - wrench_u @ rest[:, 1] - wrench_v @ rest[:, 2]
+        count = int(carrying.sum())
+        half = np.pi / CONE_SIDES
+        cos, sin = _cone_directions(half)
+        # unknowns: u and v of each carrying point's tangential force, then s; per point
+        # and pyramid side, (side normal . tangent) / cos(pi / S) - s N <= 0
+        constraints = sp.bmat(
+            [
+                [wrench_u[:, carrying], wrench_v[:, carrying], None],
+                [
+                    sp.kron(sp.identity(count), cos[:, None] / math.cos(half)),
+                    sp.kron(sp.identity(count), sin[:, None] / math.cos(half)),
+                    -np.repeat(normal[carrying], CONE_SIDES)[:, None],
+                ],
+            ],
+            format="csc",
+        )
+        settings = clarabel.DefaultSettings()
+        settings.verbose = False
+        settings.time_limit = LP_TIME_LIMIT
+        solved = clarabel.DefaultSolver(
+            sp.csc_matrix((2 * count + 1, 2 * count + 1)),
+            np.r_[np.zeros(2 * count), 1.0],
+            constraints,
+            np.r_[rhs, np.zeros(count * CONE_SIDES)],
+            [clarabel.ZeroConeT(len(rows)), clarabel.NonnegativeConeT(count * CONE_SIDES)],
+            settings,
+        ).solve()
+        spread = forces.copy()
+        spread[carrying, 1:] = np.asarray(solved.x[: 2 * count]).reshape(2, count).T
+        spread_gauge = _gauge(spread[:, 1:])
+        least = float(np.max(spread_gauge[carrying] / normal[carrying], initial=0.0))
+        # NaN where the solver gave up: not less
+        if not least < found or self._unbalanced(spread, free).any():
+            return found
+        self._balances[0] = (spread, spread_gauge)
+        return least
+
+    def tips(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> bool:
+        """Whether ``present`` falls with ``fixed`` immobile even with unbounded friction:
+        whether no compressive normal forces (``N >= 0``) with free tangential forces,
+        at the corners of its points (:meth:`stands`), balance every free part (one
+        program, :func:`balance`: columns the normal wrench of each point and its ``u``
+        and ``v`` wrenches of both signs). A state that falls but not then needs more
+        friction than it has (it slides); one that falls even then tips over, as does
+        one with free parts and no contact (docs/planning.md, "Under gravity")."""
+        free = present & ~fixed
+        if not free.any():
+            return False
+        selected = self._touching(present) & self.corners
+        if not selected.any():
+            return True
+        rows = self._rows(free)
+        normal, along_u, along_v = (m[rows][:, selected] for m in self._point_wrenches)
+        matrix = sp.hstack([normal, along_u, -along_u, along_v, -along_v], format="csc")
+        return not balance(matrix, -self.load[rows]).found
 
 
 def equilibrium_model(
@@ -983,6 +1106,14 @@ def equilibrium(
     return model.check(held=held)
 
 
+def _friction_cell(needed: float | None, tips: bool) -> str:
+    """The friction needed as a table cell: the coefficient, or when ``friction`` does
+    not suffice "tips" (no friction would hold it) or "more than μ" (more would)."""
+    if needed is not None:
+        return f"{needed:.3f}"
+    return "tips" if tips else "more than μ"
+
+
 @dataclass(frozen=True)
 class StepStability:
     """A disassembly step under gravity: ``held`` are the parts held during it (one grip
@@ -1003,6 +1134,10 @@ class StepStability:
     holds beyond the grips): how far beyond :attr:`threshold` the fall is."""
     threshold: float = 0.0
     """The residual beyond which a part falls (the model's tolerance)."""
+    tips: bool = False
+    """When ``friction`` does not suffice: whether a state of the step falls even with
+    unbounded friction (it tips over; otherwise it slides: more friction would hold it,
+    :meth:`EquilibriumModel.tips`)."""
 
     @property
     def margin(self) -> float | None:
@@ -1012,9 +1147,10 @@ class StepStability:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON keys added to a step: ``held``, ``would_fall``, ``stands``,
-        ``friction_needed``, ``stability_margin`` (the friction that may be lost), and for
+        ``friction_needed``, ``stability_margin`` (the friction that may be lost), for
         a step that does not stand ``unbalanced`` with the ``fall_threshold`` it is
-        compared to (how far the verdict is from the solver's tolerance)."""
+        compared to (how far the verdict is from the solver's tolerance), and ``tips``
+        (:attr:`tips`)."""
         return {
             "held": list(self.held),
             "would_fall": list(self.would_fall),
@@ -1023,13 +1159,15 @@ class StepStability:
             "stability_margin": self.margin,
             "unbalanced": self.unbalanced,
             "fall_threshold": self.threshold,
+            "tips": self.tips,
         }
 
     def cells(self) -> list[str]:
-        """Table cells: held, would fall, friction needed; long lists of parts cut to
-        their first names and how many more, as the plan's "away from" cells are
+        """Table cells: held, would fall, friction needed ("tips" when no friction
+        holds a state, "more than μ" when more would); long lists of parts cut to their
+        first names and how many more, as the plan's "away from" cells are
         (docs/planning.md, "Under gravity")."""
-        needed = "more than μ" if self.friction_needed is None else f"{self.friction_needed:.3f}"
+        needed = _friction_cell(self.friction_needed, self.tips)
         return [fmt.name_list(self.held), fmt.name_list(self.would_fall) or "-", needed]
 
 
@@ -1044,22 +1182,33 @@ class GravityReport:
     whole: Equilibrium
     friction_needed: float | None
     stable: bool
+    tips: bool = False
+    """When ``friction`` does not suffice for the whole assembly: whether it falls even
+    with unbounded friction (:meth:`EquilibriumModel.tips`)."""
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: the settings, ``fixed``, ``stable``, ``stands`` and ``would_fall``
-        (of the whole assembly) and its ``friction_needed``."""
+        """JSON form: the settings, ``fixed``, ``stable``, ``stands``, ``would_fall``
+        and ``tips`` (of the whole assembly) and its ``friction_needed``."""
         return {
             **self.settings.to_dict(),
             "fixed": list(self.fixed),
             "stable": self.stable,
             "stands": self.whole.stands,
             "would_fall": list(self.whole.would_fall),
+            "tips": self.tips,
             "friction_needed": self.friction_needed,
         }
 
+    def cells(self) -> list[str]:
+        """Table cells of the whole assembly as given, as :meth:`StepStability.cells`
+        has them: nothing held, the parts that would fall, the friction needed."""
+        needed = _friction_cell(self.friction_needed, self.tips)
+        return ["-", fmt.name_list(self.whole.would_fall) or "-", needed]
+
     def summary(self) -> str:
         """One phrase for a table title."""
-        holds = f"{self.settings.holds} hold{'s' if self.settings.holds > 1 else ''}"
+        extra = self.settings.extra_holds
+        holds = "no extra hold" if extra == 0 else fmt.count(extra, "extra hold")
         verdict = "every state stands" if self.stable else "some states fall"
         return f"gravity, μ = {self.settings.friction:g}, {holds}: {verdict}"
 
@@ -1227,14 +1376,21 @@ class StateJudge:
         return [min(self.ordered(sets), key=lambda m: int(self.assess(members, m).falls.sum()))]
 
     def judge(self, members: int, moved: int) -> StepStability:
-        """The step's stability, with the least friction its states need."""
+        """The step's stability, with the least friction its states need and, when
+        ``friction`` does not suffice, whether one of them tips over (one program per
+        state that falls: :meth:`EquilibriumModel.tips`)."""
         found = self.assess(members, moved)
         names = self.model.names
-        needed: list[float | None] = [
+        states = [(present, fixed) for present, fixed in found.states if (present & ~fixed).any()]
+        needed = [
             self.model.friction_needed(present, fixed, self.falling(present, fixed))
-            for present, fixed in found.states
-            if (present & ~fixed).any()
+            for present, fixed in states
         ]
+        tips = any(
+            self.model.tips(present, fixed)
+            for (present, fixed), need in zip(states, needed, strict=True)
+            if need is None
+        )
         return StepStability(
             held=tuple(names[i] for i in np.flatnonzero(found.held)),
             would_fall=tuple(names[i] for i in np.flatnonzero(found.falls)),
@@ -1243,4 +1399,5 @@ class StateJudge:
             friction=self.model.friction,
             unbalanced=None if found.stands else float(found.residuals.max()),
             threshold=self.model.threshold,
+            tips=tips,
         )
