@@ -254,7 +254,11 @@ def test_an_assembly_that_does_not_stand_as_given_is_step_0(capsys, tmp_path):
     gravity = json.loads(out)["gravity"]
     assert gravity["stands"] is False and gravity["would_fall"] == ["top"]
     assert gravity["tips"] is True and gravity["friction_needed"] is None
-    code, out, err = run(capsys, "plan", str(folder), "--gravity")
+    page = tmp_path / "tipping.html"
+    code, out, err = run(capsys, "plan", str(folder), "--gravity", "--html", str(page))
     assert code == 0, err
     first = next(line for line in out.splitlines() if line.startswith("│ 0 "))
     assert "as given" in first and "top" in first and "tips" in first
+    shown = page.read_text()
+    assert "<td>0</td><td>-</td><td>-</td><td>as given</td>" in shown
+    assert "<th>would fall unheld</th>" in shown and "<td>tips</td>" in shown

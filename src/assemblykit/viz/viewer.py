@@ -510,18 +510,27 @@ def caption(number: int, plan: Plan, tol: Tolerance | None = None) -> str:
 
 
 def _step_table(plan: Plan, tol: Tolerance | None) -> str:
-    headers = ("step", "move", "direction", "motion", "away from", "held in place")
+    """The steps; under gravity also the parts held, those that would fall unheld and
+    the friction needed, after a step 0 when the assembly as given does not stand."""
+    headers = ["step", "move", "direction", "motion", "away from", "held in place"]
+    if plan.gravity is not None:
+        headers += ["held", "would fall unheld", "friction needed"]
     head = "".join(f"<th>{h}</th>" for h in headers)
     rows = []
+    if plan.gravity is not None and not plan.gravity.whole.stands:
+        start = ["0", "-", "-", "as given", "-", "-", *plan.gravity.cells()]
+        rows.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in start) + "</tr>")
     for number, step in enumerate(plan.steps, start=1):
-        cells = (
+        cells = [
             str(number),
             _names_cell(step.parts),
             html.escape(fmt.direction(step.direction, tol)),
             html.escape(step.motion),
             _names_cell(step.rest, folded=True),
             _names_cell(_held(step)),
-        )
+        ]
+        if step.stability is not None:
+            cells += [html.escape(c) for c in step.stability.cells()]
         rows.append(
             f'<tr class="step" data-step="{number}">'
             + "".join(f"<td>{c}</td>" for c in cells)
