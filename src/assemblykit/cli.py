@@ -87,35 +87,55 @@ def _option_fault(message: str, param: click.Parameter | None) -> NoReturn:
     raise InputError(message, where=option)
 
 
-def _outside(number: float, bounds: click.FloatRange | click.IntRange) -> str | None:
-    """What ``number`` misses of ``bounds``, in words ("must be at least 1"), or
-    ``None`` when it is inside."""
-    low, high = bounds.min, bounds.max
-    if low is not None and (number <= low if bounds.min_open else number < low):
-        return f"must be {'more than' if bounds.min_open else 'at least'} {low:g}"
-    if high is not None and (number >= high if bounds.max_open else number > high):
-        return f"must be {'less than' if bounds.max_open else 'at most'} {high:g}"
-    return None
+class _BadInput:
+    """What a range of :func:`_option_fault` faults shares: a value typed on the command
+    line is first read as a number (``parse``: it is ``what``, else one line says it is
+    not) and checked against the range in words (:meth:`outside`), before click's own
+    conversion, whose words name its types ("not a valid float range", "x>=0")."""
 
-
-class _OptionRange(click.FloatRange):
-    """A number in a range whose faults are bad input (:func:`_option_fault`)."""
+    parse: Callable[[str], float]
+    what: str
+    min: Any
+    max: Any
+    min_open: bool
+    max_open: bool
 
     def fail(
         self, message: str, param: click.Parameter | None = None, ctx: click.Context | None = None
     ) -> NoReturn:
         _option_fault(message, param)
 
+    def outside(self, number: float) -> str | None:
+        """What ``number`` misses of the range, in words ("must be at least 1"), or
+        ``None`` when it is inside."""
+        low, high = self.min, self.max
+        if low is not None and (number <= low if self.min_open else number < low):
+            return f"must be {'more than' if self.min_open else 'at least'} {low:g}"
+        if high is not None and (number >= high if self.max_open else number > high):
+            return f"must be {'less than' if self.max_open else 'at most'} {high:g}"
+        return None
+
+    def checked(self, value: Any, param: click.Parameter | None) -> None:
+        """Fail on a typed ``value`` that is not a number or lies outside the range."""
+        if not isinstance(value, str):
+            return
+        try:
+            number = self.parse(value)
+        except ValueError:
+            self.fail(f"{value!r} is not {self.what}", param)
+        missed = self.outside(number)
+        if missed is not None:
+            self.fail(f"{value} {missed}", param)
+
+
+class _OptionRange(_BadInput, click.FloatRange):
+    """A number in a range whose faults are bad input (:class:`_BadInput`)."""
+
+    parse = float
+    what = "a number"
+
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
-        if isinstance(value, str):
-            try:
-                float(value)
-            except ValueError:
-                # click's own words ("not a valid float range") name its type, not the value
-                self.fail(f"{value!r} is not a number", param, ctx)
-            missed = _outside(float(value), self)
-            if missed is not None:
-                self.fail(f"{value} {missed}", param, ctx)
+        self.checked(value, param)
         number = super().convert(value, param, ctx)
         if number != number:  # NaN passes every range comparison
             self.fail(f"{value!r} is not a number", param, ctx)
@@ -124,24 +144,14 @@ class _OptionRange(click.FloatRange):
         return number
 
 
-class _CountRange(click.IntRange):
-    """A whole number in a range whose faults are bad input (:func:`_option_fault`)."""
+class _CountRange(_BadInput, click.IntRange):
+    """A whole number in a range whose faults are bad input (:class:`_BadInput`)."""
 
-    def fail(
-        self, message: str, param: click.Parameter | None = None, ctx: click.Context | None = None
-    ) -> NoReturn:
-        _option_fault(message, param)
+    parse = int
+    what = "a whole number"
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
-        if isinstance(value, str):
-            try:
-                int(value)
-            except ValueError:
-                # click's own words ("not a valid integer range") name its type
-                self.fail(f"{value!r} is not a whole number", param, ctx)
-            missed = _outside(int(value), self)
-            if missed is not None:
-                self.fail(f"{value} {missed}", param, ctx)
+        self.checked(value, param)
         return super().convert(value, param, ctx)
 
 

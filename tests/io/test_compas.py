@@ -10,24 +10,10 @@ from assemblykit.errors import SchemaError
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.compas import load_compas
+from compas_documents import box_mesh
 from datasets import dataset
 
-CUBE = {
-    "vertex": {
-        str(i): {"x": x, "y": y, "z": z}
-        for i, (x, y, z) in enumerate(
-            [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
-        )
-    },
-    "face": {
-        "0": [0, 3, 2, 1],
-        "1": [4, 5, 6, 7],
-        "2": [0, 1, 5, 4],
-        "3": [1, 2, 6, 5],
-        "4": [2, 3, 7, 6],
-        "5": [3, 0, 4, 7],
-    },
-}
+CUBE = box_mesh((0, 0, 0), (1, 1, 1))
 
 
 def lifted(dz: float) -> dict:

@@ -22,35 +22,15 @@ from assemblykit.geometry.overlaps import resolve_overlaps
 from assemblykit.io.assembly import load_assembly
 from assemblykit.planning.planner import plan
 from cli_runs import run
+from compas_documents import block
 from datasets import dataset
 from plan_checks import assert_steps_clear
 
-FACES = {
-    "0": [0, 3, 2, 1],
-    "1": [4, 5, 6, 7],
-    "2": [0, 1, 5, 4],
-    "3": [1, 2, 6, 5],
-    "4": [2, 3, 7, 6],
-    "5": [3, 0, 4, 7],
-}
 SCENE = {
     "leg_a": ((0, 0, 0), (1, 1, 2)),
     "leg_b": ((3, 0, 0), (4, 1, 2)),
     "slab": ((0, 0, 2), (4, 1, 3)),
 }
-
-
-def block(low: tuple[float, ...], high: tuple[float, ...]) -> dict:
-    """A COMPAS 2 block: the box between ``low`` and ``high``."""
-    corners = [(x, y, z) for z in (0, 1) for x, y in ((0, 0), (1, 0), (1, 1), (0, 1))]
-    vertex = {
-        str(i): {axis: (high if c[k] else low)[k] for k, axis in enumerate("xyz")}
-        for i, c in enumerate(corners)
-    }
-    return {
-        "dtype": "compas_assembly.datastructures/Block",
-        "data": {"vertex": vertex, "face": FACES},
-    }
 
 
 def compas_file(folder: Path, supports: dict[str, object] | None = None) -> Path:
