@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import math
 from pathlib import Path
@@ -224,11 +226,23 @@ def test_a_step_along_an_axis_names_it_and_keeps_the_exact_vector(capsys):
     assert data["steps"][0]["axis"] == "+Z"
 
 
+@pytest.fixture(scope="module")
+def demo_plan() -> dict:
+    """The whole plan of the demo gearbox, as ``plan --json`` prints it."""
+    from assemblykit.cli import main
+
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        try:
+            main(["plan", str(DEMO), "--json"])
+        except SystemExit as done:
+            assert not done.code
+    return json.loads(printed.getvalue())
+
+
 @pytest.mark.parametrize("limit", [0, 1, 2])
-def test_a_plan_stopped_at_its_step_limit_is_the_whole_plans_prefix(capsys, limit):
-    code, out, err = run(capsys, "plan", str(DEMO), "--json")
-    assert code == 0, err
-    whole = json.loads(out)
+def test_a_plan_stopped_at_its_step_limit_is_the_whole_plans_prefix(capsys, demo_plan, limit):
+    whole = demo_plan
     code, out, err = run(capsys, "plan", str(DEMO), "--max-steps", str(limit), "--json")
     assert code == 0, err
     prefix = json.loads(out)

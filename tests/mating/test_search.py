@@ -362,7 +362,8 @@ def _tilted(data: dict, tilt: float) -> dict:
     return tilted
 
 
-@pytest.mark.parametrize("tilt", [1e-8, 1e-6])
+# one tilt well within the angle tolerance in the default tier, one near it in the slow one
+@pytest.mark.parametrize("tilt", [1e-8, pytest.param(1e-6, marks=pytest.mark.slow)])
 def test_a_bore_tilted_within_the_angle_tolerance_mates_as_the_exact_one(
     example2_data: dict, tilt: float
 ) -> None:
