@@ -58,10 +58,9 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from assemblykit.algebra.se3 import axis_basis, line_classes
+from assemblykit.graphs import component_labels
 from assemblykit.model.surfaces import Surface, SurfaceKind
 from assemblykit.tolerance import Tolerance, current
 
@@ -111,11 +110,6 @@ class Segmentation:
         return self.order[self.start[g] : self.start[g + 1]]
 
 
-def _components(n: int, pairs: NDArray[np.int64]) -> NDArray[np.int64]:
-    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    return connected_components(graph, directed=False)[1].astype(np.int64)
-
-
 def segment(
     vertices: NDArray[np.float64],
     faces: NDArray[np.int64],
@@ -158,8 +152,8 @@ def segment(
     coplanar = both if strict else (surer <= tol.length) & ((cosine > 0) | thin)
     smooth = coplanar | (cosine >= np.cos(smooth_angle))
     n_faces = len(faces)
-    group = _components(n_faces, adjacency[coplanar])
-    region = _components(n_faces, adjacency[smooth])
+    group = component_labels(n_faces, adjacency[coplanar])
+    region = component_labels(n_faces, adjacency[smooth])
     n_regions = int(region.max()) + 1 if n_faces else 0
     curved = np.zeros(n_regions, dtype=bool)
     curved[region[f0[smooth & ~coplanar]]] = True
@@ -168,7 +162,7 @@ def segment(
         # a sliver thinner than the tolerance lies in both faces of an edge and would
         # join them: where a group is not flat, its faces keep their strict groups
         bent = planes[-1][group] > tol.length
-        strict_group = _components(n_faces, adjacency[both])
+        strict_group = component_labels(n_faces, adjacency[both])
         kept = np.unique(group[~bent])
         group = np.unique(np.where(bent, strict_group + n_faces, group), return_inverse=True)[1]
         planes = _regrouped(planes, kept, corners, normals, areas, group.astype(np.int64), bent)
@@ -587,14 +581,14 @@ def split_surfaces(
     pairs = np.column_stack([node[: len(adjacency)], node[len(adjacency) :]])
     # a face between two parallel rounded edges would join them: within each set of
     # joined groups, drop the groups much wider across the axis than the typical strip
-    label = _components(len(nodes), pairs)
+    label = component_labels(len(nodes), pairs)
     first = np.unique(cluster, return_index=True)[1]
     width = _widths(vertices, faces, seg, nodes[:, 0], axes[first[nodes[:, 1]]])
     typical = _medians(width, label)
     narrow = width <= STRIP_WIDTHS * typical
     kept = narrow[pairs[:, 0]] & narrow[pairs[:, 1]]
     adjacency, edges, axes, pairs = adjacency[kept], edges[kept], axes[kept], pairs[kept]
-    label = _components(len(nodes), pairs)[pairs[:, 0]]
+    label = component_labels(len(nodes), pairs)[pairs[:, 0]]
     claimed = np.zeros(len(faces), dtype=bool)
     found: list[Piece] = []
     candidates = _strip_candidates(vertices, faces, seg, tol, adjacency, edges, axes, label)
@@ -606,7 +600,7 @@ def split_surfaces(
             found.append(piece)
             claimed[ids] = True
     rest = ~claimed[adjacency[:, 0]] & ~claimed[adjacency[:, 1]]
-    label = _components(len(faces), adjacency[rest])
+    label = component_labels(len(faces), adjacency[rest])
     # the unclaimed faces inside, sorted by patch (each patch's in ascending order)
     free = np.flatnonzero(inside & ~claimed)
     free = free[np.argsort(label[free], kind="stable")]

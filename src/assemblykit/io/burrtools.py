@@ -41,10 +41,9 @@ from xml.etree import ElementTree
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from assemblykit.errors import GeometryError, InputError, SchemaError
+from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance
 
@@ -445,12 +444,11 @@ def voxel_mesh(voxels: NDArray[np.int64], source: str | None = None) -> trimesh.
                 )
     slots = 4 * len(corners)
     links = np.array(joins, dtype=np.int64).reshape(-1, 2)
-    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(slots, slots))
-    _, label = connected_components(graph, directed=False)
+    label = component_labels(slots, links)
     positions = np.zeros((label.max() + 1 if slots else 0, 3), dtype=np.float64)
     positions[label] = np.array(corners, dtype=np.float64).reshape(-1, 3)
-    quads = label.reshape(-1, 4)
-    faces = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    corner_of = label.reshape(-1, 4)
+    faces = np.concatenate([corner_of[:, [0, 1, 2]], corner_of[:, [0, 2, 3]]])
     mesh = trimesh.Trimesh(positions, faces, process=False)
     if not mesh.is_watertight or len(faces) == 0:
         raise GeometryError("the voxel piece has no closed surface", source=source)

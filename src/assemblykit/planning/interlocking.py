@@ -47,8 +47,6 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from assemblykit import formatting as fmt
 from assemblykit.blocking.arrangement import Arrangement
@@ -62,6 +60,7 @@ from assemblykit.blocking.planar import areas
 from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import InputError, UnknownNameError
+from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.sequence import EXACT_GROUP_PARTS
 from assemblykit.tolerance import Tolerance, order_key
@@ -985,8 +984,7 @@ def _free_directions(
         return ()
     low, high = arrangement.links_low, arrangement.links_high
     both = free[low] & free[high]
-    graph = coo_matrix((np.ones(int(both.sum())), (low[both], high[both])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
+    label = component_labels(n, np.stack([low[both], high[both]], axis=1))
     closure = _closure_lists(arrangement)
     out = [
         _described(arrangement, np.flatnonzero((label == value) & free), free, closure, is_free)

@@ -63,11 +63,11 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linprog
-from scipy.sparse.csgraph import connected_components
 
 from assemblykit import formatting as fmt
 from assemblykit.errors import InputError, NumericError
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import lowest_parts
 from assemblykit.tolerance import MIN_REL_LENGTH, Tolerance, order_key
 
@@ -800,11 +800,7 @@ class EquilibriumModel:
         free = present & ~fixed
         ends = self.point_parts
         joined = free[ends[:, 0]] & free[ends[:, 1]]
-        count = len(self.names)
-        graph = sp.coo_matrix(
-            (np.ones(int(joined.sum())), (ends[joined, 0], ends[joined, 1])), shape=(count, count)
-        )
-        _, label = connected_components(graph, directed=False)
+        label = component_labels(len(self.names), ends[joined])
         return [free & (label == piece) for piece in np.unique(label[free])]
 
     def slack(
