@@ -92,9 +92,10 @@ def test_no_step_of_the_arch_goes_down_through_the_ground(one_at_a_time):
     tol = assembly.tolerance()
     assert all(step.direction[2] >= -tol.angle for step in result.steps)
     if one_at_a_time:
-        # a block at a time from the crown down, each lifted
+        # a block at a time from the crown down, each lifted (14 and 15 are mirror
+        # images: which one goes first is a float tie)
         assert all(len(step.parts) == 1 for step in result.steps)
-        assert result.steps[0].parts == ("14",)
+        assert result.steps[0].parts in (("14",), ("15",))
         assert all(step.direction[2] > 1 - tol.angle for step in result.steps[:5])
 
 
