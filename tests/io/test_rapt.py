@@ -110,7 +110,8 @@ def test_rapt_to_dict_gives_the_task_file_mapping_and_lines():
     }
     assert data["situations"][1]["actions"] == [
         ["move", "peg", {"along": "peg.shaft", "by": -5}],
-        ["turn", "block", {"about": "block.bore", "by": math.pi / 2}],
+        # an angle as written, which the task file reads as the loader of YAML does
+        ["turn", "block", {"about": "block.bore", "by": "90 deg"}],
     ]
     assert places["bodies.block.features.bore"] == "line 7"
     assert places["situations[0].relations[0]"] == "line 13"
@@ -276,3 +277,17 @@ def test_a_bare_word_that_is_not_a_flag():
         "t.rapt: line 2, column 47: 'hollow' needs a value "
         "(bare words: male, female, directed, undirected)"
     )
+
+
+@pytest.mark.parametrize(
+    "option", ["offset 90 deg", "offset 1.5 rad"], ids=["degrees", "radians"]
+)
+def test_an_angle_written_for_a_length_is_refused_with_its_line(tmp_path, option):
+    path = tmp_path / "angle.rapt"
+    path.write_text(
+        "units mm\nbody a fixed\n  plane p point (0,0,0) normal (0,0,1)\nend\n"
+        "body b\n  plane q point (0,0,0) normal (0,0,-1)\nend\n"
+        f"situation s\n  against q of b, p of a {option}\nend\n"
+    )
+    with pytest.raises(SchemaError, match=r"line 9.*offset is a length in model units"):
+        load_task(path)

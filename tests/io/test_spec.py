@@ -112,6 +112,22 @@ def test_angles_in_degrees_become_radians(tmp_path: Path):
     assert task.situations[0].relations[2].options == {"angle": pytest.approx(math.pi / 4)}
 
 
+@pytest.mark.parametrize(
+    ("where", "text"),
+    [("relation", "90 deg"), ("relation", "1.5 rad"), ("action", "5 deg")],
+)
+def test_an_angle_written_for_a_length_is_refused(tmp_path: Path, where: str, text: str):
+    data = base()
+    if where == "relation":
+        data["situations"][0]["relations"][0].append({"offset": text})
+        fault = r"situations\[0\]\.relations\[0\].*offset is a length in model units"
+    else:
+        data["situations"][1]["actions"][0][2]["by"] = text
+        fault = r"situations\[1\]\.actions\[0\].*'by' must be a finite length"
+    with pytest.raises(SchemaError, match=fault):
+        load_task(write_yaml(tmp_path, data))
+
+
 def test_units_default_to_millimetres(tmp_path: Path):
     data = base()
     del data["units"]

@@ -74,7 +74,10 @@ def test_relation_parse():
         Relation.parse(["fits", "a.x", "b.y", {"offset": 1}], "s1[3]")
     with pytest.raises(SchemaError, match="needs the option angle"):
         Relation.parse(["angle", "a.x", "b.y"], "s1[4]")
-    assert Relation.parse(["angle", "a.x", "b.y", {"angle": "30 deg"}]).options["angle"] == "30 deg"
+    angle = Relation.parse(["angle", "a.x", "b.y", {"angle": "30 deg"}]).options["angle"]
+    assert angle == pytest.approx(math.pi / 6, abs=1e-15)
+    with pytest.raises(SchemaError, match="offset is a length in model units, not an angle"):
+        Relation.parse(["against", "a.x", "b.y", {"offset": "90 deg"}], "s1[5]")
 
 
 def test_every_kind_is_registered():

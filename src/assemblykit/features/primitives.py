@@ -45,6 +45,13 @@ Matrix = NDArray[np.float64]
 _ANGLE = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(deg|rad)?\s*$")
 
 
+def is_angle_text(text: str) -> bool:
+    """Whether ``text`` is an angle written with its unit, such as ``"30 deg"`` or
+    ``"0.5 rad"``."""
+    match = _ANGLE.match(text)
+    return match is not None and match.group(2) is not None
+
+
 def parse_angle(value: Any, where: str | None = None) -> float:
     """An angle in radians from a number (radians) or a string such as ``"30 deg"``
     (DESIGN §4: degrees are allowed in files when written with ``deg``)."""

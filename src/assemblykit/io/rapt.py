@@ -202,7 +202,7 @@ def _line(meta: Any) -> str:
 class _Builder(Transformer[Token, tuple[dict[str, Any], dict[str, str]]]):
     """Turns the parse tree into the task-file mapping plus the line of each entry."""
 
-    def number(self, token: Token, unit: Token | None = None) -> int | float:
+    def number(self, token: Token, unit: Token | None = None) -> int | float | str:
         text = str(token)
         where = f"line {token.line}, column {token.column}"
         digits = len(text.lstrip("+-").partition(".")[0].lower().partition("e")[0])
@@ -213,9 +213,9 @@ class _Builder(Transformer[Token, tuple[dict[str, Any], dict[str, str]]]):
         value: int | float = float(text) if any(c in text for c in ".eE") else int(text)
         if not math.isfinite(value) or abs(value) > FLOAT_MAX:
             raise SchemaError(f"{text[:40]} is beyond the range of a float", where=where)
-        if unit is not None:
-            value = math.radians(value) if unit == "deg" else float(value)
-        return value
+        # an angle stays as written ("90 deg"), as in a task file, so that only the
+        # options and fields that are angles read it (a length refuses it)
+        return value if unit is None else f"{text} {unit}"
 
     def vector(self, *items: Any) -> list[Any]:
         return list(items)

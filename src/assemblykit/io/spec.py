@@ -114,14 +114,8 @@ def _situation(model: SituationModel, locate: Locate, place: str) -> Situation:
 
 
 def _relation(items: list[Any], where: str) -> Relation:
-    """``[kind, body.feature, ..., {options}]``; a string option value is an angle such as
-    ``"30 deg"``, stored in radians."""
-    if items and isinstance(items[-1], Mapping):
-        options = {
-            key: parse_angle(value, f"{where}.{key}") if isinstance(value, str) else value
-            for key, value in items[-1].items()
-        }
-        items = [*items[:-1], options]
+    """``[kind, body.feature, ..., {options}]``; an ``angle`` option may be written
+    ``"30 deg"`` (:meth:`Relation.values`, which refuses an angle given for a length)."""
     return Relation.parse(items, where)
 
 

@@ -56,6 +56,7 @@ from assemblykit.features.primitives import (
     Socket,
     Thread,
     Torus,
+    is_angle_text,
     parse_angle,
 )
 from assemblykit.tolerance import Tolerance, current
@@ -201,6 +202,12 @@ class RelationType(ABC):
         for key, value in options.items():
             if key == "angle":
                 values[key] = parse_angle(value, where)
+            elif isinstance(value, str) and is_angle_text(value):
+                raise SchemaError(
+                    f"{self.kind} option {key} is a length in model units, not an angle: "
+                    f"got {value!r}",
+                    where=where,
+                )
             elif (
                 isinstance(value, bool)
                 or not isinstance(value, int | float)
@@ -299,9 +306,10 @@ class Relation:
         law = relation_type(kind, where)
         if len(rest) != law.arity:
             raise SchemaError(f"{kind} relates {law.arity} features, got {len(rest)}", where=where)
-        law.values(options, where)
+        values = law.values(options, where)
         refs = tuple(FeatureRef.parse(text, where) for text in rest)
-        return cls(kind, refs, dict(options), where)
+        # the options given, as numbers (an angle written "30 deg" in radians)
+        return cls(kind, refs, {key: values[key] for key in options}, where)
 
     @property
     def type(self) -> RelationType:
