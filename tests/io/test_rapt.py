@@ -279,9 +279,7 @@ def test_a_bare_word_that_is_not_a_flag():
     )
 
 
-@pytest.mark.parametrize(
-    "option", ["offset 90 deg", "offset 1.5 rad"], ids=["degrees", "radians"]
-)
+@pytest.mark.parametrize("option", ["offset 90 deg", "offset 1.5 rad"], ids=["degrees", "radians"])
 def test_an_angle_written_for_a_length_is_refused_with_its_line(tmp_path, option):
     path = tmp_path / "angle.rapt"
     path.write_text(
