@@ -329,18 +329,18 @@ def test_explain_text_says_where_a_merged_body_ended(capsys):
 
 
 V_GROOVE = """\
-# a bar in a 120-degree V-groove, the groove's normals typed with 6-decimal cosines
+# a bar in a 120-degree V-groove, the groove's normals typed with {digits}-decimal cosines
 units: mm
 bodies:
   block:
     fixed: true
     features:
-      left:  {type: plane, point: [-5, 0, 0], normal: [0.866025, 0, 0.5]}
-      right: {type: plane, point: [5, 0, 0], normal: [-0.866025, 0, 0.5]}
+      left:  {{type: plane, point: [-5, 0, 0], normal: [{cosine}, 0, 0.5]}}
+      right: {{type: plane, point: [5, 0, 0], normal: [-{cosine}, 0, 0.5]}}
   bar:
     features:
-      a: {type: plane, point: [-5, 0, 0], normal: [-0.8660254037844386, 0, -0.5]}
-      b: {type: plane, point: [5, 0, 0], normal: [0.8660254037844386, 0, -0.5]}
+      a: {{type: plane, point: [-5, 0, 0], normal: [-0.8660254037844386, 0, -0.5]}}
+      b: {{type: plane, point: [5, 0, 0], normal: [0.8660254037844386, 0, -0.5]}}
 situations:
   - name: s1
     relations:
@@ -349,42 +349,46 @@ situations:
 """
 
 
-def groove_json(tmp_path: Path, capsys, *extra: str) -> dict:
+def groove_json(tmp_path: Path, capsys, *extra: str, cosine: str = "0.86603") -> dict:
     path = tmp_path / "groove.yaml"
-    path.write_text(V_GROOVE)
+    path.write_text(V_GROOVE.format(cosine=cosine, digits=len(cosine) - 2))
     assert run(["solve", str(path), "--json", *extra]) == 0
     return json.loads(capsys.readouterr().out)
 
 
 @needs_engine
 def test_rounded_v_groove_is_prismatic_once_the_tolerance_covers_its_angle(tmp_path, capsys):
-    # the typed normals are 120° - 4.04e-7 rad apart (by hand: acos of (1/4 - c²)/(1/4 + c²))
+    # written to six decimals, the groove is within the default tolerance
+    six = groove_json(tmp_path, capsys, cosine="0.866025")
+    assert (six["bodies"]["bar@s1"]["dof"], six["bodies"]["bar@s1"]["motion"]) == (1, "prismatic")
+    # to five, the typed normals are 120° - 4.60e-6 rad apart (by hand: acos of
+    # (1/4 - c²)/(1/4 + c²))
     strict = groove_json(tmp_path, capsys)
     assert strict["status"] == "inconsistent"
     (conflict,) = strict["conflicts"]
     assert conflict["kind"] == "angle"
-    assert conflict["value"] == pytest.approx(4.0378e-7, rel=1e-4)
-    assert conflict["needed_tolerance"] == 4.1e-7
-    assert strict["suggested_tolerance"] == 4.1e-7
-    loose = groove_json(tmp_path, capsys, "--tolerance", "1e-6")
+    assert conflict["value"] == pytest.approx(4.5962e-6, rel=1e-4)
+    assert conflict["needed_tolerance"] == 4.6e-6
+    assert strict["suggested_tolerance"] == 4.6e-6
+    loose = groove_json(tmp_path, capsys, "--tolerance", "1e-5")
     assert loose["status"] == "underconstrained"
     bar = loose["bodies"]["bar@s1"]
     assert (bar["dof"], bar["motion"]) == (1, "prismatic")
     assert "suggested_tolerance" not in loose
-    # --tolerance alone had no effect on angles before: now an explicit angle overrides it
-    held = groove_json(tmp_path, capsys, "--tolerance", "1e-6", "--angle-tolerance", "1e-9")
+    # an explicit angle tolerance overrides the one following --tolerance
+    held = groove_json(tmp_path, capsys, "--tolerance", "1e-5", "--angle-tolerance", "1e-6")
     assert held["status"] == "inconsistent"
-    angle_only = groove_json(tmp_path, capsys, "--angle-tolerance", "1e-6")
+    angle_only = groove_json(tmp_path, capsys, "--angle-tolerance", "1e-5")
     assert angle_only["bodies"]["bar@s1"]["motion"] == "prismatic"
 
 
 @needs_engine
 def test_the_table_says_how_far_to_loosen_the_tolerance(tmp_path, capsys):
     path = tmp_path / "groove.yaml"
-    path.write_text(V_GROOVE)
+    path.write_text(V_GROOVE.format(cosine="0.86603", digits=5))
     assert run(["solve", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "nearly consistent: loosen the tolerance to 4.1e-07 (--tolerance 4.1e-07)" in out
+    assert "nearly consistent: loosen the tolerance to 4.6e-06 (--tolerance 4.6e-06)" in out
 
 
 @needs_engine

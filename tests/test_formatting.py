@@ -18,7 +18,7 @@ def test_numbers_snap_to_zero_within_the_tolerance_and_keep_four_digits():
     tol = Tolerance()
     assert fmt.number(math.cos(math.pi / 2), tol) == "0"
     assert fmt.number(-1e-12, tol) == "0"  # never "-0"
-    assert fmt.number(2e-9, tol) == "2e-09"  # above the tolerance: shown
+    assert fmt.number(2e-6, tol) == "2e-06"  # above the tolerance: shown
     assert fmt.number(1234.5678, tol) == "1235"
     assert fmt.number(-0.000123456, tol) == "-0.0001235"
     assert fmt.number(math.inf) == "inf"
@@ -32,9 +32,10 @@ def test_directions_along_an_axis_are_words():
     assert fmt.direction([-0.0, -0.0, -1.0]) == "-Z"
     assert fmt.direction([0.0, -1.0]) == "-Y"  # a planar direction
     assert fmt.direction([0.6, 0.0, -0.8]) == "(0.6, 0, -0.8)"
-    # 1e-6 rad off +X: not an axis at 1e-9 rad, rounded to 4 decimals
-    assert fmt.direction([1.0, 1e-6, 0.0]) == "(1, 0, 0)"
-    assert fmt.direction([1.0, 1e-6, 0.0], Tolerance(angle=1e-5)) == "+X"
+    # 1e-5 rad off +X: not an axis at the default 1e-6 rad, rounded to 4 decimals
+    assert fmt.direction([1.0, 1e-5, 0.0]) == "(1, 0, 0)"
+    assert fmt.direction([1.0, 1e-5, 0.0], Tolerance(angle=1e-4)) == "+X"
+    assert fmt.direction([1.0, 1e-7, 0.0]) == "+X"
 
 
 def test_directions_off_an_axis_print_rounded_components_without_noise():

@@ -21,8 +21,10 @@ from assemblykit.tolerance import DEFAULT, MAX_REL_LENGTH, Tolerance, round_up, 
 TASKS = Path(assemblykit.__file__).parent / "examples" / "tasks"
 BUNDLED = sorted(TASKS.glob("*.yaml"))
 SQRT3_2 = math.sqrt(3.0) / 2.0
-#: The option documented for data rounded to 1e-7 of the model's size: ten times it.
-ROUNDED_1E7 = Tolerance.relative(1e-6)
+#: The default covers data rounded to 1e-7 of the model's size: ten times it.
+ROUNDED_1E7 = DEFAULT
+#: The tolerance of exact numbers (the default before real data's six decimals set it).
+TIGHT = Tolerance.relative(1e-9)
 SWEEP = (1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 3e-3, 1e-2)
 #: Fewer steps for rounded input, whose residues are solved numerically (slower).
 ROUNDED_SWEEP = (1e-9, 1e-8, 1e-7, 1e-6, 1e-4, 1e-2)
@@ -127,6 +129,7 @@ def test_the_angle_follows_the_relative_length_unless_given():
     # the arm turns an angle into the length it weighs: the scale when the angle follows
     assert Tolerance.relative(1e-6).with_scale(40.0).arm == pytest.approx(40.0)
     assert Tolerance.relative(1e-6, 1e-9).with_scale(40.0).arm == pytest.approx(40_000.0)
+    assert Tolerance.relative(1e-6) == DEFAULT
     # numerical decisions never loosen with the tolerance
     assert Tolerance.relative(1e-2).precision == DEFAULT.precision == 1e-9
     assert Tolerance.relative(1e-12).precision == 1e-12
@@ -151,13 +154,15 @@ def test_needed_tolerance_is_the_mismatch_over_the_size_within_a_thousandfold():
     assert Tolerance.relative(0.05).needed("distance", MAX_REL_LENGTH / 2) == 0.051
 
 
-def test_v_groove_with_six_decimal_cosines_is_prismatic_with_the_tolerance():
+def test_v_groove_with_six_decimal_cosines_is_prismatic_at_the_default():
     exact = solve(v_groove(SQRT3_2))
     assert exact.status == "underconstrained"
     assert (exact.bodies["bar@s1"].dof, exact.bodies["bar@s1"].motion) == (1, "prismatic")
 
     typed = v_groove(0.866025)
-    strict = solve(typed)
+    bar = solve(typed).bodies["bar@s1"]
+    assert (bar.dof, bar.motion) == (1, "prismatic")
+    strict = solve(typed, TIGHT)
     (conflict,) = strict.conflicts
     assert conflict.kind == "angle"
     assert conflict.value == pytest.approx(groove_mismatch(0.866025), rel=1e-6)  # 4.04e-7 rad
@@ -209,7 +214,8 @@ def test_offset_planes_are_nearly_consistent_with_the_tolerance_that_accepts_the
         ],
     }
     size = math.hypot(10.0, offset)  # the bounding-box diagonal of the feature points
-    strict = solve(data)
+    assert solve(data).status == "underconstrained"  # 1e-7 of the size: within the default
+    strict = solve(data, TIGHT)
     assert strict.status == "inconsistent"
     (conflict,) = strict.conflicts
     assert conflict.kind == "distance"
@@ -237,17 +243,19 @@ def test_a_far_miss_suggests_nothing():
 
 
 @pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
-def test_rounded_bundled_tasks_keep_their_answers_with_the_documented_option(path):
+def test_rounded_bundled_tasks_keep_their_answers_at_the_default(path):
     data = load(path)
     assert answers(solve(noisy(data, 1e-7, 0), ROUNDED_1E7)) == answers(solve(data))
 
 
 @pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
-def test_rounded_bundled_tasks_are_nearly_consistent_at_the_default(path):
-    strict = solve(noisy(load(path), 1e-7, 0))
-    if strict.status != "inconsistent":
+def test_rounded_bundled_tasks_are_nearly_consistent_at_a_tight_tolerance(path):
+    data = load(path)
+    strict = solve(noisy(data, 1e-7, 0), TIGHT)
+    if answers(strict) == answers(solve(data, TIGHT)):
         return
-    # every near miss names a tolerance below the documented option's tenfold
+    # every near miss names a tolerance below the default's tenfold
+    assert strict.status == "inconsistent"
     assert strict.suggested_tolerance is not None
     assert strict.suggested_tolerance <= 1e-5
 
@@ -337,16 +345,18 @@ def tilted_edge(tilt: float) -> dict[str, Any]:
 
 def test_the_residue_holds_angles_to_the_angle_tolerance():
     """By hand: the best pose tilts the block by half the edge's tilt, so each relation
-    misses by 5e-7 rad, weighed as 5e-7 x 10 (the model's size) = 5e-6."""
-    data = tilted_edge(1e-6)
+    misses by 5e-5 rad, weighed as 5e-5 x 10 (the model's size) = 5e-4."""
+    data = tilted_edge(1e-4)
     strict = solve(data)
     (conflict,) = strict.conflicts
     assert conflict.kind == "residual"
-    assert conflict.value == pytest.approx(5e-6, rel=1e-4)
-    assert conflict.needed_tolerance == 5e-7
-    for tol in (Tolerance.relative(5e-7), Tolerance.relative(1e-5), Tolerance.relative(1e-9, 1e-5)):
+    assert conflict.value == pytest.approx(5e-4, rel=1e-4)
+    assert conflict.needed_tolerance == 5e-5
+    for tol in (Tolerance.relative(5e-5), Tolerance.relative(1e-3), Tolerance.relative(1e-6, 1e-3)):
         loose = solve(data, tol)
         block = loose.bodies["block@s1"]
         assert (loose.status, block.dof, block.motion) == ("underconstrained", 3, "planar")
     # a loose length tolerance does not excuse an angle held tight
-    assert solve(data, Tolerance.relative(1e-5, 1e-9)).status == "inconsistent"
+    assert solve(data, Tolerance.relative(1e-3, 1e-6)).status == "inconsistent"
+    # tilted by 1e-6 rad (an axis written to six decimals), the default accepts it
+    assert solve(tilted_edge(1e-6)).status == "underconstrained"

@@ -17,10 +17,12 @@
   measured against its own residual (:meth:`Tolerance.rank`), not the tolerance.
 * **Near misses**: a mismatch within ``NEARLY_CONSISTENT`` times the tolerance is reported
   with the tolerance that accepts it (:meth:`Tolerance.needed`).
-* Exact input (task files, STEP surfaces) uses the tight defaults (1e-9).
-  Approximate input (triangle meshes, fitted surfaces) uses the looser
-  ``mesh_rel_length`` / ``mesh_angle``, because coordinates in OBJ/STL files carry only
-  about seven significant digits.
+* **Defaults from real data**: 1e-6 of the model's size and 1e-6 rad, the precision of
+  numbers written to six decimals, so that rounded, rotated and slightly perturbed
+  input keeps its answers (task files and STEP surfaces alike). Triangle meshes and
+  fitted surfaces use ``mesh_rel_length`` / ``mesh_angle`` as a floor (coordinates in
+  OBJ/STL files carry about seven significant digits), raised to the precision measured
+  in the input itself (:mod:`assemblykit.geometry.precision`).
 
 Every geometric predicate takes its tolerance from a :class:`Tolerance` value: either
 passed explicitly or the *current* one, set for a block of code with :func:`using`.
@@ -35,8 +37,20 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
-DEFAULT_REL_LENGTH = 1e-9
-DEFAULT_ANGLE = 1e-9
+DEFAULT_REL_LENGTH = 1e-6
+"""The default relative length tolerance: numbers as real data writes them, to six
+decimals (CAD exports, hand-written tasks, float32 meshes resolve about 6e-8), so that a
+model rounded, rotated or perturbed at that precision keeps its answers while a misfit
+of 1e-4 of the model is still one."""
+
+DEFAULT_ANGLE = 1e-6
+"""The default angle tolerance (radians): a unit vector written to six decimals points
+within about 1e-6 rad of the one meant."""
+
+SOLVER_PRECISION = 1e-9
+"""Where numeric solvers stop and what counts as a singular system
+(:attr:`Tolerance.precision`): far below any tolerance, so that loosening one never stops a
+solver short of a solution it found before."""
 DEFAULT_MESH_REL_LENGTH = 1e-6
 DEFAULT_MESH_ANGLE = 1e-5
 
@@ -123,7 +137,7 @@ class Tolerance:
         singular. The tighter of the tolerances and the default, so a looser tolerance
         never stops a solver earlier nor calls a regular system singular (which would make
         answers depend on the coordinates, not only on the geometry)."""
-        return min(self.rel_length, self.angle, DEFAULT_REL_LENGTH)
+        return min(self.rel_length, self.angle, SOLVER_PRECISION)
 
     def rank(self, residual: float = 0.0) -> float:
         """Relative singular value below which a Jacobian direction counts as free at a

@@ -14,6 +14,7 @@ from assemblykit.algebra.lattices import (
     IntegerPoints,
     commensurate,
     integer_points,
+    lattice_denominator,
 )
 from assemblykit.tolerance import Tolerance
 
@@ -27,17 +28,42 @@ def test_commensurate_recovers_ratios_of_lengths():
 
 def test_incommensurate_ratios_and_the_denominator_bound():
     assert commensurate(math.sqrt(2)) is None
-    assert commensurate(math.pi) is None
+    assert commensurate(math.e) is None
     assert commensurate(float("nan")) is None
-    assert commensurate(1.0 / (MAX_LATTICE_DENOMINATOR + 1)) is None
-    assert commensurate(1.0 / MAX_LATTICE_DENOMINATOR) == Fraction(1, MAX_LATTICE_DENOMINATOR)
+    tight = Tolerance(1.0, rel_length=1e-9)
+    assert commensurate(math.pi, tight) is None
+    assert commensurate(1.0 / (MAX_LATTICE_DENOMINATOR + 1), tight) is None
+    largest = Fraction(1, MAX_LATTICE_DENOMINATOR)
+    assert commensurate(float(largest), tight) == largest
+
+
+def test_the_denominator_bound_shrinks_with_the_tolerance():
+    # 1 / sqrt(10 tol): 10^4 at 1e-9, 316 at the default 1e-6, 10 at 1e-3
+    bounds = [lattice_denominator(Tolerance(1.0, rel_length=t)) for t in (1e-9, 1e-6, 1e-3, 0.1)]
+    assert bounds == [MAX_LATTICE_DENOMINATOR, 316, 10, 1]
+    # 355/113 is within 8.5e-8 of pi (relative): a fraction at 1e-6, not at 1e-9
+    assert commensurate(math.pi) == Fraction(355, 113)
+    # an exact ratio of a large denominator cannot be told from an irrational at 1e-6
+    assert commensurate(1393 / 985) is None
+    assert commensurate(1393 / 985, Tolerance(1.0, rel_length=1e-9)) == Fraction(1393, 985)
 
 
 def test_the_rational_test_uses_the_relative_length_tolerance():
-    # The best fraction with denominator <= 10^4 misses sqrt(2) by 1.07e-8 (relative 7.6e-9).
-    loose = Tolerance(1.0, rel_length=1e-7)
-    assert commensurate(math.sqrt(2), loose) == Fraction(11482, 8119)
+    # the best fraction with denominator <= 316 misses sqrt(2) by 1.2e-5 (239/169)
     assert commensurate(math.sqrt(2)) is None
+    assert commensurate(math.sqrt(2), Tolerance(1.0, rel_length=1e-5)) is None
+    assert commensurate(math.sqrt(2), Tolerance(1.0, rel_length=1e-4)) is None
+    assert commensurate(239 / 169 + 1e-7) == Fraction(239, 169)
+    assert commensurate(239 / 169 + 1e-5) is None
+
+
+@given(st.floats(min_value=1e-9, max_value=0.1), st.sampled_from([2.0, 5.0]))
+def test_badly_approximable_ratios_are_never_commensurate(rel_length, square):
+    # sqrt(2) = [1; 2, 2, ...] and the golden ratio (1 + sqrt(5)) / 2 = [1; 1, 1, ...]
+    # miss every p/q by more than 1 / (4 q^2) and 1 / (3 q^2): at the bound's
+    # denominators (1 / q^2 >= 10 tol) by more than the tolerance, whatever it is
+    ratio = math.sqrt(2) if square == 2.0 else (1 + math.sqrt(5)) / 2
+    assert commensurate(ratio, Tolerance(1.0, rel_length=rel_length)) is None
 
 
 def test_single_integer_points():

@@ -243,7 +243,7 @@ def test_poses_equal_is_symmetric_and_scales_with_the_tolerance(seed):
 
 
 def test_poses_equal_from_numeric_solvers_takes_the_looser_mesh_tolerance():
-    tol = Tolerance()
+    tol = Tolerance(rel_length=1e-9, angle=1e-9)
     a = np.eye(4)
     b = se3.translation((0.5 * (tol.length + tol.mesh_length), 0.0, 0.0))
     assert tol.mesh_length > tol.length

@@ -24,7 +24,7 @@ def unit(v) -> np.ndarray:
 
 def test_snap_merges_parallel_and_antiparallel_within_angle():
     tiny = 1e-12
-    normals = np.array([[1, 0, 0], [-1, tiny, 0], [0, 1, 0], [1, 1e-6, 0]], dtype=float)
+    normals = np.array([[1, 0, 0], [-1, tiny, 0], [0, 1, 0], [1, 1e-5, 0]], dtype=float)
     circles, index, orient = snap_normals(normals, TOL)
     assert len(circles) == 3
     assert index.tolist() == [0, 0, 1, 2]

@@ -43,7 +43,7 @@ def test_noise_below_the_tolerance_prints_as_zero_and_the_rest_keeps_12_digits()
 
 def test_a_mismatch_above_the_tolerance_is_never_rounded_away():
     tol = Tolerance()
-    assert json_number(2e-9, tol) == 2e-9
+    assert json_number(2e-6, tol) == 2e-6
     assert json_number(1.00000000002e-3, tol) == 1.00000000002e-3
     with using(Tolerance(rel_length=1e-3, angle=1e-3)):
         assert json_number(5e-4) == 0.0

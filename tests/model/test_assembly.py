@@ -36,7 +36,10 @@ def test_tolerance_uses_mesh_thresholds_scaled_to_the_model(tower):
     with using(Tolerance(mesh_rel_length=1e-3)):
         assert tower.tolerance().length == pytest.approx(1e-3 * np.sqrt(11))
     exact = Assembly(tower.parts, exact=True)
-    assert exact.tolerance().length == pytest.approx(1e-9 * np.sqrt(11))
+    assert exact.tolerance().length == pytest.approx(1e-6 * np.sqrt(11))
+    with using(Tolerance.relative(1e-9)):
+        assert exact.tolerance().length == pytest.approx(1e-9 * np.sqrt(11))
+        assert tower.tolerance().length == pytest.approx(1e-6 * np.sqrt(11))
 
 
 def test_contacts_are_kept_in_the_memo_per_tolerance(tower):

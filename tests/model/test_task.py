@@ -69,7 +69,7 @@ def test_equality_compares_numbers_within_the_tolerance():
     near = bodies()
     near["peg"] = Body("peg", {"shaft": Shaft((0, 0, 1e-13), (0, 0, -1), 2, name="shaft")})
     far = bodies()
-    far["peg"] = Body("peg", {"shaft": Shaft((0, 0, 1e-6), (0, 0, -1), 2, name="shaft")})
+    far["peg"] = Body("peg", {"shaft": Shaft((0, 0, 1e-4), (0, 0, -1), 2, name="shaft")})
     assert Task("mm", near, (S1,)) == task()
     assert Task("mm", far, (S1,)) != task()
 

@@ -21,7 +21,7 @@ from assemblykit.algebra.groups import (
     lattice_parameter,
     one_parameter,
 )
-from assemblykit.algebra.lattices import MAX_LATTICE_DENOMINATOR, commensurate
+from assemblykit.algebra.lattices import commensurate, lattice_denominator
 from assemblykit.algebra.lie import HELICAL_KINDS, Kind, RotationPart, null_space, scaled_twists
 from assemblykit.algebra.subspaces import (
     Subspace,
@@ -192,7 +192,7 @@ def lattice_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> Symmetry
 
     Closed form when the other group is connected or cyclic: m comes from the rational
     test on the one-parameter group through tau (:func:`_cyclic_meet`). Otherwise the
-    first power k = 1..MAX_LATTICE_DENOMINATOR with tau^k in the other group generates it.
+    first power k = 1..lattice_denominator(tol) with tau^k in the other group generates it.
     """
     if not _is_cyclic(a):
         if _is_cyclic(b):
@@ -204,7 +204,7 @@ def lattice_meet(a: SymmetryGroup, b: SymmetryGroup, tol: Tolerance) -> Symmetry
         if found is not None:
             return found
     power = np.eye(4)
-    for _ in range(MAX_LATTICE_DENOMINATOR):
+    for _ in range(lattice_denominator(tol)):
         power = power @ tau
         if b.contains(power, tol):
             return SymmetryGroup(Kind.FIXED, np.eye(4), 0.0, (IDENTITY_MATRIX,), (power,))

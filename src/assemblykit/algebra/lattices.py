@@ -15,20 +15,38 @@ from fractions import Fraction
 
 from assemblykit.tolerance import Tolerance, current
 
-__all__ = ["MAX_LATTICE_DENOMINATOR", "IntegerPoints", "commensurate", "integer_points"]
+__all__ = [
+    "MAX_LATTICE_DENOMINATOR",
+    "IntegerPoints",
+    "commensurate",
+    "integer_points",
+    "lattice_denominator",
+]
 
-#: Largest denominator accepted when deciding that two lattice periods are commensurate
-#: (docs/algebra.md §2.4, "Finite parts": bounded-denominator continued fraction).
+#: Largest denominator ever accepted when deciding that two lattice periods are
+#: commensurate (docs/algebra.md §2.4, "Finite parts": bounded-denominator continued
+#: fraction); the bound in force shrinks with the tolerance (:func:`lattice_denominator`).
 MAX_LATTICE_DENOMINATOR = 10_000
 
 
+def lattice_denominator(tol: Tolerance | None = None) -> int:
+    """The largest denominator a ratio may have to count as commensurate at ``tol``:
+    ``1 / sqrt(10 x rel_length)``, at most :data:`MAX_LATTICE_DENOMINATOR` (docs/algebra.md
+    §7). Every number lies within about ``1 / n**2`` of a fraction of denominator up to
+    ``n`` (Dirichlet), so with larger denominators every ratio would be one; at this bound
+    a ratio is taken for a fraction only when it is ten times nearer to it than a number
+    in general is: √2 is not commensurate at 1e-6 (239/169 is 1.2e-5 away) nor at 1e-9."""
+    tol = tol or current()
+    return max(1, min(MAX_LATTICE_DENOMINATOR, math.floor(1 / math.sqrt(10 * tol.rel_length))))
+
+
 def commensurate(ratio: float, tol: Tolerance | None = None) -> Fraction | None:
-    """The fraction r/n (n <= ``MAX_LATTICE_DENOMINATOR``) equal to ``ratio`` within the
+    """The fraction r/n (n <= :func:`lattice_denominator`) equal to ``ratio`` within the
     relative length tolerance, or ``None`` when the ratio is incommensurate (§7)."""
     tol = tol or current()
     if not math.isfinite(ratio):
         return None
-    frac = Fraction(ratio).limit_denominator(MAX_LATTICE_DENOMINATOR)
+    frac = Fraction(ratio).limit_denominator(lattice_denominator(tol))
     if abs(float(frac) - ratio) > tol.rel_length * max(1.0, abs(ratio)):
         return None
     return frac
