@@ -1,4 +1,5 @@
-"""The input's measured precision: float coordinates, rounded poses, block joints."""
+"""The input's measured precision: float coordinates, faces out of plane, rounded poses,
+block joints."""
 
 from __future__ import annotations
 
@@ -14,10 +15,14 @@ from assemblykit.geometry.precision import (
     coordinate_precision,
     decimals,
     joint_mismatch,
+    mesh_precision,
     pose_precision,
     round_up,
+    surface_warp,
 )
 from assemblykit.model.assembly import Assembly, Part, Precision
+from assemblykit.planning.planner import plan
+from plan_checks import assert_steps_clear
 
 UNIT_BOX = trimesh.creation.box(extents=[1, 1, 1])
 
@@ -58,6 +63,61 @@ def test_coordinates_exact_in_float32_have_float32_precision():
     assert coordinate_precision(np.array([[0.1, 0.0, 1.0]])) == Precision(
         2.0**-52 / 2, "float64 coordinates"
     )
+
+
+def jittered(mesh: trimesh.Trimesh, amplitude: float, seed: int) -> trimesh.Trimesh:
+    """``mesh`` with its faces split (so that flat faces have inner vertices) and every
+    vertex moved by up to ``amplitude`` along each axis."""
+    fine = mesh.subdivide().subdivide()
+    rng = np.random.default_rng(seed)
+    moved = fine.vertices + rng.uniform(-amplitude, amplitude, fine.vertices.shape)
+    return trimesh.Trimesh(moved, fine.faces, process=False)
+
+
+def test_exact_flat_faces_and_curved_surfaces_are_not_warped():
+    assert surface_warp(box([0, 0, 0], [3, 2, 1]).subdivide()) == 0.0
+    # a curved surface turns by more than the flat angle over its extent, however fine
+    assert surface_warp(trimesh.creation.icosphere(6)) == 0.0
+    assert surface_warp(trimesh.creation.cylinder(1.0, 5.0, sections=2000)) < 1e-15
+    assert mesh_precision(UNIT_BOX) == coordinate_precision(UNIT_BOX.vertices)
+
+
+def test_a_face_with_one_corner_lifted_is_warped_by_a_quarter_of_the_lift():
+    # by hand: the top's two triangles meet along a diagonal; lifting the corner of one by
+    # h tilts it by the gradient (h, h), its mean plane by (h/2, h/2) (equal areas).
+    # Above that plane the four corners stand at 0, -h/2, -h/2 and 0: a spread of h/2,
+    # a warp of h/4, a precision of twice that
+    h = 1e-5
+    top = UNIT_BOX.copy()
+    corner = np.flatnonzero(np.all(top.vertices == [0.5, 0.5, 0.5], axis=1))
+    top.vertices[corner] += [0.0, 0.0, h]
+    assert surface_warp(top) == pytest.approx(h / 4, rel=1e-3)
+    measured = mesh_precision(top)
+    assert measured.length == pytest.approx(h / 2, rel=0.03)
+    assert "out of plane" in measured.source
+
+
+def test_jittered_meshes_touch_and_come_apart_as_exact_ones():
+    """A lid on a base, every vertex jittered by up to 1e-6 of the model's size: their
+    faces cross by up to twice that, beyond the policy's 1e-6, and the lid would be held
+    by interference; measured, the warp makes them a contact, the lid lifts off along +Z,
+    and the step is clear of the base in an independent sweep."""
+    size = math.sqrt(10**2 + 10**2 + 4**2)
+    amplitude = 1e-6 * size
+    base = jittered(box([0, 0, 0], [10, 10, 3]), amplitude, 1)
+    lid = jittered(box([0, 0, 3], [10, 10, 4]), amplitude, 2)
+    measured = combined([mesh_precision(base), mesh_precision(lid)])
+    assert measured is not None and amplitude <= measured.length <= 4 * amplitude
+    parts = [Part("base", base), Part("lid", lid)]
+    noisy = Assembly(parts, precision=measured)
+    assert noisy.tolerance().length == measured.length
+    result = plan(noisy)
+    assert result.feasible and [step.parts for step in result.steps] == [("lid",)]
+    np.testing.assert_allclose(result.steps[0].direction, [0, 0, 1], atol=1e-3)
+    assert_steps_clear(noisy, result)
+    # a real misfit, the lid sunk by 1e-3 of the model, stays one
+    sunk = Assembly([parts[0], Part("lid", lid.copy().apply_translation([0, 0, -1e-3 * size]))])
+    assert not plan(sunk, max_and_or_parts=0).feasible
 
 
 def test_pose_rounding_bound_is_hand_computed():

@@ -9,6 +9,15 @@ precisely it was *given*. A loader measures the second (a
 * **Coordinates.** Vertices that are all exactly representable in float32 carry the
   precision of float32 (half a float32 spacing at the largest coordinate); float64
   coordinates carry half a float64 spacing.
+* **Faces out of plane.** Coordinates may carry more digits than they are precise to: a
+  mesh processed in float32, written by a program that rounds, or jittered. Its flat
+  faces then come as triangles slightly out of one plane. A *flat* is a group of
+  triangles joined by edges across which the surface turns by less than
+  :data:`FLAT_ANGLE`, every triangle's normal within that angle of the group's mean
+  (a curved surface, however finely tessellated, turns by more over its whole extent);
+  its *warp* is the largest distance of its vertices from its mean plane. Two warped
+  faces in contact may cross each other by both warps, so the precision is twice the
+  largest warp (rounded up to two significant digits).
 * **Poses** (``final_state`` of a mesh folder's ``config.json``). A number written with
   ``k >= 1`` decimals is taken as rounded to ``k`` decimals; integers are exact. With
   ``k_t`` the most decimals among the translations and ``k_r`` among the angles, a
@@ -33,6 +42,7 @@ from decimal import Decimal
 
 import numpy as np
 import shapely
+import trimesh
 from numpy.typing import NDArray
 
 from assemblykit.geometry.contacts import (
@@ -43,10 +53,17 @@ from assemblykit.geometry.contacts import (
     triangle_overlaps,
 )
 from assemblykit.geometry.recognition import segment
+from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import Assembly, Precision
 from assemblykit.tolerance import Tolerance
 
 MAX_JOINT_TILT = math.radians(10.0)
+
+FLAT_ANGLE = 1e-3
+"""Triangles whose normals are within this angle (radians, 0.057 degrees) of each
+other and of their group's mean count as one flat face out of plane (module docstring):
+well above the turn that noise of 1e-5 of a triangle's size gives, well below a draft
+angle or the facets of a tessellated cylinder."""
 
 
 def combined(precisions: Iterable[Precision]) -> Precision | None:
@@ -73,6 +90,56 @@ def coordinate_precision(vertices: NDArray[np.float64]) -> Precision:
         float(np.spacing(kind(largest))) / 2,
         f"{'float32' if single else 'float64'} coordinates",
     )
+
+
+ROUNDING_WARP = 16.0
+"""A warp within this many times the coordinates' precision is the rounding of computed
+heights (a few units in the last place), which the coordinates' precision already
+covers."""
+
+
+def surface_warp(mesh: trimesh.Trimesh) -> float:
+    """The largest distance of a vertex of a flat face (module docstring, "Faces out of
+    plane") from that face's mean plane; 0 when every flat face is exactly flat."""
+    normals, areas = mesh.face_normals, mesh.area_faces
+    if len(normals) < 2:
+        return 0.0
+    pairs = mesh.face_adjacency[mesh.face_adjacency_angles < FLAT_ANGLE]
+    labels = component_labels(len(normals), pairs)
+    counts = np.bincount(labels)
+    mean = np.zeros((len(counts), 3))
+    np.add.at(mean, labels, normals * areas[:, None])
+    length = np.linalg.norm(mean, axis=1, keepdims=True)
+    mean = np.divide(mean, length, out=np.zeros_like(mean), where=length > 0)
+    # a group is a flat when it has two faces or more, none turned too far from its mean
+    turned = np.zeros(len(counts), dtype=bool)
+    np.logical_or.at(
+        turned, labels, np.einsum("ij,ij->i", normals, mean[labels]) < math.cos(FLAT_ANGLE)
+    )
+    flat = (counts >= 2) & ~turned & (length[:, 0] > 0)
+    faces = np.flatnonzero(flat[labels])
+    if not len(faces):
+        return 0.0
+    group = np.repeat(labels[faces], 3)
+    heights = np.einsum("ij,ij->i", mesh.vertices[mesh.faces[faces].ravel()], mean[group])
+    top = np.full(len(counts), -np.inf)
+    bottom = np.full(len(counts), np.inf)
+    np.maximum.at(top, group, heights)
+    np.minimum.at(bottom, group, heights)
+    spread = (top - bottom)[flat]
+    return float(spread.max() / 2)
+
+
+def mesh_precision(mesh: trimesh.Trimesh) -> Precision:
+    """How precise a mesh's geometry is: the coarser of its coordinates' float precision
+    (:func:`coordinate_precision`) and twice the warp of its flat faces
+    (:func:`surface_warp`; module docstring)."""
+    coordinates = coordinate_precision(mesh.vertices)
+    warp = round_up(2 * surface_warp(mesh))
+    # a warp of a few units in the last place is the arithmetic's, not the data's
+    if warp <= ROUNDING_WARP * coordinates.length:
+        return coordinates
+    return Precision(warp, f"flat faces out of plane by up to {warp / 2:.2g}")
 
 
 def decimals(value: float) -> int:

@@ -20,7 +20,7 @@ from typing import Any
 
 from assemblykit.errors import GeometryError, InputError
 from assemblykit.geometry.contacts import Contact, assembly_contacts, assembly_surfaces
-from assemblykit.geometry.precision import coordinate_precision
+from assemblykit.geometry.precision import mesh_precision
 from assemblykit.io.documents import read_json, read_text
 from assemblykit.io.meshes import MESH_SUFFIXES, load_manifest, load_mesh_folder, read_mesh
 from assemblykit.model.assembly import Assembly, Part
@@ -67,7 +67,7 @@ def load_assembly(path: str | Path, tol: Tolerance | None = None, settle: bool =
             [part],
             source=str(path),
             policy=tol,
-            precision=coordinate_precision(part.mesh.vertices),
+            precision=mesh_precision(part.mesh),
             warnings=notes,
         )
     raise GeometryError(

@@ -43,7 +43,7 @@ from scipy.spatial.transform import Rotation
 
 from assemblykit.errors import GeometryError, SchemaError
 from assemblykit.geometry.contacts import candidate_pairs
-from assemblykit.geometry.precision import combined, coordinate_precision, pose_precision
+from assemblykit.geometry.precision import combined, mesh_precision, pose_precision
 from assemblykit.geometry.settling import settle as settle_parts
 from assemblykit.geometry.solids import placed
 from assemblykit.io.documents import MAX_COORDINATE, read_json, read_text, read_yaml
@@ -258,7 +258,7 @@ def load_mesh_folder(
         state = states.get(file.stem)
         pose = np.eye(4) if state is None else pose_from_state(state)
         mesh = read_mesh(file, notes)
-        measured.append(coordinate_precision(mesh.vertices))
+        measured.append(mesh_precision(mesh))
         rounding = None
         if state is not None:
             radius = float(np.linalg.norm(mesh.vertices, axis=1).max())
@@ -406,6 +406,6 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         pose = pose_from_spec(entry.get("pose"), source=source, where=f"{where}.pose", tol=tol)
         mesh_path = path.parent / entry["mesh"]
         mesh = read_mesh(mesh_path, notes)
-        measured.append(coordinate_precision(mesh.vertices))
+        measured.append(mesh_precision(mesh))
         parts.append(Part(name, placed(mesh, pose), pose, source=str(mesh_path)))
     return _assembly(parts, units, units is not None, source, tol, combined(measured), notes)
