@@ -184,9 +184,9 @@ def test_v_groove_with_six_decimal_cosines_is_prismatic_at_the_default():
         assert (bar.dof, bar.motion) == (1, "prismatic"), t
 
 
-def test_offset_planes_are_nearly_consistent_with_the_tolerance_that_accepts_them():
-    offset = 1e-6
-    data = {
+def offset_planes(offset: float) -> dict[str, Any]:
+    """A block on two feet 10 apart, on two table planes ``offset`` apart in height."""
+    return {
         "units": "mm",
         "bodies": {
             "table": {
@@ -213,6 +213,11 @@ def test_offset_planes_are_nearly_consistent_with_the_tolerance_that_accepts_the
             }
         ],
     }
+
+
+def test_offset_planes_are_nearly_consistent_with_the_tolerance_that_accepts_them():
+    offset = 1e-6
+    data = offset_planes(offset)
     size = math.hypot(10.0, offset)  # the bounding-box diagonal of the feature points
     assert solve(data).status == "underconstrained"  # 1e-7 of the size: within the default
     strict = solve(data, TIGHT)
@@ -233,6 +238,14 @@ def test_offset_planes_are_nearly_consistent_with_the_tolerance_that_accepts_the
     # the answer turns at half the suggestion, never above it
     assert solve(data, Tolerance.relative(0.45 * offset / size)).status == "inconsistent"
     assert solve(data, Tolerance.relative(0.55 * offset / size)).status == "underconstrained"
+
+
+def test_a_misfit_of_1e_4_of_the_model_is_one_at_the_default_with_its_size():
+    strict = solve(offset_planes(1e-3))
+    assert strict.status == "inconsistent"
+    (conflict,) = strict.conflicts
+    assert conflict.kind == "distance" and conflict.value == pytest.approx(1e-3, rel=1e-9)
+    assert conflict.needed_tolerance == 1e-4  # 1e-3 over a size a hair above 10
 
 
 def test_a_far_miss_suggests_nothing():
