@@ -349,7 +349,7 @@ situations:
 """
 
 
-def groove_json(tmp_path: Path, capsys, *extra: str, cosine: str = "0.86603") -> dict:
+def groove_json(tmp_path: Path, capsys, *extra: str, cosine: str = "0.866") -> dict:
     path = tmp_path / "groove.yaml"
     path.write_text(V_GROOVE.format(cosine=cosine, digits=len(cosine) - 2))
     assert run(["solve", str(path), "--json", *extra]) == 0
@@ -358,37 +358,38 @@ def groove_json(tmp_path: Path, capsys, *extra: str, cosine: str = "0.86603") ->
 
 @needs_engine
 def test_rounded_v_groove_is_prismatic_once_the_tolerance_covers_its_angle(tmp_path, capsys):
-    # written to six decimals, the groove is within the default tolerance
-    six = groove_json(tmp_path, capsys, cosine="0.866025")
-    assert (six["bodies"]["bar@s1"]["dof"], six["bodies"]["bar@s1"]["motion"]) == (1, "prismatic")
-    # to five, the typed normals are 120° - 4.60e-6 rad apart (by hand: acos of
-    # (1/4 - c²)/(1/4 + c²))
+    # written to six or five digits, the groove is within the precision its numbers have
+    for cosine in ("0.866025", "0.86603"):
+        bar = groove_json(tmp_path, capsys, cosine=cosine)["bodies"]["bar@s1"]
+        assert (bar["dof"], bar["motion"]) == (1, "prismatic"), cosine
+    # written 0.866 (a value as designed, three digits), the typed normals are
+    # 120° - 2.54e-5 rad apart (by hand: acos of (1/4 - c²)/(1/4 + c²))
     strict = groove_json(tmp_path, capsys)
     assert strict["status"] == "inconsistent"
     (conflict,) = strict["conflicts"]
     assert conflict["kind"] == "angle"
-    assert conflict["value"] == pytest.approx(4.5962e-6, rel=1e-4)
-    assert conflict["needed_tolerance"] == 4.6e-6
-    assert strict["suggested_tolerance"] == 4.6e-6
-    loose = groove_json(tmp_path, capsys, "--tolerance", "1e-5")
+    assert conflict["value"] == pytest.approx(2.5404e-5, rel=1e-4)
+    assert conflict["needed_tolerance"] == 2.6e-5
+    assert strict["suggested_tolerance"] == 2.6e-5
+    loose = groove_json(tmp_path, capsys, "--tolerance", "3e-5")
     assert loose["status"] == "underconstrained"
     bar = loose["bodies"]["bar@s1"]
     assert (bar["dof"], bar["motion"]) == (1, "prismatic")
     assert "suggested_tolerance" not in loose
     # an explicit angle tolerance overrides the one following --tolerance
-    held = groove_json(tmp_path, capsys, "--tolerance", "1e-5", "--angle-tolerance", "1e-6")
+    held = groove_json(tmp_path, capsys, "--tolerance", "3e-5", "--angle-tolerance", "1e-6")
     assert held["status"] == "inconsistent"
-    angle_only = groove_json(tmp_path, capsys, "--angle-tolerance", "1e-5")
+    angle_only = groove_json(tmp_path, capsys, "--angle-tolerance", "3e-5")
     assert angle_only["bodies"]["bar@s1"]["motion"] == "prismatic"
 
 
 @needs_engine
 def test_the_table_says_how_far_to_loosen_the_tolerance(tmp_path, capsys):
     path = tmp_path / "groove.yaml"
-    path.write_text(V_GROOVE.format(cosine="0.86603", digits=5))
+    path.write_text(V_GROOVE.format(cosine="0.866", digits=3))
     assert run(["solve", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "nearly consistent: loosen the tolerance to 4.6e-06 (--tolerance 4.6e-06)" in out
+    assert "nearly consistent: loosen the tolerance to 2.6e-05 (--tolerance 2.6e-05)" in out
 
 
 @needs_engine

@@ -13,10 +13,18 @@ import pytest
 
 import assemblykit
 from assemblykit.inference import solve_task
-from assemblykit.inference.reduction import model_scale
+from assemblykit.inference.reduction import model_scale, task_tolerance
 from assemblykit.io.documents import read_text, read_yaml
 from assemblykit.io.spec import parse_task
-from assemblykit.tolerance import DEFAULT, MAX_REL_LENGTH, Tolerance, round_up, using
+from assemblykit.model.task import Rounding
+from assemblykit.tolerance import (
+    DEFAULT,
+    MAX_REL_LENGTH,
+    Tolerance,
+    round_up,
+    using,
+    written_resolution,
+)
 
 TASKS = Path(assemblykit.__file__).parent / "examples" / "tasks"
 BUNDLED = sorted(TASKS.glob("*.yaml"))
@@ -162,26 +170,68 @@ def test_v_groove_with_six_decimal_cosines_is_prismatic_at_the_default():
     typed = v_groove(0.866025)
     bar = solve(typed).bodies["bar@s1"]
     assert (bar.dof, bar.motion) == (1, "prismatic")
-    strict = solve(typed, TIGHT)
+    # written to six digits, the cosines may be 5e-7 off: the tolerance is at least ten
+    # times the turn that allows, whatever was asked for
+    assert parse_task(typed).rounding == Rounding(0.0, pytest.approx(5e-7, rel=1e-5))
+    assert solve(typed, TIGHT).status == "underconstrained"
+
+    # the same numbers written to full precision are taken as exact
+    precise = v_groove(math.nextafter(0.866025, 1.0))
+    assert parse_task(precise).rounding == Rounding()
+    strict = solve(precise, TIGHT)
     (conflict,) = strict.conflicts
     assert conflict.kind == "angle"
     assert conflict.value == pytest.approx(groove_mismatch(0.866025), rel=1e-6)  # 4.04e-7 rad
     assert conflict.needed_tolerance == 4.1e-7
 
-    loose = solve(typed, Tolerance.relative(1e-6))
+    loose = solve(precise, Tolerance.relative(1e-6))
     bar = loose.bodies["bar@s1"]
     assert loose.status == "underconstrained"
     assert (bar.dof, bar.motion) == (1, "prismatic")
     np.testing.assert_allclose(np.abs(bar.invariants["direction"]), [0, 1, 0], atol=1e-12)
     # the suggested tolerance is enough, and the one just below it is not
-    assert solve(typed, Tolerance.relative(4.1e-7)).status == "underconstrained"
-    assert solve(typed, Tolerance.relative(4.0e-7)).status == "inconsistent"
+    assert solve(precise, Tolerance.relative(4.1e-7)).status == "underconstrained"
+    assert solve(precise, Tolerance.relative(4.0e-7)).status == "inconsistent"
     # an explicit angle tolerance overrides the rule
-    assert solve(typed, Tolerance.relative(1e-6, 1e-9)).status == "inconsistent"
+    assert solve(precise, Tolerance.relative(1e-6, 1e-9)).status == "inconsistent"
     # and the answer holds at every looser tolerance, up to the largest allowed
     for t in (*SWEEP[SWEEP.index(1e-6) :], MAX_REL_LENGTH):
-        bar = solve(typed, Tolerance.relative(t)).bodies["bar@s1"]
+        bar = solve(precise, Tolerance.relative(t)).bodies["bar@s1"]
         assert (bar.dof, bar.motion) == (1, "prismatic"), t
+
+
+def test_written_numbers_raise_the_tolerance_to_ten_times_their_rounding():
+    # by hand: 12.346 (five digits) may be 5e-4 off, and the model is about 24.7 across
+    data = offset_planes(0.0)
+    data["bodies"]["table"]["features"]["far"]["point"] = [12.346, 0, 0]
+    data["bodies"]["block"]["features"]["foot2"]["point"] = [12.346, 0, 0]
+    task = parse_task(data)
+    assert task.rounding == Rounding(5e-4, 0.0)
+    tol = task_tolerance(task)
+    assert tol.length == pytest.approx(10 * 5e-4)
+    assert tol.angle == DEFAULT.angle
+    # numbers as designed (few digits) or computed (full precision) are exact
+    assert parse_task(offset_planes(0.25)).rounding == Rounding()
+    assert task_tolerance(parse_task(offset_planes(0.25))).rel_length == DEFAULT.rel_length
+
+
+@pytest.mark.parametrize(
+    ("value", "resolution"),
+    [
+        (0.86603, 5e-6),
+        (-0.707107, 5e-7),
+        (123.457, 5e-4),
+        (1.2345e-5, 5e-10),
+        (12.5, 0.0),
+        (0.25, 0.0),
+        (100.0, 0.0),
+        (1234567.0, 0.0),
+        (math.sqrt(3) / 2, 0.0),
+        (0.0, 0.0),
+    ],
+)
+def test_the_resolution_of_a_written_number(value, resolution):
+    assert written_resolution(value) == pytest.approx(resolution, rel=1e-12)
 
 
 def offset_planes(offset: float) -> dict[str, Any]:

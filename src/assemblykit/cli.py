@@ -858,12 +858,12 @@ def _is_task_file(path: str) -> bool:
 
 def _task_motion(path: str, tol: Tolerance, as_json: bool) -> None:
     """Emit the motion of every body of the task at ``path`` from its relations."""
-    from assemblykit.inference.reduction import model_scale
+    from assemblykit.inference.reduction import task_tolerance
     from assemblykit.io.tasks import load_task
     from assemblykit.motion.relational import task_motion
 
     task = load_task(path)
-    emit(task_motion(task, tol), as_json, tol.with_scale(model_scale(task)))
+    emit(task_motion(task, tol), as_json, task_tolerance(task, tol))
 
 
 @command

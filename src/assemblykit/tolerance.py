@@ -93,6 +93,40 @@ heights), while real data is written to 1e-6. Without the rounding such ties wer
 by the last bits, and a plan differed between installs."""
 
 
+ROUNDED_DIGITS = range(5, 10)
+"""A number written with this many significant digits (5 to 9) is taken as rounded at its
+last digit (:func:`written_resolution`): a value typed from a drawing or exported to a
+fixed count of digits (``0.86603``, ``12.3457``). Fewer digits (``12.5``, ``0.25``) are
+values as designed, more (``0.8660254037844386``) are computed to full precision."""
+
+ROUNDING_MARGIN = 10.0
+"""How many times the resolution of a task's written numbers its tolerance is at least
+(docs/inference.md, "Tolerances and rounded numbers"): rounding errors add up over the
+coordinates of a point and the two features of a relation, and ten times the rounding is
+what the bundled tasks need to keep their answers."""
+
+
+def written_resolution(value: float) -> float:
+    """Half a unit in the last place of ``value`` as its shortest text writes it
+    (``repr``, which gives back the digits a file wrote), when it has
+    :data:`ROUNDED_DIGITS` significant digits and is not a whole number; 0 otherwise
+    (docs/architecture.md, "Tolerances").
+
+    >>> written_resolution(0.86603), written_resolution(12.5), written_resolution(math.sqrt(3) / 2)
+    (5e-06, 0.0, 0.0)
+    """
+    if not math.isfinite(value) or value == round(value):
+        return 0.0  # whole numbers are exact, as a drawing's dimensions in whole units
+    digits = repr(abs(float(value))).lower()
+    mantissa, _, exponent = digits.partition("e")
+    whole, _, fraction = mantissa.partition(".")
+    fraction = fraction.rstrip("0")
+    significant = (whole + fraction).lstrip("0")
+    if len(significant) not in ROUNDED_DIGITS:
+        return 0.0
+    return 0.5 * 10.0 ** (int(exponent or 0) - len(fraction))
+
+
 def order_key(value: float, scale: float) -> int:
     """``value`` as the integer that orders it (:data:`ORDER_RESOLUTION` of ``scale``)."""
     return round(value / (ORDER_RESOLUTION * scale)) if scale > 0 else 0

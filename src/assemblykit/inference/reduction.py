@@ -112,7 +112,14 @@ from assemblykit.inference.solution import (
 )
 from assemblykit.model.relations import line_normals, signed_angle
 from assemblykit.model.task import Task
-from assemblykit.tolerance import Tolerance, current, using
+from assemblykit.tolerance import (
+    MAX_ANGLE,
+    MAX_REL_LENGTH,
+    ROUNDING_MARGIN,
+    Tolerance,
+    current,
+    using,
+)
 
 CYCLE_LENGTH = 4  # Corner et al. 1983 §III F: "we restrict the size of the cycles ... to four"
 
@@ -1638,6 +1645,24 @@ def model_scale(task: Task) -> float:
     return diagonal if diagonal > 0 else 1.0
 
 
+def task_tolerance(task: Task, tol: Tolerance | None = None) -> Tolerance:
+    """The tolerance ``task`` is solved with: ``tol`` (default: the one in force) scaled to
+    :func:`model_scale`, its length and angle raised to :data:`ROUNDING_MARGIN` times
+    the rounding of the numbers its file wrote (:attr:`Task.rounding`; docs/inference.md,
+    "Tolerances and rounded numbers"), as a mesh's tolerance is raised to its measured
+    precision."""
+    policy = (tol or current()).with_scale(model_scale(task))
+    written = task.rounding
+    return replace(
+        policy,
+        rel_length=min(
+            max(policy.rel_length, ROUNDING_MARGIN * written.length / policy.scale),
+            MAX_REL_LENGTH,
+        ),
+        angle=min(max(policy.angle, ROUNDING_MARGIN * written.angle), MAX_ANGLE),
+    )
+
+
 def solve_task(
     task: Task,
     tol: Tolerance | None = None,
@@ -1651,7 +1676,7 @@ def solve_task(
     (:mod:`assemblykit.inference.conflicts`). ``max_branches`` (default
     :data:`MAX_BRANCHES`) bounds the finite alternatives followed (rule 3); a cut search
     is reported in :attr:`Solution.cut`."""
-    tol = tol or current().with_scale(model_scale(task))
+    tol = task_tolerance(task, tol)
     branches = max_branches or MAX_BRANCHES
 
     def solve(part: Task, residue: bool = True) -> Solution:

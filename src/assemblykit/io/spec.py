@@ -21,7 +21,8 @@ from assemblykit.errors import InputError, SchemaError
 from assemblykit.features.primitives import FEATURE_TYPES, Feature, feature_from_dict, parse_angle
 from assemblykit.model.body import Body
 from assemblykit.model.relations import FeatureRef, Relation
-from assemblykit.model.task import ACTION_KINDS, Action, ActionKind, Situation, Task
+from assemblykit.model.task import ACTION_KINDS, Action, ActionKind, Rounding, Situation, Task
+from assemblykit.tolerance import written_resolution
 
 NAME_PATTERN = r"^[A-Za-z_][A-Za-z0-9_]*$"
 """Body, feature and situation names: identifiers, so that ``body.feature`` and the
@@ -98,7 +99,44 @@ def parse_task(
         )
     except InputError as error:
         raise with_source(error, source) from None
-    return Task(model.units, bodies, situations, source).validate()
+    return Task(model.units, bodies, situations, source, written_rounding(data)).validate()
+
+
+DIRECTIONS = frozenset({"normal", "axis", "ref"})
+"""The feature fields that are directions: their rounding turns them (an angle)."""
+
+
+def written_rounding(data: Mapping[str, Any]) -> Rounding:
+    """How precisely the task-file mapping ``data`` writes its numbers
+    (:class:`Rounding`): the coarsest :func:`written_resolution` of its lengths (every
+    number but a direction's), and of its directions the largest turn their rounded
+    components allow, ``|resolutions| / |v|``."""
+    length, angle = 0.0, 0.0
+    for key, value in _numbers(data):
+        if key in DIRECTIONS and isinstance(value, list):
+            norm = math.hypot(*value)
+            if norm > 0:
+                angle = max(angle, math.hypot(*map(written_resolution, value)) / norm)
+        else:
+            length = max(
+                length, *map(written_resolution, value if isinstance(value, list) else [value])
+            )
+    return Rounding(length, angle)
+
+
+def _numbers(data: Any, key: str = "") -> list[tuple[str, float | list[float]]]:
+    """Every number of ``data`` and every list of numbers, with the key it is under."""
+    if isinstance(data, Mapping):
+        return [item for k, v in data.items() for item in _numbers(v, str(k))]
+    if isinstance(data, list):
+        if data and all(_is_real(v) for v in data):
+            return [(key, [float(v) for v in data])]
+        return [item for v in data for item in _numbers(v, key)]
+    return [(key, float(data))] if _is_real(data) else []
+
+
+def _is_real(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def _situation(model: SituationModel, locate: Locate, place: str) -> Situation:

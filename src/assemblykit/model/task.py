@@ -69,6 +69,18 @@ class Situation:
     actions: tuple[Action, ...] = ()
 
 
+@dataclass(frozen=True)
+class Rounding:
+    """How precisely a task's numbers are written
+    (:func:`assemblykit.tolerance.written_resolution`): ``length``, half a unit in the
+    last place of its coarsest rounded length (model units), and ``angle``, the largest
+    turn that rounding its direction vectors' components may give (radians); 0 where
+    every number is as designed or computed."""
+
+    length: float = 0.0
+    angle: float = 0.0
+
+
 @dataclass(frozen=True, eq=False)
 class Task:
     """A validated RAPT task (docs/tutorial.md §1).
@@ -83,6 +95,9 @@ class Task:
     bodies: Mapping[str, Body]
     situations: tuple[Situation, ...]
     source: str | None = None
+    rounding: Rounding = Rounding()
+    """How precisely its file wrote its numbers (the tolerance is at least ten times it:
+    :func:`assemblykit.inference.reduction.task_tolerance`)."""
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Task):

@@ -35,11 +35,11 @@ import numpy as np
 
 from assemblykit.algebra import Coset, SymmetryGroup, intersect_groups
 from assemblykit.inference import Solution
-from assemblykit.inference.reduction import model_scale, solve_task
+from assemblykit.inference.reduction import solve_task, task_tolerance
 from assemblykit.model.relations import Relation
 from assemblykit.model.task import Task
 from assemblykit.motion.freedom import GroupMotion, motion_summary
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import Tolerance
 
 
 def relation_label(relation: Relation) -> str:
@@ -174,7 +174,7 @@ def task_motion(task: Task, tol: Tolerance | None = None) -> TaskMotionReport:
     """The motion of every movable body in every situation of ``task`` relative to the
     rest, from the relations it takes part in (module docstring); lengths in the
     tolerance are scaled to the task's size."""
-    working = (tol or current()).with_scale(model_scale(task))
+    working = task_tolerance(task, tol)
     solution = solve_task(task, working)
     motions = [
         m
