@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import assemblykit
 from assemblykit.inference import solve_task
@@ -88,6 +89,20 @@ def scaled(data: dict[str, Any], k: float) -> dict[str, Any]:
         for action in situation.get("actions") or []:
             if action[0] == "move" and len(action) > 2 and "by" in action[2]:
                 action[2]["by"] = k * action[2]["by"]
+    return out
+
+
+def rotated_and_rounded(data: dict[str, Any], rotation: np.ndarray, digits: int) -> dict[str, Any]:
+    """The task turned by ``rotation`` about the origin (every feature point, normal, axis
+    and reference direction), each number then written to ``digits`` decimals, as a
+    CAD export of the model in another frame would write it."""
+    out = copy.deepcopy(data)
+    for body in out["bodies"].values():
+        for feature in (body.get("features") or {}).values():
+            for key in ("point", "normal", "axis", "ref"):
+                if key in feature:
+                    turned = rotation @ np.asarray(feature[key], dtype=float)
+                    feature[key] = [round(float(x), digits) for x in turned]
     return out
 
 
@@ -321,6 +336,15 @@ def test_rounded_bundled_tasks_are_nearly_consistent_at_a_tight_tolerance(path):
     assert strict.status == "inconsistent"
     assert strict.suggested_tolerance is not None
     assert strict.suggested_tolerance <= 1e-5
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
+def test_bundled_tasks_in_a_generic_frame_written_to_six_decimals_keep_their_answers(path):
+    # a rotation about (0.3, -0.7, 0.5) by 0.91 rad: no feature stays along an axis
+    axis = np.array([0.3, -0.7, 0.5])
+    turn = Rotation.from_rotvec(axis).as_matrix()
+    data = load(path)
+    assert answers(solve(rotated_and_rounded(data, turn, 6))) == answers(solve(data))
 
 
 @pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
