@@ -17,6 +17,7 @@ import manifold3d
 import numpy as np
 import pytest
 
+from assemblykit.algebra import Kind, se3
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.interference import interferences, overlap_volume, solid
 from assemblykit.geometry.tessellation import sags_out
@@ -453,12 +454,22 @@ def test_a_trimmed_screw_keeps_its_surfaces_and_fits_its_pilot_hole(self_tapping
     assert max(sweep_overlaps(prepared, found.steps)) <= 1e-6 * shared
     # a fitter reads it as a screw turned out of the plate along its axis
     assert step.fastener is not None
+    # an M3 (2.9 mm, 3% under 3): its tip at z = 0.5 turns out of the plate's top at
+    # z = 6, 5.5 mm at 0.5 per turn
     assert step.to_dict()["fastener"] == {
         "part": PIN,
         "kind": "screw",
         "axis": [0.0, 0.0, 1.0],
         "holes": [PLATE],
+        "diameter": pytest.approx(2.9, rel=1e-9),
+        "thread": {"size": "M3", "pitch": 0.5, "turns": 11.0, "implied": True},
     }
+    assert step.fastener.summary() == "unscrew M3 (pitch 0.5, 11 turns)"
+    # the helical group of its pitch about the screw's axis: half a turn lifts it 0.25
+    motion = step.fastener.motion()
+    assert motion.kind is Kind.HELICAL and motion.dof == 1
+    lift = se3.translation((0.0, 0.0, 0.25)) @ se3.rotation((0.0, 0.0, 1.0), math.pi)
+    assert motion.contains(lift) and not motion.contains(se3.translation((0.0, 0.0, 0.25)))
 
 
 @pytest.fixture(scope="module")

@@ -11,6 +11,7 @@ import trimesh
 
 from assemblykit.geometry.overlaps import resolve_overlaps
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning.fasteners import implied_thread
 from assemblykit.planning.planner import plan
 from stability_blocks import box
 
@@ -61,11 +62,43 @@ def test_a_rod_drawn_out_of_two_holes_is_named_with_both(rod, kind):
     assert holes[0] == "first"
     found = out.to_dict()["fastener"]
     assert found["axis"] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)
-    assert {k: v for k, v in found.items() if k != "axis"} == {
+    assert found["diameter"] == pytest.approx(2.0, rel=1e-6)  # the holes' (a trimmed rod's)
+    assert {k: v for k, v in found.items() if k not in ("axis", "diameter")} == {
         "part": "rod",
         "kind": kind,
         "holes": holes,
+        # by hand: an M2 (2 mm), whose tip at x = 12 leaves the first block at x = -4,
+        # 16 mm at 0.4 per turn
+        **(
+            {"thread": {"size": "M2", "pitch": 0.4, "turns": 40.0, "implied": True}}
+            if kind == "screw"
+            else {}
+        ),
     }
+    assert out.fastener is not None
+    assert out.fastener.summary() == (
+        "pull pin" if kind == "pin" else "unscrew M2 (pitch 0.4, 40 turns)"
+    )
     # the blocks lifted off the base are no fasteners
     assert all(s.fastener is None for s in result.steps if "rod" not in s.parts)
     assert all("fastener" not in s.to_dict() for s in result.steps if "rod" not in s.parts)
+
+
+@pytest.mark.parametrize(
+    ("diameter", "units", "size", "pitch"),
+    [
+        (2.9, "mm", "M3", 0.5),
+        (6.0, "mm", "M6", 1.0),
+        (0.8, "cm", "M8", 0.125),  # in the model's unit: 1.25 mm
+        (0.012, "m", "M12", 0.00175),
+        (4.5, "mm", None, None),  # between M4 and M5: no size within 10 %
+        (3.0, None, None, None),  # no unit, no size
+    ],
+)
+def test_a_thread_is_implied_by_an_iso_diameter_in_a_known_unit(diameter, units, size, pitch):
+    thread = implied_thread(diameter, 10 * (pitch or 1), units)
+    if size is None:
+        assert thread is None
+    else:
+        assert thread is not None and (thread.size, thread.turns) == (size, 10.0)
+        assert thread.pitch == pytest.approx(pitch, rel=1e-12)

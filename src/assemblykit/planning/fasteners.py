@@ -7,15 +7,24 @@ inner (shaft) side of a cylindrical contact with a part it leaves
 (:class:`~assemblykit.geometry.contacts.CurvedPatch`) whose axis is the step's direction
 within the angle tolerance, and a **screw** when it also interferes with one of those
 parts by design (a thread cut into its pilot hole or a nut's insert, resolved by
-:func:`~assemblykit.geometry.overlaps.resolve_overlaps`); otherwise a **pin**. A screw
-comes out by the helical motion of the screw group about that axis (Liu 1997:
-the helical pair); its pitch is not read from the model. Bolts and screws drawn at
-their nominal diameter, with no thread modelled and no interference, are reported as
-pins (docs/planning.md, "Fasteners").
+:func:`~assemblykit.geometry.overlaps.resolve_overlaps`); otherwise a **pin**. Bolts and
+screws drawn at their nominal diameter, with no thread modelled and no interference, are
+reported as pins (docs/planning.md, "Fasteners").
+
+A screw comes out by the helical motion of the screw group about its axis (Liu 1997:
+the helical pair; :meth:`Fastener.motion`), whose sweep is the translation's for a part
+round about its axis, so the step's path is checked as a translation. Its **thread** is
+implied by its diameter, the fit's, when that is within :data:`NOMINAL_MATCH` of an ISO
+metric size and the model's unit is one of :data:`MILLIMETRES` (millimetres unless the
+input says otherwise): the coarse pitch of ISO 261 for that size
+(:data:`ISO_COARSE_PITCH`; a right-hand thread, unscrewed by turning anticlockwise seen
+from its head), and the **turns** it takes are the distance its tip travels until it
+leaves the last hole it is threaded into, over the pitch.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -23,11 +32,79 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.algebra import SymmetryGroup
+from assemblykit.geometry.contacts import CurvedPatch, assembly_contacts
 from assemblykit.model.assembly import Assembly
 from assemblykit.tolerance import Tolerance
 
 FastenerKind = Literal["screw", "pin"]
+
+ISO_COARSE_PITCH: dict[float, float] = {
+    1.0: 0.25,
+    1.2: 0.25,
+    1.4: 0.3,
+    1.6: 0.35,
+    2.0: 0.4,
+    2.5: 0.45,
+    3.0: 0.5,
+    3.5: 0.6,
+    4.0: 0.7,
+    5.0: 0.8,
+    6.0: 1.0,
+    8.0: 1.25,
+    10.0: 1.5,
+    12.0: 1.75,
+    14.0: 2.0,
+    16.0: 2.0,
+    20.0: 2.5,
+    24.0: 3.0,
+    30.0: 3.5,
+    36.0: 4.0,
+}
+"""The coarse pitch (mm) of each ISO metric thread size (nominal diameter, mm), ISO 261."""
+
+NOMINAL_MATCH = 0.1
+"""How far (a fraction of the size) a fit's diameter may be from an ISO size to take it
+for that size: a self-tapping M3 screw cut to a 2.9 mm pilot hole is an M3."""
+
+MILLIMETRES = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
+"""Millimetres per model unit, for the units whose threads are sized."""
+
+
+@dataclass(frozen=True)
+class Thread:
+    """A screw's thread, implied by its diameter (module docstring): the ISO ``size``
+    (``"M3"``), the ``pitch`` (model units per turn, a right-hand thread) and the
+    ``turns`` it takes to come out."""
+
+    size: str
+    pitch: float
+    turns: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form: ``size``, ``pitch`` (model units), ``turns``, ``implied`` (true: read
+        from the diameter, not from a modelled thread)."""
+        return {"size": self.size, "pitch": self.pitch, "turns": self.turns, "implied": True}
+
+
+def implied_thread(diameter: float, travel: float, units: str | None) -> Thread | None:
+    """The ISO thread of a screw whose fit has ``diameter`` and whose tip travels
+    ``travel`` while threaded (model units of ``units``), or ``None`` when no ISO size is
+    within :data:`NOMINAL_MATCH` or the unit is not known (module docstring).
+
+    >>> implied_thread(2.9, 6.0, "mm")
+    Thread(size='M3', pitch=0.5, turns=12.0)
+    """
+    scale = MILLIMETRES.get(units or "")
+    if scale is None or not diameter > 0:
+        return None
+    millimetres = diameter * scale
+    size = min(ISO_COARSE_PITCH, key=lambda nominal: abs(nominal - millimetres))
+    if abs(size - millimetres) > NOMINAL_MATCH * size:
+        return None
+    pitch = ISO_COARSE_PITCH[size] / scale
+    name = f"M{size:g}"
+    return Thread(name, pitch, round(max(travel, 0.0) / pitch, 1))
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,14 +117,42 @@ class Fastener:
     kind: FastenerKind
     axis: NDArray[np.float64]
     holes: tuple[str, ...]
+    center: NDArray[np.float64] | None = None
+    """A point of the axis (the fit's)."""
+    diameter: float | None = None
+    """The diameter of its fit (model units)."""
+    thread: Thread | None = None
+    """A screw's thread, where implied (module docstring)."""
+
+    def motion(self) -> SymmetryGroup:
+        """The motion that takes it out: the helical group about its axis, of the
+        thread's pitch (``pitch / 2 pi`` per radian, right-handed), for a screw whose
+        thread is known; the translations along the axis otherwise."""
+        center = np.zeros(3) if self.center is None else self.center
+        if self.thread is None:
+            return SymmetryGroup.prismatic(self.axis)
+        return SymmetryGroup.helical(center, self.axis, self.thread.pitch / (2 * math.pi))
+
+    def summary(self) -> str:
+        """In words: ``"unscrew M3 (pitch 0.5, 12 turns)"``, ``"unscrew"`` or ``"pull pin"``."""
+        if self.kind == "pin":
+            return "pull pin"
+        if self.thread is None:
+            return "unscrew"
+        thread = self.thread
+        return f"unscrew {thread.size} (pitch {thread.pitch:g}, {thread.turns:g} turns)"
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``part``, ``kind`` (``"screw"`` or ``"pin"``), ``axis``, ``holes``."""
+        """JSON form: ``part``, ``kind`` (``"screw"`` or ``"pin"``), ``axis``, ``holes``,
+        ``diameter`` (of the fit), and for a screw whose thread is implied ``thread``
+        (:meth:`Thread.to_dict`)."""
         return {
             "part": self.part,
             "kind": self.kind,
             "axis": [float(x) + 0.0 for x in self.axis],
             "holes": list(self.holes),
+            **({} if self.diameter is None else {"diameter": self.diameter}),
+            **({} if self.thread is None else {"thread": self.thread.to_dict()}),
         }
 
 
@@ -66,22 +171,53 @@ def step_fastener(
     (part,) = parts
     staying = set(rest)
     d = np.asarray(direction, dtype=np.float64) / np.linalg.norm(direction)
-    holes = []
+    fits: dict[str, list[CurvedPatch]] = {}
     for contact in assembly_contacts(assembly, tol):
         other = contact.b if contact.a == part else contact.a if contact.b == part else None
         if other is None or other not in staying:
             continue
-        if any(
-            patch.kind == "cylindrical"
+        found = [
+            patch
+            for patch in contact.curved
+            if patch.kind == "cylindrical"
             and patch.inner == part
             and patch.axis is not None
             and abs(float(patch.axis @ d)) >= np.cos(tol.mesh_angle)
-            for patch in contact.curved
-        ):
-            holes.append(other)
-    if not holes:
+        ]
+        if found:
+            fits.setdefault(other, []).extend(found)
+    if not fits:
         return None
     order = {name: k for k, name in enumerate(assembly.names)}
-    holes.sort(key=order.__getitem__)
-    threaded = any({o.a, o.b} & {part} and {o.a, o.b} & set(holes) for o in assembly.overlaps)
-    return Fastener(part, "screw" if threaded else "pin", d, tuple(holes))
+    holes = sorted(fits, key=order.__getitem__)
+    threaded = [
+        hole for hole in holes if any({o.a, o.b} == {part, hole} for o in assembly.overlaps)
+    ]
+    first = fits[holes[0]][0]
+    diameter = 2 * max(patch.radius for hole in holes for patch in fits[hole])
+    thread = None
+    if threaded:
+        tip = float((assembly[part].mesh.vertices @ d).min())
+        travel = max(_far_end(patch, d) for hole in threaded for patch in fits[hole]) - tip
+        thread = implied_thread(diameter, travel, assembly.units)
+    return Fastener(
+        part,
+        "screw" if threaded else "pin",
+        d,
+        tuple(holes),
+        np.asarray(first.center, dtype=np.float64),
+        diameter,
+        thread,
+    )
+
+
+def _far_end(patch: CurvedPatch, direction: NDArray[np.float64]) -> float:
+    """How far along ``direction`` the fit ``patch`` reaches (its whole surface when its
+    extent is not known)."""
+    assert patch.axis is not None
+    along = float(patch.axis @ direction)
+    base = float(np.asarray(patch.center) @ direction)
+    if patch.extent is not None:
+        return base + max(along * patch.extent[0], along * patch.extent[1])
+    points = patch.points if patch.points is not None else np.asarray([patch.center])
+    return float((np.asarray(points) @ direction).max())
