@@ -36,7 +36,7 @@ import numpy as np
 import shapely
 import trimesh
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import HalfspaceIntersection
+from scipy.spatial import ConvexHull, HalfspaceIntersection
 
 from assemblykit.tolerance import Tolerance, current
 
@@ -115,21 +115,25 @@ _LARGEST_FACES = 8
 
 
 def hull_vertices(mesh: trimesh.Trimesh) -> NDArray[np.float64]:
-    """The corners of a polytope holding ``mesh``: its convex hull (qhull, through
-    trimesh) cut down to the planes of the 26 :data:`_DOP_AXES` touching it and of its
-    :data:`_LARGEST_FACES` largest faces (scipy's half-space intersection), a few dozen
+    """The corners of a polytope holding ``mesh``: its convex hull (scipy's qhull, whose
+    facets come with their outward planes) cut down to the planes of the 26
+    :data:`_DOP_AXES` touching it and of its :data:`_LARGEST_FACES` largest faces (scipy's half-space intersection), a few dozen
     corners where a tessellated cylinder's hull has hundreds; all the mesh's vertices
     where the hull is degenerate (a flat part). Projected along any direction, the
     polytope's outline holds the mesh's: where two outlines do not overlap, neither do
     the meshes (:func:`hulls_may_block`)."""
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     try:
-        hull = mesh.convex_hull
-        corners = np.asarray(hull.vertices, dtype=np.float64)
+        hull = ConvexHull(vertices, qhull_options="QbB Pp Qt")
+        corners = vertices[hull.vertices]
         if len(corners) <= len(_DOP_AXES) + _LARGEST_FACES:
             return corners
-        largest = np.argsort(-hull.area_faces, kind="stable")[:_LARGEST_FACES]
-        normals = np.vstack([_DOP_AXES, hull.face_normals[largest]])
+        triangles = vertices[hull.simplices]
+        areas = np.linalg.norm(
+            np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]), axis=1
+        )
+        largest = np.argsort(-areas, kind="stable")[:_LARGEST_FACES]
+        normals = np.vstack([_DOP_AXES, hull.equations[largest, :3]])
         offsets = (corners @ normals.T).max(axis=0)
         planes = np.column_stack([normals, -offsets])
         cut = HalfspaceIntersection(planes, corners.mean(axis=0)).intersections
