@@ -111,13 +111,17 @@ def test_finished_inputs_are_answers_keyed_by_command_path_and_content(tmp_path)
 
 
 FAKE_PYTHON = """#!/bin/sh
-# the Python of a batch's children: $3 is the command, $4 the input's absolute path
-echo "$4" >> "$(dirname "$0")/ran.txt"
-case "$4" in
-  *die*) kill -9 $$ ;;
-  *bad*) echo '{"status": "error", "error": "'"$4"': not an assembly"}' ;;
-  *) echo '{"status": "ok", "result": {"ran": "'"$4"'"}}' ;;
-esac
+# the Python of a batch's workers ("-m assemblykit.batch --serve"): one request per line
+# on stdin ({"command": ..., "path": ...}), one answer per line on stdout
+while IFS= read -r line; do
+  path=$(printf '%s\\n' "$line" | sed -n 's/.*"path": "\\([^"]*\\)".*/\\1/p')
+  echo "$path" >> "$(dirname "$0")/ran.txt"
+  case "$path" in
+    *die*) kill -9 $$ ;;
+    *bad*) echo '{"status": "error", "error": "'"$path"': not an assembly"}' ;;
+    *) echo '{"status": "ok", "result": {"ran": "'"$path"'"}}' ;;
+  esac
+done
 """
 
 

@@ -39,12 +39,16 @@ main(sys.argv[1:])
 """
 
 FAKE_PYTHON = """#!/bin/sh
-# the Python of a batch's children: $3 is the command, $4 the input's absolute path
-echo "$4" >> "$(dirname "$0")/started.txt"
-case "$4" in
-  *slow*) echo $$ > "$(dirname "$0")/slow.pid"; exec sleep 600 ;;
-esac
-echo '{"status": "ok", "result": {"ran": "'"$4"'"}}'
+# the Python of a batch's workers ("-m assemblykit.batch --serve"): one request per line
+# on stdin ({"command": ..., "path": ...}), one answer per line on stdout
+while IFS= read -r line; do
+  path=$(printf '%s\\n' "$line" | sed -n 's/.*"path": "\\([^"]*\\)".*/\\1/p')
+  echo "$path" >> "$(dirname "$0")/started.txt"
+  case "$path" in
+    *slow*) echo $$ > "$(dirname "$0")/slow.pid"; exec sleep 600 ;;
+  esac
+  echo '{"status": "ok", "result": {"ran": "'"$path"'"}}'
+done
 """
 
 

@@ -1,11 +1,15 @@
 """Many assemblies in parallel: ``assemblykit batch`` (docs/planning.md, "Many assemblies").
 
-Every assembly runs in its own child process (``python -m assemblykit.batch INPUT``), so
-a per-assembly timeout really stops the work and a crash is recorded instead of ending
-the batch. The children are driven either locally (a pool of ``workers`` threads, each
-waiting on one child at a time) or by Dask (``dask.distributed``; a local cluster when no
-scheduler address is given), whose tasks start the same child. Both engines therefore
-give the same answers.
+The assemblies run in worker processes (``python -m assemblykit.batch --serve``), each
+answering one assembly after another, so that a batch pays for importing assemblykit and
+its dependencies once per worker, not once per assembly. A worker is a child process, so
+a per-assembly timeout really stops the work (the worker is killed, and the next
+assembly starts a new one) and a crash is recorded instead of ending the batch. The
+workers are driven either locally (a pool of ``workers`` threads, each with its own
+worker) or by Dask (``dask.distributed``; a local cluster when no scheduler address is
+given), whose tasks ask the same workers. Both engines therefore give the same answers.
+With a remote scheduler each assembly runs in a new child on the remote worker
+(``python -m assemblykit.batch COMMAND INPUT``), which leaves no process behind there.
 
 The output is JSON Lines, one line per assembly, appended as soon as it is known:
 ``input`` (as given), ``status`` (``ok``, ``error`` or ``timeout``), ``result`` (the
@@ -39,9 +43,11 @@ import io
 import json
 import logging
 import os
+import queue
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from collections import Counter
@@ -49,7 +55,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal, cast
+from typing import IO, Any, Literal, cast
 
 from assemblykit.errors import AssemblyKitError, InputError, MissingExtraError
 
@@ -157,14 +163,14 @@ class _Children:
         self._running: set[subprocess.Popen[str]] = set()
         self._stopping = False
 
-    def start(self, command: list[str]) -> subprocess.Popen[str]:
-        """A child running ``command``; :class:`_Stopped` while stopping."""
+    def start(self, command: list[str], **streams: Any) -> subprocess.Popen[str]:
+        """A child running ``command`` (stdout and stderr piped unless ``streams`` say
+        otherwise); :class:`_Stopped` while stopping."""
         with self._lock:
             if self._stopping:
                 raise _Stopped(command[-1])
-            child = subprocess.Popen(
-                command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-            )
+            pipes: dict[str, Any] = {"stdout": subprocess.PIPE, "stderr": subprocess.PIPE}
+            child = subprocess.Popen(command, text=True, **{**pipes, **streams})
             self._running.add(child)
             return child
 
@@ -172,6 +178,12 @@ class _Children:
         """Forget ``child``; whether it ended while stopping (its outcome is void)."""
         with self._lock:
             self._running.discard(child)
+            return self._stopping
+
+    @property
+    def is_stopping(self) -> bool:
+        """Whether the running children are being ended (an interruption)."""
+        with self._lock:
             return self._stopping
 
     @contextlib.contextmanager
@@ -191,19 +203,25 @@ class _Children:
 _CHILDREN = _Children()
 
 
-def run_job(job: Job) -> dict[str, Any]:
-    """Run one job in a child process and return its JSON line (as a dict).
+def run_job(job: Job, keep: bool = True) -> dict[str, Any]:
+    """Run one job and return its JSON line (as a dict): in this thread's worker
+    (:class:`_Worker`) with ``keep``, else in a child of its own.
 
-    The child prints ``{"status": ..., "result"|"error": ...}``; a child that exceeds
+    A worker answers ``{"status": ..., "result"|"error": ...}``; one that exceeds
     ``job.timeout`` seconds is killed (status ``timeout``); one that dies without an
     answer is an ``error`` carrying the last line of its stderr or the signal that killed
-    it; both carry ``"retry": true``. A child ended by an interruption (Ctrl-C, or the
+    it; both carry ``"retry": true``. A job ended by an interruption (Ctrl-C, or the
     batch stopping) raises :class:`_Stopped`.
     """
+    start = time.perf_counter()
+    if keep:
+        outcome = _worker().ask(job)
+        if _CHILDREN.is_stopping:
+            raise _Stopped(job.input)
+        return _line(job, outcome, start)
     command = [sys.executable, "-m", "assemblykit.batch", job.command, job.path or job.input]
     if job.rel_tolerance is not None:
         command.append(repr(job.rel_tolerance))
-    start = time.perf_counter()
     child = _CHILDREN.start(command)
     try:
         outcome = _outcome(child, job.timeout)
@@ -212,6 +230,124 @@ def run_job(job: Job) -> dict[str, Any]:
     if stopped or child.returncode in INTERRUPTED_CODES:
         raise _Stopped(job.input)
     return _line(job, outcome, start)
+
+
+class _Worker:
+    """A worker process (``python -m assemblykit.batch --serve``) that answers jobs one
+    after another, one JSON line each (module docstring). It is started by the first job
+    it is asked, killed by a timeout, and started again by the job after one that killed
+    it; its stderr goes to a temporary file, whose last line says why it died."""
+
+    def __init__(self) -> None:
+        self._child: subprocess.Popen[str] | None = None
+        self._answers: queue.Queue[str | None] = queue.Queue()
+        self._errors: IO[str] | None = None
+
+    def ask(self, job: Job) -> dict[str, Any]:
+        """The outcome of ``job``: the worker's answer, a timeout or its death."""
+        child = self._child if self._child is not None else self._start()
+        request: dict[str, Any] = {"command": job.command, "path": job.path or job.input}
+        if job.rel_tolerance is not None:
+            request["rel_tolerance"] = job.rel_tolerance
+        try:
+            assert child.stdin is not None
+            child.stdin.write(json.dumps(request) + "\n")
+            child.stdin.flush()
+            answer = self._answers.get(timeout=job.timeout)
+        except queue.Empty:
+            self.close(kill=True)
+            return {"status": "timeout", "error": f"over {job.timeout} s", "retry": True}
+        except (BrokenPipeError, OSError):
+            answer = None
+        if answer is not None:
+            return cast(dict[str, Any], json.loads(answer))
+        return {"status": "error", "error": f"worker died: {self._death()}", "retry": True}
+
+    def _start(self) -> subprocess.Popen[str]:
+        # kept open for the worker's life, closed by _death or close
+        self._errors = tempfile.TemporaryFile("w+", encoding="utf-8")  # noqa: SIM115
+        command = [sys.executable, "-m", "assemblykit.batch", "--serve"]
+        child = _CHILDREN.start(command, stdin=subprocess.PIPE, stderr=self._errors)
+        self._child, self._answers = child, queue.Queue()
+        threading.Thread(target=_read_lines, args=(child, self._answers), daemon=True).start()
+        return child
+
+    def _death(self) -> str:
+        """Why the worker ended (the last line of its stderr, or its signal or exit
+        code), once it has; it is forgotten."""
+        child, errors = self._child, self._errors
+        assert child is not None and errors is not None
+        code = child.wait()
+        _CHILDREN.finish(child)
+        errors.seek(0)
+        last = errors.read().strip().splitlines()
+        errors.close()
+        self._child = self._errors = None
+        if code in INTERRUPTED_CODES:
+            raise _Stopped("interrupted")
+        if last:
+            return last[-1]
+        if code < 0:
+            return f"killed by {signal.Signals(-code).name}"
+        return f"exit code {code}"
+
+    def close(self, kill: bool = False) -> None:
+        """End the worker: at once with ``kill``, else once it has read the end of its
+        input (it finishes no job then: it has none)."""
+        child = self._child
+        if child is None:
+            return
+        if kill:
+            child.kill()
+        elif child.stdin is not None:
+            with contextlib.suppress(OSError):
+                child.stdin.close()
+        try:
+            child.wait(timeout=WORKER_EXIT)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            child.wait()
+        _CHILDREN.finish(child)
+        if self._errors is not None:
+            self._errors.close()
+        self._child = self._errors = None
+
+
+WORKER_EXIT = 10.0
+"""Seconds a worker is given to end once its input is closed, before it is killed."""
+
+
+def _read_lines(child: subprocess.Popen[str], answers: queue.Queue[str | None]) -> None:
+    """Put each line ``child`` prints into ``answers``, then ``None`` at its end."""
+    assert child.stdout is not None
+    for line in child.stdout:
+        answers.put(line)
+    answers.put(None)
+
+
+_WORKERS = threading.local()
+_ALL_WORKERS: list[_Worker] = []
+_WORKERS_LOCK = threading.Lock()
+
+
+def _worker() -> _Worker:
+    """This thread's worker (each thread of a pool drives its own; a new one after
+    :func:`close_workers`)."""
+    found = getattr(_WORKERS, "worker", None)
+    if found is None or found not in _ALL_WORKERS:
+        found = _WORKERS.worker = _Worker()
+        with _WORKERS_LOCK:
+            _ALL_WORKERS.append(found)
+    return cast(_Worker, found)
+
+
+def close_workers() -> None:
+    """End every worker this process started (a batch's end)."""
+    with _WORKERS_LOCK:
+        workers = list(_ALL_WORKERS)
+        _ALL_WORKERS.clear()
+    for worker in workers:
+        worker.close()
 
 
 def _outcome(child: subprocess.Popen[str], timeout: float | None) -> dict[str, Any]:
@@ -340,6 +476,7 @@ def _local(jobs: Sequence[Job], workers: int) -> Iterator[Iterator[dict[str, Any
     finally:
         with _CHILDREN.stopping():
             pool.shutdown(cancel_futures=True)
+        close_workers()
 
 
 SCHEDULER_TIMEOUT = 10
@@ -372,13 +509,18 @@ def _dask(
                 source=scheduler,
                 where="--scheduler",
             ) from None
+    # the workers of a local cluster are threads of this process: each keeps a worker
+    # process; a remote one's jobs each run in a child of their own
+    keep = cluster is not None
     try:
-        yield _answers(dask_completed([client.submit(run_job, j, pure=False) for j in jobs]))
+        futures = [client.submit(run_job, j, keep, pure=False) for j in jobs]
+        yield _answers(dask_completed(futures))
     finally:
         with _CHILDREN.stopping(), _quiet_logger("distributed"):
             client.close()
             if cluster is not None:
                 cluster.close()
+        close_workers()
 
 
 @contextlib.contextmanager
@@ -466,30 +608,56 @@ def run_batch(
     return BatchSummary(str(target), len(names), skipped, dict(statuses), tuple(failed))
 
 
-def _child(argv: Sequence[str]) -> int:
-    """The child process: print one JSON object with ``status`` and ``result``/``error``."""
-    command, path, *rest = argv
-    rel_tolerance = float(rest[0]) if rest else None
+def answer(command: str, path: str, rel_tolerance: float | None = None) -> dict[str, Any]:
+    """One job's outcome as a worker prints it: ``status`` and ``result`` or ``error``
+    (``internal`` for a fault of assemblykit rather than of the input)."""
     try:
-        outcome: dict[str, Any] = {
+        return {
             "status": "ok",
             "result": compute(command, path, rel_tolerance),  # type: ignore[arg-type]
         }
     except (InputError, MissingExtraError) as bad:
-        outcome = {"status": "error", "error": str(bad)}
+        return {"status": "error", "error": str(bad)}
     except AssemblyKitError as failure:  # a fault of the computation, not of the input
-        outcome = {"status": "error", "error": f"internal error: {failure}", "internal": True}
+        return {"status": "error", "error": f"internal error: {failure}", "internal": True}
     except Exception as bug:  # recorded, never fatal to the batch
-        outcome = {
+        return {
             "status": "error",
             "error": f"internal error: {type(bug).__name__}: {bug}",
             "internal": True,
         }
+
+
+def _child(argv: Sequence[str]) -> int:
+    """A child of one job: print one JSON object (:func:`answer`)."""
+    command, path, *rest = argv
+    rel_tolerance = float(rest[0]) if rest else None
+    try:
+        outcome = answer(command, path, rel_tolerance)
     except KeyboardInterrupt:  # Ctrl-C reaches the whole process group; the batch stops
         return INTERRUPTED_CODES[0]
     sys.stdout.write(json.dumps(outcome) + "\n")
     return 0
 
 
+def _serve(requests: IO[str], answers: IO[str]) -> int:
+    """A worker: for each request line (``{"command", "path", "rel_tolerance"}``), one
+    answer line (:func:`answer`), flushed at once; it ends with its input."""
+    from assemblykit.io.assembly import load_assembly  # noqa: F401  (imported once, here)
+    from assemblykit.planning.planner import plan  # noqa: F401
+
+    try:
+        for line in requests:
+            request = json.loads(line)
+            outcome = answer(request["command"], request["path"], request.get("rel_tolerance"))
+            answers.write(json.dumps(outcome) + "\n")
+            answers.flush()
+    except KeyboardInterrupt:
+        return INTERRUPTED_CODES[0]
+    return 0
+
+
 if __name__ == "__main__":
+    if sys.argv[1:] == ["--serve"]:
+        raise SystemExit(_serve(sys.stdin, sys.stdout))
     raise SystemExit(_child(sys.argv[1:]))
