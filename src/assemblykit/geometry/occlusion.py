@@ -117,8 +117,9 @@ _LARGEST_FACES = 8
 def hull_vertices(mesh: trimesh.Trimesh) -> NDArray[np.float64]:
     """The corners of a polytope holding ``mesh``: its convex hull (scipy's qhull, whose
     facets come with their outward planes) cut down to the planes of the 26
-    :data:`_DOP_AXES` touching it and of its :data:`_LARGEST_FACES` largest faces (scipy's half-space intersection), a few dozen
-    corners where a tessellated cylinder's hull has hundreds; all the mesh's vertices
+    :data:`_DOP_AXES` touching it and of its :data:`_LARGEST_FACES` largest faces
+    (scipy's half-space intersection), a few dozen corners where a tessellated
+    cylinder's hull has hundreds; all the mesh's vertices
     where the hull is degenerate (a flat part). Projected along any direction, the
     polytope's outline holds the mesh's: where two outlines do not overlap, neither do
     the meshes (:func:`hulls_may_block`)."""
