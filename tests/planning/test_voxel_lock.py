@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from assemblykit.blocking.extended import extended_free
-from assemblykit.blocking.free_cones import exact_free_directions, lattice_cells, lattice_locked
+from assemblykit.blocking.free_cones import exact_free_directions, lattice_locked
+from assemblykit.blocking.lattice import lattice_cells
 from assemblykit.io.burrtools import load_burrtools, voxel_mesh
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.planner import plan

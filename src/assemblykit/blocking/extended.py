@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph
+from assemblykit.blocking.lattice import cells_block, lattice_direction
 from assemblykit.geometry.minkowski import blocks_along
 from assemblykit.geometry.occlusion import (
     blocking_witnesses,
@@ -108,11 +109,55 @@ def extended_arcs(
     for pairs of convex parts, the projection test for the others (all of their pairs at
     once: one projection of each mesh serves every pair, so no coarser test first).
     With ``first_only``, at least one arc of each blocked mover and maybe no more:
-    which movers leave, at the cost of finding one blocker each."""
+    which movers leave, at the cost of finding one blocker each. Parts all made of unit
+    cells are decided on their cells along a lattice direction
+    (:mod:`assemblykit.blocking.lattice`), every arc found."""
     d = np.asarray(direction, dtype=np.float64).ravel()
     d = d / np.linalg.norm(d)
     cache = BlockingCache.of(assembly).obstacles
-    moving_parts = list(movers)
+    moving_parts, still = list(movers), list(blockers)
+    found = _lattice_arcs(cache, d, moving_parts, still, tol)
+    if found is not None:
+        return found
+    return projected_arcs(assembly, d, moving_parts, still, tol, first_only=first_only)
+
+
+def _lattice_arcs(
+    cache: Obstacles,
+    direction: NDArray[np.float64],
+    movers: list[str],
+    blockers: list[str],
+    tol: Tolerance,
+) -> set[tuple[str, str]] | None:
+    """The arcs of :func:`extended_arcs` when every part is made of unit cells and
+    ``direction`` is a lattice direction (:func:`~assemblykit.blocking.lattice.cells_block`);
+    ``None`` otherwise."""
+    lattice = lattice_direction(direction, tol)
+    if lattice is None:
+        return None
+    cells = {name: cache.cells(name) for name in {*movers, *blockers}}
+    if any(found is None for found in cells.values()):
+        return None
+    return {
+        (moving, blocker)
+        for moving in movers
+        for blocker in blockers
+        if blocker != moving and cells_block(cells[moving], cells[blocker], lattice)  # type: ignore[arg-type]
+    }
+
+
+def projected_arcs(
+    assembly: Assembly,
+    d: NDArray[np.float64],
+    moving_parts: list[str],
+    blockers: list[str],
+    tol: Tolerance,
+    *,
+    first_only: bool = False,
+) -> set[tuple[str, str]]:
+    """:func:`extended_arcs` on the parts' meshes, along the unit direction ``d``: cones
+    for pairs of convex parts, the projection test for the others."""
+    cache = BlockingCache.of(assembly).obstacles
     near_parts = sweep_candidates(assembly, moving_parts, d, blockers)
     arcs: set[tuple[str, str]] = set()
     projected: list[tuple[str, str]] = []

@@ -701,48 +701,6 @@ LATTICE_LOCK_PARTS = 8
 subsets (``2^n - 2`` of them, one bit per ordered pair of parts in 64); larger sets
 are left to the faces and cells above."""
 
-_SPREAD = np.array([0.5 + 1e-3 * np.pi, 0.5 + 1e-3 * np.exp(1.0)])
-"""Where in its cell's cross-section a cell is probed (:func:`lattice_cells`): off every
-line through two lattice points of a small model, so no probe lies on an edge."""
-
-
-def lattice_cells(mesh: Any) -> NDArray[np.int64] | None:
-    """The unit cells ``[c, c + 1]`` a closed mesh is the union of, when it is one: every
-    vertex on the integer lattice and every face square to an axis (a BurrTools piece, a
-    part made of voxels); ``None`` otherwise. A cell is inside when a ray from a point of
-    it along ``+z`` crosses the mesh's faces an odd number of times; the cells must make
-    up the mesh's whole volume."""
-    vertices = np.asarray(mesh.vertices, dtype=np.float64)
-    if not len(vertices) or not bool(mesh.is_volume):
-        return None
-    lattice = np.round(vertices)
-    normals = np.abs(np.asarray(mesh.face_normals, dtype=np.float64))
-    if np.abs(vertices - lattice).max() > 1e-9 or np.abs(normals.max(axis=1) - 1.0).max() > 1e-9:
-        return None
-    tris = lattice[np.asarray(mesh.faces)]
-    flat = tris[normals[:, 2] > 0.5]  # faces square to z
-    low, high = lattice.min(axis=0).astype(np.int64), lattice.max(axis=0).astype(np.int64)
-    grid = np.stack(
-        np.meshgrid(*(np.arange(a, b) for a, b in zip(low, high, strict=True)), indexing="ij"),
-        axis=-1,
-    ).reshape(-1, 3)
-    probe = grid[:, :2] + _SPREAD
-    a, b, c = flat[:, 0, :2], flat[:, 1, :2], flat[:, 2, :2]
-
-    def side(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64]:
-        e = (q - p)[None]
-        r = probe[:, None, :] - p[None]
-        out: NDArray[np.float64] = e[..., 0] * r[..., 1] - e[..., 1] * r[..., 0]
-        return out
-
-    s1, s2, s3 = side(a, b), side(b, c), side(c, a)
-    within = ((s1 > 0) & (s2 > 0) & (s3 > 0)) | ((s1 < 0) & (s2 < 0) & (s3 < 0))
-    above = flat[None, :, 0, 2] > grid[:, None, 2] + 0.5
-    cells: NDArray[np.int64] = grid[np.count_nonzero(within & above, axis=1) % 2 == 1]
-    if abs(len(cells) - float(mesh.volume)) > 1e-6:
-        return None
-    return cells
-
 
 def _primitive(vectors: NDArray[np.int64]) -> NDArray[np.int64]:
     """Nonzero integer vectors divided by their gcd, sign fixed (first nonzero entry

@@ -18,6 +18,7 @@ import manifold3d
 import numpy as np
 from numpy.typing import NDArray
 
+from assemblykit.blocking.lattice import lattice_cells
 from assemblykit.geometry.interference import interference_threshold, shared_volume, solid
 from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
 from assemblykit.geometry.occlusion import hull_vertices, triangle_spheres
@@ -47,6 +48,7 @@ class Obstacles:
         self.solids: dict[str, manifold3d.Manifold] = {}
         self.hulls: dict[str, NDArray[np.float64]] = {}
         self.balls: dict[str, NDArray[np.float64]] = {}
+        self.lattice: dict[str, NDArray[np.int64] | None] = {}
         self.witnesses: dict[tuple[str, str], tuple[int, int]] = {}
         """Per pair (moving, blocker) found blocking by the projection test, the last
         two faces that showed it (:func:`~assemblykit.geometry.occlusion.witnesses_hold`)."""
@@ -63,6 +65,13 @@ class Obstacles:
                 self.assembly.parts[name].mesh, self.assembly.tolerance()
             )
         return self.pieces[name]
+
+    def cells(self, name: str) -> NDArray[np.int64] | None:
+        """The unit cells a part is made of, ``None`` when it is not
+        (:func:`~assemblykit.blocking.lattice.lattice_cells`), found once."""
+        if name not in self.lattice:
+            self.lattice[name] = lattice_cells(self.assembly.parts[name].mesh)
+        return self.lattice[name]
 
     def convex(self, name: str) -> bool:
         """Whether the part is a union of convex bodies (cones are exact for it)."""

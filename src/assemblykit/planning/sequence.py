@@ -1219,7 +1219,8 @@ def _voxel_lock(assembly: Assembly) -> Callable[[list[str]], bool]:
     :func:`~assemblykit.blocking.free_cones.lattice_locked` (no set of them leaves by one
     extended translation in any direction, docs/blocking.md, "Three kinds of motion"):
     then no exact free set needs computing. Each part's cells are found once."""
-    from assemblykit.blocking.free_cones import LATTICE_LOCK_PARTS, lattice_cells, lattice_locked
+    from assemblykit.blocking.free_cones import LATTICE_LOCK_PARTS, lattice_locked
+    from assemblykit.blocking.lattice import lattice_cells
 
     cells: dict[str, NDArray[np.int64] | None] = {}
 
