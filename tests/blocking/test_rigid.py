@@ -90,12 +90,17 @@ def test_rotation_is_blocked_with_a_full_floor_and_ceiling():
     assert rigid.free_twist({"block"}) is None
     assert rigid.removable() == []
     assert rigid.to_dict()["removable"] == []
+    assert not rigid.frees_some()
+    # with the floor and ceiling of the first, a turn frees it
+    assert blocking_graph(asm, "rigid").frees_some()
 
 
 def test_fig5_is_freed_by_a_rotation_in_a_cell_of_the_arrangement():
     asm = fig5_points()
     assert blocking_graph(asm, "infinitesimal").removable() == []
     rigid = blocking_graph(asm, "rigid")
+    # no single part is freed by the linear program alone: the arrangement decides
+    assert rigid.frees_some() == bool(rigid.removable()) is True
     result = rigid.to_dict()
     # the in-plane constraints (omega_y, v_x, v_z) and the y walls (omega_x, omega_z,
     # v_y) are independent: 4 generic planes of R^3 (14 cells) times 2 of R^3 (4 cells)

@@ -86,6 +86,32 @@ def _no_circles() -> NDArray[np.float64]:
     return np.zeros((0, 3))
 
 
+SNAP_GRID = 1e-12
+"""The grid (chart units, where the sphere's directions span about 2) to which an
+overlay that GEOS's floating overlay cannot node is snapped (:func:`robust_union`): far
+below any angle tolerance, it moves no vertex that decides an answer."""
+
+
+def robust_union(geometries: Any) -> Any:
+    """The union of ``geometries`` (shapely's ``union_all``), made robust by :func:`_robust`."""
+    return _robust(shapely.union_all, geometries)
+
+
+def _robust(operation: Any, *geometries: Any) -> Any:
+    """``operation(*geometries)``; where near-degenerate slivers make GEOS's floating
+    overlay fail (a ``TopologyException``), the same on the geometries made valid
+    (``make_valid``: a sliver clipped into a bow tie becomes its two triangles), then
+    also snapped to :data:`SNAP_GRID`, which GEOS's snap-rounding overlay always nodes."""
+    try:
+        return operation(*geometries)
+    except shapely.errors.GEOSException:
+        valid = [shapely.make_valid(g) for g in geometries]
+    try:
+        return operation(*valid)
+    except shapely.errors.GEOSException:
+        return operation(*valid, grid_size=SNAP_GRID)
+
+
 @dataclass(frozen=True, eq=False)
 class ChartSet:
     """A set of directions as one shapely geometry per chart (:data:`CHARTS`), with the
@@ -120,7 +146,7 @@ class ChartSet:
             ]
             polys = np.concatenate(pieces) if pieces else np.zeros(0, dtype=object)
             polys = polys[~shapely.is_empty(polys)]
-            regions.append(shapely.union_all(polys) if len(polys) else shapely.Polygon())
+            regions.append(robust_union(polys) if len(polys) else shapely.Polygon())
         kept = _no_circles() if contacts is None else np.asarray(contacts, dtype=np.float64)
         return cls(
             tuple(regions),
@@ -148,7 +174,7 @@ class ChartSet:
         if not sets:
             return cls(tuple(shapely.Polygon() for _ in CHARTS))
         return cls(
-            tuple(shapely.union_all([s.regions[c] for s in sets]) for c in range(len(CHARTS))),
+            tuple(robust_union([s.regions[c] for s in sets]) for c in range(len(CHARTS))),
             _stacked([s.cones for s in sets]),
             np.concatenate([s.contacts for s in sets]).reshape(-1, 3),
             np.concatenate([s.seamed for s in sets]),
@@ -535,7 +561,7 @@ def free_faces(blocked: ChartSet, tol: Tolerance) -> Faces:
     square = shapely.box(-1.0, -1.0, 1.0, 1.0)
     polygons: list[tuple[int, shapely.Polygon]] = []
     for c, region in enumerate(blocked.regions):
-        rest = shapely.difference(square, region)
+        rest = _robust(shapely.difference, square, region)
         polygons.extend((c, p) for p in shapely.get_parts(rest) if isinstance(p, shapely.Polygon))
     return _faces(polygons, tol)
 
@@ -551,7 +577,7 @@ def overlay_faces(sets: Sequence[ChartSet], tol: Tolerance, limit: int = 20_000)
         lines = [square.boundary] + [
             s.regions[c].boundary for s in sets if not s.regions[c].is_empty
         ]
-        noded = shapely.union_all(lines)
+        noded = robust_union(lines)
         faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
         polygons.extend((c, p) for p in faces[:limit])
     found = _faces(polygons, tol)

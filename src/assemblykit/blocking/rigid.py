@@ -260,6 +260,16 @@ class RigidBlockingGraph:
         everything = frozenset(self.parts)
         return sorted((s for s in found if s != everything), key=lambda s: (len(s), sorted(s)))
 
+    def frees_some(self) -> bool:
+        """Whether some rigid twist frees a proper subassembly: :meth:`removable` is not
+        empty. The connected subassemblies of at most ``RIGID_MAX_SIZE`` parts are tried
+        first, one small linear program each (:meth:`free_twist`), so that the
+        arrangement of S⁵, whose cells grow as the fifth power of the contacts, is built
+        only when none of them is freed."""
+        if any(self.free_twist(s) is not None for s in self._candidates(RIGID_MAX_SIZE)):
+            return True
+        return bool(self.removable())
+
     def removable(self, max_size: int | None = None) -> list[Removal]:
         """Subassemblies that some rigid twist frees (a necessary condition for
         removal, Wilson & Latombe 1992): those free in a cell's DBG (up to ``max_size`` parts), with

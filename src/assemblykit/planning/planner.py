@@ -17,6 +17,7 @@ import numpy as np
 from assemblykit.blocking.directions import DirectionTable, bits, mask_of, union_of
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.polygons import PolygonAssembly
+from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.blocking.tables import translation_slots, translation_table
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.geometry.interference import interferences
@@ -64,7 +65,9 @@ def rigid_may_free(
     if isinstance(assembly, PolygonAssembly):
         # polygons move in their plane: lifting off it would free every part
         return planar_rigid_may_free(assembly, parts, assembly.tolerance(tol))
-    return bool(blocking_graph(assembly, motion="rigid", parts=parts, tol=tol).removable())
+    graph = blocking_graph(assembly, motion="rigid", parts=parts, tol=tol)
+    assert isinstance(graph, RigidBlockingGraph)
+    return graph.frees_some()
 
 
 def plan(
