@@ -2,8 +2,9 @@
 equilibrium of the dome (527 blocks) <= 1 s, the cross vault planned with gravity
 <= 10 s, the ASAP beam planned with gravity <= 1 s.
 
-Run ``python benchmarks/bench_stability.py [--crossvault-plan]``. Figures (wall time, one
-run each, loading and contacts excluded unless said; the machine is named first):
+Run ``python benchmarks/bench_stability.py [--crossvault-plan] [--dome-plan]``. Figures
+(wall time, one run each, loading and contacts excluded unless said; the machine is named
+first):
 
 * equilibrium of the whole arch, dome and cross vault: assembling the sparse equations,
   then the equilibrium program (Clarabel, interior point, in Farkas form over the
@@ -20,7 +21,8 @@ run each, loading and contacts excluded unless said; the machine is named first)
   polygon vertex (an independent check); the cross vault's first 20
   steps with three holds, with the programs they ran; its whole plan with one hold only
   with ``--crossvault-plan`` (minutes: from step 40 on no single block's removal
-  stands, and each step then asks which parts would fall).
+  stands, and each step then asks which parts would fall); the dome's first 20 steps
+  under gravity with ``--dome-plan``, in CPU seconds next to the whole plan's target.
 
 The dome is skipped unless ``$ASSEMBLYKIT_DATA`` holds
 ``compas_assembly/dome_assembly.json``.
@@ -190,6 +192,32 @@ def first_steps(path: Path | None, steps: int, tol: Tolerance) -> None:
     )
 
 
+DOME_PLAN_TARGET = 120.0
+"""CPU seconds the dome's whole plan under gravity should take."""
+
+DOME_STEPS = 20
+"""How many steps of the dome's plan ``--dome-plan`` times (the whole plan is hours)."""
+
+
+def dome_steps(path: Path | None, steps: int) -> None:
+    """CPU time of the first ``steps`` steps of the dome's plan under gravity with one
+    hold (contacts included), and how many of them stand; the whole plan's target is
+    :data:`DOME_PLAN_TARGET`."""
+    if path is None:
+        print(f"{'dome plan':<24} skipped (not found; set ASSEMBLYKIT_DATA)")
+        return
+    assembly = load_assembly(path)
+    start = time.process_time()
+    found = plan(assembly, max_and_or_parts=0, gravity=Gravity(), max_steps=steps)
+    seconds = time.process_time() - start
+    standing = sum(step.stability is not None and step.stability.stands for step in found.steps)
+    print(
+        f"{f'dome, first {steps}':<24} {seconds:8.1f} CPU s, {seconds / steps:.1f} s a step, "
+        f"{standing} of {len(found.steps)} standing; {len(assembly.names)} blocks "
+        f"(whole plan target <= {DOME_PLAN_TARGET:g} s)"
+    )
+
+
 def state_programs(path: Path | None, tol: Tolerance) -> None:
     """Time one state of the cross vault that stands (the whole vault) and one that does
     not (its three highest blocks taken away), each solved whole, then the second decided
@@ -240,6 +268,10 @@ def main() -> None:
         planned("crossvault, 1 hold", vault, Gravity(), CROWN_JOINTS)
     else:
         print("crossvault, 1 hold        skipped: minutes; run with --crossvault-plan")
+    if "--dome-plan" in sys.argv:
+        dome_steps(dataset("compas_assembly/dome_assembly.json"), DOME_STEPS)
+    else:
+        print(f"dome, first {DOME_STEPS:<12} skipped: minutes; run with --dome-plan")
 
 
 if __name__ == "__main__":
