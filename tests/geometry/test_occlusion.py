@@ -121,10 +121,10 @@ def test_a_side_face_whose_shadow_is_thinner_than_the_tolerance_casts_none(scale
     assert len(view.owner) == kept
 
 
-def test_triangle_overlaps_match_shapely_intersections():
+def test_clipped_triangles_match_shapely_intersections():
     import shapely
 
-    from assemblykit.geometry.occlusion import triangle_overlaps
+    from assemblykit.geometry.occlusion import clip_triangles
 
     rng = np.random.default_rng(3)
     first = rng.uniform(0.0, 1.0, (3000, 3, 2))
@@ -133,7 +133,7 @@ def test_triangle_overlaps_match_shapely_intersections():
     second[50:100] = first[50:100, ::-1]  # the same, wound the other way
     second[100:150, :2] = first[100:150, :2]  # a shared edge
     second[150:200] = first[150:200] + 2.0  # apart
-    points, corner, area, perimeter = triangle_overlaps(first, second)
+    points, corner, area, perimeter = clip_triangles(first, second)
     overlap = shapely.intersection(shapely.polygons(first), shapely.polygons(second))
     np.testing.assert_allclose(area, shapely.area(overlap), atol=1e-12)
     solid = shapely.area(overlap) > 1e-9

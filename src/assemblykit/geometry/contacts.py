@@ -438,7 +438,7 @@ def _triangles_2d(
 
 
 OVERLAP_CHUNK = 1 << 20
-"""How many triangle pairs :func:`triangle_overlaps` projects and intersects at once: the
+"""How many triangle pairs :func:`group_overlaps` projects and intersects at once: the
 pairs of large coplanar groups (a plate on a plate) run to millions, and their 2D
 triangles, boxes and polygons are made chunk by chunk to bound the memory they take."""
 
@@ -448,7 +448,7 @@ union of each group's triangles, which tile it), at a cost that follows the tria
 count rather than its product: two plates' faces of thousands of triangles each."""
 
 
-def triangle_overlaps(
+def group_overlaps(
     stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], margin: float
 ) -> tuple[NDArray[np.int64], NDArray[Any], NDArray[np.float64], NDArray[np.float64]]:
     """Where the triangles of groups ``g[k]`` and ``h[k]`` overlap, projected on the plane
@@ -476,7 +476,7 @@ def _triangle_pieces(
     v: NDArray[np.float64],
     margin: float,
 ) -> tuple[NDArray[np.int64], NDArray[Any]]:
-    """:func:`triangle_overlaps` triangle by triangle, chunk by chunk."""
+    """:func:`group_overlaps` triangle by triangle, chunk by chunk."""
     work = np.cumsum((seg.start[g + 1] - seg.start[g]) * (seg.start[h + 1] - seg.start[h]))
     cuts = np.searchsorted(
         work, np.arange(OVERLAP_CHUNK, int(work[-1]) if len(g) else 0, OVERLAP_CHUNK)
@@ -497,7 +497,7 @@ def _outline_pieces(
     u: NDArray[np.float64],
     v: NDArray[np.float64],
 ) -> tuple[NDArray[np.int64], NDArray[Any]]:
-    """:func:`triangle_overlaps` outline to outline: each group's outline made once in
+    """:func:`group_overlaps` outline to outline: each group's outline made once in
     its frame (``g``'s) and intersected; the pairs whose overlap has an area."""
     if not len(g):
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=object)
@@ -539,7 +539,7 @@ def _chunk_overlaps(
     v: NDArray[np.float64],
     margin: float,
 ) -> tuple[NDArray[np.int64], NDArray[Any]]:
-    """:func:`triangle_overlaps` for the group pairs ``match`` (consecutive indices)."""
+    """:func:`group_overlaps` for the group pairs ``match`` (consecutive indices)."""
     if not len(match):
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=object)
     size_g = seg.start[g[match] + 1] - seg.start[g[match]]
@@ -566,10 +566,10 @@ def _planar_patches(
     stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], tol: Tolerance
 ) -> tuple[NDArray[np.int64], list[PlanarPatch]]:
     """The contact polygons of the matched group pairs ``(g[k], h[k])``: the union of
-    their triangles' overlaps in ``g[k]``'s plane (:func:`triangle_overlaps`), one
+    their triangles' overlaps in ``g[k]``'s plane (:func:`group_overlaps`), one
     polygon per connected piece wider than the tolerance, at the mean height of the two
     planes, counter-clockwise about ``g[k]``'s normal. Returns each patch's ``k``."""
-    owner, pieces, u, v = triangle_overlaps(stack, seg, g, h, tol.length)
+    owner, pieces, u, v = group_overlaps(stack, seg, g, h, tol.length)
     matched, slot = np.unique(owner, return_inverse=True)
     rank = np.arange(len(owner)) - np.searchsorted(owner, owner)
     table = np.full((len(matched), int(rank.max()) + 1 if len(rank) else 0), None, dtype=object)

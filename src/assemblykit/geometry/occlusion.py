@@ -295,7 +295,7 @@ def shadows(
     )
 
 
-def triangle_overlaps(
+def clip_triangles(
     subject: NDArray[np.float64], clip: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64]]:
     """The overlaps of pairs of plane triangles (``n x 3 x 2`` each), all pairs at once:
@@ -557,7 +557,7 @@ def _shows_block(
     tolerance times its perimeter) at a vertex of which ``front`` lies deeper than
     ``back`` by more than the length tolerance, measured across the faces (module
     docstring)."""
-    points, corner, area, perimeter = triangle_overlaps(view.flat[back], view.flat[front])
+    points, corner, area, perimeter = clip_triangles(view.flat[back], view.flat[front])
     which, at = np.nonzero(corner & (area > tol.length * perimeter)[:, None])
     uv = points[which, at]
     b, f = back[which], front[which]

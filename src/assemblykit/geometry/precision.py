@@ -49,8 +49,8 @@ from assemblykit.geometry.contacts import (
     candidate_pairs,
     facing_groups,
     group_deviation,
+    group_overlaps,
     stack_parts,
-    triangle_overlaps,
 )
 from assemblykit.geometry.recognition import segment
 from assemblykit.graphs import component_labels
@@ -179,7 +179,7 @@ def joint_mismatch(assembly: Assembly, tol: Tolerance | None = None) -> Precisio
     g, h = facing_groups(seg, group_part, seg.flat, part_lo, part_hi, pairs, floor)
     opposed = np.einsum("ij,ij->i", seg.normal[g], seg.normal[h]) < -math.cos(MAX_JOINT_TILT)
     g, h = g[opposed], h[opposed]
-    owner, pieces, u, v = triangle_overlaps(stack, seg, g, h, floor)
+    owner, pieces, u, v = group_overlaps(stack, seg, g, h, floor)
     coords, which = shapely.get_coordinates(pieces, return_index=True)
     pair = owner[which]
     n_g, n_h = seg.normal[g][pair], seg.normal[h][pair]
