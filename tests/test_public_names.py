@@ -303,3 +303,26 @@ def test_the_inputs_and_outputs_users_meet_are_exported() -> None:
     found = assemblykit.plan(boxes, gravity=assemblykit.Gravity(friction=0.5))
     assert isinstance(found, assemblykit.Plan) and isinstance(found.steps[0], assemblykit.Step)
     assert isinstance(boxes.contacts(), assemblykit.Contacts)
+
+
+@pytest.mark.parametrize(
+    ("old", "new"),
+    [
+        (
+            "assemblykit.blocking.free_cones.lattice_cells",
+            "assemblykit.blocking.lattice.lattice_cells",
+        ),
+        (
+            "assemblykit.geometry.contacts.triangle_overlaps",
+            "assemblykit.geometry.contacts.group_overlaps",
+        ),
+        (
+            "assemblykit.geometry.occlusion.triangle_overlaps",
+            "assemblykit.geometry.occlusion.clip_triangles",
+        ),
+    ],
+)
+def test_module_functions_that_moved_or_were_renamed_still_work(old: str, new: str) -> None:
+    with pytest.warns(DeprecationWarning, match=re.escape(f"is deprecated; use {new}")):
+        found = resolve(old)
+    assert found is resolve(new)

@@ -12,15 +12,18 @@ from typing import Any
 def moved(module: str, homes: Mapping[str, str]) -> Callable[[str], Any]:
     """A module-level ``__getattr__`` for ``module``: a name of ``homes`` is looked up in
     the module it moved to, imported when asked for (a higher layer, which ``module`` may
-    not import), after a :class:`DeprecationWarning`; any other name is missing."""
+    not import), after a :class:`DeprecationWarning`; any other name is missing. A home
+    written ``"package.module:new_name"`` is a name that moved and was renamed."""
 
     def __getattr__(name: str) -> Any:
         home = homes.get(name)
         if home is None:
             raise AttributeError(f"module {module!r} has no attribute {name!r}")
+        place, _, renamed = home.partition(":")
+        new = renamed or name
         warnings.warn(
-            f"{module}.{name} is deprecated; use {home}.{name}", DeprecationWarning, stacklevel=2
+            f"{module}.{name} is deprecated; use {place}.{new}", DeprecationWarning, stacklevel=2
         )
-        return getattr(importlib.import_module(home), name)
+        return getattr(importlib.import_module(place), new)
 
     return __getattr__

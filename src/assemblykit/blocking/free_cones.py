@@ -45,6 +45,7 @@ from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.constraints import infinitesimal_terms
 from assemblykit.blocking.extended import extended_free
 from assemblykit.blocking.obstacles import Obstacles
+from assemblykit.deprecation import moved
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.tolerance import Tolerance
@@ -837,3 +838,6 @@ def lattice_locked(cells: Sequence[NDArray[np.int64]], chunk: int = 1024) -> boo
         if not np.all(held & np.uint64(leaving)):
             return False
     return True
+
+
+__getattr__ = moved(__name__, {"lattice_cells": "assemblykit.blocking.lattice"})

@@ -48,6 +48,7 @@ from numpy.typing import NDArray
 from rtree import index
 
 from assemblykit.algebra.se3 import axis_basis
+from assemblykit.deprecation import moved
 from assemblykit.geometry.curved import (
     ARC_STEP,
     CONE_AZIMUTHS,
@@ -1152,3 +1153,6 @@ def _layer_patches(
             PlanarPatch(normal.copy(), polygon, float(piece.area), max(p.scatter for p in patches))
         )
     return found
+
+
+__getattr__ = moved(__name__, {"triangle_overlaps": "assemblykit.geometry.contacts:group_overlaps"})

@@ -38,6 +38,7 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import ConvexHull, HalfspaceIntersection
 
+from assemblykit.deprecation import moved
 from assemblykit.tolerance import Tolerance, current
 
 _FIRST_CHUNK = 1024
@@ -565,3 +566,8 @@ def _shows_block(
     shown = np.zeros(len(back), dtype=bool)
     shown[which[excess > tol.length]] = True
     return shown
+
+
+__getattr__ = moved(
+    __name__, {"triangle_overlaps": "assemblykit.geometry.occlusion:clip_triangles"}
+)
