@@ -380,8 +380,7 @@ def _disassembly_table(plan: Plan) -> Table:
             str(number),
             ", ".join(step.parts),
             fmt.direction(step.direction),
-            # a fastener's translation is what a fitter does with it (planning/fasteners.py)
-            step.motion if step.fastener is None else step.fastener.summary(),
+            step.summary(),
             fmt.name_list(step.rest),
         ]
         if step.stability is not None:

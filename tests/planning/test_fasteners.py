@@ -13,14 +13,15 @@ from assemblykit.geometry.overlaps import resolve_overlaps
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.fasteners import implied_thread
 from assemblykit.planning.planner import plan
+from assemblykit.viz.viewer import report_html
 from stability_blocks import box
 
 
-def rod_through_blocks(rod: float, hole: float) -> Assembly:
+def rod_through_blocks(rod: float, hole: float, head: float = 2.5) -> Assembly:
     """Two blocks 8 x 8 x 3 side by side along x (x in [-4, 4] and [4, 12]) with a hole
     of radius ``hole`` along x at y = z = 0 through both, on a base plate below them,
-    and a rod of radius ``rod`` 20 long through both holes, its head (radius 2.5, 1
-    long) against the first block's outer face at x = -4."""
+    and a rod of radius ``rod`` 20 long through both holes, its head (radius ``head``,
+    1 long) against the first block's outer face at x = -4."""
     drill = trimesh.creation.cylinder(hole, 40, sections=48)
     drill.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
     blocks = [
@@ -28,7 +29,7 @@ def rod_through_blocks(rod: float, hole: float) -> Assembly:
         for x in (-4.0, 4.0)
     ]
     shank = trimesh.creation.cylinder(rod, 16, sections=48)
-    head = trimesh.creation.cylinder(2.5, 1.0, sections=48)
+    head = trimesh.creation.cylinder(head, 1.0, sections=48)
     shank.apply_translation([0, 0, 8])
     head.apply_translation([0, 0, -0.5])
     pin = trimesh.boolean.union([shank, head], engine="manifold")
@@ -84,6 +85,28 @@ def test_a_rod_drawn_out_of_two_holes_is_named_with_both(rod, kind):
     assert all("fastener" not in s.to_dict() for s in result.steps if "rod" not in s.parts)
 
 
+@pytest.mark.parametrize(("head", "kind"), [(2.5, "screw"), (6.0, None)])
+def test_a_body_pressed_onto_its_shaft_is_no_fastener(head, kind):
+    # the rod pressed into both holes (0.04 larger) of a frame (the two blocks and a deep
+    # plate in one part) leaves along -x, its head's side; with a head of 2.5 radii of
+    # the fit it is a screw, with a disc of radius 6 (six radii, as a motor or servo
+    # whose shaft is pressed into a pulley or horn) it is no fastener
+    parts = rod_through_blocks(1.04, 1.0, head=head).parts
+    frame = trimesh.boolean.union(
+        [parts["first"].mesh, parts["second"].mesh, box((16, 8, 8), (-4, -4, -9.5))],
+        engine="manifold",
+    )
+    prepared = resolve_overlaps(Assembly([Part("frame", frame), parts["rod"]]))
+    assert len(prepared.overlaps) == 1
+    result = plan(prepared, max_and_or_parts=0)
+    assert result.feasible
+    (out,) = result.steps
+    assert out.parts == ("rod",)
+    np.testing.assert_allclose(out.direction, [-1, 0, 0], atol=1e-9)
+    assert (out.fastener and out.fastener.kind) == kind
+    assert ("fastener" in out.to_dict()) is (kind is not None)
+
+
 @pytest.mark.parametrize(
     ("diameter", "units", "size", "pitch"),
     [
@@ -102,3 +125,66 @@ def test_a_thread_is_implied_by_an_iso_diameter_in_a_known_unit(diameter, units,
     else:
         assert thread is not None and (thread.size, thread.turns) == (size, 10.0)
         assert thread.pitch == pytest.approx(pitch, rel=1e-12)
+
+
+def headed_rod(x: float, radius: float) -> trimesh.Trimesh:
+    """A rod of ``radius`` along z from z = 0 to 4 at (x, 0), its head (radius 2, 1 high)
+    on top."""
+    shank = trimesh.creation.cylinder(radius, 4.0, sections=48)
+    shank.apply_translation([x, 0, 2])
+    head = trimesh.creation.cylinder(2.0, 1.0, sections=48)
+    head.apply_translation([x, 0, 4.5])
+    return trimesh.boolean.union([shank, head], engine="manifold")
+
+
+def test_each_part_of_a_step_that_leaves_alone_is_named_with_its_fastener():
+    # a plate 4 thick with three holes of radius 1 along z: two screws 0.04 larger and a
+    # pin of the holes' radius, their heads on top; the three leave upwards in one step,
+    # each on its own, and each move names its fastener: by hand, an M2 whose tip at
+    # z = 0 leaves the plate's top at z = 4 in 4 / 0.4 = 10 turns
+    drills = [trimesh.creation.cylinder(1.0, 10, sections=48) for _ in range(3)]
+    for x, drill in zip((-6, 0, 6), drills, strict=True):
+        drill.apply_translation([x, 0, 2])
+    plate = trimesh.boolean.difference([box((20, 8, 4), (-10, -4, 0)), *drills], engine="manifold")
+    rods = [Part(f"screw {i}", headed_rod(x, 1.04)) for i, x in enumerate((-6, 0))]
+    assembly = Assembly([Part("plate", plate), *rods, Part("pin", headed_rod(6, 1.0))])
+    prepared = resolve_overlaps(assembly)
+    result = plan(prepared, max_and_or_parts=0)
+    assert result.feasible
+    (step,) = result.steps
+    assert set(step.parts) == {"screw 0", "screw 1", "pin"} and step.fastener is None
+    np.testing.assert_allclose(step.direction, [0, 0, 1], atol=1e-9)
+    moves = {tuple(move["parts"]): move.get("fastener") for move in step.to_dict()["moves"]}
+    assert set(moves) == {("screw 0",), ("screw 1",), ("pin",)}
+    for name in ("screw 0", "screw 1"):
+        assert moves[(name,)]["kind"] == "screw"
+        assert moves[(name,)]["thread"] == {
+            "size": "M2",
+            "pitch": 0.4,
+            "turns": 10.0,
+            "implied": True,
+        }
+    assert moves[("pin",)]["kind"] == "pin" and "thread" not in moves[("pin",)]
+    assert step.summary() == "translation; unscrew 2 x M2; pull 1 pin"
+    # the report's step table and caption say it as the text table does
+    page = report_html(prepared, result)
+    assert "<td>translation; unscrew 2 x M2; pull 1 pin</td>" in page
+    assert "along +Z (translation; unscrew 2 x M2; pull 1 pin)" in page
+
+
+@pytest.mark.parametrize(
+    ("name", "diameter", "size"),
+    [
+        ("M2x10_1", 1.6, "M2"),  # a self-tapping M2 in its 1.6 mm pilot hole
+        ("SG90.6_BS EN ISO 7045 - M2 x 4 - Z - 4S_2", 2.0, "M2"),
+        ("Screw M1.6 x 5", 1.6, "M1.6"),
+        ("screw", 1.6, "M1.6"),  # no size written: the diameter's
+        ("M3 bracket", 10.0, "M10"),  # a name far from the fit is not believed
+        ("M2x10", 3.0, "M3"),
+        ("DM3x10", 3.0, "M3"),  # no size: "DM3" is no ISO designation
+    ],
+)
+def test_a_size_written_in_the_name_is_believed_near_its_fit(name, diameter, size):
+    thread = implied_thread(diameter, 4.0, "mm", name)
+    assert thread is not None and thread.size == size
+    assert thread.turns == pytest.approx(4.0 / thread.pitch, abs=0.05)

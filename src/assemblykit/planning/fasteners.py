@@ -5,7 +5,10 @@ common axis as a fastener coming out: a pin pulled, or a screw turned out where 
 is modelled or implied. Here a step names its part a fastener when the part is the
 inner (shaft) side of a cylindrical contact with a part it leaves
 (:class:`~assemblykit.geometry.contacts.CurvedPatch`) whose axis is the step's direction
-within the angle tolerance, and a **screw** when it also interferes with one of those
+within the angle tolerance and whose every point lies within :data:`HEAD_RATIO` radii
+of that fit from the axis (a shank and a head: a servo whose output spline is pressed
+into a horn leaves along the spline's axis too, and is no fastener), and a **screw**
+when it also interferes with one of those
 parts by design (a thread cut into its pilot hole or a nut's insert, resolved by
 :func:`~assemblykit.geometry.overlaps.resolve_overlaps`); otherwise a **pin**. Bolts and
 screws drawn at their nominal diameter, with no thread modelled and no interference, are
@@ -14,9 +17,10 @@ reported as pins (docs/planning.md, "Fasteners").
 A screw comes out by the helical motion of the screw group about its axis (Liu 1997:
 the helical pair; :meth:`Fastener.motion`), whose sweep is the translation's for a part
 round about its axis, so the step's path is checked as a translation. Its **thread** is
-implied by its diameter, the fit's, when that is within :data:`NOMINAL_MATCH` of an ISO
-metric size and the model's unit is one of :data:`MILLIMETRES` (millimetres unless the
-input says otherwise): the coarse pitch of ISO 261 for that size
+the size written in its name (``M3x20``), else implied by its diameter, the fit's, when
+that is within :data:`NOMINAL_MATCH` of an ISO metric size, where the model's unit is
+one of :data:`MILLIMETRES` (millimetres unless the input says otherwise): the coarse
+pitch of ISO 261 for that size
 (:data:`ISO_COARSE_PITCH`; a right-hand thread, unscrewed by turning anticlockwise seen
 from its head), and the **turns** it takes are the distance its tip travels until it
 leaves the last hole it is threaded into, over the pitch.
@@ -25,6 +29,8 @@ leaves the last hole it is threaded into, over the pitch.
 from __future__ import annotations
 
 import math
+import re
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -67,6 +73,16 @@ NOMINAL_MATCH = 0.1
 """How far (a fraction of the size) a fit's diameter may be from an ISO size to take it
 for that size: a self-tapping M3 screw cut to a 2.9 mm pilot hole is an M3."""
 
+HEAD_RATIO = 3.0
+"""How far from its axis, in radii of its fit, a fastener reaches: the heads of ISO
+screws and bolts (hexagon across corners, pan, cheese, socket, countersunk and flange
+heads) are at most about 2.4 shank diameters wide, under 2.5 radii of the fit."""
+
+PILOT_HOLE = 0.7
+"""The smallest fit, a fraction of the size written in a screw's name, that the name is
+believed for: self-tapping screws are cut into pilot holes of about 0.8 of their size
+(an M2 into 1.6 mm, an M3 into 2.5 mm)."""
+
 MILLIMETRES = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4}
 """Millimetres per model unit, for the units whose threads are sized."""
 
@@ -87,21 +103,47 @@ class Thread:
         return {"size": self.size, "pitch": self.pitch, "turns": self.turns, "implied": True}
 
 
-def implied_thread(diameter: float, travel: float, units: str | None) -> Thread | None:
+def named_size(name: str) -> float | None:
+    """The ISO metric size written in a part's name, as a fitter reads it (``"M2x10"``,
+    ``"BS EN ISO 7045 - M2 x 4"``, ``"M3 screw"``: 2, 2, 3), or ``None``.
+
+    >>> named_size("M2x10_1"), named_size("Laserteil 3"), named_size("M1.6 x 5")
+    (2.0, None, 1.6)
+    """
+    for found in _SIZE_IN_NAME.finditer(name):
+        size = float(found.group(1))
+        if size in ISO_COARSE_PITCH:
+            return size
+    return None
+
+
+_SIZE_IN_NAME = re.compile(r"(?<![A-Za-z0-9])M(\d+(?:\.\d+)?)(?![0-9.])")
+
+
+def implied_thread(
+    diameter: float, travel: float, units: str | None, name: str = ""
+) -> Thread | None:
     """The ISO thread of a screw whose fit has ``diameter`` and whose tip travels
-    ``travel`` while threaded (model units of ``units``), or ``None`` when no ISO size is
-    within :data:`NOMINAL_MATCH` or the unit is not known (module docstring).
+    ``travel`` while threaded (model units of ``units``), or ``None`` when the unit is
+    not known or no size is: the size written in its ``name`` (:func:`named_size`: a
+    self-tapping M2 cut to a 1.6 mm pilot hole is an M2, not an M1.6) where the
+    diameter is between :data:`PILOT_HOLE` of it and :data:`NOMINAL_MATCH` above it,
+    else the ISO size within :data:`NOMINAL_MATCH` of the diameter (module docstring).
 
     >>> implied_thread(2.9, 6.0, "mm")
     Thread(size='M3', pitch=0.5, turns=12.0)
+    >>> implied_thread(1.6, 4.0, "mm", "M2x10_1")
+    Thread(size='M2', pitch=0.4, turns=10.0)
     """
     scale = MILLIMETRES.get(units or "")
     if scale is None or not diameter > 0:
         return None
     millimetres = diameter * scale
-    size = min(ISO_COARSE_PITCH, key=lambda nominal: abs(nominal - millimetres))
-    if abs(size - millimetres) > NOMINAL_MATCH * size:
-        return None
+    size = named_size(name)
+    if size is None or not PILOT_HOLE * size <= millimetres <= (1 + NOMINAL_MATCH) * size:
+        size = min(ISO_COARSE_PITCH, key=lambda nominal: abs(nominal - millimetres))
+        if abs(size - millimetres) > NOMINAL_MATCH * size:
+            return None
     pitch = ISO_COARSE_PITCH[size] / scale
     name = f"M{size:g}"
     return Thread(name, pitch, round(max(travel, 0.0) / pitch, 1))
@@ -156,6 +198,17 @@ class Fastener:
         }
 
 
+def drawn_summary(fasteners: Sequence[Fastener]) -> str:
+    """In words, the screws and pins of one step: ``"unscrew 5 x M3, 1 x M2; pull 1
+    pin"`` (screws counted by their implied size, ``"unscrew 2"`` where none is
+    implied); empty for none."""
+    sizes = Counter(f.thread.size if f.thread else "" for f in fasteners if f.kind == "screw")
+    screws = ", ".join(f"{n} x {size}" if size else str(n) for size, n in sizes.items())
+    pins = sum(f.kind == "pin" for f in fasteners)
+    said = [f"unscrew {screws}"] if screws else []
+    return "; ".join([*said, *([f"pull {pins} pin{'s' * (pins > 1)}"] if pins else [])])
+
+
 def step_fastener(
     assembly: Assembly,
     parts: Sequence[str],
@@ -195,20 +248,32 @@ def step_fastener(
     ]
     first = fits[holes[0]][0]
     diameter = 2 * max(patch.radius for hole in holes for patch in fits[hole])
+    center = np.asarray(first.center, dtype=np.float64)
+    if _reach(assembly[part].mesh.vertices, center, d) > HEAD_RATIO * diameter / 2:
+        return None
     thread = None
     if threaded:
         tip = float((assembly[part].mesh.vertices @ d).min())
         travel = max(_far_end(patch, d) for hole in threaded for patch in fits[hole]) - tip
-        thread = implied_thread(diameter, travel, assembly.units)
+        thread = implied_thread(diameter, travel, assembly.units, part)
     return Fastener(
         part,
         "screw" if threaded else "pin",
         d,
         tuple(holes),
-        np.asarray(first.center, dtype=np.float64),
+        center,
         diameter,
         thread,
     )
+
+
+def _reach(
+    points: NDArray[np.float64], center: NDArray[np.float64], axis: NDArray[np.float64]
+) -> float:
+    """The largest distance of ``points`` from the line through ``center`` along the
+    unit ``axis``."""
+    offsets = np.asarray(points, dtype=np.float64) - center
+    return float(np.linalg.norm(offsets - np.outer(offsets @ axis, axis), axis=1).max(initial=0.0))
 
 
 def _far_end(patch: CurvedPatch, direction: NDArray[np.float64]) -> float:

@@ -24,6 +24,7 @@ from assemblykit.geometry.interference import interferences
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.fasteners import step_fastener
 from assemblykit.planning.hands import hands_needed
+from assemblykit.planning.multimove import moving_groups
 from assemblykit.planning.planar import planar_rigid_may_free, planar_search
 from assemblykit.planning.sequence import (
     ExtendedDirections,
@@ -33,6 +34,7 @@ from assemblykit.planning.sequence import (
     Plan,
     Progress,
     Search,
+    Step,
     and_or_graph,
     base_part,
     distinct_directions,
@@ -380,10 +382,7 @@ def finish_plan(
     unfinished = tuple(names[i] for i in bits(union_of(search.unfinished)))
     steps = tuple(search.steps)
     if isinstance(assembly, Assembly):
-        steps = tuple(
-            replace(s, fastener=step_fastener(assembly, s.parts, s.direction, s.rest, tol))
-            for s in steps
-        )
+        steps = tuple(_with_fasteners(assembly, step, tol) for step in steps)
     return Plan(
         names,
         steps,
@@ -394,6 +393,21 @@ def finish_plan(
         overlaps=getattr(assembly, "overlaps", ()),
         joined=getattr(assembly, "joined", {}),
         unfinished=unfinished,
+    )
+
+
+def _with_fasteners(assembly: Assembly, step: Step, tol: Tolerance) -> Step:
+    """``step`` with the pins and screws it draws out of the parts it leaves: the
+    fastener of each of its moves of one part (:func:`step_fastener`), and the step's
+    own when it moves one part only."""
+    fasteners = [
+        step_fastener(assembly, group, step.direction, step.rest, tol)
+        for group in moving_groups(step.parts, step.blocking)
+        if len(group) == 1
+    ]
+    drawn = tuple(f for f in fasteners if f is not None)
+    return replace(
+        step, fastener=drawn[0] if len(step.parts) == 1 and drawn else None, fasteners=drawn
     )
 
 

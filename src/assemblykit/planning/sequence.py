@@ -61,12 +61,12 @@ from assemblykit.blocking.directions import (
 )
 from assemblykit.blocking.extended import extended_arcs, shown_arcs
 from assemblykit.deprecation import moved
+from assemblykit.planning.fasteners import Fastener, drawn_summary
 from assemblykit.planning.multimove import moving_groups
 from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance, order_key
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly, Overlap
-    from assemblykit.planning.fasteners import Fastener
     from assemblykit.planning.stability import GravityReport, StepStability
 
 Progress = Callable[[str, int, int], None]
@@ -363,21 +363,43 @@ class Step:
     fastener: Fastener | None = None
     """The pin or screw the step draws out of its holes along their axis
     (:mod:`assemblykit.planning.fasteners`)."""
+    fasteners: tuple[Fastener, ...] = ()
+    """Every pin and screw the step draws out, one per part that leaves on its own (a
+    move of one part; the step's :attr:`fastener` when it moves one part only)."""
 
     def __repr__(self) -> str:
         return fmt.summary(
             "Step", f"{fmt.name_list(self.parts)} along {fmt.direction(self.direction)}"
         )
 
+    def summary(self) -> str:
+        """What a fitter does, in words: the fastener's summary for a step drawing one
+        (``"unscrew M3 (pitch 0.5, 12 turns)"``); else the motion, then the screws and
+        pins its moves draw out (``"translation; unscrew 5 x M3; pull 1 pin"``,
+        :func:`~assemblykit.planning.fasteners.drawn_summary`)."""
+        if self.fastener is not None:
+            return self.fastener.summary()
+        drawn = drawn_summary(self.fasteners)
+        return f"{self.motion}; {drawn}" if drawn else self.motion
+
     def to_dict(self) -> dict[str, Any]:
         """JSON form (docs/planning.md, "JSON"): ``parts``, ``direction`` (and ``axis``,
         its name when it lies along a coordinate axis), ``motion``, ``rest``,
         ``blocking``, ``together`` (the moved parts hold one another: one rigid
         group) and, when they do not, ``moves`` (the sets that do, in an order they may
-        leave one after another: :func:`~assemblykit.planning.multimove.moving_groups`)."""
+        leave one after another: :func:`~assemblykit.planning.multimove.moving_groups`),
+        a move of one part that is a pin or a screw with its ``fastener``."""
         groups = moving_groups(self.parts, self.blocking)
         direction = [float(x) + 0.0 for x in self.direction]
-        moves = [{"parts": list(group), "direction": direction} for group in groups]
+        drawn = {fastener.part: fastener.to_dict() for fastener in self.fasteners}
+        moves = [
+            {
+                "parts": list(group),
+                "direction": direction,
+                **({"fastener": drawn[group[0]]} if len(group) == 1 and group[0] in drawn else {}),
+            }
+            for group in groups
+        ]
         return {
             "parts": list(self.parts),
             "direction": direction,

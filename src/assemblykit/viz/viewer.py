@@ -505,7 +505,7 @@ def caption(number: int, plan: Plan, tol: Tolerance | None = None) -> str:
     away = f" away from {fmt.count(len(step.rest), 'part')}" if step.rest else ""
     return (
         f"Step {number} of {total}: {moved} {'move' if len(step.parts) > 1 else 'moves'} "
-        f"along {fmt.direction(step.direction, tol)} ({step.motion}){away}."
+        f"along {fmt.direction(step.direction, tol)} ({step.summary()}){away}."
     )
 
 
@@ -525,7 +525,7 @@ def _step_table(plan: Plan, tol: Tolerance | None) -> str:
             str(number),
             _names_cell(step.parts),
             html.escape(fmt.direction(step.direction, tol)),
-            html.escape(step.motion),
+            html.escape(step.summary()),
             _names_cell(step.rest, folded=True),
             _names_cell(_held(step)),
         ]
