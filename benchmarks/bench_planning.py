@@ -21,7 +21,8 @@ key in steps, guillotine packings and a key in a cage too long for it. ``--puzzl
 runs only these. Monotone plans of six-piece burrs (``assemblykit plan FILE --solution N
 --max-hands 2``, processor time of ``plan`` after loading): one solvable (solution 0)
 and one stuck (257), next to their targets (0.3 s and 1 s); ``--burrs`` adds all 314
-next to theirs (60 s together).
+next to theirs (60 s together). A stuck mesh assembly: 50 links of a chain, each locked
+in the next, as meshes off the lattice, planned next to its target (5 s).
 """
 
 from __future__ import annotations
@@ -59,6 +60,9 @@ MEMORY_TARGET = 2.0
 """Peak memory of the dome's plan, GB."""
 GROWTH_TARGET = 1.5
 """Largest exponent of plan time in the number of parts of box packings."""
+STUCK_LINKS = 50
+STUCK_TARGET = 5.0
+"""CPU seconds for ``plan`` to decide a stuck mesh assembly of :data:`STUCK_LINKS` parts."""
 END_TO_END_TARGET = 0.64
 """``assemblykit plan`` of the ASAP beam from process start to its JSON, median seconds."""
 DOME = "compas_assembly/dome_assembly.json"
@@ -260,6 +264,27 @@ def monotone_burrs(every: bool) -> None:
         )
 
 
+def stuck_chain(links: int = STUCK_LINKS) -> None:
+    """A stuck mesh assembly: ``links`` links of the voxel chain of
+    ``bench_interlock.py`` and its hook, as meshes moved off the unit lattice; the
+    processor time of ``plan`` (the hook lifts out, the links are stuck), next to its
+    target (:data:`STUCK_TARGET`)."""
+    from bench_interlock import chain
+
+    cells = chain(links)
+    shift = np.array([0.37, 0.21, 0.13])
+    assembly = Assembly(
+        [Part(p.name, p.mesh.copy().apply_translation(shift)) for p in cells.parts.values()]
+    )
+    start = time.process_time()
+    result = plan(assembly)
+    took = time.process_time() - start
+    print(
+        f"stuck mesh chain of {links} links and a hook: {len(result.stuck)} stuck, "
+        f"{took:.2f} CPU s (target {STUCK_TARGET:g} s: {meets(took <= STUCK_TARGET)})"
+    )
+
+
 def caged_key() -> Assembly:
     """A 2 x 1 x 1 key in a closed cage whose cavity is one unit longer (stuck)."""
     cage = trimesh.boolean.difference(
@@ -297,6 +322,7 @@ def main() -> None:
     print(f"machine: {machine()}; shared with other work, wall times are noisy")
     puzzles()
     monotone_burrs("--burrs" in sys.argv)
+    stuck_chain()
     mesh_puzzles()
     if "--puzzles" in sys.argv:
         return

@@ -6,8 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from scipy.spatial import ConvexHull, QhullError
 
-from assemblykit.blocking.constraints import infinitesimal_terms
+from assemblykit.blocking.constraints import infinitesimal_terms, positively_spanning
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.queries import can_extract, locally_free_directions
 from assemblykit.geometry.contacts import assembly_contacts
@@ -100,3 +103,36 @@ def test_the_ball_joint_ball_lifts_out_of_its_cup(motion: str) -> None:
     assert np.all(volumes <= touching)
     down, _ = swept_overlaps(asm, "ball", -up, DISTANCES[:6])
     assert down[-1] > 100 * touching
+
+
+AXES = np.vstack([np.eye(3), -np.eye(3)])
+
+
+def test_the_six_axis_normals_positively_span_and_five_do_not() -> None:
+    assert positively_spanning(AXES)
+    assert not positively_spanning(AXES[:5])  # nothing stops a move along -z
+    assert not positively_spanning(np.vstack([AXES[:2], AXES[3:5]]))  # all in a plane
+    # a tetrahedron's outward normals positively span; three of them do not
+    tetra = np.array([[1, 1, 1], [1, -1, -1], [-1, 1, -1], [-1, -1, 1]], dtype=float)
+    assert positively_spanning(tetra) and not positively_spanning(tetra[:3])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(*[st.floats(-1, 1, allow_nan=False) for _ in range(3)]), min_size=4, max_size=9
+    )
+)
+def test_positive_spanning_is_the_origin_inside_the_normals_hull(rows) -> None:
+    # independently: the vectors positively span space exactly when the origin lies
+    # inside their convex hull (every hull facet strictly on the far side of it)
+    normals = np.array(rows, dtype=float)
+    assume(np.all(np.linalg.norm(normals, axis=1) > 1e-3))
+    try:
+        hull = ConvexHull(normals)
+    except QhullError:
+        assume(False)
+        return
+    margin = float(hull.equations[:, 3].max())  # a . 0 + b for each facet, < 0 inside
+    assume(abs(margin) > 1e-6)
+    assert positively_spanning(normals) is (margin < 0)

@@ -7,8 +7,9 @@ import numpy as np
 from blocking_helpers import ContactAssembly, square
 
 from assemblykit.blocking.graphs import blocking_graph
-from assemblykit.blocking.rigid import RIGID_MAX_HYPERPLANES
+from assemblykit.blocking.rigid import RIGID_MAX_HYPERPLANES, contact_points, stops_every_twist
 from assemblykit.geometry.contacts import Contact, PlanarPatch
+from assemblykit.tolerance import Tolerance
 
 
 def point(normal, at) -> PlanarPatch:
@@ -90,9 +91,10 @@ def test_rotation_is_blocked_with_a_full_floor_and_ceiling():
     assert rigid.free_twist({"block"}) is None
     assert rigid.removable() == []
     assert rigid.to_dict()["removable"] == []
-    assert not rigid.frees_some()
+    assert not rigid.frees_some() and rigid.held_together()
     # with the floor and ceiling of the first, a turn frees it
     assert blocking_graph(asm, "rigid").frees_some()
+    assert not blocking_graph(asm, "rigid").held_together()
 
 
 def test_fig5_is_freed_by_a_rotation_in_a_cell_of_the_arrangement():
@@ -146,3 +148,35 @@ def test_beyond_the_limit_the_lp_witness_decides():
     assert result["regions"]["faces"] is None
     assert rigid.regions() == []
     assert [r["parts"] for r in result["removable"]] == [["block"], ["frame"]]
+
+
+def boxed(inner: str, outer: str, origin, faces: int = 6) -> Contact:
+    """``inner``, a unit cube at ``origin``, touching ``outer`` on its first ``faces``
+    faces (+x, -x, +y, -y, +z, -z), each whole."""
+    normals = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+    centre = np.asarray(origin, dtype=float) + 0.5
+    patches = tuple(square(n, centre + 0.5 * np.asarray(n), 0.5) for n in normals[:faces])
+    return Contact(inner, outer, planar=patches)
+
+
+def test_a_cube_touched_on_all_six_faces_stops_every_twist_and_on_five_does_not():
+    for faces, stopped in ((6, True), (5, False)):
+        p, n = contact_points(boxed("cube", "box", (0, 0, 0), faces))
+        assert stops_every_twist(p, n, Tolerance()) is stopped
+
+
+def test_parts_held_together_pair_by_pair_free_no_subassembly():
+    # a cube boxed in a second, itself boxed in a third (each pair touching on every
+    # face): the pairs join all three, so no twist moves any subassembly, which the
+    # linear program of each subassembly confirms on its own
+    contacts = [boxed("a", "b", (0, 0, 0)), boxed("b", "c", (5, 0, 0))]
+    rigid = blocking_graph(ContactAssembly(["a", "b", "c"], contacts), "rigid")
+    assert rigid.held_together() and not rigid.frees_some()
+    for subset in ({"a"}, {"b"}, {"c"}, {"a", "b"}, {"b", "c"}, {"a", "c"}):
+        assert rigid.free_twist(subset) is None
+    # with one face of the second pair gone, "c" no longer holds "b": the pair b-c
+    # lifts apart, which both the certificate and the search see
+    opened = [boxed("a", "b", (0, 0, 0)), boxed("b", "c", (5, 0, 0), faces=5)]
+    rigid = blocking_graph(ContactAssembly(["a", "b", "c"], opened), "rigid")
+    assert not rigid.held_together() and rigid.frees_some()
+    assert rigid.free_twist({"a", "b"}) is not None

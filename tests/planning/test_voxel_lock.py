@@ -127,3 +127,41 @@ def test_the_certificate_agrees_with_the_exact_free_sets_of_a_stuck_burr():
     for name in stuck:
         found = exact_free_directions(assembly, [name], tol, stuck)
         assert found.complete and not found.directions
+
+
+def link(start: int, flat: bool) -> np.ndarray:
+    """The cells of a chain link 5 long and 3 wide with holes at its second and fourth
+    cells, starting at x = ``start``, lying in z = 0 (``flat``) or y = 0."""
+    return np.array(
+        [
+            (start + a, b, 0) if flat else (start + a, 0, b)
+            for a in range(5)
+            for b in (-1, 0, 1)
+            if not (b == 0 and a in (1, 3))
+        ],
+        dtype=np.int64,
+    )
+
+
+def test_a_chain_of_fifty_links_off_the_lattice_is_stuck_as_its_pairs_say():
+    # fifty links, each through a hole of the next and holding that one's end in its
+    # own hole, a quarter turn apart, as meshes moved off the unit lattice; a hook
+    # hangs in the first link's free hole. Each pair of linked links is interlocked on
+    # the lattice (the integer certificate, on their cells), so the linked pairs tie
+    # all fifty: the plan lifts the hook out and names the fifty stuck, by
+    # translations and by rigid motions alike
+    cells = [link(3 * k, k % 2 == 0) for k in range(50)]
+    assert all(lattice_locked([cells[k], cells[k + 1]]) for k in range(49))
+    shift = np.array([0.37, 0.21, 0.13])
+    parts = [
+        Part(f"link {k:02d}", voxel_mesh(c).apply_translation(shift)) for k, c in enumerate(cells)
+    ]
+    hook = np.array([(1, 0, 0), (1, 0, 1), (2, 0, 1)], dtype=np.int64)
+    parts.append(Part("hook", voxel_mesh(hook).apply_translation(shift)))
+    result = plan(Assembly(parts, units="unit"))
+    assert not result.feasible
+    assert [s.parts for s in result.steps] == [("hook",)]
+    np.testing.assert_allclose(result.steps[0].direction, [0, 0, 1], atol=1e-9)
+    assert sorted(result.stuck) == [f"link {k:02d}" for k in range(50)]
+    (lock,) = result.interlocked
+    assert lock.translation_locked and not lock.rigid_may_free

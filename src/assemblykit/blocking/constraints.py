@@ -79,3 +79,22 @@ def infinitesimal_terms(contacts: Iterable[Contact]) -> list[BlockingTerm]:
                 normals = curved_normals(curved, moving == curved.inner)
                 terms.extend(BlockingTerm(moving, blocker, n[None, :]) for n in normals)
     return terms
+
+
+def positively_spanning(normals: NDArray[np.float64]) -> bool:
+    """Whether the ``normals`` (rows) positively span space: every vector is a
+    combination of them with non-negative weights. Then no direction ``d`` has
+    ``n . d <= 0`` for every one but ``d = 0``: a part whose Γ_t terms have these
+    normals cannot start to translate, so no translation, infinitesimal or extended,
+    frees it (Wilson & Latombe 1992: blocking along ``d`` by a contact implies blocking
+    by the part). They do exactly when they span space and some weights all at least
+    one cancel (Gordan's alternative), one linear program (HiGHS)."""
+    from scipy.optimize import linprog
+
+    rows = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    if len(rows) < 4 or np.linalg.matrix_rank(rows) < 3:
+        return False
+    found = linprog(
+        np.zeros(len(rows)), A_eq=rows.T, b_eq=np.zeros(3), bounds=(1, None), method="highs"
+    )
+    return bool(found.status == 0)

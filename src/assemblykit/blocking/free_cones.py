@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 
 from assemblykit.blocking.arrangement import snap_normals
 from assemblykit.blocking.cache import BlockingCache
-from assemblykit.blocking.constraints import infinitesimal_terms
+from assemblykit.blocking.constraints import infinitesimal_terms, positively_spanning
 from assemblykit.blocking.extended import extended_free
 from assemblykit.blocking.obstacles import Obstacles
 from assemblykit.deprecation import moved
@@ -645,20 +645,22 @@ def _blocked_by(
 
 
 def _contact_normals(
-    assembly: Assembly, moving: tuple[str, ...], blocker: str, tol: Tolerance
+    assembly: Assembly, moving: tuple[str, ...], blockers: str | Iterable[str], tol: Tolerance
 ) -> NDArray[np.float64]:
-    """The normals of the Γ_t terms of the contacts where ``blocker`` touches a part of
-    ``moving`` (:func:`assemblykit.blocking.constraints.infinitesimal_terms`)."""
+    """The normals of the Γ_t terms of the contacts where a part of ``blockers`` (one
+    name or several) touches a part of ``moving``
+    (:func:`assemblykit.blocking.constraints.infinitesimal_terms`)."""
     inside = set(moving)
+    outside = {blockers} if isinstance(blockers, str) else set(blockers) - inside
     touching = [
         c
         for c in assembly_contacts(assembly, tol)
-        if (c.a in inside and c.b == blocker) or (c.b in inside and c.a == blocker)
+        if (c.a in inside and c.b in outside) or (c.b in inside and c.a in outside)
     ]
     rows = [
         t.normals
         for t in infinitesimal_terms(touching)
-        if t.moving in inside and t.blocker == blocker
+        if t.moving in inside and t.blocker in outside
     ]
     return np.concatenate(rows).reshape(-1, 3) if rows else _no_circles()
 
@@ -702,9 +704,15 @@ def exact_free_directions(
     """Up to ``limit`` directions, one per face of the free set of ``moving`` among the
     parts ``among`` (default: all), each checked exactly (Wilson & Latombe 1992 §5).
     When no face is free, one per free arc and free point of :func:`sliding_circles`
-    (:func:`free_cells`: a set that may only slide), then the thin faces."""
+    (:func:`free_cells`: a set that may only slide), then the thin faces. None, with
+    no cone computed, when the normals of the contacts of ``moving`` with the others
+    positively span space (:func:`~assemblykit.blocking.constraints.positively_spanning`:
+    it cannot start to move)."""
     movers = sorted(set(moving))
     others = list(assembly.names if among is None else among)
+    if positively_spanning(_contact_normals(assembly, tuple(movers), others, tol)):
+        # its contacts alone hold it in every direction: its free set is empty
+        return ExactFree((), True, False)
     sets = blocked_sets(assembly, movers, others, tol)
     if sets is None:
         return ExactFree((), False, False)

@@ -27,6 +27,7 @@ box" (scipy ``linprog``, HiGHS) decides each candidate and its optimum is the wi
 
 from __future__ import annotations
 
+import math
 from collections import defaultdict
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -92,6 +93,32 @@ def wrenches(
     """Rows ``((p - origin) x n / scale; n)``: the constraints on a twist taken about
     ``origin`` with its rotation part multiplied by ``scale``."""
     return np.column_stack([np.cross(points - origin, normals) / scale, normals])
+
+
+def stops_every_twist(
+    points: NDArray[np.float64], normals: NDArray[np.float64], tol: Tolerance
+) -> bool:
+    """Whether contacts at ``points`` with ``normals`` stop every twist of one part
+    against the other: their wrenches (:func:`wrenches`, about the points' centroid)
+    positively span twist space, by a margin. Where the twists ``x`` with every
+    ``w . x <= 1`` stay within ``R`` of the origin (twelve linear programs, HiGHS), every
+    twist pushes into some contact at ``|x|_inf / R`` at least; the pair stops them when
+    that is ten times the mesh angle tolerance, which the blocking graphs take for
+    sliding (:meth:`RigidBlockingGraph.dbg`)."""
+    if len(points) < 7:
+        return False
+    rows = wrenches(points, normals, points.mean(axis=0), tol.scale)
+    if np.linalg.matrix_rank(rows) < 6:
+        return False
+    reach = 0.0
+    for objective in np.vstack([np.eye(6), -np.eye(6)]):
+        found = linprog(
+            -objective, A_ub=rows, b_ub=np.ones(len(rows)), bounds=(None, None), method="highs"
+        )
+        if found.status != 0:
+            return False
+        reach = max(reach, -float(found.fun))
+    return 1.0 / (reach * math.sqrt(6)) > 10 * tol.mesh_angle
 
 
 def world_twist(
@@ -263,12 +290,34 @@ class RigidBlockingGraph:
     def frees_some(self) -> bool:
         """Whether some rigid twist frees a proper subassembly: :meth:`removable` is not
         empty. The connected subassemblies of at most ``RIGID_MAX_SIZE`` parts are tried
-        first, one small linear program each (:meth:`free_twist`), so that the
-        arrangement of S⁵, whose cells grow as the fifth power of the contacts, is built
-        only when none of them is freed."""
+        first, one small linear program each (:meth:`free_twist`), then whether the
+        parts are :meth:`held_together`, so that the arrangement of S⁵, whose cells grow
+        as the fifth power of the contacts, is built only when neither decides."""
         if any(self.free_twist(s) is not None for s in self._candidates(RIGID_MAX_SIZE)):
             return True
+        if self.held_together():
+            return False
         return bool(self.removable())
+
+    def held_together(self) -> bool:
+        """Whether pairs of parts whose contacts alone stop every twist of one against
+        the other (:func:`stops_every_twist`) join every part: then no twist moves a
+        proper subassembly, as some such pair crosses from it to the rest, and no rigid
+        motion frees any (a certificate, where :meth:`removable` searches the
+        arrangement)."""
+        index = {name: k for k, name in enumerate(self.parts)}
+        joined = np.arange(len(self.parts))
+
+        def root(k: int) -> int:
+            while joined[k] != k:
+                k = int(joined[k])
+            return k
+
+        for contact in self.contacts:
+            a, b = root(index[contact.a]), root(index[contact.b])
+            if a != b and stops_every_twist(*contact_points(contact), self.tol):
+                joined[a] = b
+        return len({root(k) for k in range(len(self.parts))}) == 1
 
     def removable(self, max_size: int | None = None) -> list[Removal]:
         """Subassemblies that some rigid twist frees (a necessary condition for

@@ -1006,8 +1006,12 @@ class Search:
 
     def _refined(self, members: int) -> bool:
         """Add the directions of the exact free sets of ``members`` (:func:`exact_candidates`)
-        as candidates; whether there were any."""
+        as candidates; whether there were any. None where Γ_t separates no subset of
+        ``members``: no subset can start to move, so none leaves by an extended
+        translation (Γ_e blocks at least where Γ_t does)."""
         if self.exact is None or self.add_translations is None:
+            return False
+        if not separable(self.translations, members):
             return False
         found = self.exact(members)
         if not len(found) or not isinstance(self.extended, ExtendedDirections):
