@@ -36,6 +36,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from assemblykit.algebra.se3 import line_classes
+from assemblykit.ragged import group_of, ranges
 from assemblykit.tolerance import Tolerance, current
 
 # Rounding error of a 3-term dot product of unit vectors, in units of its magnitude.
@@ -320,10 +321,8 @@ def sphere_arrangement(normals: NDArray[np.float64]) -> Arrangement:
     rows_low, rows_high, rows_c, rows_s = [], [], [], []
     for vert_of, tang in ((va, t_start), (vb, t_end)):
         size = z_ptr[vert_of + 1] - z_ptr[vert_of]
-        edge_rep = np.repeat(np.arange(ne), size)
-        pos = np.repeat(z_ptr[vert_of] - np.cumsum(np.r_[0, size[:-1]]), size) + np.arange(
-            size.sum()
-        )
+        edge_rep = group_of(size)
+        pos = ranges(z_ptr[vert_of], size)
         others = z_idx[pos]
         keep = others != circ[edge_rep]
         edge_rep, others = edge_rep[keep], others[keep]

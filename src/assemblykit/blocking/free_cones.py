@@ -48,6 +48,7 @@ from assemblykit.blocking.obstacles import Obstacles
 from assemblykit.deprecation import moved
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.minkowski import triangle_cones
+from assemblykit.ragged import group_of
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -256,7 +257,7 @@ def _clip(normals: NDArray[np.float64], frame: NDArray[np.float64]) -> NDArray[n
     solid = (count >= 3) & (area > 0)
     polys = np.full(k, shapely.Polygon(), dtype=object)
     if solid.any():
-        used = np.repeat(np.arange(int(solid.sum())), count[solid])
+        used = group_of(count[solid])
         coords = points[solid][slots[0, None, :] < count[solid][:, None]]
         polys[solid] = shapely.polygons(shapely.linearrings(coords, indices=used))
     return polys

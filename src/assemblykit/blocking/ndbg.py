@@ -35,6 +35,7 @@ from assemblykit.blocking.arrangement import (
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.directions import DirectionTable
+from assemblykit.ragged import group_of, group_starts, ranges
 from assemblykit.tolerance import Tolerance
 
 Motion = Literal["infinitesimal", "extended", "rigid"]
@@ -132,12 +133,6 @@ class ConstraintTable:
         return np.concatenate(out) if out else np.zeros((0, len(self.starts)), dtype=bool)
 
 
-def _expand(starts: NDArray[np.int64], lengths: NDArray[np.int64]) -> NDArray[np.int64]:
-    """Concatenated ranges ``starts[k] .. starts[k] + lengths[k]``."""
-    offsets = np.cumsum(lengths) - lengths
-    return np.repeat(starts - offsets, lengths) + np.arange(int(lengths.sum()))
-
-
 def crossing_rule(arrangement: Arrangement, table: ConstraintTable) -> NDArray[np.uint8]:
     """The blocking slots of every region (rows, bit-packed), by the crossing rule from
     the root region, one breadth-first layer at a time (module docstring)."""
@@ -171,19 +166,19 @@ def crossing_rule(arrangement: Arrangement, table: ConstraintTable) -> NDArray[n
     packed[frontier] = np.packbits(table.arcs(weights), axis=1)
     claim = np.full(n, -1, dtype=np.int64)
     while len(frontier):
-        half = _expand(indptr[frontier], indptr[frontier + 1] - indptr[frontier])
-        parent_row = np.repeat(np.arange(len(frontier)), indptr[frontier + 1] - indptr[frontier])
+        half = ranges(indptr[frontier], indptr[frontier + 1] - indptr[frontier])
+        parent_row = group_of(indptr[frontier + 1] - indptr[frontier])
         fresh = np.flatnonzero(~visited[dst[half]])
         # one link per new region: the one whose claim on it survives
         claim[dst[half[fresh]]] = fresh
         first = fresh[claim[dst[half[fresh]]] == fresh]
         children, link = dst[half[first]], half[first]
         counts = row_count[pid[link]]
-        picked = rows[_expand(row_start[pid[link]], counts)]
+        picked = rows[ranges(row_start[pid[link]], counts)]
         if np.all(counts == 1):
             change = stack[picked]
         else:
-            change = np.add.reduceat(stack[picked], np.cumsum(counts) - counts, axis=0)
+            change = np.add.reduceat(stack[picked], group_starts(counts), axis=0)
         weights = weights[parent_row[first]] + sign[link][:, None] * change
         packed[children] = np.packbits(table.arcs(weights), axis=1)
         visited[children] = True
@@ -408,13 +403,13 @@ class NonDirectionalBlockingGraph:
         ncol = t.plus.shape[1]
         starts = np.r_[t.starts, added.starts + ncol]
         sizes = np.diff(np.r_[starts, plus.shape[1]])
-        cols = _expand(starts[order], sizes[order])
+        cols = ranges(starts[order], sizes[order])
         table = ConstraintTable(
             t.normals,
             plus[:, cols],
             minus[:, cols],
             need[cols],
-            (np.cumsum(sizes[order]) - sizes[order]).astype(np.int64),
+            group_starts(sizes[order]),
             moving[order],
             blocker[order],
         )
@@ -455,7 +450,7 @@ class NonDirectionalBlockingGraph:
             packed[:, slot // 8] |= (arcs[:, s].astype(np.uint8) << (7 - slot % 8)).astype(np.uint8)
         align = -len(t.starts) % 8
         last = moving[-1] if len(moving) else 0
-        new_cols = _expand(added.starts[outer], added_sizes[outer])
+        new_cols = ranges(added.starts[outer], added_sizes[outer])
         ncol = plus.shape[1]
         table = ConstraintTable(
             t.normals,
@@ -465,7 +460,7 @@ class NonDirectionalBlockingGraph:
             np.r_[
                 t.starts,
                 ncol + np.arange(align),
-                ncol + align + np.cumsum(added_sizes[outer]) - added_sizes[outer],
+                ncol + align + group_starts(added_sizes[outer]),
             ],
             np.r_[moving, np.full(align, last), added.slot_moving[outer]],
             np.r_[blocker, np.full(align, last), added.slot_blocker[outer]],

@@ -70,6 +70,7 @@ from assemblykit.geometry.recognition import (
 )
 from assemblykit.model.assembly import Assembly
 from assemblykit.model.surfaces import Surface
+from assemblykit.ragged import group_of, group_starts, ranges
 from assemblykit.tolerance import Tolerance
 
 CurvedKind = Literal["cylindrical", "conical", "spherical"]
@@ -259,22 +260,15 @@ class Contacts(list[Contact]):
         return fmt.html_summary(repr(self), headers, rows)
 
 
-def _expand(starts: NDArray[np.int64], counts: NDArray[np.int64]) -> NDArray[np.int64]:
-    """Concatenate the index ranges ``starts[i] : starts[i] + counts[i]``."""
-    total = int(counts.sum())
-    firsts = np.repeat(np.cumsum(counts) - counts, counts)
-    return np.arange(total, dtype=np.int64) - firsts + np.repeat(starts, counts)
-
-
 def _cross_join(
     left_owner: NDArray[np.int64], right_owner: NDArray[np.int64], n_owners: int
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """All pairs ``(i, j)`` of entries with the same owner; owners must be sorted."""
     right_count = np.bincount(right_owner, minlength=n_owners)
-    right_start = np.cumsum(right_count) - right_count
+    right_start = group_starts(right_count)
     per_left = right_count[left_owner]
-    left = np.repeat(np.arange(len(left_owner), dtype=np.int64), per_left)
-    right = _expand(right_start[left_owner], per_left)
+    left = group_of(per_left)
+    right = ranges(right_start[left_owner], per_left)
     return left, right
 
 
@@ -326,13 +320,12 @@ def stack_parts(meshes: Iterable[trimesh.Trimesh]) -> PartStack:
     meshes = list(meshes)
     n_vertices = np.array([len(m.vertices) for m in meshes], dtype=np.int64)
     n_faces = np.array([len(m.faces) for m in meshes], dtype=np.int64)
-    vertex_start = np.cumsum(n_vertices) - n_vertices
+    vertex_start = group_starts(n_vertices)
     faces = np.concatenate(
         [np.asarray(m.faces, dtype=np.int64) + s for m, s in zip(meshes, vertex_start, strict=True)]
     )
     vertices = np.concatenate([np.asarray(m.vertices, dtype=np.float64) for m in meshes])
-    part = np.repeat(np.arange(len(meshes), dtype=np.int64), n_faces)
-    return PartStack(vertices, faces, part, np.cumsum(n_faces) - n_faces)
+    return PartStack(vertices, faces, group_of(n_faces), group_starts(n_faces))
 
 
 def facing_groups(
@@ -424,8 +417,8 @@ def group_deviation(
     """Per pair, the largest distance of a vertex of group ``g[k]`` from the plane of
     group ``h[k]``."""
     size = seg.start[g + 1] - seg.start[g]
-    owner = np.repeat(np.arange(len(g), dtype=np.int64), size)
-    corners = stack.vertices[stack.faces[seg.order[_expand(seg.start[g], size)]]]
+    owner = group_of(size)
+    corners = stack.vertices[stack.faces[seg.order[ranges(seg.start[g], size)]]]
     offsets = np.einsum("fkj,fj->fk", corners - seg.point[h][owner, None], seg.normal[h][owner])
     deviation = np.zeros(len(g))
     np.maximum.at(deviation, owner, np.abs(offsets).max(axis=1))
@@ -520,8 +513,8 @@ def _outlines(
 ) -> NDArray[Any]:
     """Per group, the union of its triangles projected with the frame ``(u, v)``."""
     size = seg.start[groups + 1] - seg.start[groups]
-    owner = np.repeat(np.arange(len(groups), dtype=np.int64), size)
-    faces = seg.order[_expand(seg.start[groups], size)]
+    owner = group_of(size)
+    faces = seg.order[ranges(seg.start[groups], size)]
     triangles = shapely.polygons(
         _triangles_2d(stack.vertices[stack.faces[faces]], u[owner], v[owner])
     )
@@ -546,9 +539,9 @@ def _chunk_overlaps(
     size_g = seg.start[g[match] + 1] - seg.start[g[match]]
     size_h = seg.start[h[match] + 1] - seg.start[h[match]]
     owner_a = np.repeat(match, size_g)
-    faces_a = seg.order[_expand(seg.start[g[match]], size_g)]
+    faces_a = seg.order[ranges(seg.start[g[match]], size_g)]
     owner_b = np.repeat(match, size_h)
-    faces_b = seg.order[_expand(seg.start[h[match]], size_h)]
+    faces_b = seg.order[ranges(seg.start[h[match]], size_h)]
     i, j = _cross_join(owner_a - match[0], owner_b - match[0], len(match))
     owner = owner_a[i]
     tri_a = _triangles_2d(stack.vertices[stack.faces[faces_a[i]]], u[owner], v[owner])

@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import ConvexHull, HalfspaceIntersection
 
 from assemblykit.deprecation import moved
+from assemblykit.ragged import group_of
 from assemblykit.tolerance import Tolerance, current
 
 _FIRST_CHUNK = 1024
@@ -218,7 +219,7 @@ def hulls_may_block(
     frame = view_frame(direction)
     used = np.unique(pairs)
     seen = [np.asarray(hulls[k], dtype=np.float64) @ frame.T for k in used]
-    owner = np.repeat(np.arange(len(used)), [len(s) for s in seen])
+    owner = group_of([len(s) for s in seen])
     points = np.concatenate(seen)
     outlines = shapely.convex_hull(shapely.multipoints(points[:, :2], indices=owner))
     deepest = np.full(len(used), -np.inf)

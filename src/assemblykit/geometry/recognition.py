@@ -62,6 +62,7 @@ from scipy.optimize import least_squares
 from assemblykit.algebra.se3 import axis_basis, line_classes
 from assemblykit.graphs import component_labels
 from assemblykit.model.surfaces import Surface, SurfaceKind
+from assemblykit.ragged import group_of, group_starts, ranges
 from assemblykit.tolerance import Tolerance, current
 
 SMOOTH_ANGLE = np.radians(30.0)
@@ -699,8 +700,8 @@ def _sphere_fits(
     if not len(lo):
         return np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool)
     sizes = hi - lo
-    piece = np.repeat(np.arange(len(lo)), 3 * sizes)
-    rows = np.arange(sizes.sum()) + np.repeat(lo - np.cumsum(sizes) + sizes, sizes)
+    piece = group_of(3 * sizes)
+    rows = ranges(lo, sizes)
     keys = np.unique(piece * len(vertices) + faces[rows].ravel())
     piece, used = np.divmod(keys, len(vertices))
     count = np.bincount(piece, minlength=len(lo))
@@ -814,11 +815,10 @@ def _widths(
     """How wide each coplanar group ``groups[i]`` is across ``axes[i]``, within its plane."""
     across = np.cross(seg.normal[groups], axes)
     sizes = seg.start[groups + 1] - seg.start[groups]
-    row = np.repeat(np.arange(len(groups)), sizes)
-    offset = np.arange(len(row)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
-    corners = vertices[faces[seg.order[seg.start[groups][row] + offset]]]
+    row = group_of(sizes)
+    corners = vertices[faces[seg.order[ranges(seg.start[groups], sizes)]]]
     spread = np.einsum("ijk,ik->ij", corners, across[row]).ravel()
-    bounds = 3 * (np.cumsum(sizes) - sizes)
+    bounds = 3 * group_starts(sizes)
     return np.maximum.reduceat(spread, bounds) - np.minimum.reduceat(spread, bounds)
 
 
@@ -829,7 +829,7 @@ def _medians(values: NDArray[np.float64], label: NDArray[np.int64]) -> NDArray[n
     starts = np.concatenate([[0], ends])
     sizes = np.diff(np.concatenate([starts, [len(order)]]))
     middle = 0.5 * (values[order[starts + (sizes - 1) // 2]] + values[order[starts + sizes // 2]])
-    return middle[np.repeat(np.arange(len(starts)), sizes)][np.argsort(order)]
+    return middle[group_of(sizes)][np.argsort(order)]
 
 
 def faces_on(surfaces: tuple[Surface, ...], n_faces: int) -> NDArray[np.bool_]:

@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
 from assemblykit.errors import UnknownNameError
+from assemblykit.ragged import group_of, ranges
 
 MAX_STATES = 250_000
 """Default limit of states visited per separation: Pelikan's 98-move first separation
@@ -374,9 +375,8 @@ def _moves(free: NDArray[np.int64]) -> tuple[list[tuple[int, int]], NDArray[np.i
         axis=0,
     )
     counts = rows[:, 3] - rows[:, 2] + 1
-    which = np.repeat(np.arange(len(rows)), counts)
-    distance = np.arange(len(which)) - np.repeat(np.cumsum(counts) - counts, counts)
-    moves = np.stack([rows[which, 0], rows[which, 1], rows[which, 2] + distance], axis=1)
+    which = group_of(counts)
+    moves = np.stack([rows[which, 0], rows[which, 1], ranges(rows[:, 2], counts)], axis=1)
     return removals, _merged(moves, (1 << m) - 1)
 
 

@@ -54,6 +54,7 @@ from assemblykit.planning.multimove import (
     Progress,
     fixed_indices,
 )
+from assemblykit.ragged import group_starts
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -110,7 +111,7 @@ class _Obstacles:
         self.first = np.array(first, dtype=np.int64)
         self.second = np.array(second, dtype=np.int64)
         counts = np.bincount(self.owner, minlength=len(first))
-        self.starts = np.cumsum(counts) - counts
+        self.starts = group_starts(counts)
 
 
 class _Intervals:
