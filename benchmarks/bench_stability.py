@@ -48,7 +48,13 @@ from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import Plan
-from assemblykit.planning.stability import CONE_SIDES, EquilibriumModel, Gravity, equilibrium_model
+from assemblykit.planning.stability import (
+    CONE_SIDES,
+    EquilibriumMemory,
+    EquilibriumModel,
+    Gravity,
+    equilibrium_model,
+)
 from assemblykit.tolerance import Tolerance
 from datasets import dataset
 
@@ -156,10 +162,10 @@ def planned(
     print(f"{name:<24} {len(result.parts):>4} parts {seconds:8.3f} s  {steps} steps, {verdict}")
     if result.gravity is not None:
         start = time.perf_counter()
-        model = equilibrium_model(assembly, tol=tol)
+        model, memory = equilibrium_model(assembly, tol=tol), EquilibriumMemory()
         for step in result.steps:
             assert step.stability is not None
-            model.check(step.rest, set(step.stability.held) & set(step.rest))
+            model.check(step.rest, set(step.stability.held) & set(step.rest), memory=memory)
         seconds = time.perf_counter() - start
         print(f"{'':<24} equations and one program per state: {seconds:.3f} s")
         # what any search reporting these states pays: each decided once, whole
@@ -238,9 +244,10 @@ def state_programs(path: Path | None, tol: Tolerance) -> None:
         seconds = time.perf_counter() - start
         verdict = "stands" if found.stands else f"{len(found.would_fall)} parts would fall"
         print(f"{'crossvault ' + label:<24} {seconds:8.3f} s  {verdict}")
-    model.check()
+    memory = EquilibriumMemory()
+    model.check(memory=memory)
     start = time.perf_counter()
-    found = model.check(rest)
+    found = model.check(rest, memory=memory)
     seconds = time.perf_counter() - start
     print(f"{'  the same, after whole':<24} {seconds:8.3f} s  {len(found.would_fall)} would fall")
 

@@ -18,6 +18,7 @@ from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import (
     CONE_SIDES,
     FRICTION_STEPS,
+    EquilibriumMemory,
     Gravity,
     GravityReport,
     StepStability,
@@ -116,16 +117,16 @@ def test_the_friction_needed_stays_in_the_bracket_of_the_resolution(assembly, le
     # the hand-computed least friction (tests/planning/test_stability.py) is not above
     # the answer, which is not above the least multiple of the resolution that stands,
     # and the whole program stands with it but not a resolution below
-    model = equilibrium_model(assembly, friction=MU)
+    model, memory = equilibrium_model(assembly, friction=MU), EquilibriumMemory()
     present, fixed = model.mask(None), model.mask(["ground"])
-    needed = model.friction_needed(present, fixed)
+    needed = model.friction_needed(present, fixed, memory=memory)
     assert needed is not None
     assert least - 1e-9 <= needed <= least_multiple(assembly, ["ground"]) + 1e-12
-    fresh = equilibrium_model(assembly, friction=MU)
-    assert fresh.stands(present, fixed, needed, local=False)
-    assert not fresh.stands(present, fixed, needed - RESOLUTION, local=False)
+    assert model.stands(present, fixed, needed, local=False)
+    assert not model.stands(present, fixed, needed - RESOLUTION, local=False)
     # asked again, the same answer from the balances kept (the search's warm start)
-    assert model.friction_needed(present, fixed) == pytest.approx(needed, abs=1e-9)
+    again = model.friction_needed(present, fixed, memory=memory)
+    assert again == pytest.approx(needed, abs=1e-9)
 
 
 def test_a_state_that_stands_without_friction_needs_none():

@@ -1,7 +1,7 @@
 """Force points on a straight stretch of a contact polygon's boundary are left out of
 the first equilibrium program (whether the equations alone have a solution): the answers
 must be those of the programs with every vertex, and vertices off the stretch must
-stay."""
+stay (which vertices are corners: test_force_points.py)."""
 
 from __future__ import annotations
 
@@ -13,13 +13,15 @@ import scipy.sparse as sp
 from scipy.optimize import linprog
 
 from assemblykit.io.assembly import load_assembly
-from assemblykit.planning import stability
+from assemblykit.planning import force_points
 from assemblykit.planning.stability import (
     CONE_SIDES,
     FRICTION_STEPS,
+    EquilibriumMemory,
     EquilibriumModel,
     contact_points,
     equilibrium_model,
+    least_residuals,
 )
 from datasets import dataset
 from stability_blocks import corbels, overhanging_stack
@@ -30,7 +32,7 @@ MU = 0.5
 def with_midpoints(monkeypatch: pytest.MonkeyPatch, bulge: float) -> None:
     """Give every contact polygon a vertex in the middle of each side, moved outwards
     (across the side, in the contact plane) by ``bulge``."""
-    original = stability.assembly_contacts
+    original = force_points.assembly_contacts
 
     def patched(assembly, tol=None):
         found = []
@@ -47,17 +49,19 @@ def with_midpoints(monkeypatch: pytest.MonkeyPatch, bulge: float) -> None:
             found.append(dataclasses.replace(contact, planar=tuple(planar)))
         return found
 
-    monkeypatch.setattr(stability, "assembly_contacts", patched)
+    monkeypatch.setattr(force_points, "assembly_contacts", patched)
 
 
 def answers(model: EquilibriumModel, states: list[set[str]]) -> list[tuple]:
-    """Per state: the parts that would fall and the least friction it needs."""
+    """Per state (asked in turn, with one memory): the parts that would fall and the
+    least friction it needs."""
     out = []
+    memory = EquilibriumMemory()
     for parts in states:
         present = model.mask(parts)
         fixed = present & model.mask(model.fixed)
-        found = model.check(parts)
-        out.append((found.would_fall, model.friction_needed(present, fixed)))
+        found = model.check(parts, memory=memory)
+        out.append((found.would_fall, model.friction_needed(present, fixed, memory=memory)))
     return out
 
 
@@ -104,46 +108,13 @@ def test_vertices_between_their_neighbours_are_left_out_with_the_same_answers(
         assert_same(answers(model, states), expected)
         # and the programs with every midpoint agree
         patch.setattr(
-            stability,
+            force_points,
             "_corners",
             lambda polygons, resolution: np.ones(sum(map(len, polygons)), dtype=bool),
         )
         full = equilibrium_model(assembly, friction=MU)
         assert full.corners.all() and not model.corners.all()
         assert_same(answers(full, states), expected)
-
-
-def test_a_vertex_off_the_segment_is_kept():
-    square = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0]], dtype=np.float64)
-    sides = (square + np.roll(square, -1, axis=0)) / 2
-    ring = np.stack([square, sides], axis=1).reshape(-1, 3)
-    assert stability._corners([ring], 1e-15).tolist() == [True, False] * 4
-    # a vertex bent outwards beyond the resolution is a corner
-    bent = ring.copy()
-    bent[1, 1] -= 1e-9
-    assert stability._corners([bent], 1e-15).sum() == 5
-    # the tip of a spike going back along its side (both neighbours at one point) is a
-    # corner; the vertex before it lies between its neighbours, the tip included
-    spike = np.array([[0, 0, 0], [2, 0, 0], [3, 0, 0], [2, 0, 0], [2, 2, 0]], dtype=np.float64)
-    assert stability._corners([spike], 1e-15).tolist() == [True, False, True, True, True]
-    # polygons one after the other: each closes on itself; two points are both corners
-    together = [square[:2], ring, spike, np.zeros((0, 3))]
-    assert stability._corners(together, 1e-15).tolist() == (
-        [True, True] + [True, False] * 4 + [True, False, True, True, True]
-    )
-    assert stability._corners([], 1e-15).tolist() == []
-
-
-def test_a_corner_given_twice_is_kept_once():
-    # the cross vault's contact polygons repeat some corners within 1e-16: each copy lies
-    # between the other and its far neighbour, so both used to be dropped and the corner
-    # lost; the first copy stays, the repeat goes, and so does a closing repeat
-    square = np.array([[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0]], dtype=np.float64)
-    twice = np.insert(square, 2, square[1] + [0.0, 1e-17, 0.0], axis=0)
-    assert stability._corners([twice], 1e-15).tolist() == [True, True, False, True, True]
-    closed = np.vstack([square, square[:1]])
-    assert stability._corners([closed], 1e-15).tolist() == [False, True, True, True, True]
-    assert stability._corners([np.zeros((3, 3))], 1e-15).tolist() == [True, False, False]
 
 
 @pytest.mark.slow
@@ -162,7 +133,7 @@ def test_the_cross_vault_has_the_same_least_residuals_on_its_corners():
     for points in (np.ones_like(model.corners), model.corners):
         columns = (CONE_SIDES * np.flatnonzero(points)[:, None] + np.arange(CONE_SIDES)).ravel()
         matrix = (model.normal_part + MU * model.tangent_part)[rows][:, columns].tocsc()
-        optimum.append(np.abs(stability.least_residuals(matrix, -model.load[rows])).sum())
+        optimum.append(np.abs(least_residuals(matrix, -model.load[rows])).sum())
     columns = (CONE_SIDES * np.arange(len(model.corners))[:, None] + np.arange(CONE_SIDES)).ravel()
     matrix = (model.normal_part + MU * model.tangent_part)[rows][:, columns].tocsc()
     eye = sp.identity(len(rows), format="csc")

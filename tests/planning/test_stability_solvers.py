@@ -1,34 +1,33 @@
 """The first equilibrium program (whether a state's equations alone have a solution) is
-solved by Clarabel (:func:`assemblykit.planning.stability.balance`): on states of the
-COMPAS arch, stacked and corbelled blocks, a block on a slope and the cross vault, at
+solved by Clarabel (:func:`assemblykit.planning.equilibrium_programs.balance`): on states
+of the COMPAS arch, stacked and corbelled blocks, a block on a slope and the cross vault, at
 several friction coefficients, its verdict must be that of HiGHS's interior point method
 (scipy's ``linprog``), the solver it replaced, on every vertex of the contact polygons
-where the model keeps only the corners. The slack program and the verdicts a model
-draws from the last balance it found are checked here too."""
+where the model keeps only the corners. The slack program solved by pieces and the
+verdicts drawn from what an :class:`EquilibriumMemory` keeps are checked here too (the
+programs themselves, on matrices written by hand: test_equilibrium_programs.py)."""
 
 from __future__ import annotations
 
 import functools
 
-import clarabel
 import numpy as np
 import pytest
-import scipy.sparse as sp
 from scipy.optimize import linprog
 
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
-from assemblykit.planning import stability
+from assemblykit.planning import equilibrium_programs
 from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import (
     CONE_SIDES,
     FRICTION_STEPS,
     LP_FEASIBILITY,
+    EquilibriumMemory,
     EquilibriumModel,
     Gravity,
-    _balances,
-    _proves_none,
     equilibrium_model,
+    least_residuals,
 )
 from assemblykit.tolerance import Tolerance
 from datasets import dataset
@@ -69,16 +68,17 @@ def highs_stands(
 def verdicts(
     model: EquilibriumModel, states: list[set[str] | None], frictions: tuple[float, ...]
 ) -> tuple[list[bool], list[bool]]:
-    """Per state and friction: Clarabel's verdict (HiGHS, its fallback, never asked)
-    and HiGHS's."""
+    """Per state and friction: Clarabel's verdict (HiGHS, its fallback, never asked;
+    the states asked one after the other, with one memory) and HiGHS's."""
     ours, reference = [], []
+    memory = EquilibriumMemory()
     for parts in states:
         present = model.mask(parts)
         fixed = present & model.mask(model.fixed)
         for friction in frictions:
             with pytest.MonkeyPatch.context() as patch:
-                patch.setattr(stability, "linprog", None)
-                ours.append(model.stands(present, fixed, friction))
+                patch.setattr(equilibrium_programs, "linprog", None)
+                ours.append(model.stands(present, fixed, friction, memory=memory))
             reference.append(highs_stands(model, present, fixed, friction))
     return ours, reference
 
@@ -128,19 +128,6 @@ def test_the_cross_vault_gets_highs_verdicts():
         assert ours == reference
 
 
-def test_the_least_residual_balance_names_every_equation_some_optimum_leaves_unbalanced():
-    # minimise |1 - x| + |-1 - x| over x >= 0: the optimum 2 is reached by every x in
-    # [0, 1]; the vertex x = 1 leaves only the second equation unbalanced, x = 0 both,
-    # and the interior point (0 < x < 1) both: the set every optimum's support lies in
-    residual = stability.least_residuals(sp.csc_matrix([[1.0], [1.0]]), np.array([1.0, -1.0]))
-    assert np.abs(residual).sum() == pytest.approx(2.0, abs=1e-7)
-    assert np.all(np.abs(residual) > 1e-3)
-    assert residual[0] > 0 > residual[1]
-    # a unique optimum: x = 1 balances both
-    unique = stability.least_residuals(sp.csc_matrix([[1.0], [2.0]]), np.array([1.0, 2.0]))
-    assert np.abs(unique).max() < LP_FEASIBILITY
-
-
 @pytest.mark.slow
 def test_local_verdicts_are_those_of_the_whole_program_on_a_vault_taken_down():
     """The cross vault taken down from its highest block, one block at a time: at each
@@ -159,6 +146,7 @@ def test_local_verdicts_are_those_of_the_whole_program_on_a_vault_taken_down():
 
     order = sorted(assembly.names, key=lambda n: -float(model.heights[model.mask([n])][0]))
     ours, whole = [], []
+    memory = EquilibriumMemory()
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(EquilibriumModel, "_local_verdict", recorded)
         for removed in range(12):
@@ -166,28 +154,11 @@ def test_local_verdicts_are_those_of_the_whole_program_on_a_vault_taken_down():
             fixed = present & model.mask(model.fixed)
             for friction in (0.5, 0.3):
                 for held in (fixed, fixed | model.mask(order[removed : removed + 1])):
-                    ours.append(model.stands(present, held, friction))
-                    whole.append(model.stands(present, held, friction, local=False))
+                    ours.append(model.stands(present, held, friction, memory=memory))
+                    whole.append(model.stands(present, held, friction, False, memory=memory))
     assert ours == whole
     assert any(ours) and not all(ours)
     assert True in decided and False in decided
-
-
-def test_the_slack_program_falls_back_to_highs_when_clarabel_stops_short(monkeypatch):
-    matrix, rhs = sp.csc_matrix([[1.0], [2.0]]), np.array([1.0, 1.0])
-    interior = stability.least_residuals(matrix, rhs)
-    settings = clarabel.DefaultSettings
-
-    def one_iteration():
-        found = settings()
-        found.max_iter = 1
-        return found
-
-    monkeypatch.setattr(clarabel, "DefaultSettings", one_iteration)
-    vertex = stability.least_residuals(matrix, rhs)
-    # by hand: |1 - x| + |1 - 2x| is least, 0.5, at x = 0.5: residuals (0.5, 0)
-    np.testing.assert_allclose(vertex, [0.5, 0.0], atol=1e-7)
-    np.testing.assert_allclose(interior, vertex, atol=1e-7)
 
 
 def two_stacks() -> Assembly:
@@ -215,7 +186,8 @@ def test_the_slack_program_solved_piece_by_piece_is_the_whole_program():
         ["loose"],
         ["right", "right_top"],
     ]
-    residuals = dict(zip(model.names, model.slack(present, fixed), strict=True))
+    memory = EquilibriumMemory()
+    residuals = dict(zip(model.names, model.slack(present, fixed, memory=memory), strict=True))
     # the loose cube keeps its whole weight, the right top falls, the left stack stands
     assert residuals["loose"] == pytest.approx(1.0)
     assert residuals["right_top"] > 1e-3 > 10 * model.threshold and residuals["ground"] == 0.0
@@ -224,18 +196,18 @@ def test_the_slack_program_solved_piece_by_piece_is_the_whole_program():
     free = present & ~fixed
     rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()
     selected = present[model.point_parts[:, 0]] & present[model.point_parts[:, 1]]
-    whole = stability.least_residuals(
-        model._matrix(rows, selected & model.corners, 0.5), -model.load[rows]
-    )
+    whole = least_residuals(model._matrix(rows, selected & model.corners, 0.5), -model.load[rows])
     falls = np.abs(whole).reshape(-1, 6).max(axis=1) > model.threshold
     named = [n for n, f in zip(np.array(model.names)[free], falls, strict=True) if f]
     assert named == ["right_top", "loose"]
     assert [n for n in model.names if residuals[n] > model.threshold] == named
-    # the left top taken away: the right piece's residuals stay, the left one stands
+    # the left top taken away: the right piece's residuals stay (kept, with the loose
+    # cube's: only the new left piece is solved), the left one stands
     without = present & ~model.mask(["left_top"])
-    again = dict(zip(model.names, model.slack(without, fixed), strict=True))
-    assert again["right_top"] == pytest.approx(residuals["right_top"], abs=model.threshold)
-    assert again["left"] < model.threshold and again["loose"] == pytest.approx(1.0)
+    again = dict(zip(model.names, model.slack(without, fixed, memory=memory), strict=True))
+    assert len(memory.residuals) == 4
+    assert again["right_top"] == residuals["right_top"] and again["loose"] == residuals["loose"]
+    assert again["left"] < model.threshold
 
 
 def bisected(model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray) -> float | None:
@@ -260,13 +232,14 @@ def test_the_least_friction_searched_from_the_last_answer_is_the_bisections():
     # programs it saves are a figure of benchmarks/bench_stability.py)
     assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
     result = plan(assembly, gravity=Gravity(holds=3))
-    ours, reference = equilibrium_model(assembly), equilibrium_model(assembly)
+    model, memory = equilibrium_model(assembly), EquilibriumMemory()
     states = []
     for step in result.steps:
-        present = ours.mask(step.rest)
-        states.append((present, present & (ours.mask(ours.fixed) | ours.mask(step.stability.held))))
-    expected = [bisected(reference, present, fixed) for present, fixed in states]
-    found = [ours.friction_needed(present, fixed) for present, fixed in states]
+        present = model.mask(step.rest)
+        held = model.mask(model.fixed) | model.mask(step.stability.held)
+        states.append((present, present & held))
+    expected = [bisected(model, present, fixed) for present, fixed in states]
+    found = [model.friction_needed(present, fixed, memory=memory) for present, fixed in states]
     # what a balance needs: never above the multiple bisection finds, less than a step
     # below it (the least one is above the step below), 0 where bisection finds 0
     assert None not in found and None not in expected
@@ -292,9 +265,9 @@ def standing_vault() -> tuple[EquilibriumModel, np.ndarray, np.ndarray]:
 
 def test_verdicts_from_kept_balances_and_certificates_are_the_whole_programs():
     # a balance found at 0.45 answers the larger frictions, a certificate of a fall at
-    # 0.3 the smaller ones; each verdict is the one a fresh model's whole program gives
+    # 0.3 the smaller ones; each verdict is the one the whole program gives, nothing kept
     model, present, fixed = standing_vault()
-    fresh = standing_vault()[0]
+    memory = EquilibriumMemory()
     for friction, stands in (
         (0.45, True),
         (0.5, True),
@@ -303,39 +276,27 @@ def test_verdicts_from_kept_balances_and_certificates_are_the_whole_programs():
         (0.2, False),
         (0.0, False),
     ):
-        assert model.stands(present, fixed, friction) is stands
-        assert fresh.stands(present, fixed, friction, local=False) is stands
+        assert model.stands(present, fixed, friction, memory=memory) is stands
+        assert model.stands(present, fixed, friction, local=False) is stands
+    assert len(memory.balances) and len(memory.certificates)
     # holding the highest block changes the state: the kept certificate does not decide it
     held = fixed | model.mask([model.names[int(np.argmin(model.heights))]])
-    assert model.stands(present, held, 0.3) == fresh.stands(present, held, 0.3, local=False)
+    whole = model.stands(present, held, 0.3, local=False)
+    assert model.stands(present, held, 0.3, memory=memory) == whole
 
 
-def test_a_state_after_one_removal_is_judged_as_a_fresh_model_judges_it():
+def test_a_state_after_one_removal_is_judged_as_the_whole_program_judges_it():
     # the cross vault, then the vault without block 4 (the first its plan under gravity
-    # takes): the model that answered the whole vault (its least friction, balances and
-    # certificates kept) answers the second state as a fresh model's whole program does
+    # takes): with what answered the whole vault kept (its least friction, balances and
+    # certificates), the second state is judged as the whole program judges it
     model, whole, fixed = standing_vault()
-    need = model.friction_needed(whole, fixed)
+    memory = EquilibriumMemory()
+    need = model.friction_needed(whole, fixed, memory=memory)
     assert need is not None and 0 < need < model.friction
+    assert memory.bracket_end is not None and memory.bracket_end * model.resolution >= need
     rest = whole & ~model.mask(["4"])
-    fresh = standing_vault()[0]
-    assert model.stands(rest, fixed) and model.stands(rest, fixed, need)
-    assert fresh.stands(rest, fixed, need, local=False)
-    assert model.stands(rest, fixed, 0.0) is fresh.stands(rest, fixed, 0.0, local=False)
-
-
-def test_an_almost_answer_is_taken_only_when_it_checks_out():
-    # x1 + x2 = -1 has no x >= 0: y = 1 proves it (rhs . y = -1 < 0, both columns gain
-    # 1), however long y is; y = -1 proves nothing. x1 + 2 x2 = 3 is balanced by (1, 1)
-    # and not by (1, 0.9) beyond the feasibility tolerance
-    none = sp.csc_matrix(np.array([[1.0, 1.0]]))
-    assert _proves_none(none, np.array([-1.0]), np.array([1.0]))
-    assert _proves_none(none, np.array([-1.0]), np.array([8.5e10]))
-    assert not _proves_none(none, np.array([-1.0]), np.array([-1.0]))
-    # a column that loses by more than the tolerance spoils it
-    mixed = sp.csc_matrix(np.array([[1.0, -1.0]]))
-    assert not _proves_none(mixed, np.array([-1.0]), np.array([1.0]))
-    some = sp.csc_matrix(np.array([[1.0, 2.0]]))
-    assert _balances(some, np.array([3.0]), np.array([1.0, 1.0]))
-    assert _balances(some, np.array([3.0]), np.array([1.0, 1.0 + LP_FEASIBILITY / 4]))
-    assert not _balances(some, np.array([3.0]), np.array([1.0, 0.9]))
+    assert model.stands(rest, fixed, memory=memory)
+    assert model.stands(rest, fixed, need, memory=memory)
+    assert model.stands(rest, fixed, need, local=False)
+    none = model.stands(rest, fixed, 0.0, local=False)
+    assert model.stands(rest, fixed, 0.0, memory=memory) is none

@@ -22,8 +22,12 @@ from assemblykit.blocking.tables import translation_slots, translation_table
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.geometry.interference import interferences
 from assemblykit.model.assembly import Assembly
+from assemblykit.planning.equilibrium import equilibrium_model
+from assemblykit.planning.equilibrium_memory import EquilibriumMemory
 from assemblykit.planning.fasteners import step_fastener
+from assemblykit.planning.gravity import Gravity, GravityReport, gravity_direction
 from assemblykit.planning.hands import hands_needed
+from assemblykit.planning.judge import StateJudge
 from assemblykit.planning.multimove import moving_groups
 from assemblykit.planning.planar import planar_rigid_may_free, planar_search
 from assemblykit.planning.sequence import (
@@ -42,13 +46,6 @@ from assemblykit.planning.sequence import (
     least_interlocked,
     one_set,
     separable,
-)
-from assemblykit.planning.stability import (
-    Gravity,
-    GravityReport,
-    StateJudge,
-    equilibrium_model,
-    gravity_direction,
 )
 from assemblykit.tolerance import Tolerance
 
@@ -258,8 +255,9 @@ def _plan_under_gravity(
     max_hands: int,
 ) -> Plan:
     """:func:`plan` under gravity: the fixed parts outweigh every other so that one of
-    them is the base that stays, and :class:`~assemblykit.planning.stability.StateJudge`
-    picks and judges the steps."""
+    them is the base that stays, and :class:`~assemblykit.planning.judge.StateJudge`
+    picks and judges the steps, with one memory of what the equilibrium programs found
+    for the whole search."""
     search.progress("equilibrium equations", 0, 1)
     model = equilibrium_model(
         assembly,
@@ -272,8 +270,10 @@ def _plan_under_gravity(
     search.volumes = anchored_volumes(model.names, search.volumes, model.fixed)
     supports = mask_of(k for k, name in enumerate(model.names) if name in set(model.fixed))
     everything = mask_of(range(len(model.names)))
+    memory = EquilibriumMemory()
     judge = StateJudge(
         model,
+        memory,
         gravity.holds,
         search.translations.vector,
         lambda members: base_part(members, search.volumes),
@@ -292,9 +292,11 @@ def _plan_under_gravity(
     else:
         _supports_last(search, everything, supports)
     result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
-    whole = model.check()
+    whole = model.check(memory=memory)
     present = model.mask(None)
-    needed = model.friction_needed(present, present & judge.fixed, model.mask(whole.would_fall))
+    needed = model.friction_needed(
+        present, present & judge.fixed, model.mask(whole.would_fall), memory=memory
+    )
     return replace(
         result,
         gravity=GravityReport(

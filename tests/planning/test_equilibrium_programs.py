@@ -1,0 +1,82 @@
+"""The linear programs of equilibrium on matrices written by hand
+(:mod:`assemblykit.planning.equilibrium_programs`): the least-residual balance names
+every equation some optimum leaves unbalanced, the slack program falls back to HiGHS
+when Clarabel stops short, an answer Clarabel calls *almost* found is taken only once
+checked, and the pyramid's gauge is that of its sides."""
+
+from __future__ import annotations
+
+import math
+
+import clarabel
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from assemblykit.planning.equilibrium_programs import (
+    CONE_SIDES,
+    LP_FEASIBILITY,
+    _balances,
+    _proves_none,
+    cone_directions,
+    least_residuals,
+    pyramid_gauge,
+)
+
+
+def test_the_least_residual_balance_names_every_equation_some_optimum_leaves_unbalanced():
+    # minimise |1 - x| + |-1 - x| over x >= 0: the optimum 2 is reached by every x in
+    # [0, 1]; the vertex x = 1 leaves only the second equation unbalanced, x = 0 both,
+    # and the interior point (0 < x < 1) both: the set every optimum's support lies in
+    residual = least_residuals(sp.csc_matrix([[1.0], [1.0]]), np.array([1.0, -1.0]))
+    assert np.abs(residual).sum() == pytest.approx(2.0, abs=1e-7)
+    assert np.all(np.abs(residual) > 1e-3)
+    assert residual[0] > 0 > residual[1]
+    # a unique optimum: x = 1 balances both
+    unique = least_residuals(sp.csc_matrix([[1.0], [2.0]]), np.array([1.0, 2.0]))
+    assert np.abs(unique).max() < LP_FEASIBILITY
+
+
+def test_the_slack_program_falls_back_to_highs_when_clarabel_stops_short(monkeypatch):
+    matrix, rhs = sp.csc_matrix([[1.0], [2.0]]), np.array([1.0, 1.0])
+    interior = least_residuals(matrix, rhs)
+    settings = clarabel.DefaultSettings
+
+    def one_iteration():
+        found = settings()
+        found.max_iter = 1
+        return found
+
+    monkeypatch.setattr(clarabel, "DefaultSettings", one_iteration)
+    vertex = least_residuals(matrix, rhs)
+    # by hand: |1 - x| + |1 - 2x| is least, 0.5, at x = 0.5: residuals (0.5, 0)
+    np.testing.assert_allclose(vertex, [0.5, 0.0], atol=1e-7)
+    np.testing.assert_allclose(interior, vertex, atol=1e-7)
+
+
+def test_an_almost_answer_is_taken_only_when_it_checks_out():
+    # x1 + x2 = -1 has no x >= 0: y = 1 proves it (rhs . y = -1 < 0, both columns gain
+    # 1), however long y is; y = -1 proves nothing. x1 + 2 x2 = 3 is balanced by (1, 1)
+    # and not by (1, 0.9) beyond the feasibility tolerance
+    none = sp.csc_matrix(np.array([[1.0, 1.0]]))
+    assert _proves_none(none, np.array([-1.0]), np.array([1.0]))
+    assert _proves_none(none, np.array([-1.0]), np.array([8.5e10]))
+    assert not _proves_none(none, np.array([-1.0]), np.array([-1.0]))
+    # a column that loses by more than the tolerance spoils it
+    mixed = sp.csc_matrix(np.array([[1.0, -1.0]]))
+    assert not _proves_none(mixed, np.array([-1.0]), np.array([1.0]))
+    some = sp.csc_matrix(np.array([[1.0, 2.0]]))
+    assert _balances(some, np.array([3.0]), np.array([1.0, 1.0]))
+    assert _balances(some, np.array([3.0]), np.array([1.0, 1.0 + LP_FEASIBILITY / 4]))
+    assert not _balances(some, np.array([3.0]), np.array([1.0, 0.9]))
+
+
+def test_a_force_along_a_generator_is_on_the_pyramid_and_one_between_two_is_beyond():
+    # a unit tangential force along a generator is held by the pyramid of mu = 1 (its
+    # gauge is 1); halfway between two generators it needs 1 / cos(pi / CONE_SIDES)
+    cos, sin = cone_directions()
+    along = np.stack([cos, sin], axis=1)
+    np.testing.assert_allclose(pyramid_gauge(along), 1.0)
+    cos, sin = cone_directions(math.pi / CONE_SIDES)
+    between = np.stack([cos, sin], axis=1)
+    np.testing.assert_allclose(pyramid_gauge(between), 1 / math.cos(math.pi / CONE_SIDES))
