@@ -120,18 +120,20 @@ def test_the_six_axis_normals_positively_span_and_five_do_not() -> None:
 @settings(max_examples=60, deadline=None)
 @given(
     st.lists(
-        st.tuples(*[st.floats(-1, 1, allow_nan=False) for _ in range(3)]), min_size=4, max_size=9
+        st.tuples(st.floats(0.05, np.pi - 0.05), st.floats(0, 2 * np.pi)), min_size=4, max_size=9
     )
 )
-def test_positive_spanning_is_the_origin_inside_the_normals_hull(rows) -> None:
-    # independently: the vectors positively span space exactly when the origin lies
+def test_positive_spanning_is_the_origin_inside_the_normals_hull(angles) -> None:
+    # independently: unit vectors positively span space exactly when the origin lies
     # inside their convex hull (every hull facet strictly on the far side of it)
-    normals = np.array(rows, dtype=float)
-    assume(np.all(np.linalg.norm(normals, axis=1) > 1e-3))
+    polar, azimuth = np.array(angles).T
+    normals = np.column_stack(
+        [np.sin(polar) * np.cos(azimuth), np.sin(polar) * np.sin(azimuth), np.cos(polar)]
+    )
     try:
         hull = ConvexHull(normals)
-    except QhullError:
-        assume(False)
+    except QhullError:  # all in a plane: no hull, and no positive span either
+        assert not positively_spanning(normals)
         return
     margin = float(hull.equations[:, 3].max())  # a . 0 + b for each facet, < 0 inside
     assume(abs(margin) > 1e-6)
