@@ -14,7 +14,7 @@ import pytest
 import trimesh
 
 from assemblykit.geometry import overlaps
-from assemblykit.geometry.interference import interferences, overlap_volume
+from assemblykit.geometry.interference import interferences, overlap_volume, solid
 from assemblykit.geometry.overlaps import DESIGNED_SHARE, joined, resolve_overlaps
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.planner import plan
@@ -90,6 +90,32 @@ def test_joined_parts_move_as_one(how):
     assert list(prepared.parts) == ["cup+peg"]
     assert prepared.parts["cup+peg"].volume == pytest.approx(17.0 + 0.22 - 0.02, rel=1e-9)
     assert [o.resolution for o in prepared.overlaps] == ["joined"]
+
+
+def test_parts_that_only_touch_are_joined_side_by_side_and_keep_their_solid():
+    # a lid resting on the cup and a peg standing in its well, apart from its walls:
+    # the three share no volume, so the joined part is their meshes side by side (no
+    # boolean, whose mesh keeps the touching faces as sheets: made into a solid again it
+    # is not their union), its solid exactly theirs; a ball of radius 0.2 just clear of
+    # the cup, the lid and the peg shares nothing with it, by the solid and by counting
+    # sample points (independently of manifold3d)
+    peg = box((0.4, 0.4, 1), (1.5, 1.3, 1))
+    lid = box((3, 3, 1), (0, 0, 2))
+    parts = [cup_and_peg().parts["cup"], Part("peg", peg), Part("lid", lid)]
+    together = joined(Assembly(parts), [["cup", "peg", "lid"]])
+    part = together.parts["cup+peg+lid"]
+    assert len(part.mesh.faces) == sum(len(p.mesh.faces) for p in parts)
+    volume = sum(p.mesh.volume for p in parts)
+    assert solid(part.mesh).volume() == pytest.approx(volume, rel=1e-12)
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=0.2)
+    ball.apply_translation([1.25, 1.5, 1.5])  # in the well, 0.05 from its wall and the peg
+    assert overlap_volume(ball, part.mesh) == pytest.approx(0.0, abs=1e-12)
+    grid = np.stack(np.meshgrid(*[np.linspace(-0.19, 0.19, 9)] * 3), axis=-1).reshape(-1, 3)
+    points = grid[np.linalg.norm(grid, axis=1) < 0.19] + [1.25, 1.5, 1.5]
+    assert not part.mesh.contains(points).any()
+    # parts that overlap are their boolean union: the cup and the peg pressed into it
+    pressed = joined(cup_and_peg(), [["cup", "peg"]]).parts["cup+peg"]
+    assert pressed.volume == pytest.approx(17.0 + 0.22 - 0.02, rel=1e-9)
 
 
 def test_joining_chains_of_parts_and_unknown_names():
