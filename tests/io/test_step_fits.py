@@ -512,3 +512,43 @@ def test_a_screw_tapped_through_plates_faceted_apart_leaves_along_its_axis(screw
     assert max(sweep_overlaps(prepared, found.steps)) <= 1e-6
     # pushed the other way the head runs into the top plate
     assert max(sweep_overlaps(prepared, found.steps[:1], reverse=True)) > 1.0
+
+
+def test_a_flange_coupling_comes_apart_as_a_fitter_takes_it(tmp_path):
+    # two flanges (discs of radius 40 with hubs, bores of radius 10) face to face, a
+    # shaft of the bore's radius in each hub, four bolts of radius 4 at their holes'
+    # radius through both discs (heads under the first) and a nut on each above the
+    # second: everything at nominal size. By hand: the nuts come off upwards and the
+    # bolts out downwards along their axes, the flanges part along the bolts once the
+    # nuts are off, and each shaft leaves along the axis; every step is clear of every
+    # part in place
+    holes = [(28 * math.cos(a), 28 * math.sin(a)) for a in np.arange(4) * math.pi / 2]
+
+    def flange(disc: float, hub: float):
+        shape = fuse(cylinder((0, 0, disc), 40, 10), cylinder((0, 0, hub), 20, 20))
+        shape = cut(shape, cylinder((0, 0, -100), 10, 300))
+        for x, y in holes:
+            shape = cut(shape, cylinder((x, y, -100), 4, 300))
+        return shape
+
+    shafts = [cylinder((0, 0, -60), 10, 58, turn=3), cylinder((0, 0, 22), 10, 58, turn=9)]
+    bolts = [fuse(cylinder((x, y, -5), 7, 5), cylinder((x, y, 0), 4, 26)) for x, y in holes]
+    nuts = [cut(cylinder((x, y, 20), 7, 6), cylinder((x, y, 19), 4, 8, turn=5)) for x, y in holes]
+    shapes = (flange(0, -20), flange(10, 20), *shafts, *bolts, *nuts)
+    asm = read(tmp_path / "flange.step", *shapes).assembly
+    assert interferences(asm) == []
+    found = plan(asm)
+    assert found.feasible and max(sweep_overlaps(asm, found.steps)) <= NOISE
+    first, second = "solid1", "solid2"
+    bolt_names = {f"solid{k}" for k in range(5, 9)}
+    nut_names = {f"solid{k}" for k in range(9, 13)}
+    when = {name: k for k, step in enumerate(found.steps) for name in step.parts}
+    moved = {name: step for step in found.steps for name in step.parts}
+    for name in bolt_names | nut_names | {"solid3", "solid4"}:
+        assert abs(float(moved[name].direction @ Z)) == pytest.approx(1.0)
+    # a bolt leaves once its nut is off (or with it); the flanges part along the bolts'
+    # axes once every nut is off (lifted off the bolts, or after them)
+    assert all(when[f"solid{9 + k}"] <= when[f"solid{5 + k}"] for k in range(4))
+    leaving = second if first not in when else first
+    assert abs(float(moved[leaving].direction @ Z)) == pytest.approx(1.0)
+    assert all(when[nut] <= when[leaving] for nut in nut_names)
