@@ -77,6 +77,8 @@ def _frozen(array: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def _is_number(value: Any) -> bool:
     """Whether ``value`` is a real number (``true`` in a file is not the number 1)."""
+    if type(value) in (int, float):
+        return True
     return isinstance(value, int | float | np.floating | np.integer) and not isinstance(
         value, bool | np.bool_
     )
@@ -93,19 +95,19 @@ def _vector(value: Any, field: str, owner: str) -> Vector:
         numeric = len(items) == 3 and all(_is_number(v) for v in items)
     if not numeric:
         raise FeatureError(f"{field} must be 3 numbers, got {value!r}", where=owner)
-    vec = np.array(items, dtype=np.float64)
-    if not np.all(np.isfinite(vec)):
-        raise FeatureError(f"{field} must be finite, got {vec.tolist()}", where=owner)
-    if np.any(np.abs(vec) > MAX_MAGNITUDE):
+    numbers = [float(v) for v in items]
+    if not all(map(math.isfinite, numbers)):
+        raise FeatureError(f"{field} must be finite, got {numbers}", where=owner)
+    if max(map(abs, numbers)) > MAX_MAGNITUDE:
         raise FeatureError(
-            f"{field} must be at most {MAX_MAGNITUDE:g} in size, got {vec.tolist()}", where=owner
+            f"{field} must be at most {MAX_MAGNITUDE:g} in size, got {numbers}", where=owner
         )
-    return _frozen(vec)
+    return _frozen(np.array(numbers, dtype=np.float64))
 
 
 def _direction(value: Any, field: str, owner: str) -> Vector:
     vec = _vector(value, field, owner)
-    norm = float(np.linalg.norm(vec))
+    norm = math.hypot(*vec.tolist())
     if not norm > 0:
         raise FeatureError(f"{field} must be a non-zero vector", where=owner)
     return _frozen(vec / norm)

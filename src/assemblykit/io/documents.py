@@ -106,29 +106,38 @@ def checked_shape(data: Any, source: str | None = None) -> Any:
 
     The walk uses its own stack (no recursion) and stops at the first limit exceeded, so
     an alias bomb costs at most :data:`MAX_NODES` steps."""
-    stack: list[tuple[Any, int]] = [(data, 0)]
-    count = 0
+    _check_number(data, source)
+    if not isinstance(data, dict | list):
+        return data
+    stack: list[tuple[dict[Any, Any] | list[Any], int]] = [(data, 0)]
+    count = 1
     while stack:
         value, depth = stack.pop()
-        count += 1
+        if depth >= MAX_DEPTH:
+            raise SchemaError(f"nested deeper than {MAX_DEPTH} levels", source=source)
+        children = value.values() if isinstance(value, dict) else value
+        count += len(children)
         if count > MAX_NODES:
             raise SchemaError(
                 f"document expands to more than {MAX_NODES} values (YAML aliases?)",
                 source=source,
             )
-        if isinstance(value, int) and not isinstance(value, bool) and abs(value) > FLOAT_MAX:
-            digits = int(value.bit_length() * math.log10(2)) + 1
-            raise SchemaError(
-                f"a number of about {digits} digits is beyond the range of a float "
-                f"({FLOAT_MAX:.4g})",
-                source=source,
-            )
-        if isinstance(value, dict | list):
-            if depth >= MAX_DEPTH:
-                raise SchemaError(f"nested deeper than {MAX_DEPTH} levels", source=source)
-            children = value.values() if isinstance(value, dict) else value
-            stack.extend((child, depth + 1) for child in children)
+        for child in children:
+            if isinstance(child, dict | list):
+                stack.append((child, depth + 1))
+            elif type(child) is int:
+                _check_number(child, source)
     return data
+
+
+def _check_number(value: Any, source: str | None) -> None:
+    """:class:`SchemaError` for an integer beyond the range of a float."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > FLOAT_MAX:
+        digits = int(value.bit_length() * math.log10(2)) + 1
+        raise SchemaError(
+            f"a number of about {digits} digits is beyond the range of a float ({FLOAT_MAX:.4g})",
+            source=source,
+        )
 
 
 def read_yaml(text: str, source: str | None = None) -> Any:

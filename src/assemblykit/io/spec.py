@@ -112,27 +112,23 @@ def written_rounding(data: Mapping[str, Any]) -> Rounding:
     number but a direction's), and of its directions the largest turn their rounded
     components allow, ``|resolutions| / |v|``."""
     length, angle = 0.0, 0.0
-    for key, value in _numbers(data):
-        if key in DIRECTIONS and isinstance(value, list):
-            norm = math.hypot(*value)
-            if norm > 0:
-                angle = max(angle, math.hypot(*map(written_resolution, value)) / norm)
-        else:
-            length = max(
-                length, *map(written_resolution, value if isinstance(value, list) else [value])
-            )
+    stack: list[tuple[str, Any]] = [("", data)]
+    while stack:
+        key, value = stack.pop()
+        if isinstance(value, Mapping):
+            stack.extend((str(k), v) for k, v in value.items() if not isinstance(v, str))
+        elif isinstance(value, list):
+            if not value or not all(map(_is_real, value)):
+                stack.extend((key, v) for v in value if not isinstance(v, str))
+            elif key in DIRECTIONS:
+                norm = math.hypot(*value)
+                if norm > 0:
+                    angle = max(angle, math.hypot(*map(written_resolution, value)) / norm)
+            else:
+                length = max(length, *map(written_resolution, value))
+        elif _is_real(value):
+            length = max(length, written_resolution(float(value)))
     return Rounding(length, angle)
-
-
-def _numbers(data: Any, key: str = "") -> list[tuple[str, float | list[float]]]:
-    """Every number of ``data`` and every list of numbers, with the key it is under."""
-    if isinstance(data, Mapping):
-        return [item for k, v in data.items() for item in _numbers(v, str(k))]
-    if isinstance(data, list):
-        if data and all(_is_real(v) for v in data):
-            return [(key, [float(v) for v in data])]
-        return [item for v in data for item in _numbers(v, key)]
-    return [(key, float(data))] if _is_real(data) else []
 
 
 def _is_real(value: Any) -> bool:
