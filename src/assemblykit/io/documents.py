@@ -125,7 +125,7 @@ def checked_shape(data: Any, source: str | None = None) -> Any:
         for child in children:
             if isinstance(child, dict | list):
                 stack.append((child, depth + 1))
-            elif type(child) is int:
+            elif type(child) is int and abs(child) > FLOAT_MAX:
                 _check_number(child, source)
     return data
 

@@ -120,6 +120,8 @@ def written_rounding(data: Mapping[str, Any]) -> Rounding:
         elif isinstance(value, list):
             if not value or not all(map(_is_real, value)):
                 stack.extend((key, v) for v in value if not isinstance(v, str))
+            elif all(type(v) is int for v in value):
+                continue  # whole numbers: written exactly, whether lengths or directions
             elif key in DIRECTIONS:
                 norm = math.hypot(*value)
                 if norm > 0:
