@@ -43,6 +43,7 @@ from scipy.spatial import ConvexHull, QhullError
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
 from assemblykit.geometry.contacts import Contact, PlanarPatch
+from assemblykit.graphs import component_labels
 from assemblykit.tolerance import Tolerance
 
 RIGID_MAX_SIZE = 2
@@ -306,18 +307,13 @@ class RigidBlockingGraph:
         motion frees any (a certificate, where :meth:`removable` searches the
         arrangement)."""
         index = {name: k for k, name in enumerate(self.parts)}
-        joined = np.arange(len(self.parts))
-
-        def root(k: int) -> int:
-            while joined[k] != k:
-                k = int(joined[k])
-            return k
-
-        for contact in self.contacts:
-            a, b = root(index[contact.a]), root(index[contact.b])
-            if a != b and stops_every_twist(*contact_points(contact), self.tol):
-                joined[a] = b
-        return len({root(k) for k in range(len(self.parts))}) == 1
+        held = [
+            (index[c.a], index[c.b])
+            for c in self.contacts
+            if stops_every_twist(*contact_points(c), self.tol)
+        ]
+        labels = component_labels(len(self.parts), np.array(held, dtype=np.int64).reshape(-1, 2))
+        return len(set(labels.tolist())) == 1
 
     def removable(self, max_size: int | None = None) -> list[Removal]:
         """Subassemblies that some rigid twist frees (a necessary condition for
