@@ -27,8 +27,9 @@ import pytest
 
 from assemblykit.cli import INTERRUPTED
 
-LIMIT = 2.0
-"""Seconds allowed from the signal to the end of the process."""
+LIMIT = 30.0
+"""Seconds allowed from the signal to the end of the process: generous, since a loaded
+machine is slow, not wrong; the plan interrupted would run for minutes."""
 
 LAUNCHER = """
 import sys

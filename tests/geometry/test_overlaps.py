@@ -32,6 +32,23 @@ def cup_and_peg() -> Assembly:
     return Assembly([Part("cup", cup), Part("peg", box((1.1, 0.2, 1), (1, 1.4, 1)))])
 
 
+def winding_numbers(mesh: trimesh.Trimesh, points: np.ndarray) -> np.ndarray:
+    """How many times the closed surfaces of ``mesh`` wind round each point: the solid
+    angles its triangles subtend there (Van Oosterom and Strackee, 1983) over 4 pi. Meshes
+    side by side add up, faces they share or not, which a ray count does not promise."""
+    corners = mesh.triangles[None, :, :, :] - points[:, None, None, :]
+    a, b, c = corners[..., 0, :], corners[..., 1, :], corners[..., 2, :]
+    la, lb, lc = (np.linalg.norm(v, axis=-1) for v in (a, b, c))
+    numerator = np.einsum("ijk,ijk->ij", a, np.cross(b, c))
+    denominator = (
+        la * lb * lc
+        + np.einsum("ijk,ijk->ij", a, b) * lc
+        + np.einsum("ijk,ijk->ij", b, c) * la
+        + np.einsum("ijk,ijk->ij", c, a) * lb
+    )
+    return 2 * np.arctan2(numerator, denominator).sum(axis=1) / (4 * np.pi)
+
+
 def screw_in_plate(thread: float = 1.5, hole: float = 1.45) -> Assembly:
     """A plate 10 x 10 x 4 with a hole of radius ``hole`` along z, and a screw of radius
     ``thread`` through it with a head (radius 2.5, 1.5 high) resting on the plate."""
@@ -112,7 +129,7 @@ def test_parts_that_only_touch_are_joined_side_by_side_and_keep_their_solid():
     assert overlap_volume(ball, part.mesh) == pytest.approx(0.0, abs=1e-12)
     grid = np.stack(np.meshgrid(*[np.linspace(-0.19, 0.19, 9)] * 3), axis=-1).reshape(-1, 3)
     points = grid[np.linalg.norm(grid, axis=1) < 0.19] + [1.25, 1.5, 1.5]
-    assert not part.mesh.contains(points).any()
+    assert np.abs(winding_numbers(part.mesh, points)).max() < 1e-9
     # parts that overlap are their boolean union: the cup and the peg pressed into it
     pressed = joined(cup_and_peg(), [["cup", "peg"]]).parts["cup+peg"]
     assert pressed.volume == pytest.approx(17.0 + 0.22 - 0.02, rel=1e-9)
