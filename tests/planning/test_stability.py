@@ -283,19 +283,19 @@ def test_the_cross_vault_stands_once_its_crown_joints_are_contacts():
     assert model.fixed and not crown & set(model.fixed)
 
 
-@pytest.mark.parametrize(
-    "steps", [pytest.param(3, id="3"), pytest.param(40, id="40", marks=pytest.mark.slow)]
-)
-def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(steps):
-    """The first ``steps`` steps of the cross vault's plan under gravity with one hold
-    (the grip); the whole plan, minutes long, is a benchmark (``bench_stability.py
+def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top():
+    """The first 40 steps of the cross vault's plan under gravity with one hold (the
+    grip); the whole plan, minutes long, is a benchmark (``bench_stability.py
     --crossvault-plan``). Each block leaves alone, held by its grip and nothing more,
     and each state is decided again by a fresh model's whole program on every polygon
     vertex (none of the plan's shortcuts: balances and certificates kept, regions, the
-    friction search's start), with the least friction it needs. Taken down from the top,
-    the vault stands for about 40 steps; which of two mirror-image blocks goes first
-    follows a rounding rule (docs/architecture.md, "Tolerances"), so the count of
-    standing states is a bound and every verdict is checked."""
+    friction search's start): a state said to stand stands with the least friction
+    said to be needed (and so with more), and on a spread of steps not with one
+    resolution less. Taken down from the top, the vault stands for about 40 steps;
+    which of two mirror-image blocks goes first follows a rounding rule
+    (docs/architecture.md, "Tolerances"), so the count of standing states is a bound
+    and every verdict is checked."""
+    steps = 40
     assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
     tol = Tolerance.relative(5e-5)
     data = plan(assembly, tol, gravity=Gravity(), max_and_or_parts=0, max_steps=steps).to_dict()
@@ -309,28 +309,27 @@ def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(s
     model = equilibrium_model(assembly, friction=MU, tol=tol)
     every = dataclasses.replace(model, corners=np.ones_like(model.corners))
     fixed = every.mask(data["gravity"]["fixed"])
-    verdicts = []
-    for step in data["steps"]:
+    spread = set(np.linspace(0, steps - 1, 4).round().astype(int).tolist())
+    for number, step in enumerate(data["steps"]):
         rest = every.mask(step["rest"])
-        stands = every.stands(rest, rest & fixed, local=False)
-        verdicts.append(stands)
-        assert step["stands"] is stands, step["parts"]
-        if stands:
+        if step["stands"]:
             assert step["would_fall"] == []
             needed = step["friction_needed"]
             assert needed is not None and 0 <= needed <= MU
-            assert every.stands(rest, rest & fixed, needed, local=False)
-            if needed > 0:
+            assert every.stands(rest, rest & fixed, needed, local=False), step["parts"]
+            if needed > 0 and number in spread:
                 assert not every.stands(rest, rest & fixed, needed - RESOLUTION, local=False)
         else:
-            # a part left unbalanced by the whole program by more than ten times the
-            # tolerance is named; a part named is unbalanced by a tenth of it at least
+            # a state said to fall does not stand; a part left unbalanced by the whole
+            # program by more than ten times the tolerance is named; a part named is
+            # unbalanced by a tenth of it at least
+            assert not every.stands(rest, rest & fixed, local=False), step["parts"]
             residual = whole_residuals(every, rest, rest & fixed)
             named = set(step["would_fall"])
             assert {n for n, r in residual.items() if r > 10 * every.threshold} <= named
             assert all(residual[n] > every.threshold / 10 for n in named)
             assert named and step["friction_needed"] is None
-    assert sum(verdicts) >= min(steps, 35)
+    assert sum(step["stands"] for step in data["steps"]) >= 35
 
 
 def test_the_arch_on_its_springers_names_what_falls_at_each_falling_step():

@@ -6,7 +6,6 @@ on the cells."""
 from __future__ import annotations
 
 import itertools
-import time
 
 import numpy as np
 import pytest
@@ -62,11 +61,8 @@ def test_a_six_piece_burr_is_decided_as_the_axis_translations_decide_it(solution
     assembly = load_burrtools(dataset(BURRS), solution=solution)
     cells = [np.asarray(p.voxels) for p in assembly.puzzle.pieces]
     assert _axis_verdict(cells) is feasible
-    start = time.process_time()
     result = plan(assembly, max_hands=2)
-    seconds = time.process_time() - start
     assert result.feasible is feasible
-    assert seconds <= 5.0  # about 0.5 s; the exact free sets took 15 s when stuck
     if not feasible:
         stuck = {assembly.names.index(n) for n in result.stuck}
         assert lattice_locked([cells[i] for i in sorted(stuck)])

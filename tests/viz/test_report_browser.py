@@ -3,7 +3,7 @@ file, draws the assembled model large in the colours of its part list, highlight
 parts of the shown step (every other part one grey) with an arrow that starts on them,
 along the step's direction, and plays the steps; the same on the 184-block crossvault
 (bundled) and the 527-block dome (when ``$ASSEMBLYKIT_DATA`` holds it), whose reports are
-written in under 5 s and 25 MB. Colours are measured on screenshots: by hue where the
+written in under 25 MB. Colours are measured on screenshots: by hue where the
 view is shaded, exactly where the test switches the shading off.
 
 Driven through Chromium's DevTools protocol (``--remote-debugging-port``) with the
