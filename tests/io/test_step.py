@@ -16,6 +16,7 @@ from assemblykit.features.primitives import Ball, Hole, Shaft, Socket
 from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import LINEAR_DEFLECTION, declared_solids, numbered
+from cli_runs import run
 from step_files import write_step
 
 pytest.importorskip("OCP")
@@ -126,30 +127,17 @@ def test_a_damaged_solid_is_listed_as_skipped(damaged_step):
     assert all("\x1b" not in w for w in asm.warnings)
 
 
-def test_a_damaged_step_is_refused_and_with_partial_gives_what_was_read(damaged_step):
-    import json
-    import subprocess
-    import sys
-
+def test_a_damaged_step_is_refused_and_with_partial_gives_what_was_read(damaged_step, capfd):
+    # captured at the descriptors: OCP writes on descriptor 1, which must not reach the
+    # JSON on standard output
     path, label = damaged_step
-    # a child process: OCP writes on the process's descriptor 1, which only a real
-    # stdout shows
-    entry = "from assemblykit.cli import main; main()"
-    refused = subprocess.run(
-        [sys.executable, "-c", entry, "contacts", str(path), "--json"],
-        capture_output=True,
-        text=True,
-    )
-    assert refused.returncode == 2 and refused.stdout == ""
-    (line,) = refused.stderr.strip().splitlines()
+    code, out, err = run(capfd, "contacts", str(path), "--json")
+    assert code == 2 and out == ""
+    (line,) = err.strip().splitlines()
     assert str(path) in line and f"{label} MANIFOLD_SOLID_BREP" in line and "--partial" in line
-    done = subprocess.run(
-        [sys.executable, "-c", entry, "contacts", str(path), "--json", "--partial"],
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    data = json.loads(done.stdout)
+    code, out, err = run(capfd, "contacts", str(path), "--json", "--partial")
+    assert code == 0
+    data = json.loads(out)
     assert list(data["parts"]) == ["solid1"]
     assert data["skipped"] == [
         {
@@ -157,7 +145,7 @@ def test_a_damaged_step_is_refused_and_with_partial_gives_what_was_read(damaged_
             "reason": "its shell could not be read; the solid is left out",
         }
     ]
-    assert f"skipped {label} MANIFOLD_SOLID_BREP" in done.stderr
+    assert f"skipped {label} MANIFOLD_SOLID_BREP" in err
 
 
 def test_an_intact_step_skips_nothing(step_file):

@@ -283,20 +283,3 @@ def test_verdicts_from_kept_balances_and_certificates_are_the_whole_programs():
     held = fixed | model.mask([model.names[int(np.argmin(model.heights))]])
     whole = model.stands(present, held, 0.3, local=False)
     assert model.stands(present, held, 0.3, memory=memory) == whole
-
-
-def test_a_state_after_one_removal_is_judged_as_the_whole_program_judges_it():
-    # the cross vault, then the vault without block 4 (the first its plan under gravity
-    # takes): with what answered the whole vault kept (its least friction, balances and
-    # certificates), the second state is judged as the whole program judges it
-    model, whole, fixed = standing_vault()
-    memory = EquilibriumMemory()
-    need = model.friction_needed(whole, fixed, memory=memory)
-    assert need is not None and 0 < need < model.friction
-    assert memory.bracket_end is not None and memory.bracket_end * model.resolution >= need
-    rest = whole & ~model.mask(["4"])
-    assert model.stands(rest, fixed, memory=memory)
-    assert model.stands(rest, fixed, need, memory=memory)
-    assert model.stands(rest, fixed, need, local=False)
-    none = model.stands(rest, fixed, 0.0, local=False)
-    assert model.stands(rest, fixed, 0.0, memory=memory) is none

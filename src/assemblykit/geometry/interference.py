@@ -90,6 +90,18 @@ def interferes(
     return overlap_volume(mesh_a, mesh_b) > interference_threshold(mesh_a, mesh_b, tol)
 
 
+def solids_interfere(a: manifold3d.Manifold, b: manifold3d.Manifold, threshold: float) -> bool:
+    """Whether two solids (:func:`solid`) share more than ``threshold``
+    (:func:`interference_threshold`), their bounding boxes compared first: the test of
+    :func:`interferes` on solids already built, so that a body tried at many poses is
+    built once and moved (``Manifold.transform``)."""
+    low_a, high_a = np.split(np.asarray(a.bounding_box()), 2)
+    low_b, high_b = np.split(np.asarray(b.bounding_box()), 2)
+    if np.any(low_a > high_b) or np.any(low_b > high_a):
+        return False
+    return shared_volume(a, b) > threshold
+
+
 def _boxes_meet(mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh) -> bool:
     return bool(
         np.all(mesh_a.bounds[0] <= mesh_b.bounds[1])

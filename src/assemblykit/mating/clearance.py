@@ -35,6 +35,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from enum import StrEnum
+from functools import cached_property
 
 import manifold3d
 import numpy as np
@@ -42,7 +43,7 @@ import shapely
 import trimesh
 
 from assemblykit.algebra import Coset, Kind, se3
-from assemblykit.geometry.interference import interference_threshold, interferes, solid
+from assemblykit.geometry.interference import interference_threshold, solid, solids_interfere
 from assemblykit.geometry.solids import placed
 from assemblykit.tolerance import Tolerance
 
@@ -119,6 +120,20 @@ class Mover:
     @property
     def dof(self) -> int:
         return len(self.span)
+
+    @cached_property
+    def own_solid(self) -> manifold3d.Manifold:
+        """The body's solid in its own frame, built once and moved to each pose."""
+        return solid(self.mesh, self.name)
+
+    @cached_property
+    def placed_solid(self) -> manifold3d.Manifold:
+        """The body's solid at the representative pose (a fixed body in every pose)."""
+        return solid(placed(self.mesh, self.coset.rep), self.name)
+
+    def solid_at(self, params: Sequence[float]) -> manifold3d.Manifold:
+        """The body's solid at the group parameters ``params``."""
+        return self.own_solid.transform(self.pose(params)[:3, :])
 
     def pose(self, params: Sequence[float]) -> np.ndarray:
         """The world pose at the group parameters ``params`` (the representative at 0)."""
@@ -259,7 +274,7 @@ def _disc(body: manifold3d.Manifold, z0: float, z1: float, tol: Tolerance) -> Di
 def sweep_solid(body: Mover, box: Box) -> manifold3d.Manifold:
     """A solid containing the body in every pose of the parameter ``box`` (world)."""
     if body.profile is None:
-        return solid(placed(body.mesh, body.coset.rep), body.name)
+        return body.placed_solid
     (a, b), (c, d) = body.extent(box)
     outer = 1.0 / math.cos(math.pi / SEGMENTS)
     parts = []
@@ -280,7 +295,7 @@ def kernel_solid(body: Mover, box: Box) -> manifold3d.Manifold | None:
     """A solid inside the body in every pose of the parameter ``box`` (world), or
     ``None`` when no disc survives the box's slide."""
     if body.profile is None:
-        return solid(placed(body.mesh, body.coset.rep), body.name)
+        return body.placed_solid
     _, (c, d) = body.extent(box)
     discs = body.profile.discs
     parts = []
@@ -321,9 +336,8 @@ def overlaps(
     first: Mover, a: Sequence[float], second: Mover, b: Sequence[float], tol: Tolerance
 ) -> bool:
     """The exact test at one joint parameter value (manifold3d volumes)."""
-    return interferes(
-        placed(first.mesh, first.pose(a)), placed(second.mesh, second.pose(b)), tol.for_mesh()
-    )
+    threshold = interference_threshold(first.mesh, second.mesh, tol.for_mesh())
+    return solids_interfere(first.solid_at(a), second.solid_at(b), threshold)
 
 
 def judge_pair(first: Mover, second: Mover, tol: Tolerance, budget: int = BOX_BUDGET) -> PairResult:

@@ -37,8 +37,7 @@ import numpy as np
 from assemblykit import formatting as fmt
 from assemblykit.algebra import Coset, EmptySet, Kind, SymmetryGroup
 from assemblykit.errors import MissingExtraError
-from assemblykit.geometry.interference import interferes as interfering_solids
-from assemblykit.geometry.solids import placed
+from assemblykit.geometry.interference import interference_threshold, solids_interfere
 from assemblykit.mating.clearance import (
     Mover,
     Verdict,
@@ -61,7 +60,7 @@ from assemblykit.mating.problem import MatingProblem
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
-    import trimesh
+    pass
 
 LAWS = (
     "candidates",
@@ -693,7 +692,7 @@ def _ranges(
         for a, b in watched:
             mine, other = (a, b) if a in inside else (b, a)
             pose = movers[mine].coset.group.element([t]) @ movers[mine].coset.rep
-            if interfering_meshes(movers[mine].mesh, pose, movers[other].mesh, poses[other], tol):
+            if interfering_movers(movers[mine], pose, movers[other], poses[other], tol):
                 return False
         return True
 
@@ -701,15 +700,17 @@ def _ranges(
     return {name: Motion(kind.value, parameter, intervals) for name in unit}
 
 
-def interfering_meshes(
-    mesh_a: trimesh.Trimesh,
-    pose_a: np.ndarray,
-    mesh_b: trimesh.Trimesh,
-    pose_b: np.ndarray,
-    tol: Tolerance,
+def interfering_movers(
+    first: Mover, pose_a: np.ndarray, second: Mover, pose_b: np.ndarray, tol: Tolerance
 ) -> bool:
-    """Whether two meshes at world poses share more than a touching volume."""
-    return interfering_solids(placed(mesh_a, pose_a), placed(mesh_b, pose_b), tol.for_mesh())
+    """Whether two bodies at world poses share more than a touching volume (their
+    solids built once, moved to the poses)."""
+    threshold = interference_threshold(first.mesh, second.mesh, tol.for_mesh())
+    return solids_interfere(
+        first.own_solid.transform(pose_a[:3, :]),
+        second.own_solid.transform(pose_b[:3, :]),
+        threshold,
+    )
 
 
 def _free_intervals(
