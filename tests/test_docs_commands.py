@@ -45,11 +45,18 @@ def documented_commands() -> list[tuple[str, int, str, int]]:
 
 
 COMMANDS = documented_commands()
-# a command shown in two places runs once, under the first
+
+
+def words(command: str) -> list[str]:
+    """The words of a command line, without its comment."""
+    return shlex.split(command, comments=True)
+
+
+# a command shown in two places (comments aside) runs once, under the first
 RUN = [
     found
     for k, found in enumerate(COMMANDS)
-    if found[2] not in {command for _, _, command, _ in COMMANDS[:k]}
+    if words(found[2]) not in [words(command) for _, _, command, _ in COMMANDS[:k]]
 ]
 
 
@@ -78,17 +85,32 @@ def test_the_documents_show_commands():
     assert readme[0] == "assemblykit demo"
 
 
-# commands whose work other tests of the default tier already do, with checks: run in
-# the slow tier (a plan of the Pelikan burr, a burr with no monotone plan)
-SLOW = ("PelikanBurr.xmpuzzle --moves multi", "SolidSixPieceBurrs.xmpuzzle --moves multi")
+# commands whose work other tests of the default tier already do, with checks, run in the
+# slow tier: those beginning with these words (a plan of the Pelikan burr, a burr with no
+# monotone plan, the demo: tests/test_cli_plan.py and the plain install of .ci/run) ...
+SLOW_BEGINNINGS = (
+    ["assemblykit", "plan", "tests/data/burrtools/PelikanBurr.xmpuzzle"],
+    ["assemblykit", "plan", "tests/data/burrtools/SolidSixPieceBurrs.xmpuzzle"],
+    ["assemblykit", "demo"],
+)
+# ... and these (a local batch of two assemblies, shown again with options)
+SLOW_COMMANDS = (
+    "assemblykit batch tests/data/compas_assembly/stack_assembly.json "
+    "tests/data/compas_assembly/arch_assembly.json --out results.jsonl",
+)
+
+
+def slow(command: str) -> bool:
+    """Whether a documented command runs in the slow tier."""
+    found = words(command)
+    return any(found[: len(mark)] == mark for mark in SLOW_BEGINNINGS) or any(
+        found == words(other) for other in SLOW_COMMANDS
+    )
 
 
 @pytest.mark.parametrize(
     "command, expected",
-    [
-        pytest.param(c, e, marks=[pytest.mark.slow] if any(m in c for m in SLOW) else [])
-        for _, _, c, e in RUN
-    ],
+    [pytest.param(c, e, marks=[pytest.mark.slow] if slow(c) else []) for _, _, c, e in RUN],
     ids=[f"{d}:{n}" for d, n, _, _ in RUN],
 )
 def test_documented_command_runs(command, expected, tmp_path, monkeypatch, capsys):
@@ -98,7 +120,7 @@ def test_documented_command_runs(command, expected, tmp_path, monkeypatch, capsy
     for folder in ("src", "tests", "examples"):
         (tmp_path / folder).symlink_to(ROOT / folder)
     monkeypatch.chdir(tmp_path)
-    args = shlex.split(command, comments=True)[1:]
+    args = words(command)[1:]
     try:
         main(args)
         code = 0
