@@ -298,7 +298,7 @@ def test_snapping_compares_each_patch_with_every_leader_as_stated():
     rng = np.random.default_rng(7)
     tol = Tolerance(scale=1.0, rel_length=1e-4)
     joined = 0
-    for _ in range(60):
+    for _ in range(25):
         n = 40
         axes = np.vstack([np.eye(3), -np.eye(3)])[rng.integers(0, 6, n)]
         directions = axes + rng.choice([0.0, 1e-7], n)[:, None] * rng.normal(size=(n, 3))
@@ -309,7 +309,7 @@ def test_snapping_compares_each_patch_with_every_leader_as_stated():
         expected = _snap_one_leader_at_a_time(directions, spreads, scatter, tol)
         assert (leader.tolist(), sign.tolist()) == expected
         joined += int((leader != np.arange(n)).sum())
-    assert joined > 1000
+    assert joined > 400
 
 
 def test_the_pieces_of_one_face_make_one_patch():
