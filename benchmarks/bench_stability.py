@@ -20,7 +20,7 @@ first):
   and every state's verdict decided again by a fresh model's whole program on every
   polygon vertex (an independent check); the cross vault's first 20
   steps with three holds, with the programs they ran; its whole plan with one hold only
-  with ``--crossvault-plan`` (minutes: from step 40 on no single block's removal
+  with ``--crossvault-plan`` (minutes: from step 78 on no single block's removal
   stands, and each step then asks which parts would fall); the dome's first 20 steps
   under gravity with ``--dome-plan``, in CPU seconds next to the whole plan's target.
 
