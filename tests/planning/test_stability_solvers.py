@@ -15,9 +15,10 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog
 
+from assemblykit.errors import NumericError
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
-from assemblykit.planning import equilibrium_programs
+from assemblykit.planning import equilibrium, equilibrium_programs
 from assemblykit.planning.planner import plan
 from assemblykit.planning.stability import (
     CONE_SIDES,
@@ -276,3 +277,40 @@ def test_verdicts_from_kept_balances_and_certificates_are_the_whole_programs():
     held = fixed | model.mask([model.names[int(np.argmin(model.heights))]])
     whole = model.stands(present, held, 0.3, local=False)
     assert model.stands(present, held, 0.3, memory=memory) == whole
+
+
+def test_a_region_no_solver_decides_is_left_to_the_whole_program(monkeypatch):
+    # the arch taken down from its highest block, with what answered the states before
+    # kept: every program on fewer equations than the state's (a region's) fails, as if
+    # no solver decided it, and every verdict is still the whole program's
+    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    model = equilibrium_model(assembly)
+    order = sorted(assembly.names, key=lambda n: -float(model.heights[model.mask([n])][0]))
+    states = []
+    for removed in range(len(order) - len(model.fixed)):
+        present = model.mask(order[removed:])
+        states.append((present, present & model.mask(model.fixed)))
+    equations = [0]
+    failed = []
+
+    def undecided(matrix, rhs):
+        if matrix.shape[0] < equations[0]:
+            failed.append(matrix.shape[0])
+            raise NumericError("equilibrium program failed: undecided")
+        return equilibrium_programs.balance(matrix, rhs)
+
+    memory = EquilibriumMemory()
+    ours = []
+    with monkeypatch.context() as patch:
+        patch.setattr(equilibrium, "balance", undecided)
+        for present, fixed in states:
+            equations[0] = 6 * int((present & ~fixed).sum())
+            for friction in (0.5, 0.2):
+                ours.append(model.stands(present, fixed, friction, memory=memory))
+    whole = [
+        model.stands(present, fixed, friction, local=False)
+        for present, fixed in states
+        for friction in (0.5, 0.2)
+    ]
+    assert failed and ours == whole
+    assert any(ours) and not all(ours)

@@ -41,7 +41,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
-from assemblykit.errors import InputError
+from assemblykit.errors import InputError, NumericError
 from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import lowest_parts
 from assemblykit.planning.equilibrium_memory import EquilibriumMemory, KeptBalance
@@ -325,7 +325,9 @@ class EquilibriumModel:
 
         Removing a block leaves its neighbours to be proved, a dozen parts, where the
         whole program has all of them; a region holding more than half the free parts
-        is left to the whole program."""
+        is left to the whole program, and so is a region whose program no solver
+        decides (:class:`NumericError`: a shortcut that cannot answer does not stop
+        the plan)."""
         for number, candidate in tuple(memory.balances.items()):
             if np.any((candidate.gauge - mu * candidate.forces[:, 0])[selected] > LP_FEASIBILITY):
                 continue
@@ -358,7 +360,10 @@ class EquilibriumModel:
                 return None
             rows = self._rows(region)
             touching = selected & self._acting_on(region)
-            found = balance(self._matrix(rows, touching, mu), -self.load[rows])
+            try:
+                found = balance(self._matrix(rows, touching, mu), -self.load[rows])
+            except NumericError:
+                return None
             if not found.found:
                 if found.certificate is not None:
                     memory.keep_certificate(self._over_every_equation(rows, found.certificate))
