@@ -50,8 +50,16 @@ def task(*later: Situation, first: Situation = S1) -> Task:
 
 def test_a_good_task_validates_to_itself():
     good = task(Situation("s2", (), (Action("move", "block", ref("block.bore"), None, 3.0),)))
-    assert good.validate() is good
+    assert good.validate() is good and good.validate() is good
     assert good.feature(ref("block.bore"), "x").radius == 2.0
+
+
+def test_a_bad_task_is_refused_each_time_it_is_checked():
+    bad = Situation("s1", (Relation("fits", (ref("pin.shaft"), ref("block.bore")), {}, None),))
+    unchecked = Task("mm", bodies(), (bad,), "t.yaml")
+    for _ in range(2):
+        with pytest.raises(UnknownNameError, match="unknown body 'pin'"):
+            unchecked.validate()
 
 
 def test_equality_ignores_file_names_and_places():

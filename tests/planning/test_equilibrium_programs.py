@@ -13,11 +13,14 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from assemblykit.planning import equilibrium_programs
 from assemblykit.planning.equilibrium_programs import (
     CONE_SIDES,
     LP_FEASIBILITY,
+    RETRY_REGULARIZATION,
     _balances,
     _proves_none,
+    balance,
     cone_directions,
     least_residuals,
     pyramid_gauge,
@@ -52,6 +55,29 @@ def test_the_slack_program_falls_back_to_highs_when_clarabel_stops_short(monkeyp
     # by hand: |1 - x| + |1 - 2x| is least, 0.5, at x = 0.5: residuals (0.5, 0)
     np.testing.assert_allclose(vertex, [0.5, 0.0], atol=1e-7)
     np.testing.assert_allclose(interior, vertex, atol=1e-7)
+
+
+def test_clarabel_stopping_short_is_asked_again_more_regularised(monkeypatch):
+    # Clarabel given one iteration at its default regularisation stops short; asked
+    # again at RETRY_REGULARIZATION it answers, and HiGHS is never asked: x1 + x2 = -1
+    # has no x >= 0 (a certificate proves it), x1 + 2 x2 = 3 has one
+    solver = clarabel.DefaultSolver
+
+    def short_unless_regularised(*program):
+        settings = program[-1]
+        if settings.static_regularization_constant < RETRY_REGULARIZATION:
+            settings.max_iter = 1
+        return solver(*program)
+
+    monkeypatch.setattr(clarabel, "DefaultSolver", short_unless_regularised)
+    monkeypatch.setattr(equilibrium_programs, "linprog", None)
+    none, rhs = sp.csc_matrix(np.array([[1.0, 1.0]])), np.array([-1.0])
+    found = balance(none, rhs)
+    assert not found.found and found.certificate is not None
+    assert _proves_none(none, rhs, found.certificate)
+    some, rhs = sp.csc_matrix(np.array([[1.0, 2.0]])), np.array([3.0])
+    found = balance(some, rhs)
+    assert found.forces is not None and _balances(some, rhs, found.forces)
 
 
 def test_an_almost_answer_is_taken_only_when_it_checks_out():

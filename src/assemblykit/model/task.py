@@ -170,8 +170,17 @@ class Task:
         Raises :class:`SchemaError` for duplicate or misplaced names,
         :class:`UnknownNameError` for a reference to a missing body or feature and
         :class:`FeatureError` for a feature that cannot take part in a relation or action;
-        each names the file and the relation's or action's place in it.
+        each names the file and the relation's or action's place in it. A task is a
+        value: once its checks pass they are not run again (a task read from a file is
+        checked as it is read, and solving it asks again).
         """
+        if not self.__dict__.get("_checked", False):
+            self._check()
+            object.__setattr__(self, "_checked", True)
+        return self
+
+    def _check(self) -> None:
+        """The checks of :meth:`validate` (each raises where it fails)."""
         for name, body in self.bodies.items():
             if body.name != name:
                 raise SchemaError(
@@ -208,7 +217,6 @@ class Task:
                     )
                 moved.add(action.body)
                 self._check_action(action, where)
-        return self
 
     def _body(self, name: str, where: str) -> Body:
         """The body called ``name``; :class:`UnknownNameError` naming ``where`` if none."""
