@@ -24,6 +24,12 @@ settings.register_profile("repeatable", derandomize=True, database=None)
 settings.load_profile("repeatable")
 
 
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The tests marked ``early`` first, the others in their order: a long test started
+    last would keep one worker busy after the others have run out of tests."""
+    items.sort(key=lambda item: item.get_closest_marker("early") is None)
+
+
 @pytest.fixture(scope="session")
 def mating_examples() -> Path:
     """The folder of bundled mating problems (Liu & Popplestone 1990 Examples 1-2, no-solution

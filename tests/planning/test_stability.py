@@ -270,6 +270,7 @@ def test_an_independent_solution_of_the_arch_agrees_with_the_program():
     assert needed is not None and needed <= enough + RESOLUTION
 
 
+@pytest.mark.early
 def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top():
     """The first 40 steps of the cross vault's plan under gravity with one hold (the
     grip); the whole plan, minutes long, is a benchmark (``bench_stability.py
