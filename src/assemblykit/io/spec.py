@@ -238,6 +238,9 @@ def _action_to_list(action: Action) -> list[Any]:
 
 
 def _locator(places: Mapping[str, str]) -> Locate:
+    if not places:
+        return str  # a YAML or JSON file: each place is shown as its path
+
     def locate(path: str) -> str:
         probe = path
         while probe:
