@@ -118,10 +118,10 @@ def written_rounding(data: Mapping[str, Any]) -> Rounding:
         if isinstance(value, Mapping):
             stack.extend((str(k), v) for k, v in value.items() if not isinstance(v, str))
         elif isinstance(value, list):
+            if value and all(type(v) is int for v in value):
+                continue  # whole numbers: written exactly, whether lengths or directions
             if not value or not all(map(_is_real, value)):
                 stack.extend((key, v) for v in value if not isinstance(v, str))
-            elif all(type(v) is int for v in value):
-                continue  # whole numbers: written exactly, whether lengths or directions
             elif key in DIRECTIONS:
                 norm = math.hypot(*value)
                 if norm > 0:
