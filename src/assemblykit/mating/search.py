@@ -29,7 +29,7 @@ import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import constraint
 import numpy as np
@@ -58,9 +58,6 @@ from assemblykit.mating.laws import (
 from assemblykit.mating.loci import World, loci_branches, numeric_closure
 from assemblykit.mating.problem import MatingProblem
 from assemblykit.tolerance import Tolerance
-
-if TYPE_CHECKING:
-    pass
 
 LAWS = (
     "candidates",
