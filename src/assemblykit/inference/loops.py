@@ -56,7 +56,8 @@ def circle_gap(circle: Circle, locus: Locus) -> float:
     e1, e2 = axes[:3, 0], axes[:3, 1]
 
     def at(phi: np.ndarray) -> np.ndarray:
-        return c + r * (np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2)
+        points: np.ndarray = c + r * (np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2)
+        return points
 
     step = 2 * math.pi / GAP_SAMPLES
     phis = np.arange(GAP_SAMPLES) * step
@@ -75,7 +76,8 @@ def circle_gap(circle: Circle, locus: Locus) -> float:
 
 def foot(point: np.ndarray, origin: np.ndarray, direction: np.ndarray) -> np.ndarray:
     """The foot of ``point`` on the line through ``origin`` with unit ``direction``."""
-    return origin + np.dot(point - origin, direction) * direction
+    along = float(np.dot(point - origin, direction))
+    return origin + along * direction
 
 
 def rotation_about(point: np.ndarray, direction: np.ndarray, angle: float) -> np.ndarray:

@@ -109,7 +109,8 @@ def _plain_value(value: Any) -> Hashable:
     """A hashable copy of a feature field (arrays become their shape and bytes)."""
     if isinstance(value, np.ndarray):
         return value.shape, value.tobytes()
-    return value
+    plain: Hashable = value
+    return plain
 
 
 def feature_key(feature: Feature) -> Hashable:

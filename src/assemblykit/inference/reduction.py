@@ -85,7 +85,6 @@ from assemblykit.inference.network import (
     LineOnPlane,
     Link,
     Network,
-    Node,
     PointLocus,
     build_network,
     instance_key,
@@ -94,6 +93,7 @@ from assemblykit.inference.network import (
 )
 from assemblykit.inference.numeric import (
     Constraint,
+    Node,
     ResidueProblem,
     solve_residue,
 )
@@ -718,7 +718,7 @@ def meet(first: Any, second: Any, tol: Tolerance) -> Any:
 def _progress(before: Any, after: Any) -> bool:
     """Whether a chained intersection removed freedom (dof, then number of components)."""
     if after.dof != before.dof:
-        return after.dof < before.dof
+        return bool(after.dof < before.dof)
     b, a = _components(before), _components(after)
     return a is not None and (b is None or a < b)
 

@@ -134,7 +134,7 @@ class EquilibriumModel:
     def resolution(self) -> float:
         """The width of :meth:`friction_needed`'s last bracket:
         ``friction / 2**FRICTION_STEPS``."""
-        return self.friction / 2**FRICTION_STEPS
+        return float(self.friction / 2**FRICTION_STEPS)
 
     def mask(self, names: Iterable[str] | None) -> NDArray[np.bool_]:
         """``names`` (default: all parts) as a boolean vector over :attr:`names`."""
@@ -252,7 +252,8 @@ class EquilibriumModel:
         normal, along_u, along_v = self._point_wrenches
         wrench = normal @ forces[:, 0] + along_u @ forces[:, 1] + along_v @ forces[:, 2]
         error = np.abs(-self.load - wrench).reshape(-1, 6).max(axis=1)
-        return free & (error > LP_FEASIBILITY)
+        unbalanced: NDArray[np.bool_] = free & (error > LP_FEASIBILITY)
+        return unbalanced
 
     def _first_certifying(
         self,
@@ -434,9 +435,12 @@ class EquilibriumModel:
         rows = self._rows(piece)
         points = self._touching(present) & self._acting_on(piece)
         if not points.any():
-            return np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
+            weights: NDArray[np.float64] = np.abs(self.load[rows]).reshape(-1, 6).max(axis=1)
+            return weights
         corners = self._matrix(rows, points & self.corners, mu)
-        return np.abs(least_residuals(corners, -self.load[rows])).reshape(-1, 6).max(axis=1)
+        residual = np.abs(least_residuals(corners, -self.load[rows]))
+        largest: NDArray[np.float64] = residual.reshape(-1, 6).max(axis=1)
+        return largest
 
     def falling(
         self,

@@ -192,7 +192,7 @@ def least_residuals(matrix: sp.csc_matrix, rhs: NDArray[np.float64]) -> NDArray[
         settings,
     ).solve()
     if found.status in (clarabel.SolverStatus.Solved, clarabel.SolverStatus.AlmostSolved):
-        multipliers = np.asarray(found.z)
+        multipliers = np.asarray(found.z, dtype=np.float64)
         return multipliers[columns : columns + rows] - multipliers[columns + rows :]
     result = linprog(
         np.r_[np.zeros(columns), np.ones(2 * rows)],
@@ -231,4 +231,5 @@ def pyramid_gauge(tangent: NDArray[np.float64]) -> NDArray[np.float64]:
     side's distance ``cos(pi / CONE_SIDES)`` from the axis. A force whose normal part is
     ``N`` is inside the pyramid of ``mu`` when its gauge is at most ``mu N``."""
     half = np.pi / CONE_SIDES
-    return (tangent @ np.stack(cone_directions(half))).max(axis=1) / math.cos(half)
+    largest: NDArray[np.float64] = (tangent @ np.stack(cone_directions(half))).max(axis=1)
+    return largest / math.cos(half)

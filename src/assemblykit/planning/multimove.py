@@ -299,7 +299,8 @@ class _Tables:
         """Entries whose two pieces are both among ``members``."""
         inside = np.zeros(self.n, dtype=bool)
         inside[list(members)] = True
-        return inside[self.first] & inside[self.second]
+        both: NDArray[np.bool_] = inside[self.first] & inside[self.second]
+        return both
 
     def free(self, offsets: NDArray[np.int64], entries: NDArray[np.bool_]) -> NDArray[np.int64]:
         """``free[d, i, j]``: how many cells piece ``i`` can move along ``AXES[d]`` before

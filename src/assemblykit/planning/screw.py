@@ -156,7 +156,8 @@ def _exit(
     for direction in _EXITS:
         sweep = manifold3d.Manifold.hull_points(np.vstack([corners, corners + reach * direction]))
         if (sweep ^ rest).volume() <= limit:
-            return direction
+            found: NDArray[np.float64] = direction
+            return found
     return None
 
 

@@ -317,7 +317,7 @@ class ExtendedDirections:
         among = mask_of(range(len(self.names))) if members is None else members
         return [(i, j) for i, mask in self.blockers(k, among, among).items() for j in bits(mask)]
 
-    def graph(self, k: int, members: int) -> nx.DiGraph:
+    def graph(self, k: int, members: int) -> nx.DiGraph[int]:
         """The Γ_e DBG along direction ``k`` induced on ``members`` (blocking is
         pairwise, so the arcs found for one subassembly serve every other)."""
         graph: nx.DiGraph[int] = nx.DiGraph()
@@ -474,12 +474,12 @@ class AndOrGraph:
     @property
     def subassemblies(self) -> int:
         """Number of OR nodes."""
-        return sum(1 for _, kind in self.graph.nodes(data="kind") if kind == "or")
+        return sum(1 for node in self.graph if self.graph.nodes[node].get("kind") == "or")
 
     @property
     def partitions(self) -> int:
         """Number of AND nodes (feasible partitions)."""
-        return sum(1 for _, kind in self.graph.nodes(data="kind") if kind == "and")
+        return sum(1 for node in self.graph if self.graph.nodes[node].get("kind") == "and")
 
     def to_dict(self) -> dict[str, int]:
         """Counts: subassemblies, partitions, plans."""
