@@ -158,6 +158,7 @@ _OCP_NAMES = {
     "GeomAdaptor": ("GeomAdaptor_Surface",),
     "GeomConvert": ("GeomConvert_SurfToAnaSurf",),
     "GProp": ("GProp_GProps",),
+    "gp": ("gp_TrsfForm",),
     "collections": ("Sequence_TDF_Label",),
     "IFSelect": ("IFSelect_ReturnStatus",),
     "ShapeFix": ("ShapeFix_Shape",),
@@ -189,19 +190,48 @@ def _vec(xyz: Any) -> NDArray[np.float64]:
     return np.array([xyz.X(), xyz.Y(), xyz.Z()], dtype=np.float64)
 
 
+def _transformed(ocp: Any, points: NDArray[np.float64], transform: Any) -> NDArray[np.float64]:
+    """``points`` (N x 3) moved by the ``gp_Trsf`` ``transform``, computed as OCCT's
+    ``gp_Pnt::Transform`` computes each point (its form first, then the vectorial part
+    row by row, the scale, the translation), in the same order of operations, so that
+    the coordinates are the ones OCCT gives, to the last bit."""
+    forms = ocp.gp_TrsfForm
+    form = transform.Form()
+    shift = np.array(transform.TranslationPart().Coord(), dtype=np.float64)
+    if form == forms.gp_Identity:
+        return points
+    if form == forms.gp_Translation:
+        return points + shift
+    if form == forms.gp_Scale:
+        return points * transform.ScaleFactor() + shift
+    if form == forms.gp_PntMirror:
+        return -points + shift
+    matrix = transform.HVectorialPart()
+    x, y, z = points.T
+    moved = np.stack(
+        [
+            matrix.Value(row, 1) * x + matrix.Value(row, 2) * y + matrix.Value(row, 3) * z
+            for row in (1, 2, 3)
+        ],
+        axis=1,
+    )
+    scale = transform.ScaleFactor()
+    if scale != 1.0:
+        moved = moved * scale
+    return moved + shift
+
+
 def _face_triangles(ocp: Any, face: Any) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """The triangulation of a face in world coordinates, oriented outward."""
     location = ocp.TopLoc_Location()
     triangulation = ocp.BRep_Tool.Triangulation_s(face, location)
     if triangulation is None:
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
-    transform = location.Transformation()
-    points = np.array(
-        [
-            _vec(triangulation.Node(i).Transformed(transform))
-            for i in range(1, triangulation.NbNodes() + 1)
-        ]
-    )
+    nodes = np.array(
+        [triangulation.Node(i).Coord() for i in range(1, triangulation.NbNodes() + 1)],
+        dtype=np.float64,
+    ).reshape(-1, 3)
+    points = _transformed(ocp, nodes, location.Transformation())
     triangles = (
         np.array(
             [triangulation.Triangle(i).Get() for i in range(1, triangulation.NbTriangles() + 1)],
