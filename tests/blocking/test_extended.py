@@ -11,7 +11,7 @@ import trimesh
 from blocking_helpers import mesh_assembly
 
 from assemblykit.blocking.cache import BlockingCache
-from assemblykit.blocking.extended import extended_dbg, extended_free
+from assemblykit.blocking.extended import extended_arcs, extended_dbg, extended_free, shown_arcs
 from assemblykit.blocking.free_cones import ChartSet, _distinct_cones, exact_free_directions
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
@@ -187,6 +187,23 @@ def test_a_cube_leaves_a_one_piece_cage_only_through_its_diagonal_tunnel():
     found = can_extract(asm, ["cube"])
     assert found is not None and not found.tolerance_dependent
     assert all(np.arccos(np.clip(d @ DIAGONAL, -1, 1)) < APERTURE for d in found.directions)
+
+
+def test_blocks_found_along_several_directions_are_all_shown_by_faces_afterwards():
+    # the caged cube is held along each axis by another wall of the cage: once the
+    # projection test has found each block, faces alone show every one of them again
+    # (not only the last found), and what faces show is always a block of Γ_e
+    asm = caged_cube()
+    tol = asm.tolerance()
+    axes = np.vstack([np.eye(3), -np.eye(3)])
+    for axis in axes:
+        assert extended_arcs(asm, axis, ["cube"], ["cage"], tol) == {("cube", "cage")}
+    for axis in axes:
+        assert shown_arcs(asm, axis, ["cube"], ["cage"], tol) == {("cube", "cage")}, axis
+    for d in [DIAGONAL, *np.random.default_rng(0).normal(size=(12, 3))]:
+        shown = shown_arcs(asm, d, ["cube"], ["cage"], tol)
+        assert shown <= extended_arcs(asm, d, ["cube"], ["cage"], tol), d
+    assert shown_arcs(asm, DIAGONAL, ["cube"], ["cage"], tol) == set()
 
 
 def test_triangle_cones_of_a_face_above_a_face():

@@ -225,20 +225,23 @@ def _witnessed(
     assembly: Assembly, direction: NDArray[np.float64], pairs: list[tuple[str, str]], tol: Tolerance
 ) -> set[tuple[str, str]]:
     """The pairs (moving, blocker) of ``pairs`` that block along ``direction`` as shown by
-    the two faces that showed it along another direction (kept in the assembly's
-    :class:`~assemblykit.blocking.obstacles.Obstacles`): two triangles projected instead
-    of two meshes. A part blocked along one direction mostly is along the next ones the
-    search tries, by the same faces."""
+    some two faces that showed it along another direction (kept in the assembly's
+    :class:`~assemblykit.blocking.obstacles.Obstacles`, a few per pair): a few triangles
+    projected instead of two meshes. A part blocked along one direction mostly is along
+    the next ones the search tries, by the same faces."""
     cache = BlockingCache.of(assembly).obstacles
     known = [pair for pair in pairs if pair in cache.witnesses]
     if not known:
         return set()
     names = sorted({name for pair in known for name in pair})
     index = {name: k for k, name in enumerate(names)}
-    witnesses = [(index[a], index[b], *cache.witnesses[(a, b)]) for a, b in known]
+    owners = [pair for pair in known for _ in cache.witnesses[pair]]
+    witnesses = [
+        (index[a], index[b], *faces) for a, b in known for faces in cache.witnesses[(a, b)]
+    ]
     meshes = [assembly.parts[name].mesh for name in names]
     holds = witnesses_hold(meshes, witnesses, direction, tol)
-    return {pair for pair, held in zip(known, holds.tolist(), strict=True) if held}
+    return {pair for pair, held in zip(owners, holds.tolist(), strict=True) if held}
 
 
 def _occluded(
@@ -280,7 +283,8 @@ def _occluded(
     found = blocking_witnesses(view, allowed, tol, first_only=first_only)
     if not shifts:
         cache = BlockingCache.of(assembly).obstacles
-        cache.witnesses.update(((names[i], names[j]), w) for (i, j), w in found.items())
+        for (i, j), faces in found.items():
+            cache.keep_witness((names[i], names[j]), faces)
     return {(names[i], names[j]) for i, j in found}
 
 

@@ -35,6 +35,13 @@ def of_meshes(assembly: object) -> Assembly:
     return assembly
 
 
+WITNESSES_KEPT = 8
+"""How many pairs of faces that showed a pair of parts blocking are kept for it: two
+faces show a block over a cone of directions, and a search that visits directions all
+over the sphere (proving a set stuck) is shown most blocks by a few such cones instead
+of projecting the meshes along each direction."""
+
+
 class Obstacles:
     """Convex bodies, hulls, solids, bounding spheres and pairwise cones, back-outs and
     blocking witnesses of one assembly's parts, each computed when first asked for and
@@ -49,14 +56,21 @@ class Obstacles:
         self.hulls: dict[str, NDArray[np.float64]] = {}
         self.balls: dict[str, NDArray[np.float64]] = {}
         self.lattice: dict[str, NDArray[np.int64] | None] = {}
-        self.witnesses: dict[tuple[str, str], tuple[int, int]] = {}
-        """Per pair (moving, blocker) found blocking by the projection test, the last
-        two faces that showed it (:func:`~assemblykit.geometry.occlusion.witnesses_hold`)."""
+        self.witnesses: dict[tuple[str, str], tuple[tuple[int, int], ...]] = {}
+        """Per pair (moving, blocker) found blocking by the projection test, the pairs
+        of faces that showed it along the last :data:`WITNESSES_KEPT` directions where
+        none known before did, the latest first
+        (:func:`~assemblykit.geometry.occlusion.witnesses_hold`)."""
         names = list(assembly.names)
         self.names = names
         bounds = np.array([assembly.parts[n].mesh.bounds for n in names]).reshape(-1, 2, 3)
         self.centers = bounds.mean(axis=1)
         self.radii = np.linalg.norm(bounds[:, 1] - bounds[:, 0], axis=1) / 2
+
+    def keep_witness(self, pair: tuple[str, str], faces: tuple[int, int]) -> None:
+        """Keep ``faces`` first among the witnesses of ``pair`` (:attr:`witnesses`)."""
+        kept = self.witnesses.get(pair, ())
+        self.witnesses[pair] = (faces, *(w for w in kept if w != faces))[:WITNESSES_KEPT]
 
     def of(self, name: str) -> list[NDArray[np.float64]] | None:
         """The convex bodies of a part, ``None`` when one of them is not convex."""
