@@ -283,8 +283,8 @@ def _occluded(
     found = blocking_witnesses(view, allowed, tol, first_only=first_only)
     if not shifts:
         cache = BlockingCache.of(assembly).obstacles
-        for (i, j), faces in found.items():
-            cache.keep_witness((names[i], names[j]), faces)
+        for (i, j), shown in found.items():
+            cache.keep_witness((names[i], names[j]), shown)
     return {(names[i], names[j]) for i, j in found}
 
 

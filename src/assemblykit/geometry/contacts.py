@@ -36,7 +36,7 @@ into ``b`` across a planar patch iff ``d . normal > 0`` (Wilson & Latombe 1992, 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Set
+from collections.abc import Iterable, Sequence, Set
 from dataclasses import dataclass, field, replace
 from functools import singledispatch
 from typing import Any, Literal
@@ -654,6 +654,35 @@ def _boundary(
     return np.unique(points[ends], axis=0)
 
 
+def _may_fit(
+    first: Sequence[Surface], second: Sequence[Surface], tol: Tolerance
+) -> list[tuple[int, int]]:
+    """The pairs ``(i, j)`` of surfaces ``first[i]``, ``second[j]`` that :func:`curved_contact`
+    may find in contact, in the order of ``i`` then ``j``: the same kind of surface of
+    revolution (cylinder, cone, sphere), one convex and one concave, and for cylinders
+    and spheres radii equal within the length tolerance. The others it would turn down
+    by these tests alone; a hundred curved surfaces of one part near a hundred of
+    another are so compared in one array operation."""
+    if not first or not second:
+        return []
+
+    def columns(
+        surfaces: Sequence[Surface],
+    ) -> tuple[NDArray[np.str_], NDArray[np.bool_], NDArray[np.float64]]:
+        return (
+            np.array([s.kind for s in surfaces]),
+            np.array([s.convex for s in surfaces], dtype=bool),
+            np.array([s.radius for s in surfaces], dtype=np.float64),
+        )
+
+    (kind_a, convex_a, radius_a), (kind_b, convex_b, radius_b) = columns(first), columns(second)
+    fits = (kind_a[:, None] == kind_b[None, :]) & (convex_a[:, None] != convex_b[None, :])
+    fits &= np.isin(kind_a, ("cylinder", "cone", "sphere"))[:, None]
+    radial = np.isin(kind_a, ("cylinder", "sphere"))[:, None]
+    fits &= ~radial | (np.abs(radius_a[:, None] - radius_b[None, :]) <= tol.length)
+    return [(int(i), int(j)) for i, j in np.argwhere(fits)]
+
+
 def curved_contact(
     first: Surface,
     second: Surface,
@@ -812,17 +841,23 @@ def find_contacts(
     for m, flat in zip(k, patches, strict=True):
         planar.setdefault((int(group_part[g[m]]), int(group_part[h[m]])), []).append(flat)
 
-    triangles = {
-        key: [_surface_triangles(assembly, names[key[0]], s) for s in found]
-        for key, found in surfaces.items()
-    }
+    triangles: dict[tuple[int, int, int], NDArray[np.float64]] = {}
+
+    def triangles_of(k: int, other: int, index: int) -> NDArray[np.float64]:
+        if (k, other, index) not in triangles:
+            triangles[k, other, index] = _surface_triangles(
+                assembly, names[k], surfaces[k, other][index]
+            )
+        return triangles[k, other, index]
+
     curved: dict[tuple[int, int], list[CurvedPatch]] = {}
     for a, b in pairs.tolist():
-        for sa, ta in zip(surfaces.get((a, b), ()), triangles.get((a, b), ()), strict=True):
-            for sb, tb in zip(surfaces.get((b, a), ()), triangles.get((b, a), ()), strict=True):
-                patch = curved_contact(sa, sb, (names[a], names[b]), (ta, tb), tol)
-                if patch is not None:
-                    curved.setdefault((a, b), []).append(patch)
+        first, second = surfaces.get((a, b), ()), surfaces.get((b, a), ())
+        for i, j in _may_fit(first, second, tol):
+            both = (triangles_of(a, b, i), triangles_of(b, a, j))
+            patch = curved_contact(first[i], second[j], (names[a], names[b]), both, tol)
+            if patch is not None:
+                curved.setdefault((a, b), []).append(patch)
 
     found = [
         Contact(names[a], names[b], tuple(planar.get(key, ())), tuple(curved.get(key, ())))
