@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.ragged import group_of, group_starts
 from assemblykit.tolerance import MIN_REL_LENGTH, Tolerance
 
 if TYPE_CHECKING:
@@ -115,8 +116,8 @@ def _corners(polygons: Sequence[NDArray[np.float64]], resolution: float) -> NDAr
     if not sizes.sum():
         return np.zeros(0, dtype=bool)
     polygon = np.vstack(polygons)
-    ring = np.repeat(np.arange(len(sizes)), sizes)
-    start = np.repeat(np.cumsum(sizes) - sizes, sizes)
+    ring = group_of(sizes)
+    start = group_starts(sizes)[ring]
     local = np.arange(len(polygon)) - start
     previous = polygon[start + (local - 1) % sizes[ring]]
     kept = np.linalg.norm(polygon - previous, axis=1) > resolution
