@@ -441,7 +441,7 @@ def _multi_move_plan(
     from assemblykit.planning.multimove_mesh import plan_meshes
 
     limit = MAX_STATES if max_states is None else max_states
-    if getattr(loaded, "dimension", 3) == 2:
+    if loaded.dimension == 2:
         raise InputError("--moves multi moves 3D parts: not for a 2D polygon assembly", source=path)
     if not isinstance(loaded, VoxelAssembly):
         return plan_meshes(loaded, tol, max_states=limit, progress=progress, fixed=fixed)
@@ -685,16 +685,16 @@ def plan_cmd(
             )
         elif join or join_interfering:
             raise InputError("--join and --join-interfering need 3D parts")
-        if getattr(loaded, "dimension", 3) == 2 and gltf is not None:
+        if loaded.dimension == 2 and gltf is not None:
             raise InputError("--gltf draws meshes: not for a 2D polygon assembly")
-        if getattr(loaded, "dimension", 3) == 2 and (html is not None or png is not None):
+        if loaded.dimension == 2 and (html is not None or png is not None):
             raise InputError("--html and --png draw meshes: not for a 2D polygon assembly")
         if moves == "multi":
             result = _multi_move_plan(loaded, assembly, tol, max_states, update, fixed)
         elif moves == "rigid":
             from assemblykit.planning.screw import plan_with_screws
 
-            if getattr(loaded, "dimension", 3) == 2:
+            if loaded.dimension == 2:
                 raise InputError("--moves rigid turns 3D parts: not for a 2D polygon assembly")
             result = plan_with_screws(loaded, tol, fixed=fixed)
         else:
@@ -1082,7 +1082,7 @@ def interlock_cmd(
         checked_output(html, "--html", HTML_SUFFIXES)
     tol = tolerance_from(tolerance)
     loaded = _plan_input(assembly, tol, as_written, 0, 0, partial)
-    if html is not None and getattr(loaded, "dimension", 3) == 2:
+    if html is not None and loaded.dimension == 2:
         raise InputError("--html draws meshes: not for a 2D polygon assembly")
     result = interlocking(loaded, keys or None, motion, tol)
     if html is not None:

@@ -21,7 +21,6 @@ from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.constraints import BlockingTerm, infinitesimal_terms
 from assemblykit.blocking.extended import all_convex, extended_arcs, extended_dbg, extended_terms
 from assemblykit.blocking.ndbg import (
-    AssemblyLike,
     ConstraintTable,
     Motion,
     NonDirectionalBlockingGraph,
@@ -33,6 +32,7 @@ from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.model.assembly import AssemblyLike
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -182,7 +182,7 @@ def blocking_graph(
         # convex parts of an assembly with others that are not: cones among them alone
         # (a stopped set of boards in a cabinet with slotted brackets)
         terms = extended_terms(of_meshes(assembly), tol, names)
-        dimension = getattr(assembly, "dimension", 3)
+        dimension = assembly.dimension
         graphs[key] = build_ndbg(names, motion, terms, len(contacts), tol, dimension)
     if key not in graphs:
         terms = [
@@ -190,7 +190,7 @@ def blocking_graph(
             for t in blocking_terms(assembly, motion, tol)
             if t.moving in inside and t.blocker in inside
         ]
-        dimension = getattr(assembly, "dimension", 3)
+        dimension = assembly.dimension
         graphs[key] = build_ndbg(names, motion, terms, len(contacts), tol, dimension)
     graph = graphs[key]
     assert isinstance(graph, NonDirectionalBlockingGraph)

@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal, Protocol
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -41,16 +41,6 @@ from assemblykit.tolerance import Tolerance
 Motion = Literal["infinitesimal", "extended", "rigid"]
 _CHUNK = 8192
 _PAD = -2
-
-
-class AssemblyLike(Protocol):
-    """What the blocking graphs need from an assembly (3D or planar); its contacts are
-    :func:`assemblykit.geometry.contacts.assembly_contacts`."""
-
-    @property
-    def names(self) -> list[str]: ...
-
-    def tolerance(self, tol: Tolerance | None = None) -> Tolerance: ...
 
 
 @dataclass(frozen=True, eq=False)

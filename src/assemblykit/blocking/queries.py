@@ -38,7 +38,6 @@ from assemblykit.blocking.extended import extended_arcs, extended_free
 from assemblykit.blocking.free_cones import blocked_sets, exact_free_directions, overlay_faces
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.blocking.ndbg import (
-    AssemblyLike,
     Motion,
     NonDirectionalBlockingGraph,
     build_ndbg,
@@ -48,6 +47,7 @@ from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.deprecation import moved
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.model.assembly import AssemblyLike
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 from assemblykit.blocking.arrangement import circle_partition, snap_normals
 from assemblykit.blocking.directions import DirectionTable, local_table, term_slots
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
-from assemblykit.blocking.ndbg import AssemblyLike
+from assemblykit.model.assembly import AssemblyLike
 from assemblykit.tolerance import Tolerance
 
 FULL_ARRANGEMENT_REGIONS = 250_000

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Mapping, Set
 from dataclasses import dataclass, field, replace
-from typing import Any, Protocol, Self
+from typing import Any, ClassVar, Protocol, Self
 
 import numpy as np
 import trimesh
@@ -43,6 +43,28 @@ class Derived(Protocol):
 
     def restricted(self, names: Set[str]) -> Derived:
         """What of it still holds for the parts ``names`` alone (the same parts)."""
+        ...
+
+
+class AssemblyLike(Protocol):
+    """What every assembly offers, whatever its parts are (meshes, voxels, polygons in
+    the plane): their names in order, the space they move in (``dimension``: 3, or 2
+    for polygons) and the tolerance policy scaled to the drawing. Code that works for
+    every kind reads these, not the class."""
+
+    @property
+    def names(self) -> list[str]:
+        """The part names, in order."""
+        ...
+
+    @property
+    def dimension(self) -> int:
+        """3 for parts in space, 2 for polygons in the plane."""
+        ...
+
+    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
+        """The tolerance policy ``tol`` (the current one when ``None``) scaled to the
+        drawing."""
         ...
 
 
@@ -131,6 +153,9 @@ class Assembly:
     ``memo`` is the slot where the geometry layer keeps what it computed from the parts
     (:class:`Derived`; ``None`` until it is asked).
     """
+
+    dimension: ClassVar[int] = 3
+    """The space the parts move in: 3 (a polygon assembly, drawn in the plane, has 2)."""
 
     def __init__(
         self,

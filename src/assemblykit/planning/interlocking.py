@@ -426,7 +426,7 @@ def interlocking(
     if motion not in MOTION_WORDS:
         raise ValueError(f"unknown motion {motion!r}")
     names = tuple(assembly.names)
-    planar = getattr(assembly, "dimension", 3) == 2
+    planar = assembly.dimension == 2
     if len(names) < 2:
         raise InputError("an interlocking assembly needs at least two parts")
     if motion == "rigid" and planar:
@@ -848,7 +848,7 @@ def _freedom(
 
         free_along = _free_directions(ndbg.arrangement, regions, is_free)
     normals, touching = _contact_normals(assembly, side, parts, tol)
-    planar = getattr(assembly, "dimension", 3) == 2
+    planar = assembly.dimension == 2
     return Freedom(
         moving,
         _shown(direction, planar) if evidence.rigid is None else direction,
@@ -925,7 +925,7 @@ def _recursion(
     the single key of the rest (the lighter of two parts); the parts left where no
     single key is found (none when the assembly is recursively interlocking); and every
     stage examined."""
-    planar = getattr(assembly, "dimension", 3) == 2
+    planar = assembly.dimension == 2
     stage, leaving = first, keys
     order: list[KeyRemoval] = []
     stages = [first]
