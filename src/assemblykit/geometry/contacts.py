@@ -789,6 +789,14 @@ def _surface_triangles(assembly: Assembly, name: str, surface: Surface) -> NDArr
     return np.asarray(mesh.vertices, dtype=np.float64)[faces]
 
 
+def _sorted_member(values: NDArray[np.int64], keys: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Whether each of ``values`` is among the sorted, distinct, non-empty ``keys``
+    (``np.isin``, by binary search: the keys are many and already sorted)."""
+    at = np.minimum(np.searchsorted(keys, values), len(keys) - 1)
+    found: NDArray[np.bool_] = keys[at] == values
+    return found
+
+
 def find_contacts(
     assembly: Assembly, tol: Tolerance | None = None, *, only: str | None = None
 ) -> list[Contact]:
@@ -824,15 +832,20 @@ def find_contacts(
     g, h = _planar_matches(stack, seg, group_part, seg.flat, part_lo, part_hi, pairs, tol)
     # a coplanar group with a face on a curved surface of its part (where that part may
     # touch the other) is a facet of that surface, not a planar face
+    groups_on: dict[Surface, NDArray[np.int64]] = {}
+    for (k, _), found in surfaces.items():
+        for s in found:
+            if s not in groups_on:
+                groups_on[s] = np.unique(seg.group[stack.face_start[k] + s.faces])
     on_curved = [
-        (k * len(names) + other) * len(seg.flat) + seg.group[stack.face_start[k] + s.faces]
+        (k * len(names) + other) * len(seg.flat) + groups_on[s]
         for (k, other), found in surfaces.items()
         for s in found
     ]
     if on_curved:
         keys = np.unique(np.concatenate(on_curved))
         pg, ph = group_part[g], group_part[h]
-        facet = np.isin((pg * len(names) + ph) * len(seg.flat) + g, keys) | np.isin(
+        facet = _sorted_member((pg * len(names) + ph) * len(seg.flat) + g, keys) | _sorted_member(
             (ph * len(names) + pg) * len(seg.flat) + h, keys
         )
         g, h = g[~facet], h[~facet]
