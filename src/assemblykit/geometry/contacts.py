@@ -833,14 +833,14 @@ def find_contacts(
     # a coplanar group with a face on a curved surface of its part (where that part may
     # touch the other) is a facet of that surface, not a planar face
     groups_on: dict[Surface, NDArray[np.int64]] = {}
-    for (k, _), found in surfaces.items():
-        for s in found:
+    for (k, _), near in surfaces.items():
+        for s in near:
             if s not in groups_on:
                 groups_on[s] = np.unique(seg.group[stack.face_start[k] + s.faces])
     on_curved = [
         (k * len(names) + other) * len(seg.flat) + groups_on[s]
-        for (k, other), found in surfaces.items()
-        for s in found
+        for (k, other), near in surfaces.items()
+        for s in near
     ]
     if on_curved:
         keys = np.unique(np.concatenate(on_curved))
