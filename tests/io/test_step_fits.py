@@ -472,6 +472,62 @@ def test_a_trimmed_screw_keeps_its_surfaces_and_fits_its_pilot_hole(self_tapping
     assert motion.contains(lift) and not motion.contains(se3.translation((0.0, 0.0, 0.25)))
 
 
+def cone(centre, bottom: float, top: float, height: float):
+    """A frustum on the z axis from ``centre``: radius ``bottom`` there, ``top`` at
+    ``height`` above."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCone
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+
+    frame = gp_Ax2(gp_Pnt(*map(float, centre)), gp_Dir(0.0, 0.0, 1.0))
+    return BRepPrimAPI_MakeCone(frame, bottom, top, height).Shape()
+
+
+@pytest.fixture(scope="module")
+def threaded_screw(tmp_path_factory) -> Read:
+    """A 20 x 20 x 5 plate with a hole of radius 1.25 and a screw with its thread drawn:
+    a shank of the hole's radius from z = -3 to 5, sixteen crests every 0.5 from z = -3
+    (rings of a triangular section out to radius 1.55, 0.4 high), and a head of radius
+    2.75 from z = 5 - 0.001 to 7, sunk a hair into the plate's top, as a head drawn on
+    a face often is: the shared volume is the crests in the plate and a thin disc under
+    the head."""
+    plate = cut(box((-10, -10, 0), (20, 20, 5)), cylinder((0, 0, -1), 1.25, 7.0))
+    screw = fuse(cylinder((0, 0, -3), 1.25, 8.0), cylinder((0, 0, 5 - 0.001), 2.75, 2.001))
+    for k in range(16):
+        z = -3.0 + 0.5 * k
+        screw = fuse(screw, cone((0, 0, z), 1.25, 1.55, 0.2))
+        screw = fuse(screw, cone((0, 0, z + 0.2), 1.55, 1.25, 0.2))
+    return read(tmp_path_factory.mktemp("thread") / "threaded.step", plate, screw)
+
+
+def test_a_screw_with_its_thread_drawn_and_its_head_sunk_leaves_along_its_axis(
+    threaded_screw,
+):
+    # the disc under the head is wide and thin: the principal axes of the shared volume
+    # lie across the screw, and the plate's hole, which the crests surround, gives the
+    # axis the thread is cut along, its crests below the plate too
+    from assemblykit.geometry.overlaps import resolve_overlaps
+
+    (plate, screw), asm = threaded_screw.shapes, threaded_screw.assembly
+    shared = common_volume(plate, screw)
+    disc = math.pi * (2.75**2 - 1.25**2) * 0.001
+    assert shared > 10 * disc
+    prepared = resolve_overlaps(asm)
+    (overlap,) = prepared.overlaps
+    assert overlap.resolution == f"trimmed from {PIN}"
+    assert interferences(prepared) == []
+    shank = prepared[PIN].mesh
+    radius = np.linalg.norm(shank.vertices[:, :2], axis=1)
+    assert radius[shank.vertices[:, 2] < 4.9].max() <= 1.25 + 1e-9
+    found = plan(prepared, max_and_or_parts=0)
+    assert found.feasible
+    (step,) = found.steps
+    assert step.parts == (PIN,) and float(step.direction @ Z) == pytest.approx(1.0)
+    assert max(sweep_overlaps(prepared, found.steps)) <= 1e-6
+    # pushed the other way the head runs into the plate
+    assert max(sweep_overlaps(prepared, found.steps, reverse=True)) > 1.0
+    assert step.fastener is not None and step.fastener.kind == "screw"
+
+
 @pytest.fixture(scope="module")
 def screwed_stack(tmp_path_factory) -> Read:
     """Three 20 x 20 x 4 plates at z in [0, 4], [6, 10] and [12, 16], each with a pilot

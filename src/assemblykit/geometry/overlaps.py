@@ -243,13 +243,28 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
     common = mine ^ theirs
     if common.volume() <= interference_threshold(part.mesh, other.mesh, tol):
         return part
-    shared = mesh_of(_bodies(common))
+    bodies = _bodies(common)
+    shared = mesh_of(bodies)
     size = float(np.linalg.norm(np.ptp(np.vstack([part.mesh.bounds, other.mesh.bounds]), axis=0)))
     axis = insertion_axis(shared)
-    removed = _extruded_shadow(shared, axis, 2 * size)
     hole = _hole_along(other, shared, axis, tol)
+    if hole is None:
+        # a thread's ring with a sheet of the head where it bears on the hole's face:
+        # the sheet's disc turns the principal axes, the hole's axis stays the same
+        hole = _hole_along(other, shared, None, tol)
+        axis = axis if hole is None or hole.axis is None else hole.axis
+    sheets = None
+    if hole is not None:
+        bulk, sheets = _sheets(bodies, axis, hole.radius)
+        if bulk is None:
+            sheets = None
+        else:
+            shared = mesh_of(bulk)
+    removed = _extruded_shadow(shared, axis, 2 * size)
     if hole is not None:
         removed = removed + _thread_tube(hole, shared, 2 * size)
+    if sheets is not None:
+        removed = removed + sheets
     cut = _bodies(mine - removed)
     mesh, source = traced_mesh(cut, original_id)
     if (cut ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
@@ -270,17 +285,42 @@ SEGMENTS = 256
 chords within 0.01% of the radius)."""
 
 
+SHEET_SHARE = 0.01
+"""The largest extent along a hole's axis, as a share of the hole's radius, of a piece
+of the volume a part shares with it that is a sheet where a face of the part bears on
+a face of the hole's part (a screw's head drawn a hair into the plate it stands on),
+not a thread's or a press fit's ring: the sheet is cut from the part as it is, and
+casts no shadow along the axis (:func:`_trimmed`)."""
+
+
+def _sheets(
+    shared: manifold3d.Manifold, axis: NDArray[np.float64], radius: float
+) -> tuple[manifold3d.Manifold | None, manifold3d.Manifold | None]:
+    """The pieces of ``shared`` thicker along ``axis`` than :data:`SHEET_SHARE` of
+    ``radius``, and the thinner ones (the sheets), each joined (``None`` for none)."""
+    thick, thin = [], []
+    for piece in shared.decompose():
+        corners = np.asarray(piece.to_mesh().vert_properties, dtype=np.float64)[:, :3]
+        flat = float(np.ptp(corners @ axis)) < SHEET_SHARE * radius
+        (thin if flat else thick).append(piece)
+
+    def joined(pieces: list[manifold3d.Manifold]) -> manifold3d.Manifold | None:
+        return manifold3d.Manifold.batch_boolean(pieces, manifold3d.OpType.Add) if pieces else None
+
+    return joined(thick), joined(thin)
+
+
 def _hole_along(
-    other: Part, shared: trimesh.Trimesh, axis: NDArray[np.float64], tol: Tolerance
+    other: Part, shared: trimesh.Trimesh, axis: NDArray[np.float64] | None, tol: Tolerance
 ) -> Surface | None:
-    """The hole (a cylinder of ``other`` with its material outside) along ``axis`` that
-    the volume ``shared`` with it surrounds, its inner side on the cylinder and its
-    centre of mass on the axis (within ``CUT_RADIUS_SHARE`` of the radius): a thread's
-    ring in its pilot hole (``None`` when there is none)."""
+    """The hole (a cylinder of ``other`` with its material outside) along ``axis`` (any
+    axis when ``None``) that the volume ``shared`` with it surrounds, its inner side on
+    the cylinder and its centre of mass on the axis (within ``CUT_RADIUS_SHARE`` of the
+    radius): a thread's ring in its pilot hole (``None`` when there is none)."""
     for surface in other.surfaces:
         if surface.kind != "cylinder" or surface.convex or surface.axis is None:
             continue
-        if abs(float(surface.axis @ axis)) < 1.0 - tol.mesh_angle:
+        if axis is not None and abs(float(surface.axis @ axis)) < 1.0 - tol.mesh_angle:
             continue
         points = np.vstack([np.asarray(shared.vertices), shared.center_mass])
         offset = points - surface.point
