@@ -479,14 +479,26 @@ def _screw(result: ScrewPlan) -> Table:
             table.add_row(
                 str(number),
                 ", ".join(turn.parts),
-                f"turn {math.degrees(turn.angle):.1f} deg"
-                + (f", pitch {turn.pitch:.4g} per rad" if turn.pitch else ""),
+                _turned(turn.angle, turn.pitch),
                 axis,
                 fmt.direction(turn.exit),
             )
     if not result.feasible:
         table.caption = "stuck: " + ", ".join(result.stages[-1].stuck)
     return table
+
+
+def _turned(angle: float, pitch: float) -> str:
+    """A turn in words: degrees and the pitch per radian, or, past a whole turn (a
+    thread followed out), the turns and the advance per turn."""
+    if angle <= 2 * math.pi:
+        return f"turn {math.degrees(angle):.1f} deg" + (
+            f", pitch {pitch:.4g} per rad" if pitch else ""
+        )
+    hand = "" if pitch >= 0 else ", left-handed"
+    return (
+        f"unscrew {angle / (2 * math.pi):.4g} turns, {abs(pitch) * 2 * math.pi:.4g} per turn{hand}"
+    )
 
 
 def _contacts(result: ContactReport) -> Group:

@@ -25,7 +25,7 @@ from assemblykit.io import step as step_module
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import LINEAR_DEFLECTION
 from assemblykit.planning.planner import plan
-from step_files import write_step
+from step_files import box, common_volume, cut, cylinder, fuse, write_step
 
 pytest.importorskip("OCP")
 
@@ -34,50 +34,6 @@ pytestmark = pytest.mark.cad
 # shared volume (mm^3) still counted as none: float rounding of touching meshes
 NOISE = 1e-9
 Z = np.array([0.0, 0.0, 1.0])
-
-
-def cylinder(centre, radius: float, height: float, turn: float = 0.0, axis=(0, 0, 1)):
-    """A cylinder from ``centre`` along ``axis``; ``turn`` (degrees) turns its seam, and so
-    its tessellation, about the axis."""
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
-    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
-
-    axis = np.asarray(axis, dtype=float)
-    seam = np.cross(axis, [0.0, 1.0, 0.0] if abs(axis[1]) < 0.9 else [1.0, 0.0, 0.0])
-    seam /= np.linalg.norm(seam)
-    seam = seam * math.cos(math.radians(turn)) + np.cross(axis, seam) * math.sin(math.radians(turn))
-    frame = gp_Ax2(gp_Pnt(*map(float, centre)), gp_Dir(*axis), gp_Dir(*seam))
-    return BRepPrimAPI_MakeCylinder(frame, radius, height).Shape()
-
-
-def box(corner, size):
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
-    from OCP.gp import gp_Pnt
-
-    return BRepPrimAPI_MakeBox(gp_Pnt(*map(float, corner)), *map(float, size)).Shape()
-
-
-def cut(a, b):
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
-
-    return BRepAlgoAPI_Cut(a, b).Shape()
-
-
-def fuse(a, b):
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
-
-    return BRepAlgoAPI_Fuse(a, b).Shape()
-
-
-def common_volume(a, b) -> float:
-    """OCCT's exact volume of ``a ∩ b`` (boolean common of the B-reps)."""
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
-    properties = GProp_GProps()
-    BRepGProp.VolumeProperties_s(BRepAlgoAPI_Common(a, b).Shape(), properties)
-    return abs(properties.Mass())
 
 
 def kernel_tessellation(path):

@@ -298,7 +298,8 @@ def _sheets(
 ) -> tuple[manifold3d.Manifold | None, manifold3d.Manifold | None]:
     """The pieces of ``shared`` thicker along ``axis`` than :data:`SHEET_SHARE` of
     ``radius``, and the thinner ones (the sheets), each joined (``None`` for none)."""
-    thick, thin = [], []
+    thick: list[manifold3d.Manifold] = []
+    thin: list[manifold3d.Manifold] = []
     for piece in shared.decompose():
         corners = np.asarray(piece.to_mesh().vert_properties, dtype=np.float64)[:, :3]
         flat = float(np.ptp(corners @ axis)) < SHEET_SHARE * radius

@@ -27,6 +27,19 @@ interlocked set that Γ_g may free, this module looks for a *finite* motion:
 A found motion is a plan step with its axis (a point and a direction), its angle, its
 pitch and the exit direction that follows. Only sampled poses are checked during the turn: the
 step between samples is ``max_angle / samples``.
+
+A thread drawn on a screw and in its nut (or tapped hole) holds the screw in every
+translation, and a quarter turn does not free it: it takes as many turns as the thread
+is long. When no turn above frees a part, its **threads** are followed
+(:func:`_thread_candidates`): about the axis of a cylinder of the part coaxial with a
+cylinder of another part, one inside the other (a screw's shank or crests in a nut's
+bore, or a nut about a screw), at the pitch of each ISO metric size near either
+diameter (ISO 261's coarse pitches, right-handed first), both ways, the poses
+checked every :data:`THREAD_STEP` until the part has advanced past the other part's
+extent along the axis; it then leaves along the axis or a coordinate axis. The helical
+group of that pitch holds the thread's surfaces onto themselves, so a drawn thread
+with clearance is clear at every pose of its own motion, and any other pitch runs its
+crests into the other's within a turn.
 """
 
 from __future__ import annotations
@@ -43,9 +56,11 @@ from numpy.typing import NDArray
 
 from assemblykit.algebra import se3
 from assemblykit.blocking.rigid import RigidBlockingGraph
-from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.geometry.interference import interference_threshold, solid
 from assemblykit.model.assembly import Assembly
+from assemblykit.model.surfaces import Surface
+from assemblykit.planning.fasteners import ISO_COARSE_PITCH, MILLIMETRES
 from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import Plan
 from assemblykit.tolerance import Tolerance
@@ -57,6 +72,17 @@ SAMPLES = 90
 """Poses checked over ``MAX_ANGLE`` (one degree apart)."""
 
 _EXITS = np.vstack([np.eye(3), -np.eye(3)])
+
+THREAD_STEP = math.pi / 12
+"""The turn between two poses checked while a part follows a thread (15 degrees)."""
+
+THREAD_LATER_STEP = math.pi / 3
+"""The turn between two poses checked after the first turn of a thread (60 degrees)."""
+
+THREAD_MATCH = 0.25
+"""How far (a share of the size) a fit's diameter may be from an ISO metric size for
+that size's pitch to be tried on a thread drawn there: the shank, crests and bore of
+an M3 are about 2.4, 3.0 and 2.5 to 3.1 mm."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,7 +108,8 @@ class ScrewStep:
         """JSON form: ``parts``, ``rest``, ``motion`` (``screw``), ``axis`` (``point``,
         ``direction``), ``angle`` (radians), ``angle_deg``, ``pitch`` (model units per
         radian along the axis; 0 for a pure turn), ``advance`` (pitch x angle) and
-        ``exit``."""
+        ``exit``, ``turns`` (the angle in whole turns: a thread followed out takes
+        several)."""
         return {
             "parts": list(self.parts),
             "rest": list(self.rest),
@@ -92,6 +119,7 @@ class ScrewStep:
             "angle_deg": math.degrees(self.angle),
             "pitch": self.pitch,
             "advance": self.pitch * self.angle,
+            "turns": self.angle / (2 * math.pi),
             "direction": self.exit.tolist(),
             "exit": self.exit.tolist(),
         }
@@ -148,12 +176,16 @@ def _placed(body: manifold3d.Manifold, pose: NDArray[np.float64]) -> manifold3d.
 
 
 def _exit(
-    body: manifold3d.Manifold, rest: manifold3d.Manifold, reach: float, limit: float
+    body: manifold3d.Manifold,
+    rest: manifold3d.Manifold,
+    reach: float,
+    limit: float,
+    first: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64] | None:
-    """A coordinate direction along which ``body`` leaves ``rest`` for good (module
-    docstring), or None."""
+    """A direction along which ``body`` leaves ``rest`` for good (module docstring):
+    ``first`` when given and free, else a coordinate direction; None when none is."""
     corners = np.asarray(body.to_mesh().vert_properties, dtype=np.float64)[:, :3]
-    for direction in _EXITS:
+    for direction in _EXITS if first is None else np.vstack([first, _EXITS]):
         sweep = manifold3d.Manifold.hull_points(np.vstack([corners, corners + reach * direction]))
         if (sweep ^ rest).volume() <= limit:
             found: NDArray[np.float64] = direction
@@ -205,7 +237,115 @@ def screw_removal(
                     return ScrewStep(
                         moving, rest, pivot + 0.0, axis + 0.0, angle, leave + 0.0, pitch + 0.0
                     )
+    for pivot, axis, pitch, angle in _thread_candidates(assembly, moving, rest, tol):
+        if _follows(body, others, limit, pivot, axis, pitch, angle):
+            moved = _placed(body, se3.screw(pivot, axis, pitch, angle))
+            leave = _exit(moved, others, reach, limit, axis)
+            if leave is not None:
+                return ScrewStep(
+                    moving, rest, pivot + 0.0, axis + 0.0, angle, leave + 0.0, pitch + 0.0
+                )
     return None
+
+
+def _follows(
+    body: manifold3d.Manifold,
+    others: manifold3d.Manifold,
+    limit: float,
+    pivot: NDArray[np.float64],
+    axis: NDArray[np.float64],
+    pitch: float,
+    angle: float,
+) -> bool:
+    """Whether ``body`` turned about the line (``pivot``, ``axis``) with ``pitch`` per
+    radian shares no more than ``limit`` with ``others`` at every pose checked up to
+    ``angle``: :data:`THREAD_STEP` apart over the first turn, where a wrong pitch runs
+    the crests into each other, then :data:`THREAD_LATER_STEP` apart (the thread holds
+    itself onto itself; what else is in the way is met later)."""
+    first = np.arange(1, math.ceil(2 * math.pi / THREAD_STEP) + 1) * THREAD_STEP
+    later = np.arange(first[-1] + THREAD_LATER_STEP, angle, THREAD_LATER_STEP)
+    for turn in [*first[first < angle], *later, angle]:
+        moved = _placed(body, se3.screw(pivot, axis, pitch, float(turn)))
+        if (moved ^ others).volume() > limit:
+            return False
+    return True
+
+
+def _thread_candidates(
+    assembly: Assembly, moving: tuple[str, ...], rest: tuple[str, ...], tol: Tolerance
+) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float, float]]:
+    """The thread motions of ``moving`` out of ``rest`` (module docstring) as ``(point,
+    unit axis it advances along, pitch per radian, angle)``: for each cylinder of a
+    moving part coaxial with one of a part at rest, one inside the other, the ISO
+    coarse pitches of the sizes within :data:`THREAD_MATCH` of either diameter (nearest
+    first), right-handed then left-handed, along the axis both ways, each turned as far
+    as takes the moving parts past the other part's extent along the axis. None where
+    the model's unit is not a length one knows in millimetres."""
+    scale = MILLIMETRES.get(assembly.units or "")
+    if scale is None:
+        return []
+    found = []
+    for inner, outer, other in _coaxial_fits(assembly, moving, rest, tol):
+        assert inner.axis is not None
+        line = inner.axis / np.linalg.norm(inner.axis)
+        diameters = [2 * inner.radius * scale, 2 * outer.radius * scale]
+        sizes = sorted(
+            (s for s in ISO_COARSE_PITCH if any(abs(s - d) <= THREAD_MATCH * s for d in diameters)),
+            key=lambda s: min(abs(s - d) for d in diameters),
+        )
+        here = np.vstack([np.asarray(assembly[n].mesh.vertices) for n in moving])
+        there = np.asarray(assembly[other].mesh.vertices)
+        for size in sizes:
+            lead = ISO_COARSE_PITCH[size] / scale
+            for hand in (1.0, -1.0):
+                for axis in (line, -line):
+                    advance = float((there @ axis).max() - (here @ axis).min())
+                    if advance <= 0:
+                        continue
+                    angle = 2 * math.pi * (advance + tol.length) / lead
+                    found.append((inner.point, axis, hand * lead / (2 * math.pi), angle))
+    return found
+
+
+def _coaxial_fits(
+    assembly: Assembly, moving: tuple[str, ...], rest: tuple[str, ...], tol: Tolerance
+) -> list[tuple[Surface, Surface, str]]:
+    """``(inner, outer, other)``: a convex cylinder inside a concave one on the same
+    axis (within 5% of the smaller radius), one on a moving part and one on a part
+    ``other`` at rest, the outer one no smaller than the inner; each pair of radii
+    once."""
+
+    def cylinders(names: tuple[str, ...]) -> list[tuple[Surface, str]]:
+        return [
+            (s, n)
+            for n in names
+            for s in assembly_surfaces(assembly, n, tol)
+            if s.kind == "cylinder" and s.axis is not None
+        ]
+
+    found: list[tuple[Surface, Surface, str]] = []
+    seen: set[tuple[float, float]] = set()
+    for a, _ in cylinders(moving):
+        for b, other in cylinders(rest):
+            if a.convex == b.convex:
+                continue
+            inner, outer = (a, b) if a.convex else (b, a)
+            assert inner.axis is not None and outer.axis is not None
+            u = inner.axis / np.linalg.norm(inner.axis)
+            offset = outer.point - inner.point
+            off_axis = float(np.linalg.norm(offset - (offset @ u) * u))
+            parallel = float(np.linalg.norm(np.cross(u, outer.axis / np.linalg.norm(outer.axis))))
+            near = 0.05 * min(inner.radius, outer.radius)
+            key = (round(inner.radius / tol.length), round(outer.radius / tol.length))
+            if (
+                off_axis <= near
+                and parallel <= tol.mesh_angle
+                and inner.radius <= outer.radius + tol.length
+                and key not in seen
+            ):
+                seen.add(key)
+                found.append((inner, outer, other))
+    return found
 
 
 @dataclass(frozen=True, eq=False)
