@@ -52,7 +52,7 @@ Method on meshes (all thresholds from the tolerance policy):
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import trimesh
@@ -159,32 +159,46 @@ def segment(
     curved = np.zeros(n_regions, dtype=bool)
     curved[region[f0[smooth & ~coplanar]]] = True
     planes = _group_planes(corners, normals, areas, group)
-    if not strict and not (planes[-1] <= tol.length).all():
+    if not strict and not (planes.deviation <= tol.length).all():
         # a sliver thinner than the tolerance lies in both faces of an edge and would
         # join them: where a group is not flat, its faces keep their strict groups
-        bent = planes[-1][group] > tol.length
+        bent = planes.deviation[group] > tol.length
         strict_group = component_labels(n_faces, adjacency[both])
         kept = np.unique(group[~bent])
         group = np.unique(np.where(bent, strict_group + n_faces, group), return_inverse=True)[1]
         planes = _regrouped(planes, kept, corners, normals, areas, group.astype(np.int64), bent)
-    normal, point, area, lo, hi, order, start, deviation = planes
-    flat = deviation <= tol.length
     return Segmentation(
-        group,
-        region,
-        normals,
-        areas,
-        normal,
-        point,
-        area,
-        lo,
-        hi,
-        flat,
-        order,
-        start,
-        curved,
-        deviation,
+        group=group,
+        region=region,
+        normals=normals,
+        areas=areas,
+        normal=planes.normal,
+        point=planes.point,
+        area=planes.area,
+        lo=planes.lo,
+        hi=planes.hi,
+        flat=planes.deviation <= tol.length,
+        order=planes.order,
+        start=planes.start,
+        curved=curved,
+        deviation=planes.deviation,
     )
+
+
+class GroupPlanes(NamedTuple):
+    """Per group of coplanar triangles: its unit ``normal``, area-weighted ``point``,
+    ``area`` and bounds ``lo``, ``hi``; the triangles sorted by group (``order``) with
+    each group's ``start`` (and the total after the last); and the ``deviation``, the
+    largest distance of its vertices from its plane."""
+
+    normal: NDArray[np.float64]
+    point: NDArray[np.float64]
+    area: NDArray[np.float64]
+    lo: NDArray[np.float64]
+    hi: NDArray[np.float64]
+    order: NDArray[np.int64]
+    start: NDArray[np.int64]
+    deviation: NDArray[np.float64]
 
 
 def _group_planes(
@@ -192,14 +206,14 @@ def _group_planes(
     normals: NDArray[np.float64],
     areas: NDArray[np.float64],
     group: NDArray[np.int64],
-) -> tuple[NDArray[Any], ...]:
+) -> GroupPlanes:
     """Per group of triangles (``corners``, unit ``normals``, ``areas``): its normal,
     area-weighted point, area, bounds, the faces sorted by group with each group's start,
     and the largest distance of its vertices from its plane (flat when within the length
     tolerance, method step 1)."""
     n_groups = int(group.max()) + 1 if len(group) else 0
     weighted = _group_sums(group, normals * areas[:, None], n_groups)
-    area = np.bincount(group, weights=areas, minlength=n_groups)
+    area = np.asarray(np.bincount(group, weights=areas, minlength=n_groups), dtype=np.float64)
     first, second, third = corners.transpose(1, 0, 2)
     moment = _group_sums(group, (first + second + third) / 3 * areas[:, None], n_groups)
     point = moment / np.where(area > 0, area, 1.0)[:, None]
@@ -212,19 +226,22 @@ def _group_planes(
     lo = np.minimum.reduceat(low, heads) if n_groups else np.zeros((0, 3))
     hi = np.maximum.reduceat(high, heads) if n_groups else np.zeros((0, 3))
     offsets = np.abs(np.einsum("fkj,fj->fk", corners - point[group][:, None], normal[group]))
-    deviation = np.maximum.reduceat(offsets.max(axis=1)[order], heads) if n_groups else area
-    return normal, point, area, lo, hi, order, start, deviation
+    deviation = np.asarray(
+        np.maximum.reduceat(offsets.max(axis=1)[order], heads) if n_groups else area,
+        dtype=np.float64,
+    )
+    return GroupPlanes(normal, point, area, lo, hi, order, start, deviation)
 
 
 def _regrouped(
-    planes: tuple[NDArray[Any], ...],
+    planes: GroupPlanes,
     kept: NDArray[np.int64],
     corners: NDArray[np.float64],
     normals: NDArray[np.float64],
     areas: NDArray[np.float64],
     group: NDArray[np.int64],
     bent: NDArray[np.bool_],
-) -> tuple[NDArray[Any], ...]:
+) -> GroupPlanes:
     """:func:`_group_planes` of the triangles regrouped as ``group``: the groups ``kept``
     of ``planes`` (numbered first, in their order) are the same, and only the ``bent``
     triangles' new groups are measured (each group's sums run over its own triangles in
@@ -234,7 +251,7 @@ def _regrouped(
     normal, point, area, lo, hi, _, _, deviation = per_group
     order = np.argsort(group, kind="stable")
     start = np.searchsorted(group[order], np.arange(len(area) + 1))
-    return normal, point, area, lo, hi, order, start, deviation
+    return GroupPlanes(normal, point, area, lo, hi, order, start, deviation)
 
 
 def _group_sums(

@@ -208,7 +208,14 @@ class _HandsSearch:
             return 1, []
         stopped = [members]
         if not locked:
-            search = Search(self.translations, self.extended, self.sizes, lambda *_: None, [], [])
+            search = Search(
+                translations=self.translations,
+                extended=self.extended,
+                volumes=self.sizes,
+                progress=lambda *_: None,
+                steps=[],
+                locked=[],
+            )
             search.disassemble(members)
             stopped = search.locked
         needed = 2

@@ -87,7 +87,14 @@ def planar_search(
     volumes = tuple(v + total if n in fixed else v for n, v in zip(names, volumes, strict=True))
     mask = mask_of(k for k, name in enumerate(names) if name in fixed)
     search = Search(
-        translations, extended, volumes, report, [], [], max_steps=max_steps, fixed=mask
+        translations=translations,
+        extended=extended,
+        volumes=volumes,
+        progress=report,
+        steps=[],
+        locked=[],
+        max_steps=max_steps,
+        fixed=mask,
     )
     search.disassemble(mask_of(range(len(translations.names))))
     return search
