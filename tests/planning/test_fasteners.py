@@ -45,12 +45,15 @@ def rod_through_blocks(rod: float, hole: float, head: float = 2.5) -> Assembly:
     )
 
 
-@pytest.mark.parametrize(("rod", "kind"), [(1.0, "pin"), (1.04, "screw")])
+@pytest.mark.parametrize(
+    ("rod", "kind"), [(1.0, "pin"), (1.005, "pressed"), (1.008, "pressed"), (1.04, "screw")]
+)
 def test_a_rod_drawn_out_of_two_holes_is_named_with_both(rod, kind):
     # at the holes' radius it is a pin; 0.04 larger it cuts a thread into both blocks
-    # by design (resolved by trimming it) and is a screw
+    # by design (resolved by trimming it) and is a screw; 0.005 or 0.008 larger (under
+    # 1% of the radius, as ISO interference fits press) it is pressed in, no thread
     prepared = resolve_overlaps(rod_through_blocks(rod, 1.0))
-    assert len(prepared.overlaps) == (2 if kind == "screw" else 0)
+    assert len(prepared.overlaps) == (0 if kind == "pin" else 2)
     result = plan(prepared, max_and_or_parts=0)
     assert result.feasible
     (out,) = [s for s in result.steps if "rod" in s.parts]
@@ -77,8 +80,13 @@ def test_a_rod_drawn_out_of_two_holes_is_named_with_both(rod, kind):
         ),
     }
     assert out.fastener is not None
-    assert out.fastener.summary() == (
-        "pull pin" if kind == "pin" else "unscrew M2 (pitch 0.4, 40 turns)"
+    assert (
+        out.fastener.summary()
+        == {
+            "pin": "pull pin",
+            "pressed": "press out",
+            "screw": "unscrew M2 (pitch 0.4, 40 turns)",
+        }[kind]
     )
     # the blocks lifted off the base are no fasteners
     assert all(s.fastener is None for s in result.steps if "rod" not in s.parts)

@@ -43,7 +43,7 @@ from assemblykit.geometry.contacts import CurvedPatch, assembly_contacts
 from assemblykit.model.assembly import Assembly
 from assemblykit.tolerance import Tolerance
 
-FastenerKind = Literal["screw", "pin"]
+FastenerKind = Literal["screw", "pin", "pressed"]
 
 ISO_COARSE_PITCH: dict[float, float] = {
     1.0: 0.25,
@@ -77,6 +77,13 @@ HEAD_RATIO = 3.0
 """How far from its axis, in radii of its fit, a fastener reaches: the heads of ISO
 screws and bolts (hexagon across corners, pan, cheese, socket, countersunk and flange
 heads) are at most about 2.4 shank diameters wide, under 2.5 radii of the fit."""
+
+PRESS_FIT_SHARE = 0.01
+"""The deepest interference, as a share of a fit's radius, of a part **pressed** into
+its hole (a bearing, a bushing, a dowel): ISO interference fits press by a few
+thousandths of the diameter, while a thread cut into its pilot hole goes deeper (a
+self-tapping M3 in a 2.9 mm hole, 3% of the radius). The depth is read as the shared
+volume over the fit's surface (its circumference times its length)."""
 
 PILOT_HOLE = 0.7
 """The smallest fit, a fraction of the size written in a screw's name, that the name is
@@ -176,18 +183,21 @@ class Fastener:
         return SymmetryGroup.helical(center, self.axis, self.thread.pitch / (2 * math.pi))
 
     def summary(self) -> str:
-        """In words: ``"unscrew M3 (pitch 0.5, 12 turns)"``, ``"unscrew"`` or ``"pull pin"``."""
+        """In words: ``"unscrew M3 (pitch 0.5, 12 turns)"``, ``"unscrew"``, ``"pull pin"``
+        or ``"press out"``."""
         if self.kind == "pin":
             return "pull pin"
+        if self.kind == "pressed":
+            return "press out"
         if self.thread is None:
             return "unscrew"
         thread = self.thread
         return f"unscrew {thread.size} (pitch {thread.pitch:g}, {thread.turns:g} turns)"
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``part``, ``kind`` (``"screw"`` or ``"pin"``), ``axis``, ``holes``,
-        ``diameter`` (of the fit), and for a screw whose thread is implied ``thread``
-        (:meth:`Thread.to_dict`)."""
+        """JSON form: ``part``, ``kind`` (``"screw"``, ``"pin"`` or ``"pressed"``),
+        ``axis``, ``holes``, ``diameter`` (of the fit), and for a screw whose thread is
+        implied ``thread`` (:meth:`Thread.to_dict`)."""
         return {
             "part": self.part,
             "kind": self.kind,
@@ -199,14 +209,16 @@ class Fastener:
 
 
 def drawn_summary(fasteners: Sequence[Fastener]) -> str:
-    """In words, the screws and pins of one step: ``"unscrew 5 x M3, 1 x M2; pull 1
-    pin"`` (screws counted by their implied size, ``"unscrew 2"`` where none is
-    implied); empty for none."""
+    """In words, the screws, pins and pressed parts of one step: ``"unscrew 5 x M3, 1 x
+    M2; pull 1 pin; press out 1"`` (screws counted by their implied size, ``"unscrew
+    2"`` where none is implied); empty for none."""
     sizes = Counter(f.thread.size if f.thread else "" for f in fasteners if f.kind == "screw")
     screws = ", ".join(f"{n} x {size}" if size else str(n) for size, n in sizes.items())
     pins = sum(f.kind == "pin" for f in fasteners)
+    pressed = sum(f.kind == "pressed" for f in fasteners)
     said = [f"unscrew {screws}"] if screws else []
-    return "; ".join([*said, *([f"pull {pins} pin{'s' * (pins > 1)}"] if pins else [])])
+    said += [f"pull {pins} pin{'s' * (pins > 1)}"] if pins else []
+    return "; ".join([*said, *([f"press out {pressed}"] if pressed else [])])
 
 
 def step_fastener(
@@ -243,9 +255,12 @@ def step_fastener(
         return None
     order = {name: k for k, name in enumerate(assembly.names)}
     holes = sorted(fits, key=order.__getitem__)
-    threaded = [
-        hole for hole in holes if any({o.a, o.b} == {part, hole} for o in assembly.overlaps)
-    ]
+    shared = {
+        hole: sum(o.volume for o in assembly.overlaps if {o.a, o.b} == {part, hole})
+        for hole in holes
+    }
+    pressed = [hole for hole in holes if shared[hole] > 0]
+    threaded = [hole for hole in pressed if _cut_deeper_than_a_press(shared[hole], fits[hole])]
     first = fits[holes[0]][0]
     diameter = 2 * max(patch.radius for hole in holes for patch in fits[hole])
     center = np.asarray(first.center, dtype=np.float64)
@@ -258,13 +273,32 @@ def step_fastener(
         thread = implied_thread(diameter, travel, assembly.units, part)
     return Fastener(
         part,
-        "screw" if threaded else "pin",
+        "screw" if threaded else "pressed" if pressed else "pin",
         d,
         tuple(holes),
         center,
         diameter,
         thread,
     )
+
+
+def _cut_deeper_than_a_press(volume: float, patches: Sequence[CurvedPatch]) -> bool:
+    """Whether a part sharing ``volume`` with a hole through the fits ``patches`` cuts
+    into it deeper than :data:`PRESS_FIT_SHARE` of their radius: a thread, not a press
+    fit (a fit of unknown length counts as a thread)."""
+    radius = max(patch.radius for patch in patches)
+    axis = patches[0].axis
+    if axis is None or any(patch.extent is None for patch in patches):
+        return True
+    # the fits' common stretch of the axis (one fit may come as several patches)
+    ends = [
+        float(np.asarray(patch.center) @ axis) + along
+        for patch in patches
+        if patch.extent is not None
+        for along in patch.extent
+    ]
+    length = max(ends) - min(ends)
+    return volume > PRESS_FIT_SHARE * radius * 2 * math.pi * radius * length
 
 
 def _reach(
