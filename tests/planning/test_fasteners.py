@@ -196,3 +196,17 @@ def test_a_size_written_in_the_name_is_believed_near_its_fit(name, diameter, siz
     thread = implied_thread(diameter, 4.0, "mm", name)
     assert thread is not None and thread.size == size
     assert thread.turns == pytest.approx(4.0 / thread.pitch, abs=0.05)
+
+
+def test_a_screw_is_sized_by_the_diameter_it_was_drawn_at_not_by_its_pilot_hole():
+    # a rod of radius 1.2 cut into holes of radius 1.0 (2 mm: the tap drill of an M2.5,
+    # and within 10% of an M2): the ring it shares with each 8 mm block is, by hand,
+    # pi (1.2^2 - 1^2) 8 = 11.06 mm^3, so it was drawn 2.4 mm across, an M2.5; its tip
+    # at x = 12 leaves the first block at x = -4, 16 mm at 0.45 a turn
+    prepared = resolve_overlaps(rod_through_blocks(1.2, 1.0))
+    assert [o.volume for o in prepared.overlaps] == pytest.approx([11.06, 11.06], rel=0.01)
+    result = plan(prepared, max_and_or_parts=0)
+    (out,) = [s for s in result.steps if "rod" in s.parts]
+    assert out.fastener is not None and out.fastener.kind == "screw"
+    assert out.fastener.diameter == pytest.approx(2.0, rel=1e-6)
+    assert out.fastener.summary() == "unscrew M2.5 (pitch 0.45, 35.6 turns)"

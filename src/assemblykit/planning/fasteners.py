@@ -270,7 +270,8 @@ def step_fastener(
     if threaded:
         tip = float((assembly[part].mesh.vertices @ d).min())
         travel = max(_far_end(patch, d) for hole in threaded for patch in fits[hole]) - tip
-        thread = implied_thread(diameter, travel, assembly.units, part)
+        drawn = max(_drawn_diameter(shared[hole], fits[hole]) for hole in threaded)
+        thread = implied_thread(drawn, travel, assembly.units, part)
     return Fastener(
         part,
         "screw" if threaded else "pressed" if pressed else "pin",
@@ -282,23 +283,43 @@ def step_fastener(
     )
 
 
-def _cut_deeper_than_a_press(volume: float, patches: Sequence[CurvedPatch]) -> bool:
-    """Whether a part sharing ``volume`` with a hole through the fits ``patches`` cuts
-    into it deeper than :data:`PRESS_FIT_SHARE` of their radius: a thread, not a press
-    fit (a fit of unknown length counts as a thread)."""
-    radius = max(patch.radius for patch in patches)
+def _fit_length(patches: Sequence[CurvedPatch]) -> float | None:
+    """The stretch of the axis the fits ``patches`` cover together (one fit may come as
+    several patches), ``None`` when one has no known extent."""
     axis = patches[0].axis
     if axis is None or any(patch.extent is None for patch in patches):
-        return True
-    # the fits' common stretch of the axis (one fit may come as several patches)
+        return None
     ends = [
         float(np.asarray(patch.center) @ axis) + along
         for patch in patches
         if patch.extent is not None
         for along in patch.extent
     ]
-    length = max(ends) - min(ends)
+    return max(ends) - min(ends)
+
+
+def _cut_deeper_than_a_press(volume: float, patches: Sequence[CurvedPatch]) -> bool:
+    """Whether a part sharing ``volume`` with a hole through the fits ``patches`` cuts
+    into it deeper than :data:`PRESS_FIT_SHARE` of their radius: a thread, not a press
+    fit (a fit of unknown length counts as a thread)."""
+    radius = max(patch.radius for patch in patches)
+    length = _fit_length(patches)
+    if length is None:
+        return True
     return volume > PRESS_FIT_SHARE * radius * 2 * math.pi * radius * length
+
+
+def _drawn_diameter(volume: float, patches: Sequence[CurvedPatch]) -> float:
+    """The diameter a screw was drawn at, from the ring ``volume`` it shares with a
+    hole through the fits ``patches`` (the ring's outer diameter, the hole's inside
+    it, along the fits' length): a screw drawn at its nominal size (M4, 4 mm) in a
+    hole of its tap drill (3.3 mm) is an M4, not the M3.5 the hole's diameter is near;
+    the fit's diameter where the length is not known."""
+    radius = max(patch.radius for patch in patches)
+    length = _fit_length(patches)
+    if not length:
+        return 2 * radius
+    return 2 * math.sqrt(radius**2 + volume / (math.pi * length))
 
 
 def _reach(
