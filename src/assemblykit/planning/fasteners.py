@@ -9,16 +9,19 @@ within the angle tolerance and whose every point lies within :data:`HEAD_RATIO` 
 of that fit from the axis (a shank and a head: a servo whose output spline is pressed
 into a horn leaves along the spline's axis too, and is no fastener), and a **screw**
 when it also interferes with one of those
-parts by design (a thread cut into its pilot hole or a nut's insert, resolved by
-:func:`~assemblykit.geometry.overlaps.resolve_overlaps`); otherwise a **pin**. Bolts and
+parts by design deeper than :data:`PRESS_FIT_SHARE` of the fit's radius (a thread cut
+into its pilot hole or a nut's insert, resolved by
+:func:`~assemblykit.geometry.overlaps.resolve_overlaps`); **pressed** when it interferes
+less deeply (a press fit); otherwise a **pin**. Bolts and
 screws drawn at their nominal diameter, with no thread modelled and no interference, are
 reported as pins (docs/planning.md, "Fasteners").
 
 A screw comes out by the helical motion of the screw group about its axis (Liu 1997:
 the helical pair; :meth:`Fastener.motion`), whose sweep is the translation's for a part
 round about its axis, so the step's path is checked as a translation. Its **thread** is
-the size written in its name (``M3x20``), else implied by its diameter, the fit's, when
-that is within :data:`NOMINAL_MATCH` of an ISO metric size, where the model's unit is
+the size written in its name (``M3x20``), else implied by the diameter it was drawn at
+(the outer diameter of the ring it shares with its hole), when that is within
+:data:`NOMINAL_MATCH` of an ISO metric size, where the model's unit is
 one of :data:`MILLIMETRES` (millimetres unless the input says otherwise): the coarse
 pitch of ISO 261 for that size
 (:data:`ISO_COARSE_PITCH`; a right-hand thread, unscrewed by turning anticlockwise seen
