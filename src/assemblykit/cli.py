@@ -875,6 +875,12 @@ def _task_motion(path: str, tol: Tolerance, as_json: bool) -> None:
     "subassembly of a STEP file; repeat for several.",
 )
 @click.option("--html", default=None, help="Also write a self-contained HTML view to FILE.")
+@click.option(
+    "--split-products",
+    is_flag=True,
+    help="Take the solids of a product of several solids (a STEP multi-body part) as "
+    "separate parts [default: one rigid part named after the product].",
+)
 @json_option
 @tolerance_option
 @angle_tolerance_option
@@ -885,6 +891,7 @@ def motion_cmd(
     assembly: str,
     subassembly: tuple[str, ...],
     html: str | None,
+    split_products: bool,
     as_json: bool,
     tolerance: float | None,
     angle_tolerance: float | None,
@@ -909,6 +916,10 @@ def motion_cmd(
         _task_motion(assembly, tol, as_json)
         return
     loaded = loaded_assembly(assembly, tol, as_written, partial)
+    if not split_products:
+        from assemblykit.geometry.overlaps import join_products
+
+        loaded = join_products(loaded)
     sets = [
         loaded.groups.get(spec.strip()) or [n.strip() for n in spec.split(",") if n.strip()]
         for spec in subassembly

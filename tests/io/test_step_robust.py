@@ -430,6 +430,27 @@ def test_a_locknut_of_two_solids_is_planned_as_one_part(locknut_step):
 
 
 @cad
+def test_the_motion_of_a_product_of_two_solids_is_that_of_one_part(locknut_step, capsys):
+    # the insert captured in its nut moves with it: the motion command takes the
+    # product as one part, the locknut, as the plan does; solid by solid on request
+    import json
+
+    from assemblykit.geometry.overlaps import join_products
+    from cli_runs import run
+
+    asm = load_assembly(locknut_step)
+    joined = join_products(asm)
+    assert joined.names == ["plate", "screw", "locknut"] and joined.products == {}
+    assert joined.joined == {"locknut": ("locknut_1", "locknut_2")}
+    code, out, _ = run(capsys, "motion", str(locknut_step), "--json")
+    assert code == 0
+    assert list(json.loads(out)["parts"]) == ["plate", "screw", "locknut"]
+    code, out, _ = run(capsys, "motion", str(locknut_step), "--json", "--split-products")
+    assert code == 0
+    assert list(json.loads(out)["parts"]) == ["plate", "screw", "locknut_1", "locknut_2"]
+
+
+@cad
 def test_a_joined_locknut_keeps_the_exact_surfaces_left_outside(locknut_step):
     # the union of nut and insert keeps its members' exact surfaces on its triangles:
     # the nut's bore (radius 1.5) above and below the insert, the insert's bore (1.2)

@@ -92,6 +92,31 @@ def joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> Assembly:
     return _joined(assembly, groups)[0]
 
 
+def join_products(assembly: Assembly) -> Assembly:
+    """``assembly`` with the solids of each product of several solids
+    (:attr:`~assemblykit.model.assembly.Assembly.products`: a locknut's nut and nylon
+    insert, a hinge leaf drawn as a plate and its knuckles) made one rigid part named
+    after the product, as :func:`resolve_overlaps` makes them, and nothing else done:
+    ``joined`` lists each such part's solids, and the groups and supports name the
+    parts they became."""
+    if not assembly.products:
+        return assembly
+    result, into = _joined(assembly, (), assembly.products)
+    prepared = type(result).like(result, scale=result.scale)
+    members: dict[str, list[str]] = {}
+    for name, part in into.items():
+        members.setdefault(part, []).append(name)
+    prepared.joined = {part: tuple(names) for part, names in members.items()}
+    prepared.products = {}
+    prepared.groups = {
+        group: tuple(dict.fromkeys(into.get(name, name) for name in names))
+        for group, names in assembly.groups.items()
+    }
+    grounded = {into.get(name, name) for name in assembly.supports}
+    prepared.supports = tuple(name for name in prepared.parts if name in grounded)
+    return prepared
+
+
 def _joined(
     assembly: Assembly,
     groups: Iterable[Iterable[str]],
