@@ -212,9 +212,6 @@ class _HandsSearch:
                 translations=self.translations,
                 extended=self.extended,
                 volumes=self.sizes,
-                progress=lambda *_: None,
-                steps=[],
-                locked=[],
             )
             search.disassemble(members)
             stopped = search.locked

@@ -91,8 +91,6 @@ def planar_search(
         extended=extended,
         volumes=volumes,
         progress=report,
-        steps=[],
-        locked=[],
         max_steps=max_steps,
         fixed=mask,
     )

@@ -199,8 +199,6 @@ def plan(
         extended=extended,
         volumes=volumes,
         progress=report,
-        steps=[],
-        locked=[],
         exact=exact_candidates(assembly, tol),
         add_translations=translation_slots(assembly, translations, tol),
         narrowers=(one_set,) if one_at_a_time else (),

@@ -957,9 +957,9 @@ class Search:
     translations: DirectionTable
     extended: DirectionTable | ExtendedDirections
     volumes: tuple[float, ...]
-    progress: Progress
-    steps: list[Step]
-    locked: list[int]
+    progress: Progress = field(default=lambda stage, done, total: None)
+    steps: list[Step] = field(default_factory=list)
+    locked: list[int] = field(default_factory=list)
     exact: Callable[[int], NDArray[np.float64]] | None = None
     add_translations: Callable[[NDArray[np.float64]], NDArray[np.bool_]] | None = None
     narrowers: tuple[Narrow, ...] = ()
