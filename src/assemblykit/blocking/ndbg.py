@@ -35,6 +35,7 @@ from assemblykit.blocking.arrangement import (
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.directions import DirectionTable
+from assemblykit.model.assembly import AssemblyLike as AssemblyLike
 from assemblykit.ragged import group_of, group_starts, ranges
 from assemblykit.tolerance import Tolerance
 

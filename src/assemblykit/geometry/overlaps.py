@@ -357,6 +357,13 @@ def _hole_along(
     return None
 
 
+def ring_radius(volume: float, inner: float, length: float) -> float:
+    """The outer radius of the ring of ``volume`` about a cylinder of radius ``inner``
+    along ``length`` of it: the radius a thread's crests reach, read from the volume a
+    screw shares with its hole."""
+    return math.sqrt(volume / (math.pi * length) + inner**2)
+
+
 def _thread_tube(hole: Surface, shared: trimesh.Trimesh, length: float) -> manifold3d.Manifold:
     """The tube about ``hole``'s axis from ``THREAD_CLEARANCE_SHARE`` inside its exact
     radius out to as far outside the outer radius of the ring of the volume and height
@@ -369,7 +376,7 @@ def _thread_tube(hole: Surface, shared: trimesh.Trimesh, length: float) -> manif
     axis = hole.axis
     along = (np.asarray(shared.vertices) - hole.point) @ axis
     height = max(float(np.ptp(along)), 1e-12)
-    ring = math.sqrt(abs(float(shared.volume)) / (math.pi * height) + hole.radius**2)
+    ring = ring_radius(abs(float(shared.volume)), hole.radius, height)
     outer = ring * (1.0 + THREAD_CLEARANCE_SHARE)
     inner = hole.radius * (1.0 - THREAD_CLEARANCE_SHARE)
     ring = manifold3d.CrossSection.circle(outer, SEGMENTS) - manifold3d.CrossSection.circle(

@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 
 from assemblykit.algebra import SymmetryGroup
 from assemblykit.geometry.contacts import CurvedPatch, assembly_contacts
+from assemblykit.geometry.overlaps import ring_radius
 from assemblykit.model.assembly import Assembly
 from assemblykit.tolerance import Tolerance
 
@@ -322,7 +323,7 @@ def _drawn_diameter(volume: float, patches: Sequence[CurvedPatch]) -> float:
     length = _fit_length(patches)
     if not length:
         return 2 * radius
-    return 2 * math.sqrt(radius**2 + volume / (math.pi * length))
+    return 2 * ring_radius(volume, radius, length)
 
 
 def _reach(
