@@ -78,6 +78,24 @@ def cylinder(centre, radius: float, height: float, turn: float = 0.0, axis=(0, 0
     return BRepPrimAPI_MakeCylinder(frame, radius, height).Shape()
 
 
+def hexagon(centre, across_flats: float, height: float, turn: float = 0.0):
+    """A hexagonal prism (a nut's body) standing on ``centre`` along +z, ``across_flats``
+    wide; ``turn`` (degrees) turns it about its axis."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+    from OCP.gp import gp_Pnt, gp_Vec
+
+    x, y, z = map(float, centre)
+    corner = across_flats / math.sqrt(3.0)
+    polygon = BRepBuilderAPI_MakePolygon()
+    for k in range(6):
+        angle = math.radians(turn + 60.0 * k)
+        polygon.Add(gp_Pnt(x + corner * math.cos(angle), y + corner * math.sin(angle), z))
+    polygon.Close()
+    face = BRepBuilderAPI_MakeFace(polygon.Wire()).Face()
+    return BRepPrimAPI_MakePrism(face, gp_Vec(0.0, 0.0, float(height))).Shape()
+
+
 def box(corner, size):
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox
     from OCP.gp import gp_Pnt

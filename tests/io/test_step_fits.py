@@ -25,7 +25,7 @@ from assemblykit.io import step as step_module
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import LINEAR_DEFLECTION
 from assemblykit.planning.planner import plan
-from step_files import box, common_volume, cut, cylinder, fuse, write_step
+from step_files import box, common_volume, cut, cylinder, fuse, hexagon, write_step
 
 pytest.importorskip("OCP")
 
@@ -158,15 +158,15 @@ BOLTS, NUTS = ("solid2", "solid3"), ("solid4", "solid5")
 @pytest.fixture(scope="module")
 def bolted(tmp_path_factory) -> Read:
     """A 60 x 30 x 8 plate with two holes of radius 4; in each a bolt of radius 4 (a head
-    of radius 7 on the plate) and a nut (radius 7, hole of radius 4) under the plate,
-    each cylinder's seam turned differently."""
+    of radius 7 on the plate) and a hexagon nut (13 across flats, hole of radius 4) under
+    the plate, each cylinder's seam turned differently."""
     plate = box((-30, -15, 0), (60, 30, 8))
     bolts, nuts = [], []
     for k, x in enumerate((-15.0, 15.0)):
         plate = cut(plate, cylinder((x, 0, -1), 4.0, 10.0))
         shank = cylinder((x, 0, -5), 4.0, 13.0, turn=5 + 7 * k)
         bolts.append(fuse(shank, cylinder((x, 0, 8), 7.0, 4.0, turn=11)))
-        nut = cylinder((x, 0, -5), 7.0, 5.0, turn=2)
+        nut = hexagon((x, 0, -5), 13.0, 5.0, turn=2)
         nuts.append(cut(nut, cylinder((x, 0, -6), 4.0, 7.0, turn=17 + 3 * k)))
     return read(tmp_path_factory.mktemp("fits") / "bolted.step", plate, *bolts, *nuts)
 
@@ -197,6 +197,79 @@ def test_the_bolts_leave_along_their_axes_through_free_sweeps(bolted):
     assert max(sweep_overlaps(asm, found.steps)) <= NOISE
     # the check is not blind: the bolts cannot go the other way
     assert min(sweep_overlaps(asm, bolts_out, reverse=True)) > 1.0
+
+
+def test_bolts_turned_out_of_their_nuts_are_screws_of_an_implied_thread(bolted):
+    # each bolt (radius 4: an M8) leaves upwards, out of the plate and of its nut, which
+    # stays: it is turned out of the nut, its tip travelling from z = -5 to the nut's
+    # top at z = 0, 5 / 1.25 = 4 turns; the nuts then leave with no bolt to unscrew from
+    found = plan(bolted.assembly)
+    screws = [f for move in found.steps for f in move.fasteners]
+    assert sorted(f.part for f in screws) == sorted(BOLTS)
+    for fastener, nut in zip(sorted(screws, key=lambda f: f.part), NUTS, strict=True):
+        assert fastener.kind == "screw" and nut in fastener.holes and PLATE in fastener.holes
+        assert fastener.thread is not None
+        assert (fastener.thread.size, fastener.thread.pitch) == ("M8", 1.25)
+        assert fastener.thread.turns == pytest.approx(4.0)
+        assert fastener.summary() == "unscrew M8 (pitch 1.25, 4 turns)"
+    assert max(sweep_overlaps(bolted.assembly, found.steps)) <= NOISE
+
+
+@pytest.fixture(scope="module")
+def trapped_head(tmp_path_factory) -> Read:
+    """A 40 x 40 x 20 base with a counterbore of radius 7 and depth 5 in its top; in it
+    the head (radius 7, 4 high, z in [15, 19]) of a bolt of radius 4 up to z = 36,
+    through a plate 8 thick on the base (hole of radius 4) and a nut (radius 7, 5 high,
+    hole of radius 4, 13 across flats: an M8's) on the plate: the bolt cannot leave
+    before the nut."""
+    base = cut(box((-20, -20, 0), (40, 40, 20)), cylinder((0, 0, 15), 7.0, 10.0))
+    bolt = fuse(cylinder((0, 0, 15), 7.0, 4.0, turn=4), cylinder((0, 0, 18), 4.0, 18.0, turn=9))
+    plate = cut(box((-20, -20, 20), (40, 40, 8)), cylinder((0, 0, 19), 4.0, 10.0, turn=13))
+    nut = cut(hexagon((0, 0, 28), 13.0, 5.0, turn=10), cylinder((0, 0, 27), 4.0, 7.0, turn=21))
+    return read(tmp_path_factory.mktemp("fits") / "trapped.step", base, bolt, plate, nut)
+
+
+def test_a_nut_is_unscrewed_off_its_bolt_before_the_bolt_is_pulled(trapped_head):
+    # the nut leaves upwards off the bolt's tip: from its back face at z = 28 to the tip
+    # at z = 36, 8 / 1.25 = 6.4 turns of an M8; the plate is lifted off; the bolt is
+    # then pulled out of its counterbore, a bolt whose nut is off (no turns left)
+    asm = trapped_head.assembly
+    found = plan(asm)
+    assert found.feasible
+    order = [move.parts for move in found.steps]
+    assert order == [("solid4",), ("solid3",), ("solid2",)]
+    nut, plate, bolt = (move.fastener for move in found.steps)
+    assert nut is not None and plate is None and bolt is not None
+    assert (nut.kind, nut.holes, nut.diameter) == ("nut", ("solid2",), 8.0)
+    assert nut.summary() == "unscrew nut M8 (pitch 1.25, 6.4 turns)"
+    assert nut.to_dict()["thread"] == {"size": "M8", "pitch": 1.25, "turns": 6.4, "implied": True}
+    assert (bolt.kind, bolt.summary()) == ("bolt", "pull bolt M8")
+    assert bolt.motion().kind == Kind.PRISMATIC and nut.motion().kind == Kind.HELICAL
+    assert [float(move.direction @ Z) for move in found.steps] == pytest.approx([1, 1, 1])
+    assert max(sweep_overlaps(asm, found.steps)) <= NOISE
+    # the check is not blind: the bolt cannot leave downwards
+    assert sweep_overlaps(asm, found.steps[2:], reverse=True)[0] > 1.0
+
+
+@pytest.mark.parametrize(
+    ("height", "hexagonal", "kind"),
+    [(1.5, True, "pin"), (5.0, True, "screw"), (14.0, True, "pin"), (5.0, False, "pin")],
+)
+def test_a_washer_or_a_spacer_is_no_nut(tmp_path, height, hexagonal, kind):
+    # round a bolt of radius 4 under its plate: a hexagon 1.5 thick (under 0.35 of the
+    # diameter: a washer) or 14 long (over 1.5 diameters: a spacer), or a round ring 5
+    # high (a spacer), leave it a pin; a hexagon 5 high is a nut and makes it a screw
+    plate = cut(box((-20, -20, 0), (40, 40, 8)), cylinder((0, 0, -1), 4.0, 10.0))
+    bolt = fuse(cylinder((0, 0, -16), 4.0, 24.0, turn=5), cylinder((0, 0, 8), 7.0, 4.0))
+    body = (
+        hexagon((0, 0, -height), 13.0, height)
+        if hexagonal
+        else cylinder((0, 0, -height), 7.0, height)
+    )
+    ring = cut(body, cylinder((0, 0, -20), 4.0, 30.0))
+    asm = read(tmp_path / "ring.step", plate, bolt, ring).assembly
+    (fastener,) = [f for move in plan(asm).steps for f in move.fasteners if f.part == "solid2"]
+    assert fastener.kind == kind
 
 
 def rotated(shape, axis, degrees: float):

@@ -5,13 +5,15 @@ in a hole of its diameter and a self-tapping screw, are in tests/io/test_step_fi
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import trimesh
 
 from assemblykit.geometry.overlaps import resolve_overlaps
 from assemblykit.model.assembly import Assembly, Part
-from assemblykit.planning.fasteners import implied_thread
+from assemblykit.planning.fasteners import Fastener, Thread, drawn_summary, implied_thread
 from assemblykit.planning.planner import plan
 from assemblykit.viz.viewer import report_html
 from stability_blocks import box
@@ -210,3 +212,23 @@ def test_a_screw_is_sized_by_the_diameter_it_was_drawn_at_not_by_its_pilot_hole(
     assert out.fastener is not None and out.fastener.kind == "screw"
     assert out.fastener.diameter == pytest.approx(2.0, rel=1e-6)
     assert out.fastener.summary() == "unscrew M2.5 (pitch 0.45, 35.6 turns)"
+
+
+def test_a_step_counts_its_screws_nuts_bolts_and_pins_by_size():
+    z = np.array([0.0, 0.0, 1.0])
+    m5, m3 = Thread("M5", 0.8, 6.0), Thread("M3", 0.5, 4.0)
+    drawn = [
+        Fastener("a", "screw", z, ("plate",), thread=m3),
+        Fastener("b", "nut", z, ("bolt1",), thread=m5),
+        Fastener("c", "nut", z, ("bolt2",), thread=m5),
+        Fastener("d", "bolt", z, ("plate",), thread=replace(m5, turns=0.0)),
+        Fastener("e", "pin", z, ("plate",)),
+    ]
+    assert drawn_summary(drawn) == (
+        "unscrew 1 x M3; unscrew nuts 2 x M5; pull bolts 1 x M5; pull 1 pin"
+    )
+    assert [f.summary() for f in drawn[1:4]] == [
+        "unscrew nut M5 (pitch 0.8, 6 turns)",
+        "unscrew nut M5 (pitch 0.8, 6 turns)",
+        "pull bolt M5",
+    ]

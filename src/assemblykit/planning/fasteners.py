@@ -16,6 +16,17 @@ less deeply (a press fit); otherwise a **pin**. Bolts and
 screws drawn at their nominal diameter, with no thread modelled and no interference, are
 reported as pins (docs/planning.md, "Fasteners").
 
+A **nut** is the outer side of such a fit round a bolt-like shaft (a part within
+:data:`HEAD_RATIO` radii of the axis): a part itself within those radii, between
+:data:`NUT_LENGTH` and :data:`NUT_LONGEST` diameters long along the axis (a washer is
+thinner, a spacer longer), whose outline is a polygon, not round (:data:`NUT_FLATS`: a
+hexagon or a square; a spacer is round). A nut implies a thread: a nut leaving along the
+axis off the bolt's end that stays is unscrewed, the turns being the distance from its
+back face to the bolt's tip over the pitch; a shaft leaving a nut that stays is a screw
+turned out of it (held by the nut, as a fitter turns a bolt out). A shaft that a nut
+came off earlier in the plan is a **bolt** when it then leaves along the same axis:
+pulled out of its holes, of the nut's thread.
+
 A screw comes out by the helical motion of the screw group about its axis (Liu 1997:
 the helical pair; :meth:`Fastener.motion`), whose sweep is the translation's for a part
 round about its axis, so the step's path is checked as a translation. Its **thread** is
@@ -35,7 +46,7 @@ import math
 import re
 from collections import Counter
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -47,7 +58,7 @@ from assemblykit.geometry.overlaps import ring_radius
 from assemblykit.model.assembly import Assembly
 from assemblykit.tolerance import Tolerance
 
-FastenerKind = Literal["screw", "pin", "pressed"]
+FastenerKind = Literal["screw", "pin", "pressed", "nut", "bolt"]
 
 ISO_COARSE_PITCH: dict[float, float] = {
     1.0: 0.25,
@@ -88,6 +99,22 @@ its hole (a bearing, a bushing, a dowel): ISO interference fits press by a few
 thousandths of the diameter, while a thread cut into its pilot hole goes deeper (a
 self-tapping M3 in a 2.9 mm hole, 3% of the radius). The depth is read as the shared
 volume over the fit's surface (its circumference times its length)."""
+
+NUT_LENGTH = 0.35
+"""The shortest nut along its axis, in diameters of its thread: ISO hexagon nuts are
+0.8 to 0.9 diameters long, thin nuts 0.5; a plain washer is 0.2 thick."""
+
+NUT_LONGEST = 1.5
+"""The longest nut along its axis, in diameters of its thread (a high nut is about
+1.2); a spacer round a pin is longer."""
+
+NUT_FLATS = 1.1
+"""How far from round a nut's outline is at least (its widest reach from the axis over
+its narrowest): a hexagon's is 1.155, a square's 1.414; a round spacer, washer or
+bushing is 1."""
+
+OUTLINE_VIEWS = 72
+"""The directions across the axis a nut's outline is measured from (every 5 degrees)."""
 
 PILOT_HOLE = 0.7
 """The smallest fit, a fraction of the size written in a screw's name, that the name is
@@ -179,29 +206,34 @@ class Fastener:
 
     def motion(self) -> SymmetryGroup:
         """The motion that takes it out: the helical group about its axis, of the
-        thread's pitch (``pitch / 2 pi`` per radian, right-handed), for a screw whose
-        thread is known; the translations along the axis otherwise."""
+        thread's pitch (``pitch / 2 pi`` per radian, right-handed), for a screw or nut
+        whose thread is known; the translations along the axis otherwise (a bolt whose
+        nut is off is pulled)."""
         center = np.zeros(3) if self.center is None else self.center
-        if self.thread is None:
+        if self.thread is None or self.kind == "bolt":
             return SymmetryGroup.prismatic(self.axis)
         return SymmetryGroup.helical(center, self.axis, self.thread.pitch / (2 * math.pi))
 
     def summary(self) -> str:
-        """In words: ``"unscrew M3 (pitch 0.5, 12 turns)"``, ``"unscrew"``, ``"pull pin"``
-        or ``"press out"``."""
+        """In words: ``"unscrew M3 (pitch 0.5, 12 turns)"``, ``"unscrew"``, ``"unscrew nut
+        M5 (pitch 0.8, 6.2 turns)"``, ``"pull bolt M5"``, ``"pull pin"`` or ``"press
+        out"``."""
         if self.kind == "pin":
             return "pull pin"
         if self.kind == "pressed":
             return "press out"
-        if self.thread is None:
-            return "unscrew"
         thread = self.thread
-        return f"unscrew {thread.size} (pitch {thread.pitch:g}, {thread.turns:g} turns)"
+        if self.kind == "bolt":
+            return "pull bolt" + (f" {thread.size}" if thread else "")
+        said = "unscrew nut" if self.kind == "nut" else "unscrew"
+        if thread is None:
+            return said
+        return f"{said} {thread.size} (pitch {thread.pitch:g}, {thread.turns:g} turns)"
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON form: ``part``, ``kind`` (``"screw"``, ``"pin"`` or ``"pressed"``),
-        ``axis``, ``holes``, ``diameter`` (of the fit), and for a screw whose thread is
-        implied ``thread`` (:meth:`Thread.to_dict`)."""
+        """JSON form: ``part``, ``kind`` (``"screw"``, ``"pin"``, ``"pressed"``,
+        ``"nut"`` or ``"bolt"``), ``axis``, ``holes`` (for a nut, its bolt), ``diameter``
+        (of the fit), and where a thread is implied ``thread`` (:meth:`Thread.to_dict`)."""
         return {
             "part": self.part,
             "kind": self.kind,
@@ -213,16 +245,31 @@ class Fastener:
 
 
 def drawn_summary(fasteners: Sequence[Fastener]) -> str:
-    """In words, the screws, pins and pressed parts of one step: ``"unscrew 5 x M3, 1 x
-    M2; pull 1 pin; press out 1"`` (screws counted by their implied size, ``"unscrew
-    2"`` where none is implied); empty for none."""
-    sizes = Counter(f.thread.size if f.thread else "" for f in fasteners if f.kind == "screw")
-    screws = ", ".join(f"{n} x {size}" if size else str(n) for size, n in sizes.items())
+    """In words, the screws, nuts, bolts, pins and pressed parts of one step:
+    ``"unscrew 5 x M3, 1 x M2; unscrew nuts 2 x M5; pull bolts 2 x M5; pull 1 pin;
+    press out 1"`` (counted by their implied size, ``"unscrew 2"`` where none is
+    implied); empty for none."""
+    verbs: tuple[tuple[FastenerKind, str], ...] = (
+        ("screw", "unscrew"),
+        ("nut", "unscrew nuts"),
+        ("bolt", "pull bolts"),
+    )
+    said = [
+        f"{verb} {_counted(fasteners, kind)}"
+        for kind, verb in verbs
+        if any(f.kind == kind for f in fasteners)
+    ]
     pins = sum(f.kind == "pin" for f in fasteners)
     pressed = sum(f.kind == "pressed" for f in fasteners)
-    said = [f"unscrew {screws}"] if screws else []
     said += [f"pull {pins} pin{'s' * (pins > 1)}"] if pins else []
     return "; ".join([*said, *([f"press out {pressed}"] if pressed else [])])
+
+
+def _counted(fasteners: Sequence[Fastener], kind: FastenerKind) -> str:
+    """The fasteners of ``kind`` counted by their implied size: ``"5 x M3, 1 x M2"``,
+    ``"2"`` where none is implied."""
+    sizes = Counter(f.thread.size if f.thread else "" for f in fasteners if f.kind == kind)
+    return ", ".join(f"{n} x {size}" if size else str(n) for size, n in sizes.items())
 
 
 def step_fastener(
@@ -234,29 +281,15 @@ def step_fastener(
 ) -> Fastener | None:
     """The fastener a step moving ``parts`` along ``direction`` out of ``rest`` takes
     out, or ``None`` (module docstring): a single part with a cylindrical fit along the
-    direction in some part of ``rest``."""
+    direction in some part of ``rest``, as its shaft (a screw, pin or pressed part) or
+    as a nut."""
     if len(parts) != 1:
         return None
     (part,) = parts
-    staying = set(rest)
     d = np.asarray(direction, dtype=np.float64) / np.linalg.norm(direction)
-    fits: dict[str, list[CurvedPatch]] = {}
-    for contact in assembly_contacts(assembly, tol):
-        other = contact.b if contact.a == part else contact.a if contact.b == part else None
-        if other is None or other not in staying:
-            continue
-        found = [
-            patch
-            for patch in contact.curved
-            if patch.kind == "cylindrical"
-            and patch.inner == part
-            and patch.axis is not None
-            and abs(float(patch.axis @ d)) >= np.cos(tol.mesh_angle)
-        ]
-        if found:
-            fits.setdefault(other, []).extend(found)
+    fits = _fits(assembly, part, d, set(rest), tol, inner=True)
     if not fits:
-        return None
+        return _nut(assembly, part, d, _fits(assembly, part, d, set(rest), tol, inner=False))
     order = {name: k for k, name in enumerate(assembly.names)}
     holes = sorted(fits, key=order.__getitem__)
     shared = {
@@ -264,7 +297,12 @@ def step_fastener(
         for hole in holes
     }
     pressed = [hole for hole in holes if shared[hole] > 0]
-    threaded = [hole for hole in pressed if _cut_deeper_than_a_press(shared[hole], fits[hole])]
+    threaded = [
+        hole
+        for hole in holes
+        if (hole in pressed and _cut_deeper_than_a_press(shared[hole], fits[hole]))
+        or _nut_on_bolt(assembly, hole, part, fits[hole], d)
+    ]
     first = fits[holes[0]][0]
     diameter = 2 * max(patch.radius for hole in holes for patch in fits[hole])
     center = np.asarray(first.center, dtype=np.float64)
@@ -285,6 +323,116 @@ def step_fastener(
         diameter,
         thread,
     )
+
+
+def _fits(
+    assembly: Assembly,
+    part: str,
+    direction: NDArray[np.float64],
+    staying: set[str],
+    tol: Tolerance,
+    *,
+    inner: bool,
+) -> dict[str, list[CurvedPatch]]:
+    """The cylindrical fits of ``part`` along the unit ``direction`` with each part of
+    ``staying`` it touches, as their shaft (``inner``) or their hole."""
+    fits: dict[str, list[CurvedPatch]] = {}
+    for contact in assembly_contacts(assembly, tol):
+        other = contact.b if contact.a == part else contact.a if contact.b == part else None
+        if other is None or other not in staying:
+            continue
+        found = [
+            patch
+            for patch in contact.curved
+            if patch.kind == "cylindrical"
+            and (patch.inner == part) is inner
+            and patch.axis is not None
+            and abs(float(patch.axis @ direction)) >= np.cos(tol.mesh_angle)
+        ]
+        if found:
+            fits.setdefault(other, []).extend(found)
+    return fits
+
+
+def _nut(
+    assembly: Assembly,
+    part: str,
+    direction: NDArray[np.float64],
+    fits: dict[str, list[CurvedPatch]],
+) -> Fastener | None:
+    """``part`` as a nut leaving the bolt its hole ``fits`` along ``direction`` (module
+    docstring), or ``None``: one shaft, both within :data:`HEAD_RATIO` radii of the
+    axis, the part at least :data:`NUT_LENGTH` diameters long."""
+    if len(fits) != 1:
+        return None
+    ((bolt, patches),) = fits.items()
+    if not _nut_on_bolt(assembly, part, bolt, patches, direction):
+        return None
+    radius = max(patch.radius for patch in patches)
+    shared = sum(o.volume for o in assembly.overlaps if {o.a, o.b} == {part, bolt})
+    tip = float((assembly[bolt].mesh.vertices @ direction).max())
+    travel = tip - float((assembly[part].mesh.vertices @ direction).min())
+    thread = implied_thread(_drawn_diameter(shared, patches), travel, assembly.units, part)
+    center = np.asarray(patches[0].center, dtype=np.float64)
+    return Fastener(part, "nut", direction, (bolt,), center, 2 * radius, thread)
+
+
+def _nut_on_bolt(
+    assembly: Assembly,
+    nut: str,
+    bolt: str,
+    patches: Sequence[CurvedPatch],
+    axis: NDArray[np.float64],
+) -> bool:
+    """Whether ``nut`` fits round ``bolt`` by ``patches`` along the unit ``axis`` as a
+    nut does (module docstring): both within :data:`HEAD_RATIO` radii of the axis, the
+    nut between :data:`NUT_LENGTH` and :data:`NUT_LONGEST` diameters long, its outline
+    a polygon (:data:`NUT_FLATS`)."""
+    center = np.asarray(patches[0].center, dtype=np.float64)
+    radius = max(patch.radius for patch in patches)
+    around, shaft = assembly[nut].mesh.vertices, assembly[bolt].mesh.vertices
+    reach = HEAD_RATIO * radius
+    if _reach(around, center, axis) > reach or _reach(shaft, center, axis) > reach:
+        return False
+    along = around @ axis
+    length = float(along.max() - along.min())
+    if not NUT_LENGTH * 2 * radius <= length <= NUT_LONGEST * 2 * radius:
+        return False
+    return _flats(around - center, axis) >= NUT_FLATS
+
+
+def _flats(points: NDArray[np.float64], axis: NDArray[np.float64]) -> float:
+    """How far ``points`` (about a point of the unit ``axis``) are from round about it:
+    their widest reach over their narrowest, seen from :data:`OUTLINE_VIEWS` directions
+    across the axis (a hexagon's corners over its flats, 2 / sqrt 3; a faceted
+    cylinder's, 1 to within its facets)."""
+    across = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
+    across /= np.linalg.norm(across)
+    angles = np.linspace(0.0, 2 * np.pi, OUTLINE_VIEWS, endpoint=False)
+    views = np.outer(np.cos(angles), across) + np.outer(np.sin(angles), np.cross(axis, across))
+    reach = (points @ views.T).max(axis=0)
+    return float(reach.max() / reach.min()) if reach.min() > 0 else 0.0
+
+
+def bolts_after_nuts(fasteners: Sequence[Sequence[Fastener]]) -> list[tuple[Fastener, ...]]:
+    """The fasteners of a plan's steps (``fasteners[k]``: step ``k``'s, in order) with
+    each pin that a nut came off in an earlier step, leaving along the nut's axis, read
+    as a **bolt** (module docstring) of the nut's thread, with no turns left."""
+    nuts: dict[str, Fastener] = {}
+    read: list[tuple[Fastener, ...]] = []
+    for step in fasteners:
+        read.append(tuple(_as_bolt(f, nuts.get(f.part)) for f in step))
+        nuts.update((f.holes[0], f) for f in step if f.kind == "nut")
+    return read
+
+
+def _as_bolt(fastener: Fastener, nut: Fastener | None) -> Fastener:
+    """``fastener`` as a bolt where it is a pin leaving along the axis of the ``nut``
+    that came off it."""
+    if nut is None or fastener.kind != "pin" or abs(float(fastener.axis @ nut.axis)) < 0.5:
+        return fastener
+    thread = None if nut.thread is None else replace(nut.thread, turns=0.0)
+    return replace(fastener, kind="bolt", thread=thread)
 
 
 def _fit_length(patches: Sequence[CurvedPatch]) -> float | None:

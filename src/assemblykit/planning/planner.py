@@ -24,7 +24,7 @@ from assemblykit.geometry.interference import interferences
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.equilibrium import equilibrium_model
 from assemblykit.planning.equilibrium_memory import EquilibriumMemory
-from assemblykit.planning.fasteners import step_fastener
+from assemblykit.planning.fasteners import bolts_after_nuts, step_fastener
 from assemblykit.planning.gravity import Gravity, GravityReport, gravity_direction
 from assemblykit.planning.hands import hands_needed
 from assemblykit.planning.judge import StateJudge
@@ -382,7 +382,7 @@ def finish_plan(
     unfinished = tuple(names[i] for i in bits(union_of(search.unfinished)))
     steps = tuple(search.steps)
     if isinstance(assembly, Assembly):
-        steps = tuple(_with_fasteners(assembly, step, tol) for step in steps)
+        steps = _with_fasteners(assembly, steps, tol)
     return Plan(
         names,
         steps,
@@ -396,18 +396,23 @@ def finish_plan(
     )
 
 
-def _with_fasteners(assembly: Assembly, step: Step, tol: Tolerance) -> Step:
-    """``step`` with the pins and screws it draws out of the parts it leaves: the
-    fastener of each of its moves of one part (:func:`step_fastener`), and the step's
-    own when it moves one part only."""
-    fasteners = [
-        step_fastener(assembly, group, step.direction, step.rest, tol)
-        for group in moving_groups(step.parts, step.blocking)
-        if len(group) == 1
+def _with_fasteners(assembly: Assembly, steps: Sequence[Step], tol: Tolerance) -> tuple[Step, ...]:
+    """``steps`` with the fasteners each draws out of the parts it leaves: the fastener
+    of each of its moves of one part (:func:`step_fastener`), a pin that a nut came
+    off earlier read as a bolt (:func:`bolts_after_nuts`), and the step's own when it
+    moves one part only."""
+    found = [
+        [
+            step_fastener(assembly, group, step.direction, step.rest, tol)
+            for group in moving_groups(step.parts, step.blocking)
+            if len(group) == 1
+        ]
+        for step in steps
     ]
-    drawn = tuple(f for f in fasteners if f is not None)
-    return replace(
-        step, fastener=drawn[0] if len(step.parts) == 1 and drawn else None, fasteners=drawn
+    drawn = bolts_after_nuts([[f for f in fasteners if f is not None] for fasteners in found])
+    return tuple(
+        replace(step, fastener=own[0] if len(step.parts) == 1 and own else None, fasteners=own)
+        for step, own in zip(steps, drawn, strict=True)
     )
 
 
