@@ -17,6 +17,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 
+def blocking_components(graph: nx.DiGraph[str] | nx.DiGraph[int]) -> nx.DiGraph[int]:
+    """The strong components of a blocking graph (its parts, an arc ``i -> j`` where
+    ``j`` blocks ``i``) as the acyclic graph of them, each node's ``members`` the parts
+    of one component: networkx's condensation, the one routine every DBG's components
+    come from (:meth:`DirectionalBlockingGraph.sccs`, the sets a step moves, the
+    minimal free sets of a plan's search; blocking/directions.py labels the same
+    components for many DBGs at once). Its sinks are the minimal locally free sets
+    (Wilson & Latombe 1992, "Directional Blocking Graph")."""
+    return nx.condensation(graph)
+
+
 @dataclass(frozen=True, eq=False)
 class DirectionalBlockingGraph:
     """G(d, A): ``parts`` in order, the motion ``direction`` (a unit 2-, 3- or 6-vector)
@@ -49,14 +60,17 @@ class DirectionalBlockingGraph:
         return (moving, blocker) in self.arcs
 
     def sccs(self) -> list[frozenset[str]]:
-        """The strongly connected components (networkx), largest first."""
-        comps = [frozenset(c) for c in nx.strongly_connected_components(self.graph)]
+        """The strongly connected components (:func:`blocking_components`), largest
+        first."""
+        members = nx.get_node_attributes(self.condensation, "members")
+        comps = [frozenset(c) for c in members.values()]
         return sorted(comps, key=lambda c: (-len(c), sorted(c)))
 
     @cached_property
     def condensation(self) -> nx.DiGraph[int]:
-        """The acyclic graph of the components; node attribute ``members`` (networkx)."""
-        return nx.condensation(self.graph)
+        """The acyclic graph of the components; node attribute ``members``
+        (:func:`blocking_components`)."""
+        return blocking_components(self.graph)
 
     def is_free(self, subassembly: frozenset[str] | set[str]) -> bool:
         """Whether ``subassembly`` is locally free: no arc from it to the rest (Wilson & Latombe

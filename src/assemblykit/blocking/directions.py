@@ -136,7 +136,8 @@ class DirectionTable:
         direction, the row of its DBG; per row and member (in bit order), its component;
         per component, whether it is a sink (no arc leaves it). The distinct DBGs are
         taken as one graph, their disjoint union, whose strong components are theirs:
-        one call to scipy's ``connected_components`` for all of them."""
+        one call to scipy's ``connected_components`` for all of them, the components
+        :func:`~assemblykit.blocking.dbg.blocking_components` gives one DBG at a time."""
         inside = self.vector(members)
         nodes = np.flatnonzero(inside)
         index = np.full(len(self.names), -1, dtype=np.int64)

@@ -40,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
+from assemblykit.blocking.dbg import blocking_components
 from assemblykit.errors import UnknownNameError
 from assemblykit.ragged import group_of, ranges
 
@@ -68,7 +69,7 @@ def moving_groups(
     graph: nx.DiGraph[str] = nx.DiGraph()
     graph.add_nodes_from(parts)
     graph.add_edges_from((i, j) for i, j in arcs if i in inside and j in inside and i != j)
-    condensed = nx.condensation(graph)
+    condensed = blocking_components(graph)
     rank = {name: k for k, name in enumerate(parts)}
 
     def first(component: int) -> int:

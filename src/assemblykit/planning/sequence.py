@@ -50,6 +50,7 @@ from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
 from assemblykit.blocking.cache import BlockingCache
+from assemblykit.blocking.dbg import blocking_components
 from assemblykit.blocking.directions import (
     DirectionTable,
     bits,
@@ -743,7 +744,7 @@ def _sinks(source: DirectionTable | ExtendedDirections, k: int, members: int) ->
     """The minimal free sets of ``members`` along direction ``k``: the sink strong
     components of its DBG, as bit masks (Wilson & Latombe 1992, "Directional Blocking
     Graph")."""
-    condensed = nx.condensation(source.graph(k, members))
+    condensed = blocking_components(source.graph(k, members))
     return [
         mask_of(condensed.nodes[c]["members"])
         for c in condensed.nodes
