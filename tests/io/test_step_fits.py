@@ -602,8 +602,8 @@ def test_a_screw_tapped_through_plates_faceted_apart_leaves_along_its_axis(screw
 def test_a_flange_coupling_comes_apart_as_a_fitter_takes_it(tmp_path):
     # two flanges (discs of radius 40 with hubs, bores of radius 10) face to face, a
     # shaft of the bore's radius in each hub, four bolts of radius 4 at their holes'
-    # radius through both discs (heads under the first) and a nut on each above the
-    # second: everything at nominal size. By hand: the nuts come off upwards and the
+    # radius through both discs (heads under the first) and a hexagon nut on each above
+    # the second: everything at nominal size. By hand: the nuts come off upwards and the
     # bolts out downwards along their axes, the flanges part along the bolts once the
     # nuts are off, and each shaft leaves along the axis; every step is clear of every
     # part in place
@@ -618,7 +618,7 @@ def test_a_flange_coupling_comes_apart_as_a_fitter_takes_it(tmp_path):
 
     shafts = [cylinder((0, 0, -60), 10, 58, turn=3), cylinder((0, 0, 22), 10, 58, turn=9)]
     bolts = [fuse(cylinder((x, y, -5), 7, 5), cylinder((x, y, 0), 4, 26)) for x, y in holes]
-    nuts = [cut(cylinder((x, y, 20), 7, 6), cylinder((x, y, 19), 4, 8, turn=5)) for x, y in holes]
+    nuts = [cut(hexagon((x, y, 20), 13, 6), cylinder((x, y, 19), 4, 8, turn=5)) for x, y in holes]
     shapes = (flange(0, -20), flange(10, 20), *shafts, *bolts, *nuts)
     asm = read(tmp_path / "flange.step", *shapes).assembly
     assert interferences(asm) == []
@@ -637,3 +637,11 @@ def test_a_flange_coupling_comes_apart_as_a_fitter_takes_it(tmp_path):
     leaving = second if first not in when else first
     assert abs(float(moved[leaving].direction @ Z)) == pytest.approx(1.0)
     assert all(when[nut] <= when[leaving] for nut in nut_names)
+    # each hexagon nut (13 across flats) is unscrewed off its M8 bolt, from its back
+    # face at z = 20 to the bolt's tip at z = 26: 6 / 1.25 = 4.8 turns; each bolt then
+    # pulled out
+    fasteners = {f.part: f for step in found.steps for f in step.fasteners}
+    for nut in nut_names:
+        assert fasteners[nut].summary() == "unscrew nut M8 (pitch 1.25, 4.8 turns)"
+    for bolt in bolt_names:
+        assert fasteners[bolt].summary() == "pull bolt M8"
