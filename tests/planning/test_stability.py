@@ -271,17 +271,15 @@ def test_an_independent_solution_of_the_arch_agrees_with_the_program():
 
 
 @pytest.mark.early
-@pytest.mark.parametrize("stride", [4, pytest.param(1, marks=pytest.mark.slow)])
-def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(stride):
+def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top():
     """The first 40 steps of the cross vault's plan under gravity with one hold (the
     grip); the whole plan, minutes long, is a benchmark (``bench_stability.py
     --crossvault-plan``). Each block leaves alone, held by its grip and nothing more,
-    and states are decided again by a fresh model's whole program (none of the plan's
-    shortcuts: balances and certificates kept, regions, the friction search's start):
-    every falling one, and of the standing ones every ``stride``-th (every one in the
-    slow tier). A state said to stand stands with the least friction said to be needed
-    (and so with more), and on four steps spread over the forty not with one resolution
-    less, even on every polygon vertex (not only the corners). The vault stands whole only
+    and each state is decided again by a fresh model's whole program (none of the plan's
+    shortcuts: balances and certificates kept, regions, the friction search's start): a
+    state said to stand stands with the least friction said to be needed (and so with
+    more), and on four steps spread over the forty not with one resolution less, even on
+    every polygon vertex (not only the corners). The vault stands whole only
     once its crown joints are contacts (the tolerance), on fixed blocks that are not
     its crown. Taken down from the top, the vault stands for about 40 steps;
     which of two mirror-image blocks goes first follows a rounding rule
@@ -310,8 +308,6 @@ def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(s
             assert step["would_fall"] == []
             needed = step["friction_needed"]
             assert needed is not None and 0 <= needed <= MU
-            if number % stride and number not in spread:
-                continue
             assert model.stands(rest, rest & fixed, needed, local=False), step["parts"]
             if number in spread and needed > 0:
                 # falling on every polygon vertex, it falls on the corners the plan uses
