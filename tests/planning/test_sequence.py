@@ -14,6 +14,7 @@ from assemblykit.blocking.directions import DirectionTable, local_table, mask_of
 from assemblykit.blocking.extended import extended_dbg, extended_free
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.blocking.tables import translation_table
+from assemblykit.geometry.overlaps import resolve_overlaps
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.planner import plan
@@ -34,6 +35,7 @@ from assemblykit.planning.sequence import (
     separable,
 )
 from datasets import dataset
+from plan_checks import assert_steps_clear
 from stability_blocks import box
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -625,3 +627,29 @@ def test_a_stopped_set_names_its_interfering_pairs_with_their_volumes():
     assert {a, b} == {"cup", "peg"} and volume == pytest.approx(0.1 * 0.2 * 1.0, rel=1e-9)
     assert lock.reason.startswith("interfering (") and "0.02" in lock.reason
     assert result.to_dict()["interlocked"][0]["interfering"][0]["volume"] == pytest.approx(0.02)
+
+
+def test_a_chain_of_plates_drawn_overlapping_leaves_as_one_and_names_an_interfering_pair():
+    # three 10 x 10 x 1 plates in one layer on a base, each drawn 4 into the next (40%
+    # of a plate: more than a designed share, so left as they are): no translation
+    # parts two plates that share a volume, so the chain lifts off as one (+z), the plan
+    # is not feasible, and the interlock it names is the first such pair, (a, b), which
+    # manifold3d finds sharing 4 x 10 x 1 = 40
+    base = box((30, 14, 1), (-2, -2, 0))
+    plates = {name: box((10, 10, 1), (x, 0, 1)) for name, x in (("a", 0), ("b", 6), ("c", 12))}
+    drawn = Assembly([Part("base", base), *(Part(n, m) for n, m in plates.items())])
+    shared = trimesh.boolean.intersection([plates["a"], plates["b"]], engine="manifold")
+    assert shared.volume == pytest.approx(40.0)
+    prepared = resolve_overlaps(drawn)
+    assert {(o.a, o.b, o.resolution) for o in prepared.overlaps} == {("a", "b", ""), ("b", "c", "")}
+    result = plan(prepared, max_and_or_parts=0)
+    assert not result.feasible and sorted(result.stuck) == ["a", "b", "c"]
+    (step,) = result.steps
+    assert sorted(step.parts) == ["a", "b", "c"] and step.rest == ("base",)
+    np.testing.assert_allclose(step.direction, [0.0, 0.0, 1.0], atol=1e-9)
+    (lock,) = result.interlocked
+    assert lock.parts == ("a", "b") and {(a, b) for a, b, _ in lock.interfering} == {
+        ("a", "b"),
+        ("b", "c"),
+    }
+    assert_steps_clear(prepared, result)

@@ -12,7 +12,7 @@ polygons, Γ_t and Γ_e come together along the regions of their common arrangem
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -63,6 +63,37 @@ def translation_slots(
         )
 
     return slots
+
+
+def with_obstacles(
+    table: DirectionTable,
+    slots: Callable[[NDArray[np.float64]], NDArray[np.bool_]],
+    pairs: Sequence[tuple[int, int]],
+) -> tuple[DirectionTable, Callable[[NDArray[np.float64]], NDArray[np.bool_]]]:
+    """Γ_t of ``table`` (and ``slots``, its rows along new directions:
+    :func:`translation_slots`) with each of ``pairs`` of parts (indices into its names)
+    blocking each other along every direction: parts left interfering, an obstacle to
+    each other in every direction (docs/planning.md, "Interfering parts"), as Γ_e has
+    them. Γ_t then blocks them where Γ_e does, and a search finds that they go
+    together without projecting a mesh."""
+    arcs = {(int(i), int(j)) for a, b in pairs for i, j in ((a, b), (b, a))}
+    if not arcs:
+        return table, slots
+    existing = set(zip(table.moving.tolist(), table.blocker.tolist(), strict=True))
+    added = sorted(arcs - existing)
+    columns = np.array(
+        list(zip(table.moving.tolist(), table.blocker.tolist(), strict=True)) + added
+    )
+    order = np.lexsort((columns[:, 1], columns[:, 0]))
+    always = np.array([(int(i), int(j)) in arcs for i, j in columns[order]], dtype=bool)
+
+    def widened(rows: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        every = np.hstack([rows, np.zeros((len(rows), len(added)), dtype=bool)])[:, order]
+        every[:, always] = True
+        return every
+
+    blocked = DirectionTable(table.names, table.directions, widened(table.slots), *columns[order].T)
+    return blocked, lambda directions: widened(slots(directions))
 
 
 def planar_direction_tables(

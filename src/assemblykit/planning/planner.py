@@ -18,7 +18,7 @@ from assemblykit.blocking.directions import DirectionTable, bits, mask_of, union
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.rigid import RigidBlockingGraph
-from assemblykit.blocking.tables import translation_slots, translation_table
+from assemblykit.blocking.tables import translation_slots, translation_table, with_obstacles
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.geometry.interference import interferences
 from assemblykit.model.assembly import Assembly
@@ -189,7 +189,17 @@ def plan(
         planar = planar_search(assembly, tol, report, max_steps, declared)
         result = finish_plan(assembly, planar, tol, max_and_or_parts, max_hands, report)
         return replace(result, fixed=declared)
-    translations = translation_table(assembly, tol)
+    index = {name: k for k, name in enumerate(names)}
+    contacting = translation_table(assembly, tol)
+    translations, add_translations = with_obstacles(
+        contacting,
+        translation_slots(assembly, contacting, tol),
+        [
+            (index[o.a], index[o.b])
+            for o in getattr(assembly, "overlaps", ())
+            if not o.resolution and o.a in index and o.b in index
+        ],
+    )
     extended = ExtendedDirections(assembly, translations.directions, tol)
     volumes = anchored_volumes(
         names, tuple(assembly.parts[name].volume for name in names), declared
@@ -200,7 +210,7 @@ def plan(
         volumes=volumes,
         progress=report,
         exact=exact_candidates(assembly, tol),
-        add_translations=translation_slots(assembly, translations, tol),
+        add_translations=add_translations,
         narrowers=(one_set,) if one_at_a_time else (),
         max_steps=max_steps,
         fixed=mask_of(k for k, name in enumerate(names) if name in declared),

@@ -1091,7 +1091,12 @@ def least_interlocked(translations: DirectionTable, extended: Any, members: int)
     a set Γ_t cannot separate is interlocked: parts are first dropped while Γ_t alone
     cannot separate the rest (:func:`minimal_interlocked` on Γ_t: a pair drawn
     interfering, a pin in a blind hole), then while Γ_e cannot, asked only along the
-    directions where Γ_t separates the rest, and only until one separates it."""
+    directions where Γ_t separates the rest, and only until one separates it. A pair
+    that Γ_t blocks both ways along every direction (parts left interfering:
+    :func:`~assemblykit.blocking.tables.with_obstacles`) is such a subset at once."""
+    held = _held_pair(translations, members)
+    if held:
+        return held
     core = members
     if not separable(translations, members):
         core = minimal_interlocked(translations, members)
@@ -1111,6 +1116,23 @@ def least_interlocked(translations: DirectionTable, extended: Any, members: int)
         return subset
 
     return drop(core)
+
+
+def _held_pair(translations: DirectionTable, members: int) -> int:
+    """The first pair of ``members`` (in index order) that Γ_t blocks both ways along
+    every direction of ``translations``, as a mask; 0 when there is none. No translation
+    separates such a pair."""
+    everywhere = translations.slots.all(axis=0)
+    inside = translations.vector(members)
+    arcs = {
+        (int(i), int(j))
+        for i, j in zip(
+            translations.moving[everywhere], translations.blocker[everywhere], strict=True
+        )
+        if inside[i] and inside[j]
+    }
+    pairs = sorted((i, j) for i, j in arcs if i < j and (j, i) in arcs)
+    return (1 << pairs[0][0]) | (1 << pairs[0][1]) if pairs else 0
 
 
 def _connected_as_shown(translations: DirectionTable, extended: Any, k: int, members: int) -> bool:
