@@ -156,14 +156,19 @@ def projected_arcs(
     first_only: bool = False,
 ) -> set[tuple[str, str]]:
     """:func:`extended_arcs` on the parts' meshes, along the unit direction ``d``: cones
-    for pairs of convex parts, the projection test for the others."""
+    for pairs of convex parts, the projection test for the others; a pair left
+    interfering (:attr:`~assemblykit.model.assembly.Assembly.overlaps`, resolution
+    ``""``) blocks along every direction, with no test."""
     cache = BlockingCache.of(assembly).obstacles
     near_parts = sweep_candidates(assembly, moving_parts, d, blockers)
+    held = {frozenset((o.a, o.b)) for o in getattr(assembly, "overlaps", ()) if not o.resolution}
     arcs: set[tuple[str, str]] = set()
     projected: list[tuple[str, str]] = []
     for moving, near in zip(moving_parts, near_parts, strict=True):
         for blocker in near:
-            if not (cache.convex(moving) and cache.convex(blocker)):
+            if frozenset((moving, blocker)) in held:
+                arcs.add((moving, blocker))
+            elif not (cache.convex(moving) and cache.convex(blocker)):
                 projected.append((moving, blocker))
             elif any(
                 blocks_along(c, d, tol.angle)[0] for c in cache.cones_of(moving, blocker, tol)
