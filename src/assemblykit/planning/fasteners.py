@@ -52,7 +52,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.algebra import SymmetryGroup
+from assemblykit.algebra import SymmetryGroup, se3
 from assemblykit.geometry.contacts import CurvedPatch, assembly_contacts
 from assemblykit.geometry.overlaps import ring_radius
 from assemblykit.model.assembly import Assembly
@@ -406,10 +406,9 @@ def _flats(points: NDArray[np.float64], axis: NDArray[np.float64]) -> float:
     their widest reach over their narrowest, seen from :data:`OUTLINE_VIEWS` directions
     across the axis (a hexagon's corners over its flats, 2 / sqrt 3; a faceted
     cylinder's, 1 to within its facets)."""
-    across = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
-    across /= np.linalg.norm(across)
+    u, v = se3.axis_basis(axis)
     angles = np.linspace(0.0, 2 * np.pi, OUTLINE_VIEWS, endpoint=False)
-    views = np.outer(np.cos(angles), across) + np.outer(np.sin(angles), np.cross(axis, across))
+    views = np.outer(np.cos(angles), u) + np.outer(np.sin(angles), v)
     reach = (points @ views.T).max(axis=0)
     return float(reach.max() / reach.min()) if reach.min() > 0 else 0.0
 
