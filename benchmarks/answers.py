@@ -4,15 +4,17 @@ Run ``python benchmarks/answers.py OUT`` with one install, again with another, t
 ``diff -r OUT1 OUT2``: plans, verdicts and poses must be identical (the deterministic
 ordering rule and the signs of docs/architecture.md, "Tolerances"). Keys that measure
 the run rather than the answer (times, versions) are left out. The commands run in this
-process, one after the other (the imports are paid once).
+process, one after the other (the imports are paid once); ``--jobs 2`` shares them
+between two processes, with the same files written.
 """
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import json
-import sys
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +31,16 @@ VOLATILE = {"seconds", "elapsed", "time", "times", "version", "timings"}
 
 def jobs() -> list[tuple[str, list[str]]]:
     """(output name, command arguments) for every bundled example."""
-    found: list[tuple[str, list[str]]] = []
+    # the longest first, so that --jobs shares out the others: the first 20 steps of the
+    # cross vault under gravity (its whole plan, 183 steps and minutes long, is compared
+    # the same way by hand: docs/planning.md, "Under gravity")
+    vault = DATA / "compas_assembly" / "crossvault_assembly.json"
+    found: list[tuple[str, list[str]]] = [
+        (
+            "plan_crossvault_gravity_20",
+            ["plan", str(vault), "--gravity", "--tolerance", "5e-5", "--max-steps", "20"],
+        )
+    ]
     for task in sorted((EXAMPLES / "tasks").glob("*.*")):
         found.append((f"solve_{task.name}", ["solve", str(task)]))
     for problem in sorted((EXAMPLES / "mating").glob("*.yaml")):
@@ -50,15 +61,6 @@ def jobs() -> list[tuple[str, list[str]]]:
     found.append(("plan_arch_gravity_3", ["plan", str(arch), "--gravity", "--extra-holds", "2"]))
     found.append(("plan_stack_gravity", ["plan", str(stack), "--gravity"]))
     found.append(("plan_beam", ["plan", str(DATA / "asap_beam_assembly")]))
-    # the first 20 steps of the cross vault under gravity (its whole plan, 183 steps and
-    # minutes long, is compared the same way by hand: docs/planning.md, "Under gravity")
-    vault = DATA / "compas_assembly" / "crossvault_assembly.json"
-    found.append(
-        (
-            "plan_crossvault_gravity_20",
-            ["plan", str(vault), "--gravity", "--tolerance", "5e-5", "--max-steps", "20"],
-        )
-    )
     return found
 
 
@@ -98,12 +100,16 @@ def answer(argv: list[str]) -> tuple[int, str]:
 
 
 def main_answers() -> None:
-    out = Path(sys.argv[1])
-    out.mkdir(parents=True, exist_ok=True)
-    for name, argv in jobs():
-        code, text = answer(argv)
-        (out / f"{name}.json").write_text(text + "\n", encoding="utf-8")
-        print(f"{name:<40} exit {code}")
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", type=Path, help="folder for one JSON file per example")
+    parser.add_argument("--jobs", type=int, default=1, help="processes sharing the examples")
+    args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    names, argvs = zip(*jobs(), strict=True)
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        for name, (code, text) in zip(names, pool.map(answer, argvs), strict=True):
+            (args.out / f"{name}.json").write_text(text + "\n", encoding="utf-8")
+            print(f"{name:<40} exit {code}")
 
 
 if __name__ == "__main__":
