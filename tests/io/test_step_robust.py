@@ -1,6 +1,6 @@
-"""STEP files as CAD tools write them: analytic faces stored as B-splines, a solid that
-BRepMesh does not mesh, product names that are placeholders, repeated or escaped
-(ISO 10303-21:2016 §6.4.3), products of several solids."""
+"""STEP files as CAD tools write them: bodies stored as surfaces, analytic faces stored
+as B-splines, a solid that BRepMesh does not mesh, product names that are placeholders,
+repeated or escaped (ISO 10303-21:2016 §6.4.3), products of several solids."""
 
 from __future__ import annotations
 
@@ -110,6 +110,117 @@ def _nurbs(shape: Any) -> Any:
     from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
 
     return BRepBuilderAPI_NurbsConvert(shape, True).Shape()
+
+
+def _faces(shape: Any) -> list[Any]:
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+
+    explorer, found = TopExp_Explorer(shape, TopAbs_FACE), []
+    while explorer.More():
+        found.append(explorer.Current())
+        explorer.Next()
+    return found
+
+
+def _shell(faces: list[Any]) -> Any:
+    """A shell of ``faces`` (closed when they close a volume), not a solid."""
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS_Shell
+
+    shell, builder = TopoDS_Shell(), BRep_Builder()
+    builder.MakeShell(shell)
+    for face in faces:
+        builder.Add(shell, face)
+    shell.Closed(len(faces) == 6)
+    return shell
+
+
+# -- bodies stored as surfaces --------------------------------------------------------
+
+
+@cad
+@pytest.mark.parametrize("inside_out", [False, True], ids=["outwards", "inside-out"])
+def test_a_body_stored_as_a_closed_shell_is_a_part_that_leaves(tmp_path, inside_out):
+    """A lid written as a surface model (its six faces a closed shell, the writer's
+    ``SHELL_BASED_SURFACE_MODEL``) on a solid base: the lid is a part of the box's volume
+    (10 x 10 x 4), said read from a shell, and is lifted off (+z) clear of the base,
+    as it would be drawn as a solid; turned inside out, the same."""
+    pytest.importorskip("OCP")
+    shell = _shell(_faces(_box(10, 10, 4, (5, 5, 5))))
+    doc = _Document()
+    rig = doc.assembly("rig")
+    doc.place(rig, doc.product("base", _box(20, 20, 5)), (0, 0, 0))
+    doc.place(rig, doc.product("lid", shell.Reversed() if inside_out else shell), (0, 0, 0))
+    path = doc.write(tmp_path / "lid.step")
+    assert "SHELL_BASED_SURFACE_MODEL" in path.read_text()
+    asm = load_assembly(path)
+    assert asm.names == ["base", "lid"] and asm.skipped == ()
+    lid = asm.parts["lid"].mesh
+    assert lid.is_watertight and lid.volume == pytest.approx(400, rel=1e-9)
+    assert asm.warnings == ("lid: a closed shell, read as a solid",)
+    result = plan(asm)
+    assert result.feasible and [s.parts for s in result.steps] == [("lid",)]
+    assert np.allclose(result.steps[0].direction, [0, 0, 1])
+    assert_steps_clear(asm, result)
+
+
+@cad
+def test_loose_faces_that_close_a_body_are_sewn_into_a_part(tmp_path):
+    """The lid's product written as its six faces, not joined in a shell: sewn, they
+    close the same box."""
+    pytest.importorskip("OCP")
+    doc = _Document()
+    rig = doc.assembly("rig")
+    doc.place(rig, doc.product("base", _box(20, 20, 5)), (0, 0, 0))
+    doc.place(rig, doc.product("lid", *_faces(_box(10, 10, 4, (5, 5, 5)))), (0, 0, 0))
+    asm = load_assembly(doc.write(tmp_path / "faces.step"))
+    assert asm.names == ["base", "lid"] and asm.skipped == ()
+    assert asm.parts["lid"].mesh.volume == pytest.approx(400, rel=1e-9)
+    assert asm.warnings == ("lid: a closed shell, read as a solid",)
+
+
+@cad
+def test_open_surfaces_and_wireframe_are_said_left_out(tmp_path, capsys):
+    """Five faces of a box (a sheet enclosing nothing) and a sketched edge beside a
+    solid: the solid is the only part; the sheet and the edge are listed as left out,
+    by their product's name, and the command line says so and plans the rest."""
+    pytest.importorskip("OCP")
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.gp import gp_Pnt
+
+    from cli_runs import run
+
+    doc = _Document()
+    rig = doc.assembly("rig")
+    doc.place(rig, doc.product("base", _box(20, 20, 5)), (0, 0, 0))
+    doc.place(rig, doc.product("sheet", _shell(_faces(_box(10, 10, 4))[:5])), (0, 0, 30))
+    edge = BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 50), gp_Pnt(10, 10, 50)).Edge()
+    doc.place(rig, doc.product("sketch", edge), (0, 0, 0))
+    path = doc.write(tmp_path / "sheet.step")
+    asm = load_assembly(path)
+    assert asm.names == ["base"]
+    assert [(s.item, s.reason, s.unreadable) for s in asm.skipped] == [
+        ("sheet", "5 faces: surfaces enclosing no volume, not a solid; left out", False),
+        ("sketch", "1 edge of wireframe geometry, no volume; left out", False),
+    ]
+    code, _, err = run(capsys, "plan", str(path))
+    assert code == 0
+    assert f"{path}: skipped sheet: 5 faces: surfaces enclosing no volume" in err
+
+
+@cad
+def test_a_file_of_surfaces_only_is_an_error_saying_what_it_holds(tmp_path, capsys):
+    pytest.importorskip("OCP")
+    from cli_runs import run
+
+    path = tmp_path / "face.step"
+    write_step(path, _faces(_box(10, 10, 4))[0])
+    with pytest.raises(GeometryError, match=r"no solids in STEP file: .*1 face: surfaces"):
+        load_assembly(path)
+    code, out, err = run(capsys, "plan", str(path))
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and "1 face: surfaces enclosing no volume" in err
 
 
 # -- analytic faces stored as B-splines ---------------------------------------------

@@ -45,6 +45,11 @@ analytic surface (OCCT's ``GeomConvert_SurfToAnaSurf``, which checks the distanc
 about 3e-12. Faces of other surface types are only tessellated. OCP reads STEP lengths
 in millimetres.
 
+A product's shells and faces outside its solids (a surface model) are sewn, and each
+closed shell is read as a solid, turned outwards (:func:`_surface_solids`; said in the
+assembly's ``warnings``); surfaces enclosing no volume and wireframe edges are listed in
+its ``skipped`` items.
+
 Tessellation: linear deflection ``LINEAR_DEFLECTION`` x the solid's bounding-box
 diagonal and angular deflection ``ANGULAR_DEFLECTION`` (below the smooth-edge angle of
 :mod:`assemblykit.geometry.recognition`). When BRepMesh leaves a face without triangles
@@ -150,6 +155,7 @@ _OCP_NAMES = {
     "BRep": ("BRep_Tool",),
     "BRepAdaptor": ("BRepAdaptor_Surface",),
     "BRepBndLib": ("BRepBndLib",),
+    "BRepBuilderAPI": ("BRepBuilderAPI_Sewing",),
     "BRepGProp": ("BRepGProp",),
     "BRepMesh": ("BRepMesh_IncrementalMesh",),
     "BRepTools": ("BRepTools",),
@@ -161,7 +167,7 @@ _OCP_NAMES = {
     "gp": ("gp_TrsfForm",),
     "collections": ("Sequence_TDF_Label",),
     "IFSelect": ("IFSelect_ReturnStatus",),
-    "ShapeFix": ("ShapeFix_Shape",),
+    "ShapeFix": ("ShapeFix_Shape", "ShapeFix_Solid"),
     "STEPCAFControl": ("STEPCAFControl_Reader",),
     "TCollection": ("TCollection_AsciiString", "TCollection_ExtendedString"),
     "TDataStd": ("TDataStd_Name",),
@@ -732,7 +738,8 @@ class _Solid:
     one); ``key``, the product's XCAF label entry; ``instance``, which placement of a
     product it belongs to (counting all placements met); ``piece``, its 1-based place
     among the product's solids (0 when the product has one solid); ``groups``, the
-    subassemblies around it (indices into the list of groups)."""
+    subassemblies around it (indices into the list of groups); ``made``, what it was
+    made from when the file gave no solid (``"a closed shell"``)."""
 
     name: str
     key: str
@@ -740,6 +747,7 @@ class _Solid:
     piece: int
     shape: Any
     groups: tuple[int, ...]
+    made: str = ""
 
 
 def numbered(bases: Sequence[str]) -> list[str]:
@@ -849,11 +857,14 @@ def _product_solids(
     groups: list[tuple[str, str]],
     placed_as: str,
     placements: Iterator[int],
+    left_out: list[Skipped],
 ) -> Iterator[_Solid]:
     """The solids of the product at ``label`` placed by ``location`` as the instance
-    named ``placed_as`` (``""`` for none), depth first in file order; each subassembly
-    met below it appends its name and product key to ``groups``, and each placement of a
-    product that is not an assembly takes the next number of ``placements``."""
+    named ``placed_as`` (``""`` for none), depth first in file order, with those its
+    closed shells make (:func:`_surface_solids`); each subassembly met below it appends
+    its name and product key to ``groups``, each placement of a product that is not an
+    assembly takes the next number of ``placements``, and surfaces enclosing no volume
+    are said in ``left_out``."""
     if tool.IsAssembly_s(label):
         for component in _labels(ocp, lambda seq: tool.GetComponents_s(label, seq, False)):
             referred = ocp.TDF_Label()
@@ -866,29 +877,99 @@ def _product_solids(
                 groups.append((name, _entry(ocp, referred)))
                 inner = (*within, len(groups) - 1)
             yield from _product_solids(
-                ocp, tool, referred, placed, inner, groups, instance, placements
+                ocp, tool, referred, placed, inner, groups, instance, placements, left_out
             )
         return
     shape = tool.GetShape_s(label).Moved(location)
-    explorer = ocp.TopExp_Explorer(shape, ocp.TopAbs_ShapeEnum.TopAbs_SOLID)
-    solids = []
-    while explorer.More():
-        solids.append(ocp.TopoDS.Solid(explorer.Current()))
-        explorer.Next()
+    kind = ocp.TopAbs_ShapeEnum
+    solids = [(ocp.TopoDS.Solid(s), "") for s in _subshapes(ocp, shape, kind.TopAbs_SOLID)]
     name = _label_name(ocp, label) or placed_as
+    closed, open_surfaces = _surface_solids(ocp, shape)
+    solids += [(solid, "a closed shell") for solid in closed]
+    if open_surfaces:
+        left_out.append(
+            Skipped(
+                name or "an unnamed product",
+                f"{open_surfaces}: surfaces enclosing no volume, not a solid; left out",
+            )
+        )
+    edges = len(_subshapes(ocp, shape, kind.TopAbs_EDGE, kind.TopAbs_FACE))
+    if edges:
+        left_out.append(
+            Skipped(
+                name or "an unnamed product",
+                f"{edges} edge{'s' * (edges != 1)} of wireframe geometry, no volume; left out",
+            )
+        )
     key, placement = _entry(ocp, label), next(placements)
-    for piece, solid in enumerate(solids, start=1):
-        yield _Solid(name, key, placement, piece if len(solids) > 1 else 0, solid, within)
+    for piece, (solid, made) in enumerate(solids, start=1):
+        yield _Solid(name, key, placement, piece if len(solids) > 1 else 0, solid, within, made)
 
 
-def _structure(ocp: Any, document: Any) -> tuple[list[_Solid], list[tuple[str, str]]]:
-    """Every solid of the document's product structure and the subassemblies' names and
-    product keys. The free products are the roots; when there are several, those that
-    are assemblies are subassemblies too."""
+def _subshapes(ocp: Any, shape: Any, kind: Any, outside: Any = None) -> list[Any]:
+    """The subshapes of ``shape`` of type ``kind``, in file order; with ``outside``,
+    only those not inside a subshape of that type."""
+    explorer = (
+        ocp.TopExp_Explorer(shape, kind)
+        if outside is None
+        else ocp.TopExp_Explorer(shape, kind, outside)
+    )
+    found = []
+    while explorer.More():
+        found.append(explorer.Current())
+        explorer.Next()
+    return found
+
+
+def _surface_solids(ocp: Any, shape: Any) -> tuple[list[Any], str]:
+    """The solids that the shells and faces of ``shape`` outside its solids enclose
+    (a surface model, as some writers store a closed body: ``SHELL_BASED_SURFACE_MODEL``),
+    and what of them encloses no volume, said in words (``""`` when nothing). Faces
+    that do not make a closed shell are sewn first (``BRepBuilderAPI_Sewing``, at its
+    default tolerance); each closed shell becomes a solid turned outwards
+    (``ShapeFix_Solid``), kept when its volume is positive."""
+    kind = ocp.TopAbs_ShapeEnum
+    shells = _subshapes(ocp, shape, kind.TopAbs_SHELL, kind.TopAbs_SOLID)
+    faces = _subshapes(ocp, shape, kind.TopAbs_FACE, kind.TopAbs_SHELL)
+    closed = [s for s in shells if ocp.BRep_Tool.IsClosed_s(s)]
+    loose = [s for s in shells if not ocp.BRep_Tool.IsClosed_s(s)] + faces
+    if loose:
+        sewing = ocp.BRepBuilderAPI_Sewing()
+        for item in loose:
+            sewing.Add(item)
+        sewing.Perform()
+        sewn = sewing.SewedShape()
+        shells = _subshapes(ocp, sewn, kind.TopAbs_SHELL)
+        closed += [s for s in shells if ocp.BRep_Tool.IsClosed_s(s)]
+        loose = [s for s in shells if not ocp.BRep_Tool.IsClosed_s(s)]
+        loose += _subshapes(ocp, sewn, kind.TopAbs_FACE, kind.TopAbs_SHELL)
+    solids = []
+    for shell in closed:
+        solid = ocp.ShapeFix_Solid().SolidFromShell(ocp.TopoDS.Shell(shell))
+        properties = ocp.GProp_GProps()
+        ocp.BRepGProp.VolumeProperties_s(solid, properties)
+        if properties.Mass() > 0:
+            solids.append(solid)
+        else:
+            loose.append(shell)
+    if not loose:
+        return solids, ""
+    faces_left = sum(len(_subshapes(ocp, item, kind.TopAbs_FACE)) for item in loose)
+    return solids, f"{faces_left} face{'s' * (faces_left != 1)}"
+
+
+def _structure(
+    ocp: Any, document: Any
+) -> tuple[list[_Solid], list[tuple[str, str]], list[Skipped]]:
+    """Every solid of the document's product structure, the subassemblies' names and
+    product keys, and the surfaces left out (:func:`_product_solids`). The free products
+    are the roots; when there are several, those that are assemblies are subassemblies
+    too."""
     tool = ocp.XCAFDoc_DocumentTool.ShapeTool_s(document.Main())
     roots = _labels(ocp, tool.GetFreeShapes)
     groups: list[tuple[str, str]] = []
     solids: list[_Solid] = []
+    left_out: list[Skipped] = []
     placements = itertools.count()
     for root in roots:
         within: tuple[int, ...] = ()
@@ -896,9 +977,9 @@ def _structure(ocp: Any, document: Any) -> tuple[list[_Solid], list[tuple[str, s
             groups.append((_label_name(ocp, root) or "subassembly", _entry(ocp, root)))
             within = (len(groups) - 1,)
         solids += _product_solids(
-            ocp, tool, root, ocp.TopLoc_Location(), within, groups, "", placements
+            ocp, tool, root, ocp.TopLoc_Location(), within, groups, "", placements, left_out
         )
-    return solids, groups
+    return solids, groups, left_out
 
 
 def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
@@ -921,10 +1002,10 @@ def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     if status != ocp.IFSelect_ReturnStatus.IFSelect_RetDone:
         said = f": {'; '.join(warnings)}" if warnings else ""
         raise GeometryError(f"cannot read STEP file{said}", source=source)
-    solids, group_items = _structure(ocp, document)
+    solids, group_items, left_out = _structure(ocp, document)
     if not solids:
-        said = f": {'; '.join(warnings)}" if warnings else ""
-        raise GeometryError(f"no solids in STEP file{said}", source=source)
+        said = "; ".join([*(f"{s.item}: {s.reason}" for s in left_out), *warnings])
+        raise GeometryError(f"no solids in STEP file{': ' + said if said else ''}", source=source)
     placements = _placement_names(solids)
     names = _part_names(solids, placements)
     products: dict[str, list[str]] = {}
@@ -935,6 +1016,8 @@ def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     unmeshed: list[Skipped] = []
     notes: list[str] = []
     for solid, name in zip(solids, names, strict=True):
+        if solid.made:
+            notes.append(f"{name}: {solid.made}, read as a solid")
         part = _solid_part(ocp, solid.shape, name, source, notes)
         if isinstance(part, str):
             unmeshed.append(Skipped(name, part))
@@ -955,7 +1038,11 @@ def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         source=source,
         exact=True,
         policy=tol,
-        skipped=[*_skipped_solids(declared, reader.Reader().Model(), distinct), *unmeshed],
+        skipped=[
+            *_skipped_solids(declared, reader.Reader().Model(), distinct),
+            *left_out,
+            *unmeshed,
+        ],
         warnings=[*warnings, *notes],
         groups=groups,
         products=products,
