@@ -223,6 +223,52 @@ def test_a_file_of_surfaces_only_is_an_error_saying_what_it_holds(tmp_path, caps
     assert err.count("\n") == 1 and "1 face: surfaces enclosing no volume" in err
 
 
+# -- mirrored placements ---------------------------------------------------------------
+
+
+@cad
+def test_a_mirrored_copy_of_a_part_is_the_mirror_image_of_it(tmp_path):
+    """A bracket with a hole (a 10 x 10 x 2 plate, Ø4 hole 3 from its left edge), placed
+    once as drawn and once mirrored in the plane x = 0 (a left-hand copy), on a base,
+    with a Ø4 pin at its hole's diameter in each hole: the mirrored copy is the bracket's
+    mirror image, its mesh outward (positive volume, the same 200 - 8π), its hole a hole
+    (concave) at x = -3, and each pin's contact with its bracket cylindrical, so each pin
+    leaves along its axis, clear of every part."""
+    pytest.importorskip("OCP")
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt, gp_Trsf
+    from OCP.TopLoc import TopLoc_Location
+
+    plate = _cut(_box(10, 10, 2, (0, -5, 0)), _cylinder(2, 4, (3, 0, -1)))
+    doc = _Document()
+    rig = doc.assembly("rig")
+    doc.place(rig, doc.product("base", _box(40, 20, 2, (-20, -10, -2))), (0, 0, 0))
+    bracket = doc.product("bracket", plate)
+    doc.place(rig, bracket, (0, 0, 0))
+    mirror = gp_Trsf()
+    mirror.SetMirror(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(1, 0, 0)))
+    doc.tool.AddComponent(rig, bracket, TopLoc_Location(mirror))
+    pin = doc.product("pin", _cylinder(2, 6, (0, 0, 0)))
+    for x in (3, -3):
+        doc.place(rig, pin, (x, 0, 0))
+    asm = load_assembly(doc.write(tmp_path / "mirrored.step"))
+    assert asm.names == ["base", "bracket_1", "bracket_2", "pin_1", "pin_2"]
+    drawn, copy = asm.parts["bracket_1"].mesh, asm.parts["bracket_2"].mesh
+    assert copy.is_watertight and copy.volume > 0
+    assert copy.volume == pytest.approx(drawn.volume) == pytest.approx(200 - 8 * np.pi, rel=1e-2)
+    assert np.allclose(drawn.bounds, [[0, -5, 0], [10, 5, 2]])
+    mirrored = np.asarray(drawn.vertices) * [-1, 1, 1]
+    assert np.allclose(
+        np.unique(mirrored.round(9), axis=0), np.unique(copy.vertices.round(9), axis=0)
+    )
+    (hole,) = [s for s in asm.parts["bracket_2"].surfaces if s.kind == "cylinder"]
+    assert not hole.convex and np.allclose(hole.point[:2], [-3, 0]) and hole.radius == 2
+    curved = {(c.a, c.b): [k.kind for k in c.curved] for c in assembly_contacts(asm) if c.curved}
+    assert curved[("bracket_1", "pin_1")] == curved[("bracket_2", "pin_2")] == ["cylindrical"]
+    result = plan(asm)
+    assert result.feasible
+    assert_steps_clear(asm, result)
+
+
 # -- analytic faces stored as B-splines ---------------------------------------------
 
 

@@ -228,7 +228,9 @@ def _transformed(ocp: Any, points: NDArray[np.float64], transform: Any) -> NDArr
 
 
 def _face_triangles(ocp: Any, face: Any) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """The triangulation of a face in world coordinates, oriented outward."""
+    """The triangulation of a face in world coordinates, oriented outward (a reversed
+    face's triangles turned, and so are those a mirroring placement, as of a left-hand
+    copy of a part, turns inside out)."""
     location = ocp.TopLoc_Location()
     triangulation = ocp.BRep_Tool.Triangulation_s(face, location)
     if triangulation is None:
@@ -245,7 +247,8 @@ def _face_triangles(ocp: Any, face: Any) -> tuple[NDArray[np.float64], NDArray[n
         )
         - 1
     )
-    if face.Orientation() == ocp.TopAbs_Orientation.TopAbs_REVERSED:
+    reversed_face = face.Orientation() == ocp.TopAbs_Orientation.TopAbs_REVERSED
+    if reversed_face != location.Transformation().IsNegative():
         triangles = triangles[:, ::-1]
     return points, triangles
 
