@@ -249,16 +249,17 @@ class ExtendedDirections:
     def known_blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
         """Per part of ``movers``, some of its blockers in ``among`` along ``k`` (every
         one where it was tested along ``k``): besides those, the parts that blocked it
-        last along other directions are tested along ``k``, alone (a few projected
-        meshes). A closure under these arcs is within the closure under all of them
-        (:func:`_free_closures`)."""
+        last along other directions are tested along ``k``, alone, until one of them
+        blocks it (a few projected meshes). A closure under these arcs is within the
+        closure under all of them (:func:`_free_closures`): one blocker on the way to the
+        base proves what all of them would."""
         k = self.same_as(k)
         asked = [
             i for i in bits(movers) if not self._knows(k, i, among) and (k, i) not in self._hinted
         ]
         hints = sorted({j for i in asked for j in self._recent.get(i, ()) if among >> j & 1})
         if asked and hints:
-            for i, j in self._extended(k, asked, hints):
+            for i, j in self._extended(k, asked, hints, first_only=True):
                 self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
         self._hinted.update((k, i) for i in asked)
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
