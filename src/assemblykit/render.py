@@ -406,7 +406,10 @@ def _disassembly_table(plan: Plan) -> Table:
         table.caption = f"needs {plan.hands.summary()}"
     elif plan.hands is not None and plan.hands.needed is None:
         table.caption = f"needs {plan.hands.summary()}"
-    if any(lock.rigid_may_free and not lock.interfering for lock in plan.interlocked):
+    if any(
+        lock.rigid_may_free and not lock.interfering and not lock.enclosed
+        for lock in plan.interlocked
+    ):
         hint = "turns and drawn threads: plan --moves rigid"
         table.caption = f"{table.caption}; {hint}" if table.caption else hint
     return table

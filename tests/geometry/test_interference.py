@@ -7,11 +7,14 @@ import pytest
 import trimesh
 
 from assemblykit.geometry.interference import (
+    enclosures,
     interference_threshold,
     interferences,
     interferes,
     overlap_volume,
+    solid,
 )
+from assemblykit.geometry.overlaps import mesh_of
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance
 
@@ -58,3 +61,24 @@ def test_interferences_of_an_assembly_report_the_volume():
     found = interferences(asm)
     assert [(a, b) for a, b, _ in found] == [("b", "c")]
     assert found[0][2] == pytest.approx(0.25, abs=1e-12)
+
+
+def test_a_part_in_a_cavity_is_enclosed_and_one_in_an_open_cup_is_not():
+    """A 20 cube with a 16 cube cavity (one mesh of two shells, the inner one facing
+    into the cavity) holds a 4 cube at its centre: all of its 64 lies in the cavity,
+    so it is enclosed. A cube above the housing is not, nor a cube in a cup whose
+    cavity opens through its top."""
+    housing = mesh_of(solid(box([0, 0, 0], [20, 20, 20])) - solid(box([2, 2, 2], [18, 18, 18])))
+    assert housing.body_count == 2 and housing.volume == pytest.approx(20**3 - 16**3)
+    cup = mesh_of(solid(box([30, 0, 0], [50, 20, 20])) - solid(box([32, 2, 2], [48, 18, 21])))
+    asm = Assembly(
+        [
+            Part("housing", housing),
+            Part("ball", box([8, 8, 8], [12, 12, 12])),
+            Part("above", box([0, 0, 25], [4, 4, 29])),
+            Part("cup", cup),
+            Part("cube", box([38, 8, 8], [42, 12, 12])),
+        ]
+    )
+    assert enclosures(asm) == [("ball", "housing")]
+    assert enclosures(asm, ["housing", "above", "cup", "cube"]) == []

@@ -645,3 +645,30 @@ def test_a_flange_coupling_comes_apart_as_a_fitter_takes_it(tmp_path):
         assert fasteners[nut].summary() == "unscrew nut M8 (pitch 1.25, 4.8 turns)"
     for bolt in bolt_names:
         assert fasteners[bolt].summary() == "pull bolt M8"
+
+
+def test_a_ball_sealed_in_a_housing_is_said_enclosed_not_interlocked(tmp_path, capsys):
+    """A 20 mm housing with a 16 mm cavity (one solid with a void: the writer's
+    ``BREP_WITH_VOIDS``) and a ball of radius 3 floating in it: no motion takes the ball
+    out, and the plan says why (``enclosed``), with no hint that a turn may free it."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeSphere
+    from OCP.gp import gp_Pnt
+
+    from cli_runs import run
+
+    housing = cut(box((0, 0, 0), (20, 20, 20)), box((2, 2, 2), (16, 16, 16)))
+    path = tmp_path / "sealed.step"
+    write_step(path, housing, BRepPrimAPI_MakeSphere(gp_Pnt(10, 10, 10), 3).Shape())
+    assert "BREP_WITH_VOIDS" in path.read_text()
+    asm = load_assembly(path)
+    outer, ball = asm.names
+    assert asm.parts[outer].mesh.volume == pytest.approx(20**3 - 16**3, rel=1e-9)
+    assert not interferences(asm)
+    result = plan(asm)
+    assert not result.feasible and sorted(result.stuck) == sorted(asm.names)
+    (lock,) = result.interlocked
+    assert lock.enclosed == ((ball, outer),)
+    assert lock.reason == f"enclosed ({ball} in a void of {outer})"
+    assert lock.to_dict()["enclosed"] == [{"part": ball, "in": outer}]
+    code, out, _ = run(capsys, "plan", str(path))
+    assert code == 0 and "in a void of" in out and "--moves rigid" not in out

@@ -24,6 +24,10 @@ from assemblykit.tolerance import Tolerance, current
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
 
+ENCLOSED_SHARE = 1e-6
+"""The share of a part's volume that may lie outside a cavity it is enclosed in (the
+rounding of manifold3d's volumes: a part in a cavity is wholly inside it)."""
+
 
 def solid(
     mesh: trimesh.Trimesh,
@@ -134,4 +138,32 @@ def interferences(
         volume = shared_volume(solids[i], solids[j])
         if volume > interference_threshold(a.mesh, b.mesh, tol):
             found.append((a.name, b.name, volume))
+    return found
+
+
+def enclosures(assembly: Assembly, parts: Collection[str] | None = None) -> list[tuple[str, str]]:
+    """``(inner, outer)`` for each part of ``parts`` (default: all) that lies in a void
+    of another: within a closed inner shell of the other's mesh (a cavity, its triangles
+    facing into it: a component of negative volume), manifold3d measuring all of the
+    part's volume inside it. No translation or turn takes such a part out."""
+    names = list(assembly.parts if parts is None else parts)
+    found = []
+    for outer in names:
+        mesh = assembly.parts[outer].mesh
+        if mesh.body_count < 2:
+            continue
+        for shell in mesh.split(only_watertight=True):
+            if shell.volume >= 0:
+                continue
+            cavity = shell.copy()
+            cavity.invert()
+            low, high = cavity.bounds
+            inside = solid(cavity, outer)
+            for inner in names:
+                part = assembly.parts[inner].mesh
+                if inner == outer or np.any(part.bounds[0] < low) or np.any(part.bounds[1] > high):
+                    continue
+                shared = shared_volume(inside, solid(part, inner))
+                if shared >= (1 - ENCLOSED_SHARE) * part.volume:
+                    found.append((inner, outer))
     return found

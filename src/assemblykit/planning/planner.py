@@ -20,7 +20,7 @@ from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.blocking.tables import translation_slots, translation_table, with_obstacles
 from assemblykit.errors import InputError, UnknownNameError
-from assemblykit.geometry.interference import interferences
+from assemblykit.geometry.interference import enclosures, interferences
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.equilibrium import equilibrium_model
 from assemblykit.planning.equilibrium_memory import EquilibriumMemory
@@ -437,14 +437,18 @@ def _interlock(
     parts = tuple(names[i] for i in bits(members))
     held = tuple(names[i] for i in bits(locked & ~members))
     interfering: tuple[tuple[str, str, float], ...] = ()
+    enclosed: tuple[tuple[str, str], ...] = ()
     if not isinstance(assembly, PolygonAssembly):
-        interfering = tuple(interferences(assembly.subset([*parts, *held]), tol))
+        stopped = assembly.subset([*parts, *held])
+        interfering = tuple(interferences(stopped, tol))
+        enclosed = tuple(enclosures(stopped))
     return Interlock(
         parts=parts,
         translation_locked=not separable(translations, members),
         rigid_may_free=rigid_may_free(assembly, parts, tol),
         held=held,
         interfering=interfering,
+        enclosed=enclosed,
     )
 
 

@@ -436,6 +436,10 @@ class Interlock:
     """The pairs of the set (``parts`` and ``held``) that share a volume beyond the
     interference threshold, ``(a, b, volume)``: a shared volume blocks a pair in every
     direction, so these, not an interlock of shapes, may be what stops the set."""
+    enclosed: tuple[tuple[str, str], ...] = ()
+    """The parts of the set that lie in a void of another, ``(inner, outer)``
+    (:func:`~assemblykit.geometry.interference.enclosures`): sealed in a cavity, no
+    motion takes them out."""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON form."""
@@ -445,6 +449,7 @@ class Interlock:
             "translation_locked": self.translation_locked,
             "rigid_may_free": self.rigid_may_free,
             "interfering": [{"a": a, "b": b, "volume": v} for a, b, v in self.interfering],
+            "enclosed": [{"part": inner, "in": outer} for inner, outer in self.enclosed],
         }
 
     @property
@@ -453,6 +458,9 @@ class Interlock:
         if self.interfering:
             pairs = "; ".join(f"{a} / {b} share {v:.3g}" for a, b, v in self.interfering)
             return f"interfering ({pairs})"
+        if self.enclosed:
+            sealed = "; ".join(f"{a} in a void of {b}" for a, b in self.enclosed)
+            return f"enclosed ({sealed})"
         return "interlocked (rigid motion may free)" if self.rigid_may_free else "interlocked"
 
 
