@@ -116,6 +116,11 @@ ANGULAR_DEFLECTION = 0.2
 CONVERSION_TOLERANCE = 1e-6
 """Distance, relative to the solid's bounding-box diagonal, within which a B-spline,
 Bezier, swept or offset face counts as the analytic surface it is close to."""
+SEWING_TOLERANCE = 1e-4
+"""Gap, relative to the bounding-box diagonal of a product's loose faces, that sewing
+them closes (:func:`_surface_solids`): writers of surface models leave gaps of a few
+thousandths of a millimetre between faces, a tenth of the linear deflection, so the
+mesh does not see them."""
 MESH_RETRIES = (
     ("a 3 times finer deflection", LINEAR_DEFLECTION / 3, ANGULAR_DEFLECTION / 2, False),
     ("a 10 times coarser deflection", 10 * LINEAR_DEFLECTION, 2 * ANGULAR_DEFLECTION, False),
@@ -928,16 +933,20 @@ def _surface_solids(ocp: Any, shape: Any) -> tuple[list[Any], str]:
     """The solids that the shells and faces of ``shape`` outside its solids enclose
     (a surface model, as some writers store a closed body: ``SHELL_BASED_SURFACE_MODEL``),
     and what of them encloses no volume, said in words (``""`` when nothing). Faces
-    that do not make a closed shell are sewn first (``BRepBuilderAPI_Sewing``, at its
-    default tolerance); each closed shell becomes a solid turned outwards
-    (``ShapeFix_Solid``), kept when its volume is positive."""
+    that do not make a closed shell are sewn first (``BRepBuilderAPI_Sewing``, closing
+    gaps up to :data:`SEWING_TOLERANCE` of their bounding-box diagonal); each closed
+    shell becomes a solid turned outwards (``ShapeFix_Solid``), kept when its volume is
+    positive."""
     kind = ocp.TopAbs_ShapeEnum
     shells = _subshapes(ocp, shape, kind.TopAbs_SHELL, kind.TopAbs_SOLID)
     faces = _subshapes(ocp, shape, kind.TopAbs_FACE, kind.TopAbs_SHELL)
     closed = [s for s in shells if ocp.BRep_Tool.IsClosed_s(s)]
     loose = [s for s in shells if not ocp.BRep_Tool.IsClosed_s(s)] + faces
     if loose:
-        sewing = ocp.BRepBuilderAPI_Sewing()
+        box = ocp.Bnd_Box()
+        for item in loose:
+            ocp.BRepBndLib.Add_s(item, box)
+        sewing = ocp.BRepBuilderAPI_Sewing(SEWING_TOLERANCE * float(np.sqrt(box.SquareExtent())))
         for item in loose:
             sewing.Add(item)
         sewing.Perform()
