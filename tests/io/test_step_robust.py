@@ -314,6 +314,37 @@ def test_a_mirrored_copy_of_a_part_is_the_mirror_image_of_it(tmp_path):
     assert_steps_clear(asm, result)
 
 
+@cad
+def test_a_product_placed_twice_is_the_same_part_in_each_place_and_scaled_where_scaled(
+    tmp_path,
+):
+    """A pin (radius 2, 10 long) placed as drawn, 30 along x, and scaled 2 times about
+    the origin (a mapped item's scale): the second is the first moved (its vertices 30
+    along x), the third has radius 4 and 8 times the volume."""
+    pytest.importorskip("OCP")
+    from OCP.gp import gp_Pnt, gp_Trsf
+    from OCP.TopLoc import TopLoc_Location
+
+    doc = _Document()
+    rig = doc.assembly("rig")
+    pin = doc.product("pin", _cylinder(2, 10, (0, 0, 0)))
+    doc.place(rig, pin, (0, 0, 0))
+    doc.place(rig, pin, (30, 0, 0))
+    double = gp_Trsf()
+    double.SetScale(gp_Pnt(0, 0, 0), 2.0)
+    doc.tool.AddComponent(rig, pin, TopLoc_Location(double))
+    asm = load_assembly(doc.write(tmp_path / "pins.step"))
+    first, moved, scaled = (asm.parts[n] for n in ("pin_1", "pin_2", "pin_3"))
+    assert np.array_equal(moved.mesh.faces, first.mesh.faces)
+    assert np.allclose(moved.mesh.vertices, first.mesh.vertices + np.array([30, 0, 0]), atol=1e-12)
+    ((_, axis, radius),) = [
+        (s.point, s.axis, s.radius) for s in moved.surfaces if s.kind == "cylinder"
+    ]
+    assert radius == 2.0 and np.allclose(np.abs(axis), [0, 0, 1])
+    assert [s.radius for s in scaled.surfaces if s.kind == "cylinder"] == [4.0]
+    assert scaled.mesh.volume == pytest.approx(8 * first.mesh.volume, rel=1e-2)
+
+
 # -- analytic faces stored as B-splines ---------------------------------------------
 
 

@@ -174,7 +174,7 @@ _OCP_NAMES = {
     "GeomAdaptor": ("GeomAdaptor_Surface",),
     "GeomConvert": ("GeomConvert_SurfToAnaSurf",),
     "GProp": ("GProp_GProps",),
-    "gp": ("gp_TrsfForm",),
+    "gp": ("gp_Trsf", "gp_TrsfForm"),
     "collections": ("Sequence_TDF_Label",),
     "IFSelect": ("IFSelect_ReturnStatus",),
     "ShapeFix": ("ShapeFix_Shape", "ShapeFix_Solid"),
@@ -1064,18 +1064,25 @@ def load_step(path: str | Path, tol: Tolerance | None = None) -> Assembly:
     for solid, name in zip(solids, names, strict=True):
         if solid.made:
             notes.append(f"{name}: {solid.made}, read as a solid")
-        local = solid.shape.Located(ocp.TopLoc_Location())
-        found = next((m for m in meshed if m[0].IsEqual(local)), None)
-        if found is None:
-            found = (local, *_solid_part(ocp, local, source))
-            meshed.append(found)
-        _, part, note = found
+        placement = solid.shape.Location().Transformation()
+        if abs(placement.ScaleFactor()) != 1.0:
+            # a scaled instance (a mapped item's scale) is meshed as placed: its radii
+            # are not the product's
+            part, note = _solid_part(ocp, solid.shape, source)
+            placement = ocp.gp_Trsf()
+        else:
+            local = solid.shape.Located(ocp.TopLoc_Location())
+            found = next((m for m in meshed if m[0].IsEqual(local)), None)
+            if found is None:
+                found = (local, *_solid_part(ocp, local, source))
+                meshed.append(found)
+            _, part, note = found
         if note:
             notes.append(f"{name}: {note}")
         if isinstance(part, str):
             unmeshed.append(Skipped(name, part))
         else:
-            parts.append(_placed(ocp, part, name, solid.shape.Location().Transformation()))
+            parts.append(_placed(ocp, part, name, placement))
     if not parts:
         said = "; ".join(f"{s.item}: {s.reason}" for s in unmeshed)
         raise GeometryError(f"no solid of the STEP file could be meshed: {said}", source=source)
