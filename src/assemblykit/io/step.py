@@ -585,9 +585,10 @@ def _placed(ocp: Any, local: Part, name: str, placement: Any) -> Part:
     the placement mirrors, its surfaces' points and axes moved with it."""
     matrix = np.array([[placement.Value(r, c) for c in (1, 2, 3)] for r in (1, 2, 3)])
     faces = np.asarray(local.mesh.faces)
+    # each instance owns its arrays: a part moved later moves alone
     mesh = trimesh.Trimesh(
-        _transformed(ocp, np.asarray(local.mesh.vertices), placement),
-        faces[:, ::-1] if placement.IsNegative() else faces,
+        np.array(_transformed(ocp, np.asarray(local.mesh.vertices), placement)),
+        np.array(faces[:, ::-1] if placement.IsNegative() else faces),
         process=False,
     )
     surfaces = tuple(
