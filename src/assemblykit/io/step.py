@@ -109,6 +109,7 @@ import trimesh
 from numpy.typing import NDArray
 from scipy.spatial import QhullError
 
+from assemblykit.algebra.se3 import unit
 from assemblykit.errors import GeometryError, MissingExtraError
 from assemblykit.geometry.recognition import is_convex
 from assemblykit.geometry.tessellation import inside_vertices
@@ -595,16 +596,11 @@ def _placed(ocp: Any, local: Part, name: str, placement: Any) -> Part:
         replace(
             surface,
             point=_transformed(ocp, surface.point[None], placement)[0],
-            axis=None if surface.axis is None else _unit(matrix @ surface.axis),
+            axis=None if surface.axis is None else unit(matrix @ surface.axis),
         )
         for surface in local.surfaces
     )
     return Part(name, mesh, np.eye(4), surfaces, local.source)
-
-
-def _unit(vector: NDArray[np.float64]) -> NDArray[np.float64]:
-    unit: NDArray[np.float64] = vector / np.linalg.norm(vector)
-    return unit
 
 
 def _solid_part(ocp: Any, solid: Any, source: str) -> tuple[Part | str, str]:
@@ -961,6 +957,15 @@ def _subshapes(ocp: Any, shape: Any, kind: Any, outside: Any = None) -> list[Any
     return found
 
 
+def _closed_and_open(ocp: Any, shells: list[Any]) -> tuple[list[Any], list[Any]]:
+    """``shells`` parted into the closed ones and the others, in order."""
+    closed = [ocp.BRep_Tool.IsClosed_s(shell) for shell in shells]
+    return (
+        [shell for shell, shut in zip(shells, closed, strict=True) if shut],
+        [shell for shell, shut in zip(shells, closed, strict=True) if not shut],
+    )
+
+
 def _surface_solids(ocp: Any, shape: Any) -> tuple[list[Any], str]:
     """The solids that the shells and faces of ``shape`` outside its solids enclose
     (a surface model, as some writers store a closed body: ``SHELL_BASED_SURFACE_MODEL``),
@@ -972,8 +977,8 @@ def _surface_solids(ocp: Any, shape: Any) -> tuple[list[Any], str]:
     kind = ocp.TopAbs_ShapeEnum
     shells = _subshapes(ocp, shape, kind.TopAbs_SHELL, kind.TopAbs_SOLID)
     faces = _subshapes(ocp, shape, kind.TopAbs_FACE, kind.TopAbs_SHELL)
-    closed = [s for s in shells if ocp.BRep_Tool.IsClosed_s(s)]
-    loose = [s for s in shells if not ocp.BRep_Tool.IsClosed_s(s)] + faces
+    closed, loose = _closed_and_open(ocp, shells)
+    loose += faces
     if loose:
         box = ocp.Bnd_Box()
         for item in loose:
@@ -984,8 +989,8 @@ def _surface_solids(ocp: Any, shape: Any) -> tuple[list[Any], str]:
         sewing.Perform()
         sewn = sewing.SewedShape()
         shells = _subshapes(ocp, sewn, kind.TopAbs_SHELL)
-        closed += [s for s in shells if ocp.BRep_Tool.IsClosed_s(s)]
-        loose = [s for s in shells if not ocp.BRep_Tool.IsClosed_s(s)]
+        sewn_closed, loose = _closed_and_open(ocp, shells)
+        closed += sewn_closed
         loose += _subshapes(ocp, sewn, kind.TopAbs_FACE, kind.TopAbs_SHELL)
     solids = []
     for shell in closed:
