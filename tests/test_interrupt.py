@@ -6,7 +6,8 @@ written and starts no more work, and numerical warnings stay off stderr unless
 Each test starts ``assemblykit`` with :mod:`subprocess` through a tiny launcher that
 says "ready" on stdout right before calling :func:`assemblykit.cli.main`, so that the
 signal is sent once the command runs (a signal during Python's own start-up is not ours
-to handle). The plan test sends it once the planner is at work on its blocking graph,
+to handle). The launcher gives Ctrl-C Python's usual handler, as a terminal does: a process
+started in the background by a non-interactive shell inherits SIGINT ignored. The plan test sends it once the planner is at work on its blocking graph,
 which the launcher marks with a file. The batch tests replace the Python of the batch's
 children by a shell script (``sys.executable``), so that which child starts, answers or
 hangs is set by the test.
@@ -32,8 +33,10 @@ LIMIT = 30.0
 machine is slow, not wrong; the plan interrupted would run for minutes."""
 
 LAUNCHER = """
+import signal
 import sys
 from assemblykit.cli import main
+signal.signal(signal.SIGINT, signal.default_int_handler)
 {setup}
 print("ready", flush=True)
 main(sys.argv[1:])
