@@ -6,9 +6,10 @@ written and starts no more work, and numerical warnings stay off stderr unless
 Each test starts ``assemblykit`` with :mod:`subprocess` through a tiny launcher that
 says "ready" on stdout right before calling :func:`assemblykit.cli.main`, so that the
 signal is sent once the command runs (a signal during Python's own start-up is not ours
-to handle). The launcher gives Ctrl-C Python's usual handler, as a terminal does: a process
-started in the background by a non-interactive shell inherits SIGINT ignored. The plan test sends it once the planner is at work on its blocking graph,
-which the launcher marks with a file. The batch tests replace the Python of the batch's
+to handle). The launcher gives Ctrl-C Python's usual handler, as a terminal does: a
+process started in the background by a non-interactive shell inherits SIGINT ignored.
+The plan test sends the signal once the planner is at work on its blocking graph, which
+the launcher marks with a file. The batch tests replace the Python of the batch's
 children by a shell script (``sys.executable``), so that which child starts, answers or
 hangs is set by the test.
 """

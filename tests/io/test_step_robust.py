@@ -639,6 +639,41 @@ def locknut_step(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @cad
+def test_a_solid_named_only_by_the_subassembly_around_it_takes_its_name(tmp_path):
+    # build123d and CadQuery write each named object as an assembly holding one product
+    # that XCAF names after its shape type (SOLID): each part takes the name of the
+    # assembly around it (an assembly placed twice numbers its parts, as a product
+    # placed twice does), a named instance inside keeps its own name, and a product
+    # with no name outside any named assembly is still solid<i>
+    doc = _Document()
+    rig = doc.assembly("Peg Turner")
+    for name, at in (("Socket Body", 0), ("Handle Knob", 5)):
+        wrapper = doc.assembly(name)
+        doc.place(wrapper, doc.product("SOLID", _box(1, 1, 1)), (0, 0, 0))
+        doc.place(rig, wrapper, (at, 0, 0))
+    bolt = doc.assembly("M3 Bolt")
+    doc.place(bolt, doc.product("SOLID", _box(1, 1, 3)), (0, 0, 0))
+    for x in (10, 12):
+        doc.place(rig, bolt, (x, 0, 0))
+    knob = doc.assembly("knob")
+    doc.place(knob, doc.product("SOLID", _box(1, 1, 1)), (0, 0, 0), "grip")
+    doc.place(rig, knob, (15, 0, 0))
+    doc.place(rig, doc.product(None, _box(1, 1, 1)), (20, 0, 0))
+    asm = load_assembly(doc.write(tmp_path / "wrapped.step"))
+    corners = {
+        "Socket Body": 0,
+        "Handle Knob": 5,
+        "M3 Bolt_1": 10,
+        "M3 Bolt_2": 12,
+        "grip": 15,
+        "solid6": 20,
+    }
+    assert asm.names == list(corners)
+    for name, x in corners.items():
+        assert asm[name].mesh.bounds[0][0] == pytest.approx(x, abs=1e-9)
+
+
+@cad
 def test_a_locknut_of_two_solids_is_planned_as_one_part(locknut_step):
     # the insert is captured in the nut: no translation separates them, as no fitter
     # would; the product is one part, and the screw's thread in the insert (a ring of

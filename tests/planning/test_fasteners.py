@@ -16,6 +16,7 @@ from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.fasteners import Fastener, Thread, drawn_summary, implied_thread
 from assemblykit.planning.planner import plan
 from assemblykit.viz.viewer import report_html
+from plan_checks import assert_steps_clear
 from stability_blocks import box
 
 
@@ -232,3 +233,76 @@ def test_a_step_counts_its_screws_nuts_bolts_and_pins_by_size():
         "unscrew nut M5 (pitch 0.8, 6 turns)",
         "pull bolt M5",
     ]
+
+
+def bolted_by_name(name: str, nut: bool) -> Assembly:
+    """A block 24 x 24 x 6 (z from 0 to 6) with a blind hole of radius 1.5 (an M3's
+    diameter) from its top down to z = 1 at x = -6, under a plate 3 thick (z from 6 to 9)
+    with through holes of that radius there and of radius 4 (an M8's) at x = 5, the
+    block's hole there through it too: in the first, a part ``name`` of the holes'
+    radius from z = 2 up, its head (radius 2.75, 2 high) on the plate; in the second a
+    bolt ``M8 bolt`` of radius 4 from z = 0 up, its head under the block, and with
+    ``nut`` a hexagon nut (13 across flats, 6.5 high) on it from the plate's top."""
+
+    def drill(x: float, radius: float, bottom: float, height: float) -> trimesh.Trimesh:
+        mesh = trimesh.creation.cylinder(radius, height, sections=48)
+        mesh.apply_translation([x, 0, bottom + height / 2])
+        return mesh
+
+    block = trimesh.boolean.difference(
+        [box((24, 24, 6), (-12, -12, 0)), drill(-6, 1.5, 1, 10), drill(5, 4, -1, 10)],
+        engine="manifold",
+    )
+    plate = trimesh.boolean.difference(
+        [box((24, 24, 3), (-12, -12, 6)), drill(-6, 1.5, 5, 5), drill(5, 4, 5, 5)],
+        engine="manifold",
+    )
+    screw = trimesh.boolean.union([drill(-6, 1.5, 2, 7), drill(-6, 2.75, 9, 2)], engine="manifold")
+    bolt = trimesh.boolean.union([drill(5, 4, 0, 15.5), drill(5, 7, -3, 3)], engine="manifold")
+    parts = [Part("block", block), Part("plate", plate), Part(name, screw), Part("M8 bolt", bolt)]
+    if nut:
+        hexagon = trimesh.creation.cylinder(13 / np.sqrt(3), 6.5, sections=6)
+        hexagon.apply_translation([5, 0, 9 + 3.25])
+        parts.append(
+            Part(
+                "nut",
+                trimesh.boolean.difference([hexagon, drill(5, 4, 8, 9)], engine="manifold"),
+            )
+        )
+    return Assembly(parts)
+
+
+@pytest.mark.parametrize(("name", "kind"), [("M3 Bolt", "screw"), ("dowel", "pin")])
+def test_a_part_drawn_at_the_size_its_name_writes_is_unscrewed_from_its_last_hole(name, kind):
+    # drawn at 3 mm in holes of 3 mm (no thread modelled, no volume shared), the part
+    # named "M3 Bolt" is a screw: by hand it is threaded into the block, the last hole
+    # on its way in, its tip at z = 2 leaving the block's top at z = 6 in 4 / 0.5 = 8
+    # turns; named otherwise it is a pin. The M8 bolt, its head under the block and no
+    # nut on it, lets the plate lift off it, then leaves downwards threaded into the
+    # block: its tip at z = 15.5 leaves the block's bottom in 15.5 / 1.25 = 12.4 turns
+    assembly = bolted_by_name(name, nut=False)
+    result = plan(assembly, max_and_or_parts=0)
+    assert result.feasible
+    assert_steps_clear(assembly, result)
+    fasteners = {f.part: f for step in result.steps for f in step.fasteners}
+    assert fasteners[name].kind == kind and fasteners[name].holes == ("block", "plate")
+    said = "unscrew M3 (pitch 0.5, 8 turns)" if kind == "screw" else "pull pin"
+    assert fasteners[name].summary() == said
+    assert fasteners["M8 bolt"].holes == ("block",)
+    assert fasteners["M8 bolt"].summary() == "unscrew M8 (pitch 1.25, 12.4 turns)"
+
+
+def test_a_bolt_named_by_its_size_is_pulled_once_its_nut_is_off():
+    # with its nut on, the M8 bolt is held by it: the nut is unscrewed upwards first,
+    # from its back face at z = 9 to the bolt's tip at z = 15.5 (6.5 / 1.25 = 5.2
+    # turns), and the bolt is then pulled out downwards, no thread left to turn
+    assembly = bolted_by_name("M3 Bolt", nut=True)
+    result = plan(assembly, max_and_or_parts=0)
+    assert result.feasible
+    assert_steps_clear(assembly, result)
+    when = {name: k for k, step in enumerate(result.steps) for name in step.parts}
+    assert when["nut"] < when["M8 bolt"]
+    fasteners = {f.part: f for step in result.steps for f in step.fasteners}
+    assert fasteners["nut"].summary() == "unscrew nut M8 (pitch 1.25, 5.2 turns)"
+    assert fasteners["M8 bolt"].summary() == "pull bolt M8"
+    assert fasteners["M3 Bolt"].summary() == "unscrew M3 (pitch 0.5, 8 turns)"

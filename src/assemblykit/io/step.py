@@ -10,7 +10,10 @@ uses it), read through OCP's XCAF document:
   unnamed products, or a shape type such as ``SOLID`` or ``COMPOUND``, which XCAF gives
   unnamed shapes) is no name: the solid is then named after the instance that places
   it, when the occurrence has a name (not XCAF's reference ``=>[0:1:1:2]`` nor a bare
-  number), and otherwise it is ``solid<i>``, ``i`` its 1-based place among all solids;
+  number), else after the nearest subassembly around it that has a name (its instance's
+  or its product's: build123d and CadQuery write each named object as an assembly of
+  one product named ``SOLID``), and otherwise it is ``solid<i>``, ``i`` its 1-based
+  place among all solids;
 * distinct products with one name keep distinct names, suffixed as CAD tools do: the
   first one met keeps the name, the next ones are ``Body (2)``, ``Body (3)``, ...;
 * the instances of a product used several times are numbered in file order
@@ -896,7 +899,8 @@ def _product_solids(
     left_out: list[Skipped],
 ) -> Iterator[_Solid]:
     """The solids of the product at ``label`` placed by ``location`` as the instance
-    named ``placed_as`` (``""`` for none), depth first in file order, with those its
+    named ``placed_as`` (``""`` for none: the name of the instance, else that of the
+    nearest subassembly around it with one), depth first in file order, with those its
     closed shells make (:func:`_surface_solids`); each subassembly met below it appends
     its name and product key to ``groups``, each placement of a product that is not an
     assembly takes the next number of ``placements``, and surfaces enclosing no volume
@@ -907,13 +911,15 @@ def _product_solids(
             tool.GetReferredShape_s(component, referred)
             placed = location.Multiplied(tool.GetLocation_s(component))
             instance = _label_name(ocp, component, instance=True)
-            inner = within
+            inner, given = within, instance or placed_as
             if tool.IsAssembly_s(referred):
-                name = _label_name(ocp, referred) or instance or "subassembly"
+                product = _label_name(ocp, referred)
+                name = product or instance or "subassembly"
                 groups.append((name, _entry(ocp, referred)))
                 inner = (*within, len(groups) - 1)
+                given = instance or product or placed_as
             yield from _product_solids(
-                ocp, tool, referred, placed, inner, groups, instance, placements, left_out
+                ocp, tool, referred, placed, inner, groups, given, placements, left_out
             )
         return
     shape = tool.GetShape_s(label).Moved(location)

@@ -203,6 +203,9 @@ class Fastener:
     """The diameter of its fit (model units)."""
     thread: Thread | None = None
     """A screw's thread, where implied (module docstring)."""
+    named: bool = False
+    """Whether it is a screw by its name alone (drawn at the size its name writes,
+    sharing no volume with its holes)."""
 
     def motion(self) -> SymmetryGroup:
         """The motion that takes it out: the helical group about its axis, of the
@@ -308,6 +311,9 @@ def step_fastener(
     center = np.asarray(first.center, dtype=np.float64)
     if _reach(assembly[part].mesh.vertices, center, d) > HEAD_RATIO * diameter / 2:
         return None
+    named = not threaded and not pressed and _named_for(part, diameter, assembly.units)
+    if named:
+        threaded = [min(holes, key=lambda hole: min(_near_end(p, d) for p in fits[hole]))]
     thread = None
     if threaded:
         tip = float((assembly[part].mesh.vertices @ d).min())
@@ -322,7 +328,18 @@ def step_fastener(
         center,
         diameter,
         thread,
+        named,
     )
+
+
+def _named_for(part: str, diameter: float, units: str | None) -> bool:
+    """Whether the name of ``part`` writes an ISO size (:func:`named_size`) that its fit
+    of ``diameter`` (model units of ``units``) is drawn at: between :data:`PILOT_HOLE`
+    of the size and :data:`NOMINAL_MATCH` above it."""
+    size, scale = named_size(part), MILLIMETRES.get(units or "")
+    if size is None or scale is None:
+        return False
+    return PILOT_HOLE * size <= diameter * scale <= (1 + NOMINAL_MATCH) * size
 
 
 def _fits(
@@ -426,12 +443,13 @@ def bolts_after_nuts(fasteners: Sequence[Sequence[Fastener]]) -> list[tuple[Fast
 
 
 def _as_bolt(fastener: Fastener, nut: Fastener | None) -> Fastener:
-    """``fastener`` as a bolt where it is a pin leaving along the axis of the ``nut``
-    that came off it."""
-    if nut is None or fastener.kind != "pin" or abs(float(fastener.axis @ nut.axis)) < 0.5:
+    """``fastener`` as a bolt where it is a pin, or a screw by its name alone, leaving
+    along the axis of the ``nut`` that came off it."""
+    unthreaded = fastener.kind == "pin" or fastener.named
+    if nut is None or not unthreaded or abs(float(fastener.axis @ nut.axis)) < 0.5:
         return fastener
     thread = None if nut.thread is None else replace(nut.thread, turns=0.0)
-    return replace(fastener, kind="bolt", thread=thread)
+    return replace(fastener, kind="bolt", thread=thread, named=False)
 
 
 def _fit_length(patches: Sequence[CurvedPatch]) -> float | None:
@@ -480,6 +498,12 @@ def _reach(
     unit ``axis``."""
     offsets = np.asarray(points, dtype=np.float64) - center
     return float(np.linalg.norm(offsets - np.outer(offsets @ axis, axis), axis=1).max(initial=0.0))
+
+
+def _near_end(patch: CurvedPatch, direction: NDArray[np.float64]) -> float:
+    """How far along ``direction`` the fit ``patch`` begins: how far against it it
+    reaches, negated (:func:`_far_end` along the opposite direction)."""
+    return -_far_end(patch, -direction)
 
 
 def _far_end(patch: CurvedPatch, direction: NDArray[np.float64]) -> float:
