@@ -520,6 +520,39 @@ def test_a_file_without_any_part_is_an_error(tmp_path, monkeypatch):
 
 
 @cad
+def test_a_solid_that_touches_itself_along_an_edge_keeps_its_shape(tmp_path):
+    # one solid: two unit cubes drawn as one prism whose outline passes twice through
+    # (1, 1), so its side faces meet four at the edge x = y = 1 (valid for BRepCheck);
+    # a cube fills the notch at x in [0, 1], y in [1, 2]. By hand the part's volume is
+    # 2, not the 3 of its convex hull, and the cube shares nothing with it
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakePolygon
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
+    from OCP.gp import gp_Pnt, gp_Vec
+
+    from step_files import box
+
+    outline = BRepBuilderAPI_MakePolygon()
+    for x, y in [(0, 0), (1, 0), (1, 1), (2, 1), (2, 2), (1, 2), (1, 1), (0, 1)]:
+        outline.Add(gp_Pnt(x, y, 0))
+    outline.Close()
+    face = BRepBuilderAPI_MakeFace(outline.Wire()).Face()
+    steps = BRepPrimAPI_MakePrism(face, gp_Vec(0, 0, 1)).Shape()
+    path = tmp_path / "steps.step"
+    write_step(path, steps, box((0, 1, 0), (1, 1, 1)))
+    asm = load_assembly(path)
+    assert asm.warnings == (
+        "solid1: its surface meets itself along 1 edge; its mesh is split there into sheets",
+    )
+    assert asm["solid1"].mesh.is_watertight
+    assert asm["solid1"].volume == pytest.approx(2.0, rel=1e-9)
+    assert {s.kind for s in asm["solid1"].surfaces} == {"plane"}
+    assert resolve_overlaps(asm).overlaps == ()
+    result = plan(asm, max_and_or_parts=0)
+    assert result.feasible
+    assert_steps_clear(asm, result)
+
+
+@cad
 @pytest.mark.slow
 def test_the_gripper_loads_every_part():
     """``gripper.step`` of online-robotics/CAD-data (commit 74ada1e), 144 solids:

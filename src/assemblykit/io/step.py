@@ -114,6 +114,7 @@ from scipy.spatial import QhullError
 
 from assemblykit.algebra.se3 import unit
 from assemblykit.errors import GeometryError, MissingExtraError
+from assemblykit.geometry.nonmanifold import split_touching
 from assemblykit.geometry.recognition import is_convex
 from assemblykit.geometry.tessellation import inside_vertices
 from assemblykit.model.assembly import Assembly, Part, Skipped
@@ -528,6 +529,35 @@ def _closed(
     return (blocks, mesh, keep) if mesh.is_watertight else None
 
 
+def _split(
+    ocp: Any, solid: Any, mesh: trimesh.Trimesh
+) -> tuple[trimesh.Trimesh, NDArray[np.bool_], str] | None:
+    """Where ``mesh``, closed, has edges that more than two triangles share (the solid's
+    surface meets itself along a line), the mesh with its sheets split there
+    (:func:`~assemblykit.geometry.nonmanifold.split_touching`) when its volume is within
+    ``FILL_VOLUME_TOLERANCE`` of the solid's exact one, every triangle kept, and what
+    was done; else ``None``."""
+    edges = mesh.edges_sorted
+    _, shared = np.unique(edges, axis=0, return_counts=True)
+    if np.any(shared == 1) or not np.any(shared > 2):
+        return None
+    split = split_touching(mesh)
+    volume = _exact_volume(ocp, solid)
+    if split is None or abs(split.volume - volume) > FILL_VOLUME_TOLERANCE * volume:
+        return None
+    touching = int(np.count_nonzero(shared > 2))
+    said = f"{touching} edge{'s' * (touching != 1)}"
+    note = f"its surface meets itself along {said}; its mesh is split there into sheets"
+    return split, np.ones(len(split.faces), dtype=bool), note
+
+
+def _exact_volume(ocp: Any, solid: Any) -> float:
+    """The volume of the exact ``solid`` (OCCT's ``BRepGProp``)."""
+    properties = ocp.GProp_GProps()
+    ocp.BRepGProp.VolumeProperties_s(solid, properties)
+    return abs(float(properties.Mass()))
+
+
 def _tessellated(ocp: Any, solid: Any, diagonal: float) -> _Tessellation | str:
     """The closed mesh of a solid (module docstring): BRepMesh's, meshed again with each
     of ``MESH_RETRIES`` and after ``ShapeFix_Shape``'s repair when it leaves a face without
@@ -540,6 +570,8 @@ def _tessellated(ocp: Any, solid: Any, diagonal: float) -> _Tessellation | str:
     first = _merged(blocks) if blocks else None
     if not missing and first is not None and first[0].is_watertight:
         return _Tessellation(blocks, *first, "")
+    if not missing and first is not None and (split := _split(ocp, solid, first[0])):
+        return _Tessellation(blocks, *split)
     if missing:
         problem = f"BRepMesh left {missing} face{'s' if missing > 1 else ''} untriangulated"
     else:
@@ -554,9 +586,7 @@ def _tessellated(ocp: Any, solid: Any, diagonal: float) -> _Tessellation | str:
     if again := _closed(ocp, repaired, LINEAR_DEFLECTION * diagonal, ANGULAR_DEFLECTION, False):
         return _Tessellation(*again, f"{problem}; meshed again after ShapeFix_Shape's repair")
     if first is not None and (fanned := _fanned(first[0])) is not None:
-        properties = ocp.GProp_GProps()
-        ocp.BRepGProp.VolumeProperties_s(solid, properties)
-        volume = abs(properties.Mass())
+        volume = _exact_volume(ocp, solid)
         with np.errstate(divide="ignore", invalid="ignore"):  # a flat fill has no volume
             closed_volume = abs(fanned.volume) if fanned.is_winding_consistent else 0.0
         if (

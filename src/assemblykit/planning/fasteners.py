@@ -12,9 +12,11 @@ when it also interferes with one of those
 parts by design deeper than :data:`PRESS_FIT_SHARE` of the fit's radius (a thread cut
 into its pilot hole or a nut's insert, resolved by
 :func:`~assemblykit.geometry.overlaps.resolve_overlaps`); **pressed** when it interferes
-less deeply (a press fit); otherwise a **pin**. Bolts and
-screws drawn at their nominal diameter, with no thread modelled and no interference, are
-reported as pins (docs/planning.md, "Fasteners").
+less deeply (a press fit); otherwise a **pin**, unless its name writes the ISO size
+it is drawn at (``M3 Bolt`` at 3 mm: :func:`named_size`), which makes it a screw
+threaded into the last of its holes on its way in. Other bolts and screws drawn at their
+nominal diameter, with no thread modelled and no interference, are reported as pins
+(docs/planning.md, "Fasteners").
 
 A **nut** is the outer side of such a fit round a bolt-like shaft (a part within
 :data:`HEAD_RATIO` radii of the axis): a part itself within those radii, between
