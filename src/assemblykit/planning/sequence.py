@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
+from assemblykit.blocking.arrangement import snap_normals
 from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.dbg import blocking_components
 from assemblykit.blocking.directions import (
@@ -62,6 +63,7 @@ from assemblykit.blocking.directions import (
 )
 from assemblykit.blocking.extended import extended_arcs, shown_arcs
 from assemblykit.deprecation import moved
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.planning.fasteners import Fastener, drawn_summary
 from assemblykit.planning.multimove import moving_groups
 from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance, order_key
@@ -988,15 +990,18 @@ class Search:
     is taken, and lifting goes before sliding (:func:`_best_direction`)."""
     max_steps: int | None = None
     """Stop after this many steps (``None``: go on until every set is apart or stopped)."""
+    axes: NDArray[np.float64] | None = None
+    """Directions added once, before the exact free sets, when the sampled ones free
+    nothing (:func:`fit_axes`)."""
     unfinished: list[int] = field(default_factory=list)
     """The sets not taken apart because :attr:`max_steps` was reached (bit masks)."""
 
     def _choose(self, members: int, previous: int | None) -> tuple[int, list[int]] | None:
-        """The next removal from ``members``: each narrower in turn, then the same once
-        more with the directions of the exact free sets when the sampled ones free
-        nothing."""
+        """The next removal from ``members``: each narrower in turn, then the same again
+        with more candidate directions while the sampled ones free nothing (:attr:`axes`,
+        then the directions of the exact free sets)."""
         narrowers: tuple[Narrow | None, ...] = self.narrowers or (None,)
-        for refine in (False, True):
+        for refine in (False, True, True):
             if refine and not self._refined(members):
                 return None
             for narrow in narrowers:
@@ -1021,9 +1026,12 @@ class Search:
         translation (Γ_e blocks at least where Γ_t does)."""
         if self.exact is None or self.add_translations is None:
             return False
-        if not separable(self.translations, members):
+        if self.axes is not None and isinstance(self.extended, ExtendedDirections):
+            found, self.axes = self.axes, None
+        elif not separable(self.translations, members):
             return False
-        found = self.exact(members)
+        else:
+            found = self.exact(members)
         if not len(found) or not isinstance(self.extended, ExtendedDirections):
             return False
         self.translations = self.translations.appended(found, self.add_translations(found))
@@ -1234,6 +1242,25 @@ def and_or_graph(table: DirectionTable) -> AndOrGraph:
 EXACT_GROUP_PARTS = 12
 """The largest set left by the candidates of Γ_t whose groups get the directions of the
 overlay of every pair's blocked set (single parts always get their free set's)."""
+
+
+def fit_axes(assembly: Assembly, tol: Tolerance) -> NDArray[np.float64]:
+    """The coordinate axes and the axes of the cylindrical contacts, both ways, each once
+    within the angle tolerance: where the circles of every radial contact normal of a
+    fit meet. Normals a rounding apart (tessellated CAD) make the arrangement a cluster
+    of slivers there instead of one vertex, each on the blocked side of some circle; a
+    direction added as a row of its own is decided within the tolerance
+    (:func:`~assemblykit.blocking.tables.translation_slots`), so a ring lifts off its
+    pins along their common axis."""
+    axes = [np.eye(3)]
+    for contact in assembly_contacts(assembly, tol):
+        axes += [
+            np.asarray(patch.axis, dtype=np.float64)[None]
+            for patch in contact.curved
+            if patch.kind == "cylindrical" and patch.axis is not None
+        ]
+    lines = snap_normals(np.vstack(axes), tol)[0]
+    return np.vstack([lines, -lines])
 
 
 def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDArray[np.float64]]:
