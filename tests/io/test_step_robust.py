@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from assemblykit.errors import GeometryError
 from assemblykit.geometry.contacts import assembly_contacts
-from assemblykit.geometry.overlaps import resolve_overlaps
+from assemblykit.geometry.overlaps import resolve_overlaps, touching_products
 from assemblykit.io import step
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.step import declared_solids, decode_step_string, distinct_products
@@ -731,6 +731,29 @@ def test_a_locknut_of_two_solids_is_planned_as_one_part(locknut_step):
     # planned solid by solid, the insert stays locked in its nut
     apart = plan(resolve_overlaps(asm, join_products=False), max_and_or_parts=0)
     assert not apart.feasible and {"locknut_1", "locknut_2"} <= set(apart.stuck)
+
+
+@cad
+def test_the_solids_of_a_product_that_lie_apart_stay_parts_of_their_own(tmp_path):
+    # one product "bolts" of four solids: two bolts 10 apart, each drawn with a washer
+    # touching it (a head on top of its washer), as one body; by hand the product falls
+    # into two touching sets, each joined (named by its solids), the two sets apart
+    doc = _Document()
+    rig = doc.assembly("rig")
+    solids = []
+    for x in (0, 10):
+        solids += [_box(2, 2, 6, (x, 0, 0)), _box(4, 4, 1, (x - 1, -1, 6))]
+    doc.place(rig, doc.product("bolts", *solids), (0, 0, 0))
+    doc.place(rig, doc.product("plate", _box(20, 6, 1, (-4, -2, -1))), (0, 0, 0))
+    asm = load_assembly(doc.write(tmp_path / "bolts.step"))
+    assert asm.products == {"bolts": ("bolts_1", "bolts_2", "bolts_3", "bolts_4")}
+    assert touching_products(asm) == {
+        "bolts_1+bolts_2": ("bolts_1", "bolts_2"),
+        "bolts_3+bolts_4": ("bolts_3", "bolts_4"),
+    }
+    prepared = resolve_overlaps(asm)
+    assert sorted(prepared.names) == ["bolts_1+bolts_2", "bolts_3+bolts_4", "plate"]
+    assert prepared["bolts_1+bolts_2"].volume == pytest.approx(24 + 16, rel=1e-9)
 
 
 @cad

@@ -8,9 +8,11 @@ otherwise, and :func:`resolve_overlaps` does the same, saying what it did for ea
 
 * **joined** parts (``join``, and with ``join_interfering`` every connected set of
   interfering parts) become one rigid part named ``A+B``: the union of their solids
-  (manifold3d). The solids of one product of several solids (a locknut's nut and its
-  nylon insert, captured in it) are one physical part, joined and named after the
-  product, unless ``join_products`` is false;
+  (manifold3d). The solids of one product of several solids that touch one another (a
+  locknut's nut and its nylon insert, captured in it) are one physical part, joined and
+  named after the product, unless ``join_products`` is false; solids of a product apart
+  from the others (a pattern of six bolts drawn as one body) stay parts of their own
+  (:func:`touching_products`);
 * **designed interference**: a pair sharing at most ``ignore_overlap`` (default:
   ``DESIGNED_SHARE`` of the smaller part's volume) has the shared volume cut from the
   smaller part, with all of that part in the shared volume's shadow along the axis it
@@ -92,6 +94,44 @@ def joined(assembly: Assembly, groups: Iterable[Iterable[str]]) -> Assembly:
     return _joined(assembly, groups)[0]
 
 
+TOUCHING_GAP = 1e-3
+"""The largest gap, a share of the smaller solid's bounding-box diagonal, between two
+solids of one product that are read as touching (one physical part): a thousandth of
+its size, beyond the sag of a tessellated curved face."""
+
+
+def touching_products(assembly: Assembly) -> dict[str, tuple[str, ...]]:
+    """The products of several solids (:attr:`~assemblykit.model.assembly.Assembly.products`)
+    as the sets of their solids that touch or overlap one another, each within
+    :data:`TOUCHING_GAP` of the next (manifold3d's ``min_gap``): a product whose solids
+    all hang together keeps its name; each set of two solids or more of a product that
+    falls apart is named by joining its solids' names with ``+``, and a solid touching
+    no other of its product is no set (a part of its own)."""
+    found: dict[str, tuple[str, ...]] = {}
+    for product, members in assembly.products.items():
+        meshes = {name: assembly[name].mesh for name in members}
+        bodies = {name: solid(mesh, name) for name, mesh in meshes.items()}
+        graph: nx.Graph = nx.Graph()
+        graph.add_nodes_from(members)
+        for a, b in itertools.combinations(members, 2):
+            size = min(float(np.linalg.norm(np.ptp(meshes[n].bounds, axis=0))) for n in (a, b))
+            gap = TOUCHING_GAP * size
+            # min_gap answers its search length where nothing is nearer
+            if bodies[a].min_gap(bodies[b], 2 * gap) <= gap:
+                graph.add_edge(a, b)
+        order = {name: k for k, name in enumerate(members)}
+        sets = [
+            tuple(sorted(c, key=order.__getitem__))
+            for c in nx.connected_components(graph)
+            if len(c) > 1
+        ]
+        if len(sets) == 1 and len(sets[0]) == len(members):
+            found[product] = sets[0]
+            continue
+        found.update(("+".join(group), group) for group in sorted(sets, key=lambda g: order[g[0]]))
+    return found
+
+
 def join_products(assembly: Assembly) -> Assembly:
     """``assembly`` with the solids of each product of several solids
     (:attr:`~assemblykit.model.assembly.Assembly.products`: a locknut's nut and nylon
@@ -101,7 +141,7 @@ def join_products(assembly: Assembly) -> Assembly:
     parts they became."""
     if not assembly.products:
         return assembly
-    result, into = _joined(assembly, (), assembly.products)
+    result, into = _joined(assembly, (), touching_products(assembly))
     prepared = type(result).like(result, scale=result.scale)
     members: dict[str, list[str]] = {}
     for name, part in into.items():
@@ -467,7 +507,7 @@ def resolve_overlaps(
     groups = [list(group) for group in join]
     if join_interfering:
         groups += [[a, b] for a, b, _ in found]
-    result, into = _joined(assembly, groups, assembly.products if join_products else None)
+    result, into = _joined(assembly, groups, touching_products(assembly) if join_products else None)
     overlaps = [
         Overlap(a, b, volume, "joined")
         for a, b, volume in found
