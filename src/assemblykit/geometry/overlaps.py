@@ -296,7 +296,9 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
     (a screw through two plates, trimmed along its whole shank by the first) is left
     as it is: what it still shares is rounding, whose shadow means nothing. ``None``
     when what the cut leaves of ``part`` still shares more than the interference
-    threshold with ``other`` (a cut that cannot be made)."""
+    threshold with ``other`` (a cut that cannot be made). The cut's mesh is measured
+    again as it will be used: where reading it back collapses slivers into ``other``,
+    ``other`` is subtracted from it once more (:func:`_cut_again`)."""
     # the triangles of surface k numbered k, the others each their own number after them
     count = len(part.surfaces)
     ids = count + np.arange(len(part.mesh.faces))
@@ -334,8 +336,27 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
     mesh, source = traced_mesh(cut, original_id)
     if (cut ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
         return None
+    if (solid(mesh) ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
+        mesh, source = _cut_again(mesh, source, theirs)
+        if (solid(mesh) ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
+            return None
     surfaces = _cut_surfaces(part, other, mesh, source, axis, tol) if part.surfaces else ()
     return replace(part, mesh=mesh, surfaces=surfaces)
+
+
+def _cut_again(
+    mesh: trimesh.Trimesh, source: NDArray[np.int64], theirs: manifold3d.Manifold
+) -> tuple[trimesh.Trimesh, NDArray[np.int64]]:
+    """The cut part's ``mesh`` (its triangles on the surfaces numbered ``source``, -1 on
+    the cut) less ``theirs``, and the numbers of its triangles: a cut whose faces lie on
+    the other part's leaves slivers thinner than manifold3d's tolerance, which its
+    mesh, read back, collapses into the other part; subtracting the other part from
+    that mesh removes what they then share."""
+    cut_id = int(source.max(initial=0)) + 1
+    original_id = manifold3d.Manifold.reserve_ids(1)
+    again = solid(mesh, original_id=original_id, face_ids=np.where(source >= 0, source, cut_id))
+    trimmed, numbers = traced_mesh(_bodies(again - theirs), original_id)
+    return trimmed, np.where(numbers == cut_id, -1, numbers)
 
 
 THREAD_CLEARANCE_SHARE = 0.01
