@@ -148,6 +148,11 @@ def iris(path: Path, blades: int) -> Path:
     builder.MakeCompound(compound)
     for shape in (base, *shafts, *leaves, cover):
         builder.Add(compound, shape)
+    from OCP.Message import Message, Message_Gravity
+
+    # the writer's statistics (its trace) would fill the figures' lines: failures only
+    for printer in Message.DefaultMessenger_s().Printers():
+        printer.SetTraceLevel(Message_Gravity.Message_Fail)
     writer = STEPControl_Writer()
     writer.Transfer(compound, STEPControl_AsIs)
     writer.Write(str(path))
