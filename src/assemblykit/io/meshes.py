@@ -43,7 +43,6 @@ from scipy.spatial.transform import Rotation
 
 from assemblykit.errors import GeometryError, SchemaError
 from assemblykit.geometry.contacts import candidate_pairs
-from assemblykit.geometry.nonmanifold import split_touching
 from assemblykit.geometry.precision import combined, mesh_precision, pose_precision
 from assemblykit.geometry.settling import settle as settle_parts
 from assemblykit.geometry.solids import placed
@@ -103,9 +102,7 @@ def repaired(
     if len(fixed.faces) == 0:
         raise GeometryError("all triangles are degenerate", source=source)
     if not fixed.is_watertight:
-        # solids meeting along an edge (voxel pieces whose cubes touch along one)
-        split = split_touching(fixed)
-        fixed = fixed if split is None else split
+        fixed = _split_at_shared_edges(fixed)
     if not fixed.is_watertight:
         edges = fixed.edges_sorted[trimesh.grouping.group_rows(fixed.edges_sorted, require_count=1)]
         border = len(edges)
@@ -150,6 +147,46 @@ def _flat_holes(mesh: trimesh.Trimesh, edges: NDArray[np.int64]) -> bool:
             if spread > current().mesh_rel_length * scale * np.sqrt(len(points)):
                 return False
     return True
+
+
+def _split_at_shared_edges(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh`` with its vertices duplicated where closed solids meet along an edge or at
+    a vertex only (voxel pieces whose cubes touch along an edge: four faces on one edge),
+    when that makes every solid watertight; else ``mesh`` unchanged.
+
+    Faces are grouped across the edges that exactly two faces share; each group becomes
+    a body with vertices of its own, so an edge where two solids meet counts once per
+    solid. The union of solids touching along a line is still one solid (its volume is
+    the sum), so the part keeps its mesh as one."""
+    edges = mesh.edges_sorted
+    _, inverse, counts = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    if not np.any(counts > 2):
+        return mesh  # an open mesh, not solids meeting along an edge: nothing to split
+    manifold = counts[inverse] == 2
+    # faces sharing a manifold edge are neighbours (edges_face gives each edge's face)
+    order = np.argsort(inverse, kind="stable")
+    faces_of = mesh.edges_face[order]
+    groups = inverse[order]
+    keep = manifold[order]
+    pairs = [
+        (int(faces_of[k]), int(faces_of[k + 1]))
+        for k in range(len(order) - 1)
+        if keep[k] and groups[k] == groups[k + 1]
+    ]
+    labels = trimesh.graph.connected_component_labels(pairs, node_count=len(mesh.faces))
+    bodies: list[trimesh.Trimesh] = []
+    for label in np.unique(labels):
+        body = mesh.submesh([np.flatnonzero(labels == label)], append=True, only_watertight=False)
+        assert isinstance(body, trimesh.Trimesh)  # append=True joins the faces in one mesh
+        bodies.append(body)
+    if not all(body.is_watertight for body in bodies):
+        return mesh
+    vertices = np.vstack([body.vertices for body in bodies])
+    offsets = np.cumsum([0] + [len(body.vertices) for body in bodies[:-1]])
+    faces = np.vstack([body.faces + offset for body, offset in zip(bodies, offsets, strict=True)])
+    # no processing: merging the duplicated vertices would join the solids again
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
 
 
 def pose_from_state(state: Sequence[float]) -> NDArray[np.float64]:
