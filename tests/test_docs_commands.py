@@ -87,16 +87,27 @@ def test_the_documents_show_commands():
 
 # commands whose work other tests of the default tier already do, with checks, run in the
 # slow tier: those beginning with these words (a plan of the Pelikan burr, a burr with no
-# monotone plan, the demo: tests/test_cli_plan.py and the plain install of .ci/run) ...
+# monotone plan, the demo, the demo gearbox's plan and contacts with their files:
+# tests/test_cli_plan.py, tests/io/test_exports.py, tests/test_bad_input.py and the plain
+# install of .ci/run) ...
+GEARBOX = "src/assemblykit/examples/gearbox_demo/gearbox.yaml"
 SLOW_BEGINNINGS = (
     ["assemblykit", "plan", "tests/data/burrtools/PelikanBurr.xmpuzzle"],
     ["assemblykit", "plan", "tests/data/burrtools/SolidSixPieceBurrs.xmpuzzle"],
     ["assemblykit", "demo"],
+    ["assemblykit", "plan", GEARBOX],
+    ["assemblykit", "contacts", GEARBOX],
 )
-# ... and these (a local batch of two assemblies, shown again with options)
+# ... and these (a batch of two assemblies, shown again with worker processes, and with
+# Dask: tests/test_batch.py starts both engines)
 SLOW_COMMANDS = (
     "assemblykit batch tests/data/compas_assembly/stack_assembly.json "
     "tests/data/compas_assembly/arch_assembly.json --out results.jsonl",
+    "assemblykit batch tests/data/compas_assembly/stack_assembly.json "
+    "tests/data/compas_assembly/arch_assembly.json --out results.jsonl --engine local "
+    "--workers 2 --timeout 120",
+    "assemblykit batch tests/data/compas_assembly/stack_assembly.json --out results.jsonl "
+    "--engine dask",
 )
 
 

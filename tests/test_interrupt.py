@@ -143,7 +143,7 @@ def started(fake_python: Path) -> list[str]:
     return log.read_text().splitlines() if log.exists() else []
 
 
-@pytest.mark.parametrize("engine", ["local", "dask"])
+@pytest.mark.parametrize("engine", ["local", pytest.param("dask", marks=pytest.mark.slow)])
 def test_ctrl_c_stops_a_batch_and_keeps_its_finished_lines(
     tmp_path: Path, fake_python: Path, engine: str
 ) -> None:

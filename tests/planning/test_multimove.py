@@ -288,7 +288,7 @@ def test_plan_command_on_burrtools_files_compares_with_the_stored_level(capsys):
     [
         ("CubeInCage.xmpuzzle", "4.9.3"),
         ("AlPackino.xmpuzzle", "1.1.1.1.1.2.1.3.1.2.1.2"),
-        ("DraculasDentalDesaster.xmpuzzle", "3.5.16.6.4.1.1.1"),
+        pytest.param("DraculasDentalDesaster.xmpuzzle", "3.5.16.6.4.1.1.1", marks=pytest.mark.slow),
         ("PelikanBurr.xmpuzzle", "98.1.2.1.4.2"),
     ],
 )

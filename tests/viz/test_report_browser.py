@@ -448,6 +448,7 @@ def test_the_gearbox_fills_the_view_step_one_is_highlighted_and_play_walks_on(
     )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "source",
     [
