@@ -271,7 +271,11 @@ def test_an_independent_solution_of_the_arch_agrees_with_the_program():
 
 
 @pytest.mark.parametrize(
-    "steps", [pytest.param(5, marks=pytest.mark.early), pytest.param(40, marks=pytest.mark.slow)]
+    "steps",
+    [
+        pytest.param(5, marks=pytest.mark.early),
+        pytest.param(40, marks=[pytest.mark.slow, pytest.mark.early]),
+    ],
 )
 def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(steps: int):
     """The first ``steps`` steps of the cross vault's plan under gravity with one hold
