@@ -11,6 +11,7 @@ from dataclasses import replace
 import manifold3d
 import numpy as np
 import pytest
+import shapely
 import trimesh
 
 from assemblykit.geometry import overlaps
@@ -19,6 +20,7 @@ from assemblykit.geometry.overlaps import DESIGNED_SHARE, joined, resolve_overla
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.planner import plan
 from cli_runs import run
+from plan_checks import assert_steps_clear
 from stability_blocks import box
 
 
@@ -236,3 +238,55 @@ def test_a_cut_that_leaves_the_pair_interfering_leaves_it_as_it_is(monkeypatch):
     assert prepared.parts["peg"].mesh.volume == pytest.approx(0.22, rel=1e-9)
     ((_, _, left),) = interferences(prepared)
     assert left == pytest.approx(0.02, rel=1e-9)
+
+
+def motor_through_mount() -> Assembly:
+    """A motor 42 x 42 in y and z, from x = -40, drawn 1.5 into the 2-thick plate of
+    the mount it should stand against, the mount's walls, floor and roof boxing it in
+    from x = -30 to 40 (4 thick, 5 away from it): they share a slab 1.5 x 42 x 42, 9%
+    of the mount, which is the smaller part."""
+    mount = trimesh.boolean.union(
+        [
+            box((2, 60, 60), (0, -30, -30)),
+            box((70, 4, 60), (-30, -30, -30)),
+            box((70, 4, 60), (-30, 26, -30)),
+            box((70, 52, 4), (-30, -26, -30)),
+            box((70, 52, 4), (-30, -26, 26)),
+        ],
+        engine="manifold",
+    )
+    return Assembly([Part("mount", mount), Part("motor", box((41.5, 42, 42), (-40, -21, -21)))])
+
+
+def test_a_motor_drawn_through_its_mounts_plate_leaves_along_its_axis():
+    # the slab's smallest shadows are along y and z, but a cut along either leaves the
+    # motor boxed in by the walls; along x the plate loses the 42 x 42 x 2 the motor
+    # passes through, and nothing else, and the motor slides out along its axis
+    assembly = motor_through_mount()
+    mount_volume = assembly.parts["mount"].mesh.volume
+    prepared = resolve_overlaps(assembly)
+    (overlap,) = prepared.overlaps
+    assert overlap.resolution == "trimmed from mount"
+    assert overlap.volume == pytest.approx(1.5 * 42 * 42, rel=1e-9)
+    mount = prepared.parts["mount"].mesh
+    assert mount_volume - mount.volume == pytest.approx(2 * 42 * 42, rel=1e-9)
+    result = plan(prepared, max_and_or_parts=0)
+    assert result.feasible
+    (step,) = result.steps
+    assert abs(step.direction[0]) == pytest.approx(1.0, abs=1e-12)
+    assert_steps_clear(prepared, result)
+
+
+def test_the_axes_of_a_slab_lie_along_its_faces():
+    # a slab 2 thick in z whose outline is a quadrilateral with no symmetry, one corner
+    # of its top face moved sideways by 3 (a slab cut through tessellated faces, its
+    # sides not square to it): its principal axes lean, and the one across it is taken
+    # along its faces, square to z
+    outline = np.array([[0.0, 0.0], [40.0, 3.0], [35.0, 30.0], [4.0, 22.0]])
+    slab = trimesh.creation.extrude_polygon(shapely.Polygon(outline), 2.0)
+    corner = np.flatnonzero((slab.vertices[:, 2] > 1) & (slab.vertices[:, 1] > 25))
+    slab.vertices[corner] += [3.0, 0.0, 0.0]
+    axes = overlaps.insertion_axes(slab)
+    assert max(abs(axis[2]) for axis in np.asarray(slab.principal_inertia_vectors)) < 1 - 1e-7
+    across = max(axes, key=lambda axis: abs(axis[2]))
+    np.testing.assert_allclose(np.abs(across), [0, 0, 1], atol=1e-12)

@@ -39,6 +39,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from assemblykit.geometry.interference import interference_threshold, interferences, solid
+from assemblykit.geometry.occlusion import blocking_witnesses, shadows
 from assemblykit.model.assembly import Assembly, Overlap, Part
 from assemblykit.model.surfaces import Surface
 from assemblykit.ragged import group_of, group_starts
@@ -257,11 +258,34 @@ def _joined_surfaces(
 def insertion_axis(shared: trimesh.Trimesh) -> NDArray[np.float64]:
     """The axis along which a shared volume was pressed in: of its principal axes of
     inertia, the one along which its shadow is smallest (the ring a screw's thread shares
-    with its hole casts the ring along the screw's axis, a pin's press fit likewise)."""
+    with its hole casts the ring along the screw's axis, a pin's press fit likewise),
+    the first of :func:`insertion_axes`."""
+    return insertion_axes(shared)[0]
+
+
+AXIS_SNAP_ANGLE = 0.01
+"""Radians within which a principal axis of a shared volume is taken along the faces
+of it that are nearly square to it (:func:`insertion_axes`): the axes of inertia of a
+slab whose outline is not symmetric lean by a few thousandths of a radian, and a cut
+along a leaning axis leaves the parts overlapping in a sliver all along it."""
+
+
+def insertion_axes(shared: trimesh.Trimesh) -> list[NDArray[np.float64]]:
+    """The principal axes of inertia of a shared volume, the one along which its shadow
+    is smallest first, each taken along the area-weighted normal of its faces within
+    :data:`AXIS_SNAP_ANGLE` of square to it, when it has such faces (a slab's faces, a
+    ring's ends)."""
     axes = np.asarray(shared.principal_inertia_vectors, dtype=np.float64)
     normals, areas = np.asarray(shared.face_normals), np.asarray(shared.area_faces)
     shadows = [float(np.abs(normals @ axis) @ areas) / 2 for axis in axes]
-    return axes[int(np.argmin(shadows))]
+    snapped = []
+    for k in np.argsort(shadows, kind="stable").tolist():
+        along = normals @ axes[k]
+        square = np.abs(along) >= math.cos(AXIS_SNAP_ANGLE)
+        mean = (normals[square] * (np.sign(along[square]) * areas[square])[:, None]).sum(axis=0)
+        norm = float(np.linalg.norm(mean))
+        snapped.append(mean / norm if norm > 0 else axes[k])
+    return snapped
 
 
 def _extruded_shadow(
@@ -289,9 +313,12 @@ def _extruded_shadow(
 
 def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
     """``part`` without what it shares with ``other``, and without the rest of ``part``
-    in that shared volume's shadow along its :func:`insertion_axis`: a screw loses its
-    thread's ring along the whole shank, so that it leaves along its axis through the
-    hole it is screwed into. Its exact surfaces keep the triangles that remain of them
+    in that shared volume's shadow along the axis it was pressed in by: of its
+    :func:`insertion_axes`, the first whose cut lets the two parts apart along it
+    (:func:`_parts_leave_along`), else the first. A screw loses its thread's ring along
+    the whole shank, so that it leaves along its axis through the hole it is screwed
+    into; a plate that a motor is drawn through loses what the motor passes through,
+    not a strip across it. Its exact surfaces keep the triangles that remain of them
     (:func:`_cut_surfaces`). A part that an earlier cut already took out of ``other``
     (a screw through two plates, trimmed along its whole shank by the first) is left
     as it is: what it still shares is rounding, whose shadow means nothing. ``None``
@@ -313,7 +340,40 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
     bodies = _bodies(common)
     shared = mesh_of(bodies)
     size = float(np.linalg.norm(np.ptp(np.vstack([part.mesh.bounds, other.mesh.bounds]), axis=0)))
-    axis = insertion_axis(shared)
+    # the first axis whose cut lets the two parts apart along it, else the first one
+    cuts: list[tuple[manifold3d.Manifold, NDArray[np.float64]]] = []
+    for candidate in insertion_axes(shared):
+        removed, axis = _removed_along(other, bodies, shared, candidate, size, tol)
+        cuts.append((_bodies(mine - removed), axis))
+        if _parts_leave_along(mesh_of(cuts[-1][0]), other.mesh, axis, tol):
+            break
+    else:
+        cuts.append(cuts[0])
+    cut, axis = cuts[-1]
+    mesh, source = traced_mesh(cut, original_id)
+    if (cut ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
+        return None
+    if (solid(mesh) ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
+        mesh, source = _cut_again(mesh, source, theirs)
+        if (solid(mesh) ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
+            return None
+    surfaces = _cut_surfaces(part, other, mesh, source, axis, tol) if part.surfaces else ()
+    return replace(part, mesh=mesh, surfaces=surfaces)
+
+
+def _removed_along(
+    other: Part,
+    bodies: manifold3d.Manifold,
+    shared: trimesh.Trimesh,
+    axis: NDArray[np.float64],
+    size: float,
+    tol: Tolerance,
+) -> tuple[manifold3d.Manifold, NDArray[np.float64]]:
+    """What :func:`_trimmed` cuts from a part that shares ``bodies`` (whose mesh is
+    ``shared``) with ``other`` when it was pressed in along ``axis``, and the axis it
+    then leaves along: the shadow of the shared volume along the axis, ``size`` long
+    each way; in a hole of ``other`` (:func:`_hole_along`), along the hole's axis, with
+    the thread's tube and the sheets where the part bears on the hole's face."""
     hole = _hole_along(other, shared, axis, tol)
     if hole is None:
         # a thread's ring with a sheet of the head where it bears on the hole's face:
@@ -332,16 +392,23 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
         removed = removed + _thread_tube(hole, shared, 2 * size)
     if sheets is not None:
         removed = removed + sheets
-    cut = _bodies(mine - removed)
-    mesh, source = traced_mesh(cut, original_id)
-    if (cut ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
-        return None
-    if (solid(mesh) ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
-        mesh, source = _cut_again(mesh, source, theirs)
-        if (solid(mesh) ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
-            return None
-    surfaces = _cut_surfaces(part, other, mesh, source, axis, tol) if part.surfaces else ()
-    return replace(part, mesh=mesh, surfaces=surfaces)
+    return removed, axis
+
+
+def _parts_leave_along(
+    cut: trimesh.Trimesh, other: trimesh.Trimesh, axis: NDArray[np.float64], tol: Tolerance
+) -> bool:
+    """Whether a part trimmed to ``cut`` and ``other`` come apart along ``axis`` one way
+    or the other (the projection test of :mod:`assemblykit.geometry.occlusion`): a cut
+    along the axis a part was pressed in by lets it leave that way, unless the part that
+    was pressed in is the larger one (a motor drawn through the plate that holds it:
+    the plate's slab, cut along an axis in its plane, leaves the motor's body in the
+    way)."""
+    movers = np.array([[False, True], [False, False]])
+    return any(
+        not blocking_witnesses(shadows([cut, other], way * axis, tol), movers, tol, first_only=True)
+        for way in (1.0, -1.0)
+    )
 
 
 def _cut_again(
