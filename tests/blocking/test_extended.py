@@ -93,6 +93,23 @@ def test_a_layer_thinner_than_the_interference_policy_is_a_contact():
     assert not any(extended_free(deep, ["post"], d, tol) for d in ([0, 0, 1], [1, 0, 0], [0, 1, 1]))
 
 
+def test_a_pin_sharing_a_rounding_volume_with_its_blind_hole_is_not_backed_out(monkeypatch):
+    # a pin standing 4 deep in a blind hole of its radius: should its solids share a
+    # volume of rounding (1e-15), backing it out of the hole along its whole depth would
+    # free it sideways; it is not backed out, and only leaves up its axis
+    hole = trimesh.creation.cylinder(1.0, 8, sections=32)
+    hole.apply_translation([0, 0, 6])
+    block = trimesh.boolean.difference([box((-5, -5, 0), (5, 5, 6)), hole], engine="manifold")
+    pin = trimesh.creation.cylinder(1.0, 6, sections=32)
+    pin.apply_translation([0, 0, 5])
+    asm = mesh_assembly({"block": block, "pin": pin})
+    tol = asm.tolerance()
+    monkeypatch.setattr("assemblykit.blocking.obstacles.shared_volume", lambda *_: 1e-15)
+    assert not BlockingCache.of(asm).obstacles.backout("pin", "block", tol).any()
+    assert extended_arcs(asm, [1, 0, 0], ["pin"], ["block"], tol) == {("pin", "block")}
+    assert extended_free(asm, ["pin"], [0, 0, 1], tol)
+
+
 def test_interlocked_rings_have_no_removable_subassembly():
     asm = mesh_assembly({"r1": ring([0, 0, 0], "xy"), "r2": ring([1.25, 0, 0], "xz")})
     assert assembly_contacts(asm) == []

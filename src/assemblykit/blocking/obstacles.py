@@ -114,8 +114,8 @@ class Obstacles:
     def backout(self, moving: str, blocker: str, tol: Tolerance) -> NDArray[np.float64]:
         """The translation that backs ``moving`` out of ``blocker`` before blocking is
         decided: their separation when they share a volume counted as touching (module
-        docstring) and it is longer than the length tolerance the tests allow anyway,
-        else zero."""
+        docstring), beyond rounding (the cube of the length tolerance), and it is longer
+        than the length tolerance the tests allow anyway, else zero."""
         key = (moving, blocker, tol)
         if key not in self.backouts:
             flipped = (blocker, moving, tol)
@@ -127,7 +127,10 @@ class Obstacles:
                 # parts whose boxes are apart share no volume: no solid is made for them
                 apart = np.any(a.bounds[0] > b.bounds[1]) or np.any(b.bounds[0] > a.bounds[1])
                 volume = 0.0 if apart else shared_volume(self.solid(moving), self.solid(blocker))
-                if 0 < volume <= interference_threshold(a, b, tol):
+                # a volume below the cube of the length tolerance is rounding: no
+                # layer to back out of (a pin trimmed to its hole, which would be
+                # backed out along its whole length)
+                if tol.length**3 < volume <= interference_threshold(a, b, tol):
                     pair = [self.solid(moving), self.solid(blocker)]
                     shifts = settle([a, b], [(0, 1)], pair).shifts
                     if np.linalg.norm(shifts[0] - shifts[1]) > tol.length:
