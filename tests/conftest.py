@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Generator
 from pathlib import Path
 
 # One thread per process for the linear algebra libraries: the suite runs one process
@@ -22,6 +23,20 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 # clean checkout passes or fails as a whole (the example database is not kept).
 settings.register_profile("repeatable", derandomize=True, database=None)
 settings.load_profile("repeatable")
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_make_collect_report(collector: pytest.Collector) -> Generator[None]:
+    """Test modules imported with their rewritten asserts cached beside them (pytest's
+    ``__pycache__`` files), even where ``PYTHONDONTWRITEBYTECODE`` is set: without the
+    cache each worker rewrites every module's asserts again, about 10 s of every run."""
+    if not (isinstance(collector, pytest.Module) and sys.dont_write_bytecode):
+        return (yield)
+    sys.dont_write_bytecode = False
+    try:
+        return (yield)
+    finally:
+        sys.dont_write_bytecode = True
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

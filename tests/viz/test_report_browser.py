@@ -414,6 +414,7 @@ def check_step_one(shown: dict[str, Any], assembly: Assembly, moved: Sequence[st
     assert shown["current"] == ["1"]
 
 
+@pytest.mark.early
 def test_the_gearbox_fills_the_view_step_one_is_highlighted_and_play_walks_on(
     chromium: Chromium, gearbox_report: Path
 ) -> None:
@@ -494,6 +495,7 @@ def test_a_large_report_is_small_large_on_screen_and_highlights_step_one(
     assert np.ptp(centres[:, :2], axis=0).max() > 0.3 * assembly.scale  # spread out
 
 
+@pytest.mark.slow
 def test_on_a_phone_the_report_fits_the_screen_and_still_shows_the_model(
     chromium: Chromium, gearbox_report: Path
 ) -> None:
