@@ -250,6 +250,33 @@ def test_a_socket_lies_outside_its_sphere(steps):
     assert np.linalg.norm(moved - centre, axis=1).max() <= radius + sag
 
 
+def test_a_spindle_torus_is_left_alone():
+    """The band of a lemon (major radius 10 under the tube's 14: the tube crosses the
+    axis) between heights -5 and 5, convex: its chords lie inside it, and reading its
+    points from the tube's centre at their own azimuth (10 out, where the nearest centre
+    is 10 out the other way) would send them far out."""
+    major, tube = 10.0, 14.0
+
+    def point(i, j):
+        z = -5.0 + 10.0 * i / 8
+        rho, u = math.sqrt(tube**2 - z**2) - major, 2 * math.pi * j / 24
+        return np.array([rho * math.cos(u), rho * math.sin(u), z])
+
+    vertices, faces = grid(point, 9, 24)
+    faces = outward(vertices, faces, lambda c: np.column_stack([c[:, :2], np.zeros(len(c))]))
+    lemon = Surface(
+        "torus",
+        np.zeros(3),
+        Z,
+        np.arange(len(faces)),
+        0.0,
+        radius=major,
+        minor_radius=tube,
+        convex=True,
+    )
+    np.testing.assert_array_equal(inside_vertices(vertices, faces, [lemon]), vertices)
+
+
 @pytest.mark.parametrize("material", ["inside", "outside"])
 @pytest.mark.parametrize("steps", [12, 48])
 def test_a_torus_lies_on_its_material_side(material, steps):

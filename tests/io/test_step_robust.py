@@ -4,6 +4,7 @@ repeated or escaped (ISO 10303-21:2016 §6.4.3), products of several solids."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -891,3 +892,78 @@ def test_product_names_come_decoded(escaped_step):
     expected = list(ESCAPED.values())
     expected[4] = "\U0001f600 (2)"
     assert asm.names == expected
+
+
+def _barrel(major: float, tube: float, half_height: float) -> Any:
+    """A barrel turned about the z axis from an arc of a spindle torus's tube (major
+    radius ``major`` under its tube radius ``tube``: the circle of the tube across the
+    axis, its part at ``|z| <= half_height``), closed by two discs."""
+    from OCP.BRepBuilderAPI import (
+        BRepBuilderAPI_MakeEdge,
+        BRepBuilderAPI_MakeFace,
+        BRepBuilderAPI_MakeWire,
+    )
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeRevol
+    from OCP.GC import GC_MakeArcOfCircle
+    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt
+
+    rim = math.sqrt(tube**2 - half_height**2) - major
+    low, middle = gp_Pnt(rim, 0, -half_height), gp_Pnt(tube - major, 0, 0)
+    high = gp_Pnt(rim, 0, half_height)
+    wire = BRepBuilderAPI_MakeWire()
+    for edge in (
+        BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(low, middle, high).Value()).Edge(),
+        BRepBuilderAPI_MakeEdge(high, gp_Pnt(0, 0, half_height)).Edge(),
+        BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, half_height), gp_Pnt(0, 0, -half_height)).Edge(),
+        BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, -half_height), low).Edge(),
+    ):
+        wire.Add(edge)
+    profile = BRepBuilderAPI_MakeFace(wire.Wire()).Face()
+    axis = gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1))
+    return BRepPrimAPI_MakeRevol(profile, axis, 2 * math.pi).Shape()
+
+
+def _exact_volume(shape: Any) -> float:
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+
+    properties = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, properties)
+    return float(properties.Mass())
+
+
+@cad
+def test_a_barrel_turned_from_a_spindle_torus_keeps_its_shape(tmp_path):
+    # the tube (radius 14) crosses the axis (major radius 10): the barrel is 4 wide at
+    # its middle, sqrt(14² - 5²) - 10 = 3.07 at its ends, and 10 tall; a mesh read from
+    # the tube's centre at each vertex's own azimuth went out to 5.4 and 11.7 tall
+    barrel = _barrel(10.0, 14.0, 5.0)
+    path = tmp_path / "barrel.step"
+    write_step(path, barrel)
+    (part,) = load_assembly(path).parts.values()
+    assert [s.kind for s in part.surfaces if s.kind == "torus"] == ["torus"]
+    (torus,) = [s for s in part.surfaces if s.kind == "torus"]
+    assert (torus.radius, torus.minor_radius) == pytest.approx((10.0, 14.0), abs=1e-6)
+    np.testing.assert_allclose(part.mesh.bounds, [[-4, -4, -5], [4, 4, 5]], atol=0.02)
+    # the chords of its convex faces lie inside it
+    exact = _exact_volume(barrel)
+    assert exact * 0.99 < part.mesh.volume <= exact
+    assert not load_assembly(path).warnings
+
+
+@cad
+def test_vertices_moved_out_of_the_solids_box_are_left_on_its_surface(tmp_path, monkeypatch):
+    path = tmp_path / "plate.step"
+    plate = _box(40, 40, 10, (-20, -20, 0))
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+
+    write_step(path, BRepAlgoAPI_Cut(plate, _cylinder(5, 40, (0, 0, -10))).Shape())
+    kept = load_assembly(path)["solid1"].mesh
+    monkeypatch.setattr(step, "inside_vertices", lambda vertices, faces, surfaces: 3 * vertices)
+    asm = load_assembly(path)
+    assert asm["solid1"].mesh.bounds.tolist() == [[-20, -20, 0], [20, 20, 10]]
+    assert asm["solid1"].mesh.volume == pytest.approx(40 * 40 * 10 - math.pi * 25 * 10, rel=2e-3)
+    assert asm.warnings == (
+        "solid1: its vertices are left on its surface: moved into its material, some left its box",
+    )
+    assert kept.volume < asm["solid1"].mesh.volume  # the hole's chords sag into it

@@ -42,8 +42,8 @@ Every move is found in closed form (along a line where the constraint is linear 
 norm convex); the few that are not, and those that change a vertex's direction (a
 socket's rim, below), are refined by repeating the whole rule, ``MAX_ROUNDS`` times at
 most, until no vertex moves by more than float rounding. Surfaces whose chords lie in
-the material (convex cylinders, cones and spheres, planes) and faces of other types are
-left alone.
+the material (convex cylinders, cones and spheres, planes), spindle tori (whose tube
+crosses the axis) and faces of other types are left alone.
 
 **Neighbouring faces.** A vertex on the rim of a curved face is shared with the faces
 around it. When it lies on planes (of the same part) its move stays in them, so planar
@@ -107,10 +107,13 @@ BoolArray = NDArray[np.bool_]
 
 def sags_out(surface: Surface) -> bool:
     """Whether the chords of ``surface``'s triangles may leave the material: a concave
-    cylinder, cone or sphere, and any torus (the inner side of a male torus is concave
-    about its axis)."""
+    cylinder, cone or sphere, and a ring torus (the inner side of a male torus is concave
+    about its axis). A spindle torus (its tube as wide as its major radius or wider, so
+    that the tube crosses the axis: a lemon or an apple shape, the fit CAD exporters give
+    a large arc turned about an axis) is left alone: the rule reads each vertex from the
+    tube's centre at its own azimuth, which is not the nearest one there."""
     if surface.kind == "torus":
-        return True
+        return surface.minor_radius < surface.radius
     return surface.kind in ("cylinder", "cone", "sphere") and not surface.convex
 
 

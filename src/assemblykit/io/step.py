@@ -79,7 +79,9 @@ vertices of such faces are moved into the material
 (:func:`assemblykit.geometry.tessellation.inside_vertices`, in the planes of the faces
 around them): each triangle then lies on the material side of its exact surface, so the
 mesh lies inside the solid and within the linear deflection of it, and solids that share
-no volume have meshes that share none (docs/geometry.md, "STEP tessellation").
+no volume have meshes that share none (docs/geometry.md, "STEP tessellation"). Should
+a move take a vertex beyond the solid's box by more than ``BOX_MARGIN`` of its diagonal,
+the part keeps its vertices on its surface and its warning says so.
 
 A damaged file is read as far as OCP can, and what it dropped is said: the solid
 entities declared in the file (``MANIFOLD_SOLID_BREP``, ``BREP_WITH_VOIDS``,
@@ -143,6 +145,10 @@ and the angular deflection."""
 FILL_VOLUME_TOLERANCE = 0.01
 """Relative difference from the solid's exact volume within which a mesh whose holes
 were closed by fans of triangles is kept."""
+BOX_MARGIN = 0.01
+"""Distance, relative to the solid's bounding-box diagonal, beyond the solid's box that
+no vertex moved into the material may reach: ten times the linear deflection, far
+beyond the sag it moves by."""
 SOLID_ENTITIES = ("MANIFOLD_SOLID_BREP", "BREP_WITH_VOIDS", "FACETED_BREP")
 _SOLID_TYPES = {
     "StepShape_ManifoldSolidBrep",
@@ -660,9 +666,17 @@ def _solid_part(ocp: Any, solid: Any, source: str) -> tuple[Part | str, str]:
         surface = _surface(ocp, exact, merged_v, merged_f[ids], ids) if exact is not None else None
         if surface is not None:
             surfaces.append(surface)
-    # the vertices of concave faces go into the material (module docstring)
-    mesh.vertices = inside_vertices(merged_v, merged_f, surfaces)
-    return Part("", mesh, np.eye(4), tuple(surfaces), source), tessellation.note
+    # the vertices of concave faces go into the material (module docstring), and stay
+    # in the solid's box
+    inside = inside_vertices(merged_v, merged_f, surfaces)
+    low, high = np.array(box.CornerMin().Coord()), np.array(box.CornerMax().Coord())
+    margin = BOX_MARGIN * diagonal
+    if np.all((inside >= low - margin) & (inside <= high + margin)):
+        mesh.vertices = inside
+        return Part("", mesh, np.eye(4), tuple(surfaces), source), tessellation.note
+    kept = "its vertices are left on its surface: moved into its material, some left its box"
+    note = f"{tessellation.note}; {kept}" if tessellation.note else kept
+    return Part("", mesh, np.eye(4), tuple(surfaces), source), note
 
 
 def _flush_c_streams() -> None:
