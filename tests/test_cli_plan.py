@@ -109,7 +109,9 @@ def test_plan_reports_the_hands_a_planar_interlock_needs(capsys):
     code, out, _ = run(
         capsys, "plan", str(PLANAR / "three_hands.yaml"), "--json", "--max-hands", "2"
     )
-    assert json.loads(out)["hands"]["needed"] is None
+    two = json.loads(out)["hands"]
+    # three parts in two hands: a third hand might take them apart
+    assert two["needed"] is None and two["more_may_free"] is True
     code, _, err = run(capsys, "plan", str(PLANAR / "three_hands.yaml"), "--max-hands", "1")
     assert code == 2 and "--max-hands" in err
 

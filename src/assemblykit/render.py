@@ -403,9 +403,9 @@ def _disassembly_table(plan: Plan) -> Table:
                     "translation, together",
                     fmt.name_list(move.groups[0]),
                 )
-        table.caption = f"needs {plan.hands.summary()}"
+        table.caption = plan.hands.summary()
     elif plan.hands is not None and plan.hands.needed is None:
-        table.caption = f"needs {plan.hands.summary()}"
+        table.caption = plan.hands.summary()
     if any(
         lock.rigid_may_free and not lock.interfering and not lock.enclosed
         for lock in plan.interlocked

@@ -134,3 +134,25 @@ def test_three_handed_move_of_meshes_between_a_floor_and_a_ceiling():
             if still != moving:
                 relative = (velocity[moving] - velocity[still])[:2]
                 assert swept_overlap(model, moving, still, relative) == pytest.approx(0, abs=1e-9)
+
+
+def test_two_linked_rings_come_apart_with_no_number_of_hands():
+    """Two links of a chain (tori of radius 10 and tube 2, each through the other): no
+    translation separates them, and with a hand for each link there is no other way to
+    hold them, so more hands would not do either."""
+    first = trimesh.creation.torus(10.0, 2.0, major_sections=48, minor_sections=12)
+    second = first.copy()
+    second.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0]))
+    second.apply_translation([10.0, 0.0, 0.0])
+    solids = [
+        m3.Manifold(m3.Mesh(np.asarray(m.vertices, np.float32), np.asarray(m.faces, np.uint32)))
+        for m in (first, second)
+    ]
+    assert (solids[0] ^ solids[1]).volume() == 0.0  # linked, not overlapping
+    links = Assembly([Part("a", first), Part("b", second)])
+    result = plan(links)
+    assert sorted(result.stuck) == ["a", "b"]
+    hands = result.hands
+    assert hands is not None and hands.needed is None and hands.more_may_free is False
+    assert hands.summary() == "no number of hands takes it apart by translations"
+    assert result.to_dict()["hands"]["more_may_free"] is False

@@ -253,7 +253,7 @@ def hands_needed(
     else:
         search = _sampled_search(assembly, names, max_hands, tol)
     needed, moves = search.take_apart(mask_of(range(len(search.translations.names))), locked)
-    return Hands(needed, max_hands, tuple(moves))
+    return Hands(needed, max_hands, tuple(moves), more_may_free=len(names) > max_hands)
 
 
 def _exact_search(

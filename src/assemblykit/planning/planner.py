@@ -387,9 +387,11 @@ def finish_plan(
             None if None in needed else max(n for n in needed if n is not None),
             max_hands,
             tuple(move for h in found for move in h.moves),
+            more_may_free=any(h.needed is None and h.more_may_free for h in found),
         )
     elif search.locked:
-        hands = Hands(None, max_hands)
+        largest = max(members.bit_count() for members in search.locked)
+        hands = Hands(None, max_hands, more_may_free=largest > max_hands)
     report("done", len(names), len(names))
     unfinished = tuple(names[i] for i in bits(union_of(search.unfinished)))
     steps = tuple(search.steps)

@@ -545,10 +545,15 @@ class Hands:
     needed: int | None
     max_hands: int
     moves: tuple[HandsMove, ...] = ()
+    more_may_free: bool = True
+    """When ``needed`` is ``None``: whether more than ``max_hands`` hands might take the
+    stuck parts apart. False when no stuck set has more parts than ``max_hands``: each
+    part in a hand of its own is the most hands can do, and it was tried."""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON form: ``needed``, ``max_hands``, the ``groups``, ``directions`` and
-        ``speeds`` of the first operation with more than two hands, and all ``moves``."""
+        ``speeds`` of the first operation with more than two hands, all ``moves``, and
+        ``more_may_free``."""
         first = self.moves[0].to_dict() if self.moves else {}
         return {
             "needed": self.needed,
@@ -557,13 +562,18 @@ class Hands:
             "directions": first.get("directions", []),
             "speeds": first.get("speeds", []),
             "moves": [move.to_dict() for move in self.moves],
+            "more_may_free": self.needed is None and self.more_may_free,
         }
 
     def summary(self) -> str:
-        """One line: how many hands, e.g. ``3 hands`` or ``more than 4 hands``."""
+        """One line: how many hands, e.g. ``needs 3 hands``, ``needs more than 4 hands``
+        or, when a part in each hand does not take the stuck parts apart, ``no number of
+        hands takes it apart by translations``."""
         if self.needed is None:
-            return f"more than {self.max_hands} hands"
-        return f"{self.needed} hand" + ("s" if self.needed > 1 else "")
+            if not self.more_may_free:
+                return "no number of hands takes it apart by translations"
+            return f"needs more than {self.max_hands} hands"
+        return f"needs {self.needed} hand" + ("s" if self.needed > 1 else "")
 
 
 @dataclass(frozen=True, eq=False)
