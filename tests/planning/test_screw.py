@@ -125,9 +125,12 @@ def test_plan_with_turns_takes_the_hook_out_where_translations_stop():
     console = Console(record=True, width=200)
     console.print(render(result))
     assert "turn 50.0 deg" in console.export_text()
-    # the translation plan alone, as printed, says where to look
+    # the translation plan alone, as printed (its caption wrapped to the table's width),
+    # says where to look, and that more hands would not do
     console.print(render(stuck))
-    assert "turns and drawn threads: plan --moves rigid" in console.export_text()
+    said = " ".join(console.export_text().split())
+    assert "no number of hands takes it apart by translations" in said
+    assert "turns and drawn threads: plan --moves rigid" in said
 
 
 def test_plan_command_moves_rigid_prints_the_turn(tmp_path, capsys):
