@@ -264,17 +264,22 @@ def test_a_spindle_torus_is_left_alone():
 
     vertices, faces = grid(point, 9, 24)
     faces = outward(vertices, faces, lambda c: np.column_stack([c[:, :2], np.zeros(len(c))]))
-    lemon = Surface(
+    lemon = torus_about_z(major, tube, len(faces), convex=True)
+    np.testing.assert_array_equal(inside_vertices(vertices, faces, [lemon]), vertices)
+
+
+def torus_about_z(major: float, tube: float, faces: int, convex: bool) -> Surface:
+    """A torus about the z axis through the origin, on the first ``faces`` triangles."""
+    return Surface(
         "torus",
         np.zeros(3),
         Z,
-        np.arange(len(faces)),
+        np.arange(faces),
         0.0,
         radius=major,
         minor_radius=tube,
-        convex=True,
+        convex=convex,
     )
-    np.testing.assert_array_equal(inside_vertices(vertices, faces, [lemon]), vertices)
 
 
 @pytest.mark.parametrize("material", ["inside", "outside"])
@@ -298,16 +303,7 @@ def test_a_torus_lies_on_its_material_side(material, steps):
 
     side = 1.0 if material == "inside" else -1.0
     faces = outward(vertices, faces, lambda c: side * from_tube(c))
-    torus = Surface(
-        "torus",
-        np.zeros(3),
-        Z,
-        np.arange(len(faces)),
-        0.0,
-        radius=major,
-        minor_radius=tube,
-        convex=material == "inside",
-    )
+    torus = torus_about_z(major, tube, len(faces), convex=material == "inside")
     moved = inside_vertices(vertices, faces, [torus])
     distance = np.linalg.norm(from_tube(samples(moved, faces)), axis=1)
     if material == "inside":
