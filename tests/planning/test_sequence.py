@@ -3,6 +3,7 @@ real assemblies (the bundled gearbox, the bundled COMPAS and ASAP data)."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,7 @@ from assemblykit.blocking.tables import translation_table
 from assemblykit.geometry.overlaps import resolve_overlaps
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.planning import planner
 from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import (
     GROUP_REJECTIONS,
@@ -674,3 +676,51 @@ def test_the_axes_tried_when_sampled_directions_free_nothing_are_the_fits_and_co
     for direction in expected:
         assert np.abs(axes @ direction).max() == pytest.approx(1.0, abs=1e-9)
         assert (axes @ direction).max() == pytest.approx(1.0, abs=1e-9)
+
+
+def test_a_direction_a_hair_off_an_axis_is_taken_along_the_axis(monkeypatch):
+    """A block hung on a pin in a U-shaped frame, 1 apart from it everywhere: block and
+    pin leave together along +z (or along y). The candidate directions are tilted by
+    0.003 rad about x (the arrangement's points inside their regions, off the circles
+    through an axis, as a pin's tessellated contact gives on a STEP file): the step
+    still goes along +z exactly, which leaves the frame as clear (the steps are checked
+    by their extended translations and by sweeps); tilted by 0.05 rad, beyond the snap,
+    it keeps the candidate."""
+    hole = trimesh.creation.cylinder(3.0, 40.0, sections=24)
+    hole.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
+    hole.apply_translation([0, 0, 10])
+    block = trimesh.creation.box([20, 20, 20])
+    block.apply_translation([0, 0, 10])
+    block = block.difference(hole, engine="manifold")
+    pin = trimesh.creation.cylinder(3.0, 20.0, sections=24)
+    pin.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
+    pin.apply_translation([0, 0, 10])
+    sides = [trimesh.creation.box([5, 60, 36]) for _ in range(2)]
+    sides[0].apply_translation([-13.5, 0, 7])
+    sides[1].apply_translation([13.5, 0, 7])
+    floor = trimesh.creation.box([32, 60, 5])
+    floor.apply_translation([0, 0, -3.5])
+    frame = trimesh.boolean.union([*sides, floor], engine="manifold")
+    assembly = Assembly([Part("frame", frame), Part("block", block), Part("pin", pin)])
+    original = tables.translation_table
+
+    def tilted_by(angle: float):
+        turn = trimesh.transformations.rotation_matrix(angle, [1, 0, 0])[:3, :3]
+
+        def tilted(*args, **kwargs):
+            found = original(*args, **kwargs)
+            return dataclasses.replace(found, directions=found.directions @ turn.T)
+
+        return tilted
+
+    for angle, expected in ((0.003, [0.0, 0.0, 1.0]), (0.05, None)):
+        monkeypatch.setattr(planner, "translation_table", tilted_by(angle))
+        result = plan(assembly)
+        lift = [s for s in result.steps if set(s.parts) == {"block", "pin"}]
+        assert len(lift) == 1, result.steps
+        if expected is None:
+            assert lift[0].direction[2] == pytest.approx(np.cos(0.05), abs=1e-12)
+        else:
+            assert lift[0].direction.tolist() == expected
+        assert_every_step_free(assembly, result)
+        assert_steps_clear(assembly, result)

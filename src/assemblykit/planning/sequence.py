@@ -83,6 +83,9 @@ gravity) before the search for groups stops, and the next narrower is asked (und
 gravity: the removal leaving the fewest parts falling). A large vault, where no single
 block may go, has more than ten thousand candidate directions, each with its groups to
 close under extended blocking."""
+AXIS_SNAP = 0.01
+"""The angle (radians) within which a step's direction is taken along the coordinate axis
+near it, when the parts moved leave along that axis too (:meth:`Search._step_direction`)."""
 RECENT_BLOCKERS = 4
 """How many of the parts found last blocking a part are tried first, alone, along a new
 direction (:meth:`ExtendedDirections.leaving`)."""
@@ -1086,13 +1089,37 @@ class Search:
         self.steps.append(
             Step(
                 parts=tuple(names[i] for i in bits(moved)),
-                direction=self.translations.directions[k],
+                direction=self._step_direction(k, moved, rest),
                 rest=tuple(names[i] for i in bits(rest)),
                 blocking=tuple((names[i], names[j]) for i, j in arcs),
                 stability=None if self.judge is None else self.judge(members, moved),
             )
         )
         self.progress("planning", len(self.steps), len(names))
+
+    def _step_direction(self, k: int, moved: int, rest: int) -> NDArray[np.float64]:
+        """The direction a step takes ``moved`` away from ``rest`` along: candidate
+        ``k``, or the coordinate axis within :data:`AXIS_SNAP` of it (beyond rounding)
+        when the moved parts leave the rest along that axis too (Γ_e, exact), and it
+        does not go down under gravity. A candidate is a point inside a region of the
+        arrangement, off the circles that bound it: a part lifted off a pin's axis
+        otherwise leaves along (0, -0.0034, 1), not +z, as a fitter takes it."""
+        direction: NDArray[np.float64] = np.asarray(self.translations.directions[k])
+        extended = self.extended
+        if not isinstance(extended, ExtendedDirections):
+            return direction
+        along = int(np.argmax(np.abs(direction)))
+        axis = np.zeros(3)
+        axis[along] = np.sign(direction[along])
+        off = float(np.linalg.norm(direction / np.linalg.norm(direction) - axis))
+        if not ORDER_RESOLUTION < off <= AXIS_SNAP:
+            return direction
+        if self.up is not None and float(axis @ self.up) < 0:
+            return direction
+        movers = [extended.names[i] for i in bits(moved)]
+        others = [extended.names[i] for i in bits(rest)]
+        arcs = extended_arcs(extended.assembly, axis, movers, others, extended.tol)
+        return direction if arcs else axis
 
 
 def one_set(members: int, k: int, sets: list[int]) -> list[int]:
