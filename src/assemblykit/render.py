@@ -418,7 +418,7 @@ def _disassembly_table(plan: Plan) -> Table:
 def _hands(result: Hands) -> Table:
     """The operations with more than two hands (Wilson & Latombe 1992): per group its
     parts, direction and speed, the first group held fixed."""
-    table = Table(title=f"Hands: {result.summary()}")
+    table = Table(title=result.summary().capitalize())
     for column in ("operation", "group", "parts", "direction", "speed"):
         table.add_column(column)
     for number, move in enumerate(result.moves, start=1):
