@@ -115,15 +115,21 @@ def fuse(a, b):
     return BRepAlgoAPI_Fuse(a, b).Shape()
 
 
-def common_volume(a, b) -> float:
-    """OCCT's exact volume of ``a ∩ b`` (boolean common of the B-reps)."""
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+def exact_volume(shape) -> float:
+    """OCCT's exact volume of ``shape`` (BRepGProp)."""
     from OCP.BRepGProp import BRepGProp
     from OCP.GProp import GProp_GProps
 
     properties = GProp_GProps()
-    BRepGProp.VolumeProperties_s(BRepAlgoAPI_Common(a, b).Shape(), properties)
+    BRepGProp.VolumeProperties_s(shape, properties)
     return abs(properties.Mass())
+
+
+def common_volume(a, b) -> float:
+    """OCCT's exact volume of ``a ∩ b`` (boolean common of the B-reps)."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+
+    return exact_volume(BRepAlgoAPI_Common(a, b).Shape())
 
 
 def occ_mesh(shape: Any, deflection: float) -> tuple[np.ndarray, np.ndarray]:

@@ -23,7 +23,7 @@ from assemblykit.io.step import declared_solids, decode_step_string, distinct_pr
 from assemblykit.planning.planner import plan
 from datasets import dataset
 from plan_checks import assert_steps_clear
-from step_files import write_step
+from step_files import cut, exact_volume, write_step
 
 cad = pytest.mark.cad
 
@@ -923,15 +923,6 @@ def _barrel(major: float, tube: float, half_height: float) -> Any:
     return BRepPrimAPI_MakeRevol(profile, axis, 2 * math.pi).Shape()
 
 
-def _exact_volume(shape: Any) -> float:
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-
-    properties = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape, properties)
-    return float(properties.Mass())
-
-
 @cad
 def test_a_barrel_turned_from_a_spindle_torus_keeps_its_shape(tmp_path):
     # the tube (radius 14) crosses the axis (major radius 10): the barrel is 4 wide at
@@ -946,7 +937,7 @@ def test_a_barrel_turned_from_a_spindle_torus_keeps_its_shape(tmp_path):
     assert (torus.radius, torus.minor_radius) == pytest.approx((10.0, 14.0), abs=1e-6)
     np.testing.assert_allclose(part.mesh.bounds, [[-4, -4, -5], [4, 4, 5]], atol=0.02)
     # the chords of its convex faces lie inside it
-    exact = _exact_volume(barrel)
+    exact = exact_volume(barrel)
     assert exact * 0.99 < part.mesh.volume <= exact
     assert not load_assembly(path).warnings
 
@@ -954,10 +945,7 @@ def test_a_barrel_turned_from_a_spindle_torus_keeps_its_shape(tmp_path):
 @cad
 def test_vertices_moved_out_of_the_solids_box_are_left_on_its_surface(tmp_path, monkeypatch):
     path = tmp_path / "plate.step"
-    plate = _box(40, 40, 10, (-20, -20, 0))
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
-
-    write_step(path, BRepAlgoAPI_Cut(plate, _cylinder(5, 40, (0, 0, -10))).Shape())
+    write_step(path, cut(_box(40, 40, 10, (-20, -20, 0)), _cylinder(5, 40, (0, 0, -10))))
     kept = load_assembly(path)["solid1"].mesh
     monkeypatch.setattr(step, "inside_vertices", lambda vertices, faces, surfaces: 3 * vertices)
     asm = load_assembly(path)

@@ -341,15 +341,16 @@ def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
     shared = mesh_of(bodies)
     size = float(np.linalg.norm(np.ptp(np.vstack([part.mesh.bounds, other.mesh.bounds]), axis=0)))
     # the first axis whose cut lets the two parts apart along it, else the first one
-    cuts: list[tuple[manifold3d.Manifold, NDArray[np.float64]]] = []
+    first: tuple[manifold3d.Manifold, NDArray[np.float64]] | None = None
     for candidate in insertion_axes(shared):
         removed, axis = _removed_along(other, bodies, shared, candidate, size, tol)
-        cuts.append((_bodies(mine - removed), axis))
-        if _parts_leave_along(mesh_of(cuts[-1][0]), other.mesh, axis, tol):
+        cut = _bodies(mine - removed)
+        first = first or (cut, axis)
+        if _parts_leave_along(mesh_of(cut), other.mesh, axis, tol):
             break
     else:
-        cuts.append(cuts[0])
-    cut, axis = cuts[-1]
+        assert first is not None  # a shared volume has three principal axes
+        cut, axis = first
     mesh, source = traced_mesh(cut, original_id)
     if (cut ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
         return None
