@@ -24,7 +24,7 @@ from assemblykit.geometry.precision import combined, coordinate_precision
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.tolerance import Tolerance
-from datasets import dataset
+from datasets import dataset, shared_assembly
 
 EXAMPLES = Path(assemblykit.__file__).parent / "examples"
 MATCHING = Tolerance.relative(5e-6)
@@ -141,7 +141,7 @@ def test_the_arch_keeps_every_joint_under_noise(name):
 
 def test_the_beam_keeps_its_joints_and_stays_fixed_under_noise():
     # the five pieces of ASAP's beam interlock through four planar joints
-    noisy = _changed(load_assembly(dataset("asap_beam_assembly")), 1e-8)
+    noisy = _changed(shared_assembly("asap_beam_assembly"), 1e-8)
     joints = [("0", "2"), ("1", "3"), ("2", "6"), ("3", "6")]
     assert _contacts(noisy) == dict.fromkeys(joints, "planar")
     assert set(_kinds(noisy).values()) == {"fixed"}

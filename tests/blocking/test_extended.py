@@ -20,7 +20,7 @@ from assemblykit.geometry.interference import solid
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.packings import box_mesh as box
-from datasets import dataset
+from datasets import shared_assembly
 
 
 def ring(center, plane: str) -> trimesh.Trimesh:
@@ -126,7 +126,7 @@ DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yam
 
 @pytest.mark.slow
 def test_gearbox_pins_and_cover_lift_out_exactly():
-    asm = load_assembly(DEMO)
+    asm = shared_assembly(DEMO)
     tol = asm.tolerance()
     up = np.array([0.0, 0.0, 1.0])
     g = blocking_graph(asm, "extended")
@@ -145,7 +145,7 @@ def test_gearbox_pins_and_cover_lift_out_exactly():
 
 
 def test_asap_beam_parts_are_removable_along_exact_directions():
-    asm = load_assembly(dataset("asap_beam_assembly"))
+    asm = shared_assembly("asap_beam_assembly")
     tol = asm.tolerance()
     removals = removable_parts(asm)
     assert removals, "some beam part comes out by one translation"

@@ -13,7 +13,7 @@ from assemblykit.geometry import recognition
 from assemblykit.geometry.contacts import assembly_surfaces
 from assemblykit.geometry.recognition import recognise, segment
 from assemblykit.tolerance import Tolerance
-from datasets import dataset
+from datasets import dataset, shared_assembly
 
 TOL = Tolerance(scale=10.0).for_mesh()
 
@@ -116,9 +116,8 @@ def test_rounded_edges_and_corners_are_split_into_cylinders_spheres_and_planes()
 
 
 def test_asap_beam_fillets_are_found():
-    from assemblykit.io.assembly import load_assembly
 
-    beam = load_assembly(dataset("asap_beam_assembly"))
+    beam = shared_assembly("asap_beam_assembly")
     surfaces = assembly_surfaces(beam, "0")
     cylinders = [s for s in surfaces if s.kind == "cylinder"]
     spheres = [s for s in surfaces if s.kind == "sphere"]

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from assemblykit.io.assembly import load_assembly
 from assemblykit.io.exports import CSV_COLUMNS, write_gltf, write_plan
 from assemblykit.planning.sequence import Plan, Step
 from assemblykit.viz.viewer import part_colors
 from cli_runs import run
+from datasets import shared_assembly
 
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "src" / "assemblykit" / "examples" / "gearbox_demo" / "gearbox.yaml"
@@ -40,11 +40,11 @@ def test_plan_writes_the_step_table_and_the_exploded_gltf(capsys, tmp_path):
 
     loaded = trimesh.load(scene)
     assert isinstance(loaded, trimesh.Scene)
-    assert sorted(loaded.geometry) == sorted(load_assembly(DEMO).names)
+    assert sorted(loaded.geometry) == sorted(shared_assembly(DEMO).names)
     assert loaded.metadata["plan"]["order"][0] == steps[-1]["parts"]
     # the base never moves; the cover, removed first along +z, carries every later
     # step's move: 1.25 x the extent of each step's parts along its direction
-    assembly = load_assembly(DEMO)
+    assembly = shared_assembly(DEMO)
     travel = 0.0
     for step in steps:
         d = np.asarray(step["direction"])
@@ -62,7 +62,7 @@ def test_bad_export_names_are_refused_before_planning(capsys, tmp_path):
 
 
 def test_json_export_is_the_plan_json_and_gltf_text_reads_back(tmp_path):
-    assembly = load_assembly(DEMO)
+    assembly = shared_assembly(DEMO)
     step = Step(("plug",), np.array([1.0, 6e-17, 0.0]), ("base", "housing"), ())
     plan = Plan(tuple(assembly.names), (step,), (), None, 2)
     data = json.loads(write_plan(plan, tmp_path / "p.json").read_text(encoding="utf-8"))
@@ -77,7 +77,7 @@ def test_json_export_is_the_plan_json_and_gltf_text_reads_back(tmp_path):
 
 
 def test_each_part_of_the_gltf_scene_has_the_colour_of_the_report_legend(tmp_path):
-    assembly = load_assembly(DEMO)
+    assembly = shared_assembly(DEMO)
     step = Step(("cover",), UP, ("base", "housing"), ())
     plan = Plan(tuple(assembly.names), (step,), (), None, 2)
     legend = part_colors(assembly.names)

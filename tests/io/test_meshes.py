@@ -15,7 +15,7 @@ from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.interference import interferences, overlap_volume
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.meshes import load_manifest, pose_from_spec, pose_from_state, read_mesh
-from datasets import BUNDLED, dataset
+from datasets import BUNDLED, dataset, shared_assembly
 
 ASAP = BUNDLED / "asap_beam_assembly"
 STATES = {k: v["final_state"] for k, v in json.loads((ASAP / "config.json").read_text()).items()}
@@ -195,7 +195,7 @@ def test_open_sheets_meeting_along_an_edge_are_still_rejected(tmp_path):
 
 
 def test_asap_beam_touches_without_interfering_with_final_state_poses():
-    asm = load_assembly(dataset("asap_beam_assembly"))
+    asm = shared_assembly("asap_beam_assembly")
     assert asm.names == ["0", "1", "2", "3", "6"]
     # translation after Rotation.from_euler('xyz') of the mesh as read: beams on posts
     assert {c.pair for c in assembly_contacts(asm)} == {

@@ -23,7 +23,7 @@ from assemblykit.io.assembly import load_assembly
 from assemblykit.planning.planner import plan
 from cli_runs import run
 from compas_documents import block
-from datasets import dataset
+from datasets import shared_assembly
 from plan_checks import assert_steps_clear
 
 SCENE = {
@@ -54,7 +54,7 @@ def test_the_blocks_on_the_lowest_plane_are_the_supports_unless_some_are_declare
     assert load_assembly(compas_file(tmp_path)).supports == ("leg_a", "leg_b")
     declared = compas_file(tmp_path, {"leg_b": True, "slab": False})
     assert load_assembly(declared).supports == ("leg_b",)
-    assert load_assembly(dataset("compas_assembly/arch_assembly.json")).supports == ("0", "29")
+    assert shared_assembly("compas_assembly/arch_assembly.json").supports == ("0", "29")
 
 
 def test_a_support_that_is_not_true_or_false_is_refused_naming_its_node(tmp_path):
@@ -84,7 +84,7 @@ def test_floating_the_slab_is_the_base_and_the_legs_leave_it(tmp_path):
 
 @pytest.mark.parametrize("one_at_a_time", [False, True])
 def test_no_step_of_the_arch_goes_down_through_the_ground(one_at_a_time):
-    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    assembly = shared_assembly("compas_assembly/arch_assembly.json")
     result = plan(assembly, one_at_a_time=one_at_a_time)
     assert result.feasible and result.ground == ("0", "29")
     moved = {name for step in result.steps for name in step.parts}

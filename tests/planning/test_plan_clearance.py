@@ -14,11 +14,10 @@ from assemblykit.blocking.directions import DirectionTable
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 from assemblykit.geometry.interference import solid
-from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import Search, Step
-from datasets import dataset
+from datasets import shared_assembly
 from plan_checks import Sweep, assert_steps_clear, step_clashes
 from stability_blocks import box
 
@@ -247,20 +246,20 @@ def test_the_cabinet_with_touching_joints_comes_apart_clear():
 
 
 def test_the_gearbox_plan_is_clear():
-    assembly = load_assembly(DEMO)
+    assembly = shared_assembly(DEMO)
     result = plan(assembly, max_and_or_parts=0)
     assert result.feasible
     assert_steps_clear(assembly, result)
 
 
 def test_the_arch_plan_is_clear():
-    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    assembly = shared_assembly("compas_assembly/arch_assembly.json")
     assert_steps_clear(assembly, plan(assembly, max_and_or_parts=0))
 
 
 @pytest.mark.slow
 def test_the_asap_beam_plan_is_clear():
-    assembly = load_assembly(dataset("asap_beam_assembly"))
+    assembly = shared_assembly("asap_beam_assembly")
     result = plan(assembly, max_and_or_parts=0)
     assert result.feasible
     assert_steps_clear(assembly, result)

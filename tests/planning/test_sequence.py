@@ -37,7 +37,7 @@ from assemblykit.planning.sequence import (
     minimal_interlocked,
     separable,
 )
-from datasets import dataset
+from datasets import dataset, shared_assembly
 from plan_checks import assert_steps_clear
 from stability_blocks import box
 
@@ -214,7 +214,7 @@ def assert_free_by_cones(assembly: Assembly, result: Plan) -> None:
 def test_pairs_tested_for_one_subassembly_serve_the_others():
     # blocking is pairwise: the DBG asked of a set, after its supersets or subsets were
     # asked, is the one computed from scratch
-    assembly = load_assembly(DEMO)
+    assembly = shared_assembly(DEMO)
     names = tuple(assembly.names)
     tol = assembly.tolerance()
     directions = np.array([UP, DOWN, [1.0, 0.0, 0.0], [0.0, 0.6, 0.8]])
@@ -240,7 +240,7 @@ def test_parts_leaving_and_groups_along_directions_visited_in_turn_are_the_exten
     # one search visits direction after direction, trying first the parts that blocked
     # each part along the others: who leaves and which groups close are those of the
     # DBG computed from scratch along each direction, for the whole gearbox and a subset
-    assembly = load_assembly(DEMO)
+    assembly = shared_assembly(DEMO)
     names = tuple(assembly.names)
     tol = assembly.tolerance()
     translations = translation_table(assembly, tol)
@@ -274,7 +274,7 @@ def test_parts_leaving_and_groups_along_directions_visited_in_turn_are_the_exten
 
 
 def test_gearbox_plan_lifts_pins_and_cover_first():
-    assembly = load_assembly(DEMO)
+    assembly = shared_assembly(DEMO)
     result = plan(assembly)
     assert_every_step_free(assembly, result)
     first = result.steps[0]
@@ -284,7 +284,7 @@ def test_gearbox_plan_lifts_pins_and_cover_first():
 
 
 def test_the_assembly_order_reverses_the_gearbox_plan():
-    data = plan(load_assembly(DEMO), max_and_or_parts=0, max_hands=2).to_dict()
+    data = plan(shared_assembly(DEMO), max_and_or_parts=0, max_hands=2).to_dict()
     assembly_steps = data["assembly_steps"]
     assert len(assembly_steps) == len(data["steps"])
     last = assembly_steps[-1]
@@ -308,7 +308,7 @@ def test_masonry_plans_are_free_by_extended_translation(path):
 
 @pytest.mark.slow
 def test_asap_beam_plan_is_free_by_extended_translation():
-    assembly = load_assembly(dataset("asap_beam_assembly"))
+    assembly = shared_assembly("asap_beam_assembly")
     result = plan(assembly)
     assert_every_step_free(assembly, result)
     assert result.and_or is not None and result.and_or.plans >= 1
@@ -373,7 +373,7 @@ def test_the_interlock_reported_is_the_least_one_the_whole_dbgs_give():
 
 @pytest.mark.slow
 def test_crossvault_plan_takes_all_184_blocks_apart():
-    assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
+    assembly = shared_assembly("compas_assembly/crossvault_assembly.json")
     result = plan(assembly)
     assert len(assembly.names) == 184
     assert_every_step_free(assembly, result)

@@ -28,7 +28,7 @@ from assemblykit.planning.stability import (
     lowest_parts,
 )
 from assemblykit.tolerance import Tolerance
-from datasets import dataset
+from datasets import dataset, shared_assembly
 from plan_checks import assert_steps_clear
 from stability_blocks import block_on_slope, box, corbels, overhanging_stack, whole_residuals
 
@@ -184,7 +184,7 @@ def test_gravity_directions_and_lowest_parts():
 
 
 def test_the_compas_arch_is_planned_with_its_holds_listed():
-    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    assembly = shared_assembly("compas_assembly/arch_assembly.json")
     result = plan(assembly, gravity=Gravity(holds=3), max_and_or_parts=0)
     data = result.to_dict()
     assert data["feasible"] and data["gravity"]["stable"]
@@ -199,7 +199,7 @@ def test_the_compas_arch_is_planned_with_its_holds_listed():
 def test_declared_fixed_parts_are_never_moved():
     """The arch's springers declared fixed (a fixture): the 28 other blocks come off one
     at a time and the springers stay, so the assembly order starts on them."""
-    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    assembly = shared_assembly("compas_assembly/arch_assembly.json")
     data = plan(assembly, gravity=Gravity(holds=3, fixed=("0", "29")), max_and_or_parts=0).to_dict()
     assert data["feasible"] and data["gravity"]["fixed"] == ["0", "29"]
     moved = [name for step in data["steps"] for name in step["parts"]]
@@ -211,7 +211,7 @@ def test_declared_fixed_parts_are_never_moved():
 
 @pytest.mark.slow
 def test_the_asap_beam_comes_apart_beams_first_without_holds():
-    assembly = load_assembly(dataset("asap_beam_assembly"))
+    assembly = shared_assembly("asap_beam_assembly")
     data = plan(assembly, gravity=Gravity(), max_and_or_parts=0).to_dict()
     assert [set(step["parts"]) for step in data["steps"]][:2] in ([{"0"}, {"1"}], [{"1"}, {"0"}])
     assert {n for step in data["steps"][2:] for n in step["parts"]} == {"2", "3"}
@@ -273,13 +273,13 @@ def test_an_independent_solution_of_the_arch_agrees_with_the_program():
 @pytest.mark.parametrize(
     "steps",
     [
-        pytest.param(5, marks=pytest.mark.early),
+        pytest.param(3, marks=pytest.mark.early),
         pytest.param(20, marks=[pytest.mark.slow, pytest.mark.early]),
     ],
 )
 def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(steps: int):
     """The first ``steps`` steps of the cross vault's plan under gravity with one hold
-    (the grip): 5 in the default tier, 20 in the slow one; the whole plan, minutes
+    (the grip): 3 in the default tier, 20 in the slow one; the whole plan, minutes
     long, is a benchmark (``bench_stability.py --crossvault-plan``). Each block leaves
     alone, held by its grip and nothing more, and each state is decided again by a fresh
     model's whole program (none of the plan's shortcuts: balances and certificates kept,
@@ -291,7 +291,7 @@ def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(s
     its first 77 steps (docs/planning.md, "Under gravity"); which of two mirror-image
     blocks goes first follows a rounding rule (docs/architecture.md, "Tolerances"), so
     the count of standing states is a bound and every verdict is checked."""
-    assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
+    assembly = shared_assembly("compas_assembly/crossvault_assembly.json")
     tol = Tolerance.relative(5e-5)
     data = plan(assembly, tol, gravity=Gravity(), max_and_or_parts=0, max_steps=steps).to_dict()
     moved = [name for step in data["steps"] for name in step["parts"]]
@@ -336,7 +336,7 @@ def test_the_arch_on_its_springers_names_what_falls_at_each_falling_step():
     independently (:func:`whole_residuals`), leaves unbalanced, and a standing step
     names none (how many programs the plan solves for it is a figure of
     benchmarks/bench_stability.py)."""
-    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    assembly = shared_assembly("compas_assembly/arch_assembly.json")
     data = plan(assembly, gravity=Gravity(fixed=("0", "29")), max_and_or_parts=0).to_dict()
     assert data["feasible"] and not data["gravity"]["stable"]
     model = equilibrium_model(assembly, friction=MU, fixed=["0", "29"])

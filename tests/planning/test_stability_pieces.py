@@ -15,13 +15,12 @@ from __future__ import annotations
 
 import pytest
 
-from assemblykit.io.assembly import load_assembly
 from assemblykit.planning.stability import (
     EquilibriumModel,
     equilibrium_model,
 )
 from assemblykit.tolerance import Tolerance
-from datasets import dataset
+from datasets import shared_assembly
 from stability_blocks import whole_residuals
 
 TWO_PIECES = """
@@ -42,7 +41,7 @@ ONE_PIECE = """
 
 @pytest.fixture(scope="module")
 def vault() -> EquilibriumModel:
-    assembly = load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
+    assembly = shared_assembly("compas_assembly/crossvault_assembly.json")
     return equilibrium_model(assembly, friction=0.5, tol=Tolerance.relative(5e-5))
 
 

@@ -12,7 +12,6 @@ import pytest
 import scipy.sparse as sp
 from scipy.optimize import linprog
 
-from assemblykit.io.assembly import load_assembly
 from assemblykit.planning import force_points
 from assemblykit.planning.stability import (
     CONE_SIDES,
@@ -23,7 +22,7 @@ from assemblykit.planning.stability import (
     equilibrium_model,
     least_residuals,
 )
-from datasets import dataset
+from datasets import shared_assembly
 from stability_blocks import corbels, overhanging_stack
 
 MU = 0.5
@@ -125,7 +124,7 @@ def test_the_cross_vault_has_the_same_least_residuals_on_its_corners():
     optimum is checked against HiGHS's dual simplex on the program written out here,
     to the interior point method's accuracy (relative 1e-4), not against one release's
     digits."""
-    model = equilibrium_model(load_assembly(dataset("compas_assembly/crossvault_assembly.json")))
+    model = equilibrium_model(shared_assembly("compas_assembly/crossvault_assembly.json"))
     present = model.mask(None)
     free = present & ~model.mask(model.fixed)
     rows = (6 * np.flatnonzero(free)[:, None] + np.arange(6)).ravel()

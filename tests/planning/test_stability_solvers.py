@@ -9,8 +9,6 @@ programs themselves, on matrices written by hand: test_equilibrium_programs.py).
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import pytest
 from scipy.optimize import linprog
@@ -31,7 +29,7 @@ from assemblykit.planning.stability import (
     least_residuals,
 )
 from assemblykit.tolerance import Tolerance
-from datasets import dataset
+from datasets import dataset, shared_assembly
 from stability_blocks import block_on_slope, box, corbels, overhanging_stack
 
 FRICTIONS = (0.0, 0.1, 0.3, 0.5)
@@ -109,7 +107,7 @@ def test_blocks_computed_by_hand_get_highs_verdicts(assembly):
 
 
 def test_the_arch_gets_highs_verdicts_without_each_block():
-    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    assembly = shared_assembly("compas_assembly/arch_assembly.json")
     model = equilibrium_model(assembly)
     ours, reference = verdicts(model, without_each(assembly), FRICTIONS)
     assert ours == reference
@@ -231,7 +229,7 @@ def test_the_least_friction_searched_from_the_last_answer_is_the_bisections():
     # the states the arch's plan with three holds leaves standing, one after the other:
     # the search that starts from the last answer finds what bisection finds (the
     # programs it saves are a figure of benchmarks/bench_stability.py)
-    assembly = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    assembly = shared_assembly("compas_assembly/arch_assembly.json")
     result = plan(assembly, gravity=Gravity(holds=3))
     model, memory = equilibrium_model(assembly), EquilibriumMemory()
     states = []
@@ -250,16 +248,12 @@ def test_the_least_friction_searched_from_the_last_answer_is_the_bisections():
     assert len(set(expected)) > 4
 
 
-@functools.cache
-def cross_vault() -> Assembly:
-    """The cross vault, read once (each test builds its own models from it)."""
-    return load_assembly(dataset("compas_assembly/crossvault_assembly.json"))
-
-
 def standing_vault() -> tuple[EquilibriumModel, np.ndarray, np.ndarray]:
     """A new model of the cross vault with its crown joints as contacts (it stands), the
     mask of all its parts and that of its fixed ones."""
-    model = equilibrium_model(cross_vault(), tol=Tolerance.relative(5e-5))
+    model = equilibrium_model(
+        shared_assembly("compas_assembly/crossvault_assembly.json"), tol=Tolerance.relative(5e-5)
+    )
     present = model.mask(None)
     return model, present, present & model.mask(model.fixed)
 

@@ -6,9 +6,11 @@ along the step's direction, and plays the steps; the same on the 184-block cross
 written in under 25 MB. Colours are measured on screenshots: by hue where the
 view is shaded, exactly where the test switches the shading off.
 
-Driven through Chromium's DevTools protocol (``--remote-debugging-port``) with the
-``websocket-client`` package. Without Chromium or that package a test is skipped, or
-fails under CI (``$CI`` set and not empty), where these tests must run.
+All of them run in the slow tier (``python -m pytest -m slow``), which CI runs with
+Chromium installed. Driven through Chromium's DevTools protocol
+(``--remote-debugging-port``) with the ``websocket-client`` package. Without Chromium or
+that package a test is skipped, or fails under CI (``$CI`` set and not empty), where
+these tests must run.
 """
 
 from __future__ import annotations
@@ -414,6 +416,7 @@ def check_step_one(shown: dict[str, Any], assembly: Assembly, moved: Sequence[st
     assert shown["current"] == ["1"]
 
 
+@pytest.mark.slow
 @pytest.mark.early
 def test_the_gearbox_fills_the_view_step_one_is_highlighted_and_play_walks_on(
     chromium: Chromium, gearbox_report: Path
