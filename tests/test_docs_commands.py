@@ -3,7 +3,11 @@ a clone of the repository: the lines of ```bash blocks that start with ``assembl
 and the ``$ assemblykit`` lines of ```console blocks (which exit 2, printing the error
 line the transcript shows, when it shows one). The tutorial's Python blocks run in
 order, as one session, and print what they show. Each runs in a fresh folder that sees
-the repository's ``src``, ``tests`` and ``examples``, so written files land there."""
+the repository's ``src``, ``tests`` and ``examples``, so written files land there.
+
+The commands run in the slow tier: the work of each is tested, with checks, in the
+default tier by the tests of its module and of the command line (``assemblykit demo``
+by tests/test_cli_plan.py); the tutorial's Python blocks in the default tier."""
 
 from __future__ import annotations
 
@@ -92,47 +96,10 @@ def test_the_documents_show_commands():
     assert readme[0] == "assemblykit demo"
 
 
-# commands whose work other tests of the default tier already do, with checks, run in the
-# slow tier: those beginning with these words (a plan of the Pelikan burr, a burr with no
-# monotone plan, the demo, the demo gearbox's plan and contacts with their files:
-# tests/test_cli_plan.py, tests/io/test_exports.py, tests/test_bad_input.py and the plain
-# install of .ci/run) ...
-GEARBOX = "src/assemblykit/examples/gearbox_demo/gearbox.yaml"
-SLOW_BEGINNINGS = (
-    ["assemblykit", "plan", "tests/data/burrtools/PelikanBurr.xmpuzzle"],
-    ["assemblykit", "plan", "tests/data/burrtools/SolidSixPieceBurrs.xmpuzzle"],
-    ["assemblykit", "demo"],
-    ["assemblykit", "plan", GEARBOX],
-    ["assemblykit", "contacts", GEARBOX],
-)
-# ... and these (a batch of two assemblies, shown again with worker processes, and with
-# Dask: tests/test_batch.py starts both engines)
-SLOW_COMMANDS = (
-    "assemblykit batch tests/data/compas_assembly/stack_assembly.json "
-    "tests/data/compas_assembly/arch_assembly.json --out results.jsonl",
-    "assemblykit batch tests/data/compas_assembly/stack_assembly.json "
-    "tests/data/compas_assembly/arch_assembly.json --out results.jsonl --engine local "
-    "--workers 2 --timeout 120",
-    "assemblykit batch tests/data/compas_assembly/stack_assembly.json --out results.jsonl "
-    "--engine dask",
-)
-
-
-def slow(document: str, command: str) -> bool:
-    """Whether a documented command runs in the slow tier: the guides' commands do (the
-    work of each is tested, with checks, by the tests of its module and of the command
-    line), and the README's above."""
-    found = words(command)
-    return (
-        document != "README.md"
-        or any(found[: len(mark)] == mark for mark in SLOW_BEGINNINGS)
-        or any(found == words(other) for other in SLOW_COMMANDS)
-    )
-
-
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "command, expected",
-    [pytest.param(c, e, marks=[pytest.mark.slow] if slow(d, c) else []) for d, _, c, e in RUN],
+    [(c, e) for _, _, c, e in RUN],
     ids=[f"{d}:{n}" for d, n, _, _ in RUN],
 )
 def test_documented_command_runs(command, expected, tmp_path, monkeypatch, capsys):
