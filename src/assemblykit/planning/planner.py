@@ -264,10 +264,11 @@ def _plan_under_gravity(
     max_and_or_parts: int,
     max_hands: int,
 ) -> Plan:
-    """:func:`plan` under gravity: the fixed parts outweigh every other so that one of
-    them is the base that stays, and :class:`~assemblykit.planning.judge.StateJudge`
-    picks and judges the steps, with one memory of what the equilibrium programs found
-    for the whole search."""
+    """:func:`plan` under gravity: ``search`` (not yet run) configured for it before it
+    runs, as a new search: the fixed parts outweigh every other so that one of them is
+    the base that stays, :class:`~assemblykit.planning.judge.StateJudge` picks and
+    judges the steps, with one memory of what the equilibrium programs found for the
+    whole search, and no step goes down (docs/planning.md, "Under gravity")."""
     search.progress("equilibrium equations", 0, 1)
     model = equilibrium_model(
         assembly,
@@ -277,7 +278,7 @@ def _plan_under_gravity(
         dict(gravity.densities),
         tol,
     )
-    search.volumes = anchored_volumes(model.names, search.volumes, model.fixed)
+    volumes = anchored_volumes(model.names, search.volumes, model.fixed)
     supports = mask_of(k for k, name in enumerate(model.names) if name in set(model.fixed))
     everything = mask_of(range(len(model.names)))
     memory = EquilibriumMemory()
@@ -286,21 +287,27 @@ def _plan_under_gravity(
         memory,
         gravity.holds,
         search.translations.vector,
-        lambda members: base_part(members, search.volumes),
-        base_part(everything, search.volumes),
+        lambda members: base_part(members, volumes),
+        base_part(everything, volumes),
     )
-    search.narrowers = (
-        FirstAdmitted(judge.ordered, judge.stands_without, judge.known_to_fall),
-        judge.fewest_falling,
+    # declared fixed parts (a fixture) never move; the default supports leave last
+    declared = gravity.fixed is not None
+    search = replace(
+        search,
+        volumes=volumes,
+        narrowers=(
+            FirstAdmitted(judge.ordered, judge.stands_without, judge.known_to_fall),
+            judge.fewest_falling,
+        ),
+        judge=judge.judge,
+        up=-gravity_direction(gravity.direction),
+        fixed=supports,
+        ground=supports if declared else 0,
     )
-    search.judge = judge.judge
-    search.up = -gravity_direction(gravity.direction)
-    if gravity.fixed is not None:
-        # declared fixed parts (a fixture) never move
-        search.fixed = search.ground = supports
+    if declared:
         search.disassemble(everything)
     else:
-        _supports_last(search, everything, supports)
+        search = _supports_last(search, everything)
     result = finish_plan(assembly, search, tol, max_and_or_parts, max_hands, search.progress)
     whole = model.check(memory=memory)
     present = model.mask(None)
@@ -321,20 +328,21 @@ def _plan_under_gravity(
     )
 
 
-def _supports_last(search: Search, members: int, supports: int) -> None:
-    """Run ``search`` on ``members`` with the default ``supports`` (the parts on the
-    lowest plane) taken off last (docs/planning.md, "Fixed parts"): first as if they
-    were fixed, then, on what is left (the supports, and any set that could not leave
-    them), with every part free to move."""
-    search.fixed = supports
+def _supports_last(search: Search, members: int) -> Search:
+    """Run ``search``, whose fixed parts are the default supports (the parts on the
+    lowest plane), on ``members`` with those taken off last (docs/planning.md, "Fixed
+    parts"): first as if they were fixed, then, on what is left (the supports, and any
+    set that could not leave them), with every part free to move. The search of that
+    second part, returned, goes on with the first's steps and sets (the same lists)."""
     search.disassemble(members)
-    search.fixed = 0
     if search.unfinished:
-        return
+        return search
     moved = mask_of(i for step in search.steps for i in _indices(search, step.parts))
     left = members & ~moved
     search.locked[:] = [lock for lock in search.locked if lock != left]
-    search.disassemble(left)
+    rest = replace(search, fixed=0)
+    rest.disassemble(left)
+    return rest
 
 
 def _indices(search: Search, parts: Iterable[str]) -> list[int]:
