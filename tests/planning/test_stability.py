@@ -284,7 +284,7 @@ def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(s
     alone, held by its grip and nothing more, and each state is decided again by a fresh
     model's whole program (none of the plan's shortcuts: balances and certificates kept,
     regions, the friction search's start): a state said to stand stands with the least
-    friction said to be needed (and so with more), and on four steps spread over them
+    friction said to be needed (and so with more), and on up to four steps spread over them
     not with one resolution less, even on every polygon vertex (not only the corners).
     The vault stands whole only once its crown joints are contacts (the tolerance), on
     fixed blocks that are not its crown. Taken down from the top, the vault stands for
