@@ -13,7 +13,6 @@ from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly
 
 BUNDLED = Path(__file__).resolve().parent / "data"
-EXAMPLES = Path(__file__).resolve().parents[1] / "src" / "assemblykit" / "examples"
 
 
 def dataset(relative: str) -> Path:
