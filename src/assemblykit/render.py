@@ -392,7 +392,7 @@ def _disassembly_table(plan: Plan) -> Table:
         table.add_row("-", ", ".join(lock.parts), "-", lock.reason, "-")
         if lock.held:
             table.add_row("-", ", ".join(lock.held), "-", "held by the interlock", "-")
-    if plan.hands is not None and plan.hands.moves:
+    if plan.hands is not None:
         # the groups of the operations two hands cannot do, one row per group
         for move in plan.hands.moves:
             for group, direction in zip(move.groups[1:], move.directions[1:], strict=True):
@@ -403,9 +403,8 @@ def _disassembly_table(plan: Plan) -> Table:
                     "translation, together",
                     fmt.name_list(move.groups[0]),
                 )
-        table.caption = plan.hands.summary()
-    elif plan.hands is not None and plan.hands.needed is None:
-        table.caption = plan.hands.summary()
+        if plan.hands.moves or plan.hands.needed is None:
+            table.caption = plan.hands.summary()
     if any(
         lock.rigid_may_free and not lock.interfering and not lock.enclosed
         for lock in plan.interlocked
