@@ -116,7 +116,9 @@ def test_the_stacked_blocks_keep_every_joint(stack, level, tol):
     assert set(_kinds(noisy, tol).values()) == {"planar"}
 
 
-@pytest.mark.parametrize(("level", "tol"), [(1e-8, None), (1e-6, MATCHING)])
+@pytest.mark.parametrize(
+    ("level", "tol"), [pytest.param(1e-8, None, marks=pytest.mark.slow), (1e-6, MATCHING)]
+)
 def test_the_demo_gearbox_keeps_contacts_motions_and_plan(demo, level, tol):
     noisy = _changed(demo, level)
     assert _contacts(noisy, tol) == _contacts(demo)

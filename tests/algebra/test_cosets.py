@@ -689,9 +689,7 @@ def test_prism_fits_meet_as_every_pair_of_components(seed):
     assert_same_meet(second.intersect(first), all_pairs_intersect(second, first))
 
 
-@settings(max_examples=40, deadline=None)
-@given(seeds)
-def test_coaxial_prism_fits_near_the_tolerance_meet_as_every_pair(seed):
+def coaxial_prism_fits_meet_as_every_pair(seed: int) -> None:
     """Coaxial prism fits of 2 to 12 and up to twice as many sides, the second placed
     along the axis up to the model's size away and nudged by 0 to 4 tolerances (from
     1e-9 to 1e-2 of models of size 1 to 1000): the components whose keys fall near each
@@ -712,3 +710,16 @@ def test_coaxial_prism_fits_near_the_tolerance_meet_as_every_pair(seed):
     second = prism_coset(n * int(rng.integers(1, 3)), (0.0, 0.0, along), rep=rep)
     assert_same_meet(first.intersect(second, tol), all_pairs_intersect(first, second, tol))
     assert_same_meet(second.intersect(first, tol), all_pairs_intersect(second, first, tol))
+
+
+@settings(max_examples=20, deadline=None)
+@given(seeds)
+def test_coaxial_prism_fits_near_the_tolerance_meet_as_every_pair(seed):
+    coaxial_prism_fits_meet_as_every_pair(seed)
+
+
+@pytest.mark.slow
+@settings(max_examples=200, deadline=None)
+@given(seeds)
+def test_many_coaxial_prism_fits_near_the_tolerance_meet_as_every_pair(seed):
+    coaxial_prism_fits_meet_as_every_pair(seed)

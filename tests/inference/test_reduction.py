@@ -883,7 +883,7 @@ def test_a_stack_of_equal_cubes_reuses_one_intersection_and_traces_every_step():
     assert steps == [(3, 1), (1, 0)] * 3
 
 
-@pytest.mark.parametrize("count", [70, pytest.param(100, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("count", [40, pytest.param(100, marks=pytest.mark.slow)])
 def test_numeric_only_solves_a_long_stack_of_cubes(count):
     """The whole stack handed to the residue solver, one start from the identity: solved,
     the top cube at height ``count`` (hand-computed: each seat lifts a cube by the unit

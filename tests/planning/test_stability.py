@@ -273,13 +273,13 @@ def test_an_independent_solution_of_the_arch_agrees_with_the_program():
 @pytest.mark.parametrize(
     "steps",
     [
-        pytest.param(3, marks=pytest.mark.early),
+        pytest.param(2, marks=pytest.mark.early),
         pytest.param(20, marks=[pytest.mark.slow, pytest.mark.early]),
     ],
 )
 def test_the_cross_vault_planned_with_gravity_stands_step_by_step_from_the_top(steps: int):
     """The first ``steps`` steps of the cross vault's plan under gravity with one hold
-    (the grip): 3 in the default tier, 20 in the slow one; the whole plan, minutes
+    (the grip): 2 in the default tier, 20 in the slow one; the whole plan, minutes
     long, is a benchmark (``bench_stability.py --crossvault-plan``). Each block leaves
     alone, held by its grip and nothing more, and each state is decided again by a fresh
     model's whole program (none of the plan's shortcuts: balances and certificates kept,

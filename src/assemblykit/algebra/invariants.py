@@ -163,63 +163,77 @@ def transform_invariant(t: NDArray[np.float64], inv: Invariant) -> Invariant:
     return _trusted(DirectionInvariant, direction=r @ inv.direction)
 
 
-def _axis_of(inv: Invariant) -> NDArray[np.float64] | None:
-    if isinstance(inv, LineInvariant | DirectionInvariant):
-        return inv.direction
-    if isinstance(inv, PlaneInvariant):
-        return inv.normal
-    return None
-
-
 # ----------------------------------------------------------------------------- congruence
 
 
-def _angle(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
-    return math.atan2(se3.norm(se3.cross(a, b)), float(a @ b))
+def _dot(a: Vec3, b: Vec3) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def _perp(v: NDArray[np.float64], u: NDArray[np.float64]) -> NDArray[np.float64]:
-    return v - (v @ u) * u
+def _cross(a: Vec3, b: Vec3) -> Vec3:
+    return a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
+
+
+def _minus(a: Vec3, b: Vec3) -> Vec3:
+    return a[0] - b[0], a[1] - b[1], a[2] - b[2]
+
+
+def _length(v: Vec3) -> float:
+    return math.sqrt(_dot(v, v))
+
+
+def _across(v: Vec3, u: Vec3) -> float:
+    """The length of the part of ``v`` normal to the unit vector ``u``."""
+    along = _dot(v, u)
+    return _length((v[0] - along * u[0], v[1] - along * u[1], v[2] - along * u[2]))
 
 
 def _pair_measures(a: Invariant, b: Invariant, tol: Tolerance) -> list[tuple[MismatchKind, float]]:
-    """The congruence measures of one pair (§2.5 table, "congruence test" column)."""
+    """The congruence measures of one pair (§2.5 table, "congruence test" column), in
+    scalar arithmetic on the invariants' coordinates (:func:`_flat`)."""
     out: list[tuple[MismatchKind, float]] = []
-    ua, ub = _axis_of(a), _axis_of(b)
+    (ka, pa, ua), (kb, pb, ub) = _flat(a), _flat(b)
     if ua is not None and ub is not None:
-        out.append((MismatchKind.ANGLE, _angle(ua, ub)))
-    if isinstance(b, PointInvariant) and not isinstance(a, PointInvariant):
-        a, b = b, a
-    if isinstance(a, PointInvariant):
-        if isinstance(b, PointInvariant):
-            out.append((MismatchKind.DISTANCE, se3.norm(b.point - a.point)))
-        elif isinstance(b, LineInvariant):
-            out.append((MismatchKind.DISTANCE, se3.norm(_perp(a.point - b.point, b.direction))))
-        elif isinstance(b, PlaneInvariant):
-            out.append((MismatchKind.DISTANCE, float(b.normal @ (a.point - b.point))))
+        out.append((MismatchKind.ANGLE, math.atan2(_length(_cross(ua, ub)), _dot(ua, ub))))
+    if kb == _POINT and ka != _POINT:
+        (ka, pa, ua), (kb, pb, ub) = (kb, pb, ub), (ka, pa, ua)
+    if ka == _POINT:
+        assert pa is not None
+        if kb == _POINT:
+            assert pb is not None
+            out.append((MismatchKind.DISTANCE, _length(_minus(pb, pa))))
+        elif kb == _LINE:
+            assert pb is not None and ub is not None
+            out.append((MismatchKind.DISTANCE, _across(_minus(pa, pb), ub)))
+        elif kb == _PLANE:
+            assert pb is not None and ub is not None
+            out.append((MismatchKind.DISTANCE, _dot(ub, _minus(pa, pb))))
         return out
-    if isinstance(a, PlaneInvariant) and isinstance(b, LineInvariant):
-        a, b = b, a
-    if isinstance(a, LineInvariant) and isinstance(b, LineInvariant):
-        cross = se3.cross(a.direction, b.direction)
-        norm = se3.norm(cross)
-        offset = b.point - a.point
+    lines = (a, b)
+    if ka == _PLANE and kb == _LINE:
+        (ka, pa, ua), (kb, pb, ub) = (kb, pb, ub), (ka, pa, ua)
+        lines = (b, a)
+    if ka == _DIRECTION or kb == _DIRECTION:
+        return out
+    assert pa is not None and ua is not None and pb is not None and ub is not None
+    if ka == _LINE and kb == _LINE:
+        cross = _cross(ua, ub)
+        norm = _length(cross)
+        offset = _minus(pb, pa)
         if norm <= tol.angle:
-            out.append((MismatchKind.DISTANCE, se3.norm(_perp(offset, a.direction))))
+            out.append((MismatchKind.DISTANCE, _across(offset, ua)))
         else:
-            signed = float(cross @ offset) / norm
+            signed = _dot(cross, offset) / norm
             out.append((MismatchKind.DISTANCE, abs(signed)))
-            if a.directed and b.directed:
+            first, second = lines
+            assert isinstance(first, LineInvariant) and isinstance(second, LineInvariant)
+            if first.directed and second.directed:
                 out.append((MismatchKind.MOMENT, signed))
-    elif isinstance(a, LineInvariant) and isinstance(b, PlaneInvariant):
-        if abs(float(a.direction @ b.normal)) <= tol.angle:
-            out.append((MismatchKind.DISTANCE, float(b.normal @ (a.point - b.point))))
-    elif (
-        isinstance(a, PlaneInvariant)
-        and isinstance(b, PlaneInvariant)
-        and se3.norm(se3.cross(a.normal, b.normal)) <= tol.angle
-    ):
-        out.append((MismatchKind.DISTANCE, float(a.normal @ (b.point - a.point))))
+    elif ka == _LINE and kb == _PLANE:
+        if abs(_dot(ua, ub)) <= tol.angle:
+            out.append((MismatchKind.DISTANCE, _dot(ub, _minus(pa, pb))))
+    elif ka == _PLANE and kb == _PLANE and _length(_cross(ua, ub)) <= tol.angle:
+        out.append((MismatchKind.DISTANCE, _dot(ua, _minus(pb, pa))))
     return out
 
 
