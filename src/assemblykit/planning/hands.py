@@ -286,14 +286,14 @@ def _sampled_search(
     the projection test (:func:`~assemblykit.blocking.extended.extended_arcs`)."""
     local = blocking_graph(assembly, "infinitesimal", parts=names, tol=tol)
     translations = local.direction_table()
-    parts = assembly.subset(names)
-    extended = ExtendedDirections(parts, translations.directions, tol)
     order = translations.names
+    # tested in the whole assembly: the blocking data of its parts and pairs is shared
+    extended = ExtendedDirections(assembly, translations.directions, tol, parts=order)
 
     def leaves(group: int, others: int, direction: NDArray[np.float64]) -> bool:
         moving = [order[i] for i in bits(group)]
         still = [order[j] for j in bits(others)]
-        return not extended_arcs(parts, direction, moving, still, tol)
+        return not extended_arcs(assembly, direction, moving, still, tol)
 
     sizes = _sizes(assembly)
     circles = np.asarray(local.arrangement.normals, dtype=np.float64)

@@ -115,6 +115,12 @@ class ExtendedDirections:
     asks for them, and kept: per direction, the moving parts already tested and the
     parts that block each of them.
 
+    ``parts`` (default: all of the assembly's) are the parts it tests, numbered in
+    their order: a set of parts of a larger assembly is tested in that assembly, whose
+    blocking data (:class:`~assemblykit.blocking.cache.BlockingCache`: each part's
+    hull and convex bodies, each pair's witnesses) the search of the whole assembly
+    already holds.
+
     A part is tested along a direction against the set of parts asked about (the parts
     still together, as the search takes them apart), and again only if asked about a
     set holding others: blocking is pairwise, so its blockers among any subset are read
@@ -127,9 +133,15 @@ class ExtendedDirections:
     are cheap to read and are tested only when asked about (a vault has thousands of
     candidate directions)."""
 
-    def __init__(self, assembly: Assembly, directions: NDArray[np.float64], tol: Tolerance) -> None:
+    def __init__(
+        self,
+        assembly: Assembly,
+        directions: NDArray[np.float64],
+        tol: Tolerance,
+        parts: Sequence[str] | None = None,
+    ) -> None:
         self.assembly = assembly
-        self.names = tuple(assembly.names)
+        self.names = tuple(assembly.names if parts is None else parts)
         self.index = {name: i for i, name in enumerate(self.names)}
         self.directions = directions
         self.tol = tol
