@@ -38,6 +38,7 @@ import trimesh
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import ConvexHull, HalfspaceIntersection
 
+from assemblykit.algebra import se3
 from assemblykit.deprecation import moved
 from assemblykit.ragged import group_of
 from assemblykit.tolerance import Tolerance, current
@@ -52,9 +53,9 @@ def view_frame(direction: ArrayLike) -> NDArray[np.float64]:
     """Rows ``e1, e2, d``: an orthonormal frame whose third axis is the unit ``direction``."""
     d = np.asarray(direction, dtype=np.float64).ravel()
     d = d / np.linalg.norm(d)
-    e1 = np.cross(d, np.eye(3)[int(np.argmin(np.abs(d)))])
+    e1 = se3.cross(d, np.eye(3)[int(np.argmin(np.abs(d)))])
     e1 /= np.linalg.norm(e1)
-    return np.array([e1, np.cross(d, e1), d])
+    return np.array([e1, se3.cross(d, e1), d])
 
 
 @dataclass(frozen=True, eq=False)
@@ -313,24 +314,26 @@ def clip_triangles(
     turned = edges[0][:, 0] * edges[1][:, 1] - edges[0][:, 1] * edges[1][:, 0] < 0
     clip = np.where(turned[:, None, None], clip[:, ::-1], clip)
     points, corner = subject, np.ones(subject.shape[:2], dtype=bool)
+    # each row's entries picked by an index array per row (``a[rows, index]``)
+    rows = np.arange(len(subject))[:, None]
     for e in range(3):
         a, edge = clip[:, e, None], (clip[:, (e + 1) % 3] - clip[:, e])[:, None]
         after = _following(corner)
         side = edge[..., 0] * (points[..., 1] - a[..., 1]) - edge[..., 1] * (
             points[..., 0] - a[..., 0]
         )
-        side_after = np.take_along_axis(side, after, axis=1)
+        side_after = side[rows, after]
         inside = corner & (side >= 0)
         crossing = corner & ((side >= 0) != (side_after >= 0))
         t = side / np.where(crossing, side - side_after, 1.0)
-        ahead = np.take_along_axis(points, after[..., None], axis=1)
+        ahead = points[rows, after]
         candidates = np.stack([points, points + t[..., None] * (ahead - points)], axis=2)
         kept = np.stack([inside, crossing], axis=2).reshape(len(points), -1)
         # the kept points first, in their order around the overlap
         order = np.argsort(~kept, axis=1, kind="stable")[:, : max(int(kept.sum(1).max()), 1)]
-        points = np.take_along_axis(candidates.reshape(len(points), -1, 2), order[..., None], 1)
-        corner = np.take_along_axis(kept, order, axis=1)
-    step = np.take_along_axis(points, _following(corner)[..., None], axis=1) - points
+        points = candidates.reshape(len(points), -1, 2)[rows, order]
+        corner = kept[rows, order]
+    step = points[rows, _following(corner)] - points
     step[~corner] = 0.0
     twice = points[..., 0] * step[..., 1] - points[..., 1] * step[..., 0]
     area = np.abs(np.where(corner, twice, 0.0).sum(axis=1)) / 2
@@ -459,21 +462,25 @@ def witnesses_hold(
     docstring on these two triangles alone. A witness that holds shows the block (a
     pair of triangles is enough); one that fails shows nothing."""
     tol = tol or current()
-    chosen = [
-        np.unique([f for w in witnesses for m, f in ((w[0], w[2]), (w[1], w[3])) if m == k])
-        for k in range(len(meshes))
-    ]
-    view = shadows(meshes, direction, tol, [c.astype(np.int64) for c in chosen])
-    # the triangles of the view in mesh order, then face order: one sorted key
+    # a face of a mesh as one sorted key: the mesh's number, then the face's
     stride = 1 + max((len(m.faces) for m in meshes), default=0)
+    table = np.asarray(witnesses, dtype=np.int64).reshape(-1, 4)
+    back_key, front_key = table[:, 0] * stride + table[:, 2], table[:, 1] * stride + table[:, 3]
+    used = np.unique(np.concatenate([back_key, front_key]))
+    starts = np.searchsorted(used // stride, np.arange(len(meshes) + 1))
+    chosen = [used[starts[k] : starts[k + 1]] - k * stride for k in range(len(meshes))]
+    view = shadows(meshes, direction, tol, chosen)
+    # the triangles of the view in mesh order, then face order
     key = view.owner * stride + view.face
 
-    def place(mesh: int, face: int) -> int:
-        at = int(np.searchsorted(key, mesh * stride + face))
-        return at if at < len(key) and key[at] == mesh * stride + face else -1
+    def place(wanted: NDArray[np.int64]) -> NDArray[np.int64]:
+        """Where each key lies among the view's triangles (-1: not projected)."""
+        if not len(key):
+            return np.full(len(wanted), -1, dtype=np.int64)
+        at = np.minimum(np.searchsorted(key, wanted), len(key) - 1)
+        return np.where(key[at] == wanted, at, -1)
 
-    back = np.array([place(w[0], w[2]) for w in witnesses], dtype=np.int64)
-    front = np.array([place(w[1], w[3]) for w in witnesses], dtype=np.int64)
+    back, front = place(back_key), place(front_key)
     present = (back >= 0) & (front >= 0)
     holds = np.zeros(len(witnesses), dtype=bool)
     b, f = back[present], front[present]
