@@ -224,6 +224,29 @@ def test_a_witness_holds_only_where_the_projection_test_blocks(seed):
     assert held_somewhere > 0
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_witnesses_along_many_directions_hold_where_they_hold_one_direction_at_a_time(seed):
+    # the hook's witnesses tested along forty directions at once give, per direction,
+    # the verdicts of forty separate tests, and show only blocks of the projection test
+    rng = np.random.default_rng(seed)
+    hook = cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4])
+    wall = cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1])
+    meshes = [mesh_of(hook), mesh_of(wall.translate(tuple(rng.uniform(-1, 1, 3))))]
+    found = {}
+    for d in rng.normal(size=(8, 3)):
+        found |= occlusion.blocking_witnesses(shadows(meshes, d, TOL), BOTH, TOL)
+    witnesses = [(i, j, *faces) for (i, j), faces in found.items()]
+    directions = np.vstack([UP, DOWN, EAST, rng.normal(size=(37, 3))])
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    along = occlusion.witnesses_hold_along(meshes, witnesses, directions, TOL)
+    assert along.shape == (len(witnesses), len(directions)) and along.any()
+    for k, d in enumerate(directions):
+        assert list(along[:, k]) == list(occlusion.witnesses_hold(meshes, witnesses, d, TOL))
+        shown = {(w[0], w[1]) for w, h in zip(witnesses, along[:, k], strict=True) if h}
+        assert shown <= blocked(meshes, d), d
+    assert occlusion.witnesses_hold_along(meshes, [], directions, TOL).shape == (0, 40)
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_projecting_only_the_faces_near_the_other_outline_finds_the_same_blocks(seed):
     rng = np.random.default_rng(seed)

@@ -236,6 +236,27 @@ def test_pairs_tested_for_one_subassembly_serve_the_others():
     assert fresh.evaluated == {0}
 
 
+def test_parts_leaving_along_many_directions_in_turn_are_those_of_the_extended_dbgs():
+    # a search over many directions (a proof that a set is stuck) has the faces that
+    # showed each pair blocking tested along a run of directions at once: who leaves
+    # along each direction is still who leaves in the DBG computed from scratch
+    assembly = shared_assembly(DEMO)
+    names = tuple(assembly.names)
+    tol = assembly.tolerance()
+    rng = np.random.default_rng(5)
+    directions = np.vstack([np.eye(3), -np.eye(3), rng.normal(size=(4, 3))])
+    extended = ExtendedDirections(assembly, directions, tol)
+    everything = (1 << len(names)) - 1
+    left = 0
+    for k in range(len(directions)):
+        arcs = extended_dbg(assembly, directions[k], names, tol).arcs
+        held = {names.index(a) for a, _ in arcs}
+        expected = mask_of(i for i in range(len(names)) if i not in held)
+        assert extended.leaving(k, everything, everything) == expected, k
+        left += expected.bit_count()
+    assert 0 < left < len(names) * len(directions)
+
+
 def test_parts_leaving_and_groups_along_directions_visited_in_turn_are_the_extended_dbgs():
     # one search visits direction after direction, trying first the parts that blocked
     # each part along the others: who leaves and which groups close are those of the

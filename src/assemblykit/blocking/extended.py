@@ -31,7 +31,7 @@ of Γ_t (contacts) and each region's DBG is exact at the region's direction
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -47,7 +47,7 @@ from assemblykit.geometry.occlusion import (
     faces_near_outlines,
     hulls_may_block,
     shadows,
-    witnesses_hold,
+    witnesses_hold_along,
 )
 from assemblykit.tolerance import Tolerance
 
@@ -234,19 +234,36 @@ def _witnessed(
     :class:`~assemblykit.blocking.obstacles.Obstacles`, a few per pair): a few triangles
     projected instead of two meshes. A part blocked along one direction mostly is along
     the next ones the search tries, by the same faces."""
-    cache = BlockingCache.of(assembly).obstacles
-    known = [pair for pair in pairs if pair in cache.witnesses]
-    if not known:
-        return set()
-    names = sorted({name for pair in known for name in pair})
+    kept = BlockingCache.of(assembly).obstacles.witnesses
+    shown = shown_along(
+        assembly, direction[None, :], {pair: kept[pair] for pair in pairs if pair in kept}, tol
+    )
+    return {pair for pair, along in shown.items() if along[0]}
+
+
+def shown_along(
+    assembly: Assembly,
+    directions: NDArray[np.float64],
+    witnesses: Mapping[tuple[str, str], Sequence[tuple[int, int]]],
+    tol: Tolerance,
+) -> dict[tuple[str, str], NDArray[np.bool_]]:
+    """Per pair (moving, blocker) of ``witnesses``, whether some of the pairs of faces
+    given for it (blocking witnesses, as
+    :meth:`~assemblykit.blocking.obstacles.Obstacles.keep_witness` keeps them) show it
+    blocking along each of the unit ``directions`` (rows): :func:`shown_arcs` along many
+    directions at once (:func:`~assemblykit.geometry.occlusion.witnesses_hold_along`)."""
+    pairs = [pair for pair, faces in witnesses.items() if faces]
+    if not pairs:
+        return {}
+    names = sorted({name for pair in pairs for name in pair})
     index = {name: k for k, name in enumerate(names)}
-    owners = [pair for pair in known for _ in cache.witnesses[pair]]
-    witnesses = [
-        (index[a], index[b], *faces) for a, b in known for faces in cache.witnesses[(a, b)]
-    ]
+    owners = np.repeat(np.arange(len(pairs)), [len(witnesses[pair]) for pair in pairs])
+    table = [(index[a], index[b], *faces) for a, b in pairs for faces in witnesses[(a, b)]]
     meshes = [assembly.parts[name].mesh for name in names]
-    holds = witnesses_hold(meshes, witnesses, direction, tol)
-    return {pair for pair, held in zip(owners, holds.tolist(), strict=True) if held}
+    holds = witnesses_hold_along(meshes, table, directions, tol)
+    shown = np.zeros((len(pairs), len(directions)), dtype=bool)
+    np.logical_or.at(shown, owners, holds)
+    return dict(zip(pairs, shown, strict=True))
 
 
 def _occluded(

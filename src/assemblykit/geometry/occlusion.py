@@ -266,18 +266,59 @@ def shadows(
         chosen = np.arange(len(mesh.faces)) if faces is None else np.asarray(faces[k])
         face_normals = mesh.face_normals if faces is None else mesh.face_normals[chosen]
         triangles = mesh.triangles if faces is None else mesh.triangles[chosen]
-        cos = face_normals @ frame[2]
-        # every corner in the view frame once: its first two coordinates on the plane
-        seen = np.asarray(triangles, dtype=np.float64) @ frame.T
-        keep = (np.abs(cos) > tol.mesh_angle) & (_shadow_width(seen[:, :, :2]) > tol.length)
-        owner.append(np.full(int(keep.sum()), k, dtype=np.int64))
         # without a consistent outside every triangle may bound the part on either side
-        facing.append(np.sign(cos[keep]).astype(np.int8) * np.int8(mesh.is_volume))
-        corners.append(seen[keep])
-        normals.append(face_normals[keep] @ frame.T)
+        shown, sides, seen, turned = _seen(
+            np.asarray(triangles, dtype=np.float64),
+            face_normals,
+            np.int8(mesh.is_volume),
+            frame[None],
+            tol,
+        )
+        keep = shown[0]
+        owner.append(np.full(int(keep.sum()), k, dtype=np.int64))
+        facing.append(sides[0, keep])
+        corners.append(seen[0, keep])
+        normals.append(turned[0, keep])
         kept.append(chosen[keep])
-    tri = np.concatenate(corners) if corners else np.zeros((0, 3, 3))
-    n = np.concatenate(normals) if normals else np.zeros((0, 3))
+    return _shadows_of(
+        np.concatenate(owner) if owner else np.zeros(0, np.int64),
+        np.concatenate(facing) if facing else np.zeros(0, np.int8),
+        np.concatenate(corners) if corners else np.zeros((0, 3, 3)),
+        np.concatenate(normals) if normals else np.zeros((0, 3)),
+        np.concatenate(kept) if kept else np.zeros(0, np.int64),
+    )
+
+
+def _seen(
+    triangles: NDArray[np.float64],
+    normals: NDArray[np.float64],
+    volume: np.int8 | NDArray[np.int8],
+    frames: NDArray[np.float64],
+    tol: Tolerance,
+) -> tuple[NDArray[np.bool_], NDArray[np.int8], NDArray[np.float64], NDArray[np.float64]]:
+    """The triangles (``t x 3 x 3``, unit ``normals``) seen in each view frame of
+    ``frames`` (``f x 3 x 3``, :func:`view_frame`), as ``f x t`` arrays: which are kept
+    (neither within the angle tolerance of parallel to the view nor thinner than the
+    length tolerance once projected), the side each faces (times ``volume``, 0 for a
+    mesh that bounds no volume), and the corners and normals in the frame."""
+    cos = np.matmul(normals, frames[:, 2, :, None])[..., 0]
+    # every corner in the view frame once: its first two coordinates on the plane
+    seen = np.matmul(triangles, frames.transpose(0, 2, 1)[:, None])
+    width = _shadow_width(seen[..., :2].reshape(-1, 3, 2)).reshape(cos.shape)
+    keep = (np.abs(cos) > tol.mesh_angle) & (width > tol.length)
+    facing = np.sign(cos).astype(np.int8) * volume
+    return keep, facing, seen, np.matmul(normals, frames.transpose(0, 2, 1))
+
+
+def _shadows_of(
+    owner: NDArray[np.int64],
+    facing: NDArray[np.int8],
+    tri: NDArray[np.float64],
+    n: NDArray[np.float64],
+    face: NDArray[np.int64],
+) -> Shadows:
+    """The :class:`Shadows` of triangles kept by :func:`_seen` (corners ``tri`` and
+    normals ``n`` in the view frame)."""
     # plane n . x = n . p0 solved for the depth coordinate
     plane = np.column_stack(
         [-n[:, 0] / n[:, 2], -n[:, 1] / n[:, 2], np.einsum("ij,ij->i", n, tri[:, 0]) / n[:, 2]]
@@ -287,14 +328,14 @@ def shadows(
     lowest = np.minimum(np.minimum(tri[:, 0], tri[:, 1]), tri[:, 2])
     highest = np.maximum(np.maximum(tri[:, 0], tri[:, 1]), tri[:, 2])
     return Shadows(
-        np.concatenate(owner) if owner else np.zeros(0, np.int64),
-        np.concatenate(facing) if facing else np.zeros(0, np.int8),
+        owner,
+        facing,
         tri[:, :, :2],
         plane,
         lowest[:, 2],
         highest[:, 2],
         np.column_stack([lowest[:, :2], highest[:, :2]]),
-        np.concatenate(kept) if kept else np.zeros(0, np.int64),
+        face,
     )
 
 
@@ -461,34 +502,57 @@ def witnesses_hold(
     show that ``j`` blocks ``i`` along ``direction`` too: the test of the module
     docstring on these two triangles alone. A witness that holds shows the block (a
     pair of triangles is enough); one that fails shows nothing."""
+    return witnesses_hold_along(meshes, witnesses, np.reshape(direction, (1, 3)), tol)[:, 0]
+
+
+def witnesses_hold_along(
+    meshes: Sequence[trimesh.Trimesh],
+    witnesses: Sequence[tuple[int, int, int, int]],
+    directions: ArrayLike,
+    tol: Tolerance | None = None,
+) -> NDArray[np.bool_]:
+    """:func:`witnesses_hold` along each row of ``directions`` (``witnesses x
+    directions``): the faces are gathered once and the overlaps of every direction's
+    pairs clipped at once, so that a search over many directions asks once for a pair
+    of parts instead of once per direction."""
     tol = tol or current()
-    # a face of a mesh as one sorted key: the mesh's number, then the face's
-    stride = 1 + max((len(m.faces) for m in meshes), default=0)
     table = np.asarray(witnesses, dtype=np.int64).reshape(-1, 4)
-    back_key, front_key = table[:, 0] * stride + table[:, 2], table[:, 1] * stride + table[:, 3]
-    used = np.unique(np.concatenate([back_key, front_key]))
-    starts = np.searchsorted(used // stride, np.arange(len(meshes) + 1))
-    chosen = [used[starts[k] : starts[k + 1]] - k * stride for k in range(len(meshes))]
-    view = shadows(meshes, direction, tol, chosen)
-    # the triangles of the view in mesh order, then face order
-    key = view.owner * stride + view.face
-
-    def place(wanted: NDArray[np.int64]) -> NDArray[np.int64]:
-        """Where each key lies among the view's triangles (-1: not projected)."""
-        if not len(key):
-            return np.full(len(wanted), -1, dtype=np.int64)
-        at = np.minimum(np.searchsorted(key, wanted), len(key) - 1)
-        return np.where(key[at] == wanted, at, -1)
-
-    back, front = place(back_key), place(front_key)
+    along = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    count = len(table)
+    if not count or not len(along):
+        return np.zeros((count, len(along)), dtype=bool)
+    # the backward face of each witness, then the forward one
+    owner = np.concatenate([table[:, 0], table[:, 1]])
+    face = np.concatenate([table[:, 2], table[:, 3]])
+    corners = np.empty((2 * count, 3, 3))
+    normals = np.empty((2 * count, 3))
+    volume = np.empty(2 * count, dtype=np.int8)
+    for k in np.unique(owner).tolist():
+        rows = owner == k
+        corners[rows] = meshes[k].triangles[face[rows]]
+        normals[rows] = meshes[k].face_normals[face[rows]]
+        volume[rows] = meshes[k].is_volume
+    frames = np.array([view_frame(direction) for direction in along])
+    keep, facing, seen, turned = _seen(corners, normals, volume, frames, tol)
+    # where each face lies among the triangles of the view (-1: not projected)
+    place = np.full(keep.shape, -1, dtype=np.int64)
+    place[keep] = np.arange(int(keep.sum()))
+    view = _shadows_of(
+        np.zeros(int(keep.sum()), dtype=np.int64),
+        facing[keep],
+        seen[keep],
+        turned[keep],
+        np.zeros(int(keep.sum()), dtype=np.int64),
+    )
+    back, front = place[:, :count], place[:, count:]
     present = (back >= 0) & (front >= 0)
-    holds = np.zeros(len(witnesses), dtype=bool)
     b, f = back[present], front[present]
-    facing = (view.facing[b] <= 0) & (view.facing[f] >= 0)
+    facing_ok = (view.facing[b] <= 0) & (view.facing[f] >= 0)
     shown = np.zeros(len(b), dtype=bool)
-    shown[facing] = _shows_block(view, b[facing], f[facing], tol)
+    shown[facing_ok] = _shows_block(view, b[facing_ok], f[facing_ok], tol)
+    holds = np.zeros((len(along), count), dtype=bool)
     holds[present] = shown
-    return holds
+    return holds.T
 
 
 def _largest(view: Shadows, count: int) -> NDArray[np.bool_]:

@@ -61,7 +61,7 @@ from assemblykit.blocking.directions import (
     several,
     union_of,
 )
-from assemblykit.blocking.extended import extended_arcs, shown_arcs
+from assemblykit.blocking.extended import extended_arcs, shown_along
 from assemblykit.deprecation import moved
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.planning.fasteners import Fastener, drawn_summary
@@ -89,6 +89,14 @@ near it, when the parts moved leave along that axis too (:meth:`Search._step_dir
 RECENT_BLOCKERS = 4
 """How many of the parts found last blocking a part are tried first, alone, along a new
 direction (:meth:`ExtendedDirections.leaving`)."""
+SWEPT_DIRECTIONS = 256
+"""How many consecutive candidate directions the faces that showed a pair of parts
+blocking are tested along at once (:meth:`ExtendedDirections.shown_blockers`), once
+they have been asked along :data:`SWEEP_AFTER` directions one at a time."""
+SWEEP_AFTER = 4
+"""How many directions the faces that showed a pair blocking are tested along one at a
+time before they are tested along :data:`SWEPT_DIRECTIONS` at once: a step that finds a
+part to remove asks along a few directions, a proof that a set is stuck along hundreds."""
 MotionKind = Literal["translation", "rigid"]
 
 
@@ -152,7 +160,11 @@ class ExtendedDirections:
         self._recent: dict[int, list[int]] = {}
         self._hinted: set[tuple[int, int]] = set()
         self._clear: dict[tuple[int, int], int] = {}
-        self._shown: dict[tuple[int, int], int] = {}
+        self._sweeps: dict[
+            tuple[int, int, int], tuple[frozenset[tuple[int, int]], NDArray[np.bool_]]
+        ] = {}
+        self._witnessed: tuple[int, dict[int, int]] = (0, {})
+        self._asked: dict[tuple[int, int], int] = {}
 
     def same_as(self, k: int) -> int:
         """The first candidate direction the same as direction ``k`` to the mesh angle
@@ -283,31 +295,79 @@ class ExtendedDirections:
 
     def shown_blockers(self, k: int, movers: int, among: int) -> dict[int, int]:
         """Per part of ``movers``, blockers in ``among`` along ``k`` known without
-        projecting a mesh: those found before, and those shown by the two faces that
-        showed the pair blocking along another direction
-        (:func:`~assemblykit.blocking.extended.shown_arcs`; each pair asked once per
-        direction)."""
+        projecting a mesh: those found before, and those shown by the faces that showed
+        the pair blocking along other directions
+        (:func:`~assemblykit.blocking.extended.shown_along`). A pair's faces are tested
+        along :data:`SWEPT_DIRECTIONS` candidate directions at once, and again only when
+        the faces kept for it change: a search that proves a set stuck asks along
+        hundreds of directions, mostly of the same pairs."""
         k = self.same_as(k)
-        asked: dict[int, int] = {}
-        for i in bits(movers):
-            fresh = among & ~self._shown.get((k, i), 0) & ~(1 << i)
-            if fresh and not self._knows(k, i, among):
-                asked[i] = fresh
-        if asked:
-            arcs = shown_arcs(
-                self.assembly,
-                self.directions[k],
-                [self.names[i] for i in asked],
-                [self.names[j] for j in bits(union_of(asked.values()))],
-                self.tol,
+        masks = self._witnessed_masks()
+        asked = [
+            (i, j)
+            for i in bits(movers)
+            if not self._knows(k, i, among)
+            for j in bits(among & masks.get(i, 0) & ~(1 << i))
+        ]
+        for pair in asked:
+            self._asked[pair] = self._asked.get(pair, 0) + 1
+        swept = [pair for pair in asked if self._asked[pair] > SWEEP_AFTER]
+        self._sweep(k, swept)
+        chunk, at = divmod(k, SWEPT_DIRECTIONS)
+        shown = [(i, j) for i, j in swept if self._sweeps[(i, j, chunk)][1][at]]
+        once = [pair for pair in asked if self._asked[pair] <= SWEEP_AFTER]
+        if once:
+            witnesses = BlockingCache.of(self.assembly).obstacles.witnesses
+            named = {(self.names[i], self.names[j]): (i, j) for i, j in once}
+            unit = self.directions[k] / np.linalg.norm(self.directions[k])
+            found = shown_along(
+                self.assembly, unit[None, :], {pair: witnesses[pair] for pair in named}, self.tol
             )
-            for i, mask in asked.items():
-                self._shown[(k, i)] = self._shown.get((k, i), 0) | mask
-            for a, b in arcs:
-                i, j = self.index[a], self.index[b]
-                if asked[i] >> j & 1:
-                    self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
+            shown += [named[pair] for pair, along in found.items() if along[0]]
+        for i, j in shown:
+            self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
+
+    def _witnessed_masks(self) -> dict[int, int]:
+        """Per part, the mask of the parts it has blocking witnesses with (the pairs the
+        projection test found blocking), kept up to date as witnesses are found."""
+        witnesses = BlockingCache.of(self.assembly).obstacles.witnesses
+        if len(witnesses) != self._witnessed[0]:
+            masks: dict[int, int] = {}
+            for a, b in witnesses:
+                i, j = self.index.get(a), self.index.get(b)
+                if i is not None and j is not None:
+                    masks[i] = masks.get(i, 0) | 1 << j
+            self._witnessed = (len(witnesses), masks)
+        return self._witnessed[1]
+
+    def _sweep(self, k: int, pairs: list[tuple[int, int]]) -> None:
+        """Test the faces kept for each of ``pairs`` and not yet tested along ``k``, along
+        the :data:`SWEPT_DIRECTIONS` consecutive candidates around ``k`` (as many as
+        there are), all at once. What faces showed stays shown when they are no longer
+        kept (a block shown is a block)."""
+        witnesses = BlockingCache.of(self.assembly).obstacles.witnesses
+        chunk = k // SWEPT_DIRECTIONS
+        low = chunk * SWEPT_DIRECTIONS
+        rows = self.directions[low : low + SWEPT_DIRECTIONS]
+        fresh: dict[tuple[str, str], list[tuple[int, int]]] = {}
+        for i, j in pairs:
+            pair = (self.names[i], self.names[j])
+            swept = self._sweeps.get((i, j, chunk))
+            if swept is not None and len(swept[1]) < len(rows):
+                # candidates added since: every face again, along all of them
+                del self._sweeps[(i, j, chunk)]
+                swept = None
+            new = [faces for faces in witnesses[pair] if swept is None or faces not in swept[0]]
+            if new:
+                fresh[pair] = new
+        if not fresh:
+            return
+        units = np.array([row / np.linalg.norm(row) for row in rows]).reshape(-1, 3)
+        for (a, b), along in shown_along(self.assembly, units, fresh, self.tol).items():
+            key = (self.index[a], self.index[b], chunk)
+            faces, before = self._sweeps.get(key, (frozenset(), along))
+            self._sweeps[key] = (faces | set(fresh[(a, b)]), before | along)
 
     def _blocked_as_before(self, k: int, movers: list[int], among: int) -> list[int]:
         """The parts of ``movers`` not shown blocked along ``k`` by a part of ``among``:
