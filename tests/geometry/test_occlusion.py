@@ -238,13 +238,14 @@ def test_witnesses_along_many_directions_hold_where_they_hold_one_direction_at_a
     witnesses = [(i, j, *faces) for (i, j), faces in found.items()]
     directions = np.vstack([UP, DOWN, EAST, rng.normal(size=(37, 3))])
     directions /= np.linalg.norm(directions, axis=1)[:, None]
-    along = occlusion.witnesses_hold_along(meshes, witnesses, directions, TOL)
+    frames = np.array([occlusion.view_frame(d) for d in directions])
+    along = occlusion.witnesses_hold_along(meshes, witnesses, frames, TOL)
     assert along.shape == (len(witnesses), len(directions)) and along.any()
     for k, d in enumerate(directions):
         assert list(along[:, k]) == list(occlusion.witnesses_hold(meshes, witnesses, d, TOL))
         shown = {(w[0], w[1]) for w, h in zip(witnesses, along[:, k], strict=True) if h}
         assert shown <= blocked(meshes, d), d
-    assert occlusion.witnesses_hold_along(meshes, [], directions, TOL).shape == (0, 40)
+    assert occlusion.witnesses_hold_along(meshes, [], frames, TOL).shape == (0, 40)
 
 
 @pytest.mark.parametrize("seed", range(4))

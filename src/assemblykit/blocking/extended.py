@@ -47,6 +47,7 @@ from assemblykit.geometry.occlusion import (
     faces_near_outlines,
     hulls_may_block,
     shadows,
+    view_frame,
     witnesses_hold_along,
 )
 from assemblykit.tolerance import Tolerance
@@ -236,21 +237,25 @@ def _witnessed(
     the next ones the search tries, by the same faces."""
     kept = BlockingCache.of(assembly).obstacles.witnesses
     shown = shown_along(
-        assembly, direction[None, :], {pair: kept[pair] for pair in pairs if pair in kept}, tol
+        assembly,
+        view_frame(direction)[None],
+        {pair: kept[pair] for pair in pairs if pair in kept},
+        tol,
     )
     return {pair for pair, along in shown.items() if along[0]}
 
 
 def shown_along(
     assembly: Assembly,
-    directions: NDArray[np.float64],
+    frames: NDArray[np.float64],
     witnesses: Mapping[tuple[str, str], Sequence[tuple[int, int]]],
     tol: Tolerance,
 ) -> dict[tuple[str, str], NDArray[np.bool_]]:
     """Per pair (moving, blocker) of ``witnesses``, whether some of the pairs of faces
     given for it (blocking witnesses, as
     :meth:`~assemblykit.blocking.obstacles.Obstacles.keep_witness` keeps them) show it
-    blocking along each of the unit ``directions`` (rows): :func:`shown_arcs` along many
+    blocking along the direction of each of the view ``frames``
+    (:func:`~assemblykit.geometry.occlusion.view_frame`): :func:`shown_arcs` along many
     directions at once (:func:`~assemblykit.geometry.occlusion.witnesses_hold_along`)."""
     pairs = [pair for pair, faces in witnesses.items() if faces]
     if not pairs:
@@ -260,8 +265,8 @@ def shown_along(
     owners = np.repeat(np.arange(len(pairs)), [len(witnesses[pair]) for pair in pairs])
     table = [(index[a], index[b], *faces) for a, b in pairs for faces in witnesses[(a, b)]]
     meshes = [assembly.parts[name].mesh for name in names]
-    holds = witnesses_hold_along(meshes, table, directions, tol)
-    shown = np.zeros((len(pairs), len(directions)), dtype=bool)
+    holds = witnesses_hold_along(meshes, table, frames, tol)
+    shown = np.zeros((len(pairs), len(frames)), dtype=bool)
     np.logical_or.at(shown, owners, holds)
     return dict(zip(pairs, shown, strict=True))
 

@@ -502,25 +502,24 @@ def witnesses_hold(
     show that ``j`` blocks ``i`` along ``direction`` too: the test of the module
     docstring on these two triangles alone. A witness that holds shows the block (a
     pair of triangles is enough); one that fails shows nothing."""
-    return witnesses_hold_along(meshes, witnesses, np.reshape(direction, (1, 3)), tol)[:, 0]
+    return witnesses_hold_along(meshes, witnesses, view_frame(direction)[None], tol)[:, 0]
 
 
 def witnesses_hold_along(
     meshes: Sequence[trimesh.Trimesh],
     witnesses: Sequence[tuple[int, int, int, int]],
-    directions: ArrayLike,
+    frames: NDArray[np.float64],
     tol: Tolerance | None = None,
 ) -> NDArray[np.bool_]:
-    """:func:`witnesses_hold` along each row of ``directions`` (``witnesses x
-    directions``): the faces are gathered once and the overlaps of every direction's
-    pairs clipped at once, so that a search over many directions asks once for a pair
-    of parts instead of once per direction."""
+    """:func:`witnesses_hold` along the direction of each of the view ``frames``
+    (``f x 3 x 3``, :func:`view_frame`), as ``witnesses x f``: the faces are gathered
+    once and the overlaps of every direction's pairs clipped at once, so that a search
+    over many directions asks once for a pair of parts instead of once per direction."""
     tol = tol or current()
     table = np.asarray(witnesses, dtype=np.int64).reshape(-1, 4)
-    along = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
     count = len(table)
-    if not count or not len(along):
-        return np.zeros((count, len(along)), dtype=bool)
+    if not count or not len(frames):
+        return np.zeros((count, len(frames)), dtype=bool)
     # the backward face of each witness, then the forward one
     owner = np.concatenate([table[:, 0], table[:, 1]])
     face = np.concatenate([table[:, 2], table[:, 3]])
@@ -532,7 +531,6 @@ def witnesses_hold_along(
         corners[rows] = meshes[k].triangles[face[rows]]
         normals[rows] = meshes[k].face_normals[face[rows]]
         volume[rows] = meshes[k].is_volume
-    frames = np.array([view_frame(direction) for direction in along])
     keep, facing, seen, turned = _seen(corners, normals, volume, frames, tol)
     # where each face lies among the triangles of the view (-1: not projected)
     place = np.full(keep.shape, -1, dtype=np.int64)
@@ -550,7 +548,7 @@ def witnesses_hold_along(
     facing_ok = (view.facing[b] <= 0) & (view.facing[f] >= 0)
     shown = np.zeros(len(b), dtype=bool)
     shown[facing_ok] = _shows_block(view, b[facing_ok], f[facing_ok], tol)
-    holds = np.zeros((len(along), count), dtype=bool)
+    holds = np.zeros((len(frames), count), dtype=bool)
     holds[present] = shown
     return holds.T
 

@@ -64,6 +64,7 @@ from assemblykit.blocking.directions import (
 from assemblykit.blocking.extended import extended_arcs, shown_along
 from assemblykit.deprecation import moved
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.geometry.occlusion import view_frame
 from assemblykit.planning.fasteners import Fastener, drawn_summary
 from assemblykit.planning.multimove import moving_groups
 from assemblykit.tolerance import ORDER_RESOLUTION, Tolerance, order_key
@@ -165,6 +166,7 @@ class ExtendedDirections:
         ] = {}
         self._witnessed: tuple[int, dict[int, int]] = (0, {})
         self._asked: dict[tuple[int, int], int] = {}
+        self._frames: dict[int, NDArray[np.float64]] = {}
 
     def same_as(self, k: int) -> int:
         """The first candidate direction the same as direction ``k`` to the mesh angle
@@ -319,9 +321,9 @@ class ExtendedDirections:
         if once:
             witnesses = BlockingCache.of(self.assembly).obstacles.witnesses
             named = {(self.names[i], self.names[j]): (i, j) for i, j in once}
-            unit = self.directions[k] / np.linalg.norm(self.directions[k])
+            frame = view_frame(self.directions[k] / np.linalg.norm(self.directions[k]))
             found = shown_along(
-                self.assembly, unit[None, :], {pair: witnesses[pair] for pair in named}, self.tol
+                self.assembly, frame[None], {pair: witnesses[pair] for pair in named}, self.tol
             )
             shown += [named[pair] for pair, along in found.items() if along[0]]
         for i, j in shown:
@@ -363,8 +365,13 @@ class ExtendedDirections:
                 fresh[pair] = new
         if not fresh:
             return
-        units = np.array([row / np.linalg.norm(row) for row in rows]).reshape(-1, 3)
-        for (a, b), along in shown_along(self.assembly, units, fresh, self.tol).items():
+        frames = self._frames.get(chunk)
+        if frames is None or len(frames) < len(rows):
+            frames = np.array([view_frame(row / np.linalg.norm(row)) for row in rows]).reshape(
+                -1, 3, 3
+            )
+            self._frames[chunk] = frames
+        for (a, b), along in shown_along(self.assembly, frames, fresh, self.tol).items():
             key = (self.index[a], self.index[b], chunk)
             faces, before = self._sweeps.get(key, (frozenset(), along))
             self._sweeps[key] = (faces | set(fresh[(a, b)]), before | along)
