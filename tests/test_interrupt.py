@@ -186,7 +186,9 @@ tasks.load_task = loud
 
 
 def test_runtime_warnings_reach_stderr_only_with_debug(tmp_path: Path) -> None:
-    task = Path(__file__).resolve().parents[1] / "src/assemblykit/examples/tasks/four_bar.yaml"
+    task = (
+        Path(__file__).resolve().parents[1] / "src/assemblykit/examples/tasks/point_in_planes.yaml"
+    )
     runs: dict[bool, str] = {}
     for extra in ([], ["--debug"]):
         child = start(["solve", str(task), "--json", *extra], tmp_path, setup=LOUD_LOAD)
