@@ -223,6 +223,22 @@ def test_blocks_found_along_several_directions_are_all_shown_by_faces_afterwards
     assert shown_arcs(asm, DIAGONAL, ["cube"], ["cage"], tol) == set()
 
 
+def test_pairs_known_to_block_are_arcs_and_the_others_are_still_tested():
+    # the arcs along a direction are the same whether the faces kept for each pair are
+    # asked first, the pairs they show are given as known, or no pair is known at all
+    asm = caged_cube()
+    tol = asm.tolerance()
+    for d in [*np.vstack([np.eye(3), -np.eye(3)]), DIAGONAL]:
+        arcs = extended_arcs(asm, d, ["cube", "cage"], ["cube", "cage"], tol)
+        shown = shown_arcs(asm, d, ["cube", "cage"], ["cube", "cage"], tol)
+        assert shown <= arcs
+        for known in (shown, set()):
+            given = extended_arcs(asm, d, ["cube", "cage"], ["cube", "cage"], tol, known=known)
+            assert given == arcs, (d, known)
+    # along the diagonal the cube leaves its cage: nothing known, nothing found
+    assert extended_arcs(asm, DIAGONAL, ["cube"], ["cage"], tol, known=set()) == set()
+
+
 def test_triangle_cones_of_a_face_above_a_face():
     # the unit triangle at z = 0 swept upwards meets the same triangle at z = 1 (shifted
     # by 0.1 in x): the cone is spanned by the nine differences, all with z = 1

@@ -31,7 +31,7 @@ of Γ_t (contacts) and each region's DBG is exact at the region's direction
 from __future__ import annotations
 
 import itertools
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Collection, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -104,15 +104,19 @@ def extended_arcs(
     tol: Tolerance,
     *,
     first_only: bool = False,
+    known: Collection[tuple[str, str]] | None = None,
 ) -> set[tuple[str, str]]:
     """The arcs ``(i, j)``, ``i`` among ``movers`` and ``j ≠ i`` among ``blockers``,
     such that ``j`` blocks the extended translation of ``i`` along ``direction``: cones
     for pairs of convex parts, the projection test for the others (all of their pairs at
     once: one projection of each mesh serves every pair, so no coarser test first).
     With ``first_only``, at least one arc of each blocked mover and maybe no more:
-    which movers leave, at the cost of finding one blocker each. Parts all made of unit
-    cells are decided on their cells along a lattice direction
-    (:mod:`assemblykit.blocking.lattice`), every arc found."""
+    which movers leave, at the cost of finding one blocker each. ``known``, when given,
+    are pairs already shown blocking along ``direction`` (by the faces kept for them,
+    :func:`shown_along`): they are arcs without a test, and the faces kept for the
+    other pairs are not asked again. Parts all made of unit cells are decided on their
+    cells along a lattice direction (:mod:`assemblykit.blocking.lattice`), every arc
+    found."""
     d = np.asarray(direction, dtype=np.float64).ravel()
     d = d / np.linalg.norm(d)
     cache = BlockingCache.of(assembly).obstacles
@@ -120,7 +124,7 @@ def extended_arcs(
     found = _lattice_arcs(cache, d, moving_parts, still, tol)
     if found is not None:
         return found
-    return projected_arcs(assembly, d, moving_parts, still, tol, first_only=first_only)
+    return projected_arcs(assembly, d, moving_parts, still, tol, first_only=first_only, known=known)
 
 
 def _lattice_arcs(
@@ -155,6 +159,7 @@ def projected_arcs(
     tol: Tolerance,
     *,
     first_only: bool = False,
+    known: Collection[tuple[str, str]] | None = None,
 ) -> set[tuple[str, str]]:
     """:func:`extended_arcs` on the parts' meshes, along the unit direction ``d``: cones
     for pairs of convex parts, the projection test for the others; a pair left
@@ -175,12 +180,15 @@ def projected_arcs(
                 blocks_along(c, d, tol.angle)[0] for c in cache.cones_of(moving, blocker, tol)
             ):
                 arcs.add((moving, blocker))
-    plain = _may_block(
-        cache, d, [pair for pair in projected if not cache.backout(*pair, tol).any()], tol
-    )
-    witnessed = _witnessed(assembly, d, plain, tol)
-    arcs |= witnessed
-    plain = [pair for pair in plain if pair not in witnessed]
+    plain = [pair for pair in projected if not cache.backout(*pair, tol).any()]
+    if known is not None:
+        arcs |= {pair for pair in plain if pair in known}
+        plain = _may_block(cache, d, [pair for pair in plain if pair not in known], tol)
+    else:
+        plain = _may_block(cache, d, plain, tol)
+        witnessed = _witnessed(assembly, d, plain, tol)
+        arcs |= witnessed
+        plain = [pair for pair in plain if pair not in witnessed]
     if first_only:
         blocked = {moving for moving, _ in arcs}
         plain = [pair for pair in plain if pair[0] not in blocked]

@@ -39,7 +39,7 @@ every two-handed partition accepted by Γ_e is built too, and its plans are coun
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cache, cached_property
 from typing import TYPE_CHECKING, Any, Literal
@@ -202,9 +202,12 @@ class ExtendedDirections:
                 if self._projected[i] and not self._knows(k, i, among) and i not in asked
             ]
         if untested:
+            # the pairs that the faces kept for them show blocking need no projection
+            shown = self.shown_blockers(k, mask_of(untested), among)
+            known = {(self.names[i], self.names[j]) for i in untested for j in bits(shown[i])}
             for i in untested:
                 self._tested[(k, i)] = self._tested.get((k, i), 0) | among
-            for i, j in self._extended(k, untested, bits(among)):
+            for i, j in self._extended(k, untested, bits(among), known=known):
                 self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
                 self._remember(i, j)
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
@@ -254,7 +257,13 @@ class ExtendedDirections:
         return found
 
     def _extended(
-        self, k: int, movers: Iterable[int], blockers: Iterable[int], *, first_only: bool = False
+        self,
+        k: int,
+        movers: Iterable[int],
+        blockers: Iterable[int],
+        *,
+        first_only: bool = False,
+        known: Collection[tuple[str, str]] | None = None,
     ) -> list[tuple[int, int]]:
         """The arcs ``(i, j)`` of Γ_e along ``k`` from ``movers`` to ``blockers``, as
         indices (:func:`~assemblykit.blocking.extended.extended_arcs`, with ``first_only``
@@ -266,6 +275,7 @@ class ExtendedDirections:
             [self.names[j] for j in blockers],
             self.tol,
             first_only=first_only,
+            known=known,
         )
         return [(self.index[a], self.index[b]) for a, b in arcs]
 
