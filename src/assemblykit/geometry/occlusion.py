@@ -236,16 +236,19 @@ def hulls_may_block(
 
 
 def _shadow_width(flat: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The smallest altitude of each projected triangle (t x 3 x 2)."""
+    """The smallest altitude of each projected triangle (``... x 3 x 2``)."""
     # the edges from each corner to the next, as views of the corners (no gathering)
-    first = flat[:, 1] - flat[:, 0]
-    second = flat[:, 2] - flat[:, 1]
-    third = flat[:, 0] - flat[:, 2]
-    double_area = np.abs(first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0])
+    first = flat[..., 1, :] - flat[..., 0, :]
+    second = flat[..., 2, :] - flat[..., 1, :]
+    third = flat[..., 0, :] - flat[..., 2, :]
+    double_area = np.abs(first[..., 0] * second[..., 1] - first[..., 1] * second[..., 0])
     longest = np.sqrt(
         np.maximum(
-            np.maximum(np.einsum("ij,ij->i", first, first), np.einsum("ij,ij->i", second, second)),
-            np.einsum("ij,ij->i", third, third),
+            np.maximum(
+                np.einsum("...j,...j->...", first, first),
+                np.einsum("...j,...j->...", second, second),
+            ),
+            np.einsum("...j,...j->...", third, third),
         )
     )
     return double_area / np.where(longest > 0, longest, 1.0)
@@ -275,10 +278,10 @@ def shadows(
             tol,
         )
         keep = shown[0]
-        owner.append(np.full(int(keep.sum()), k, dtype=np.int64))
-        facing.append(sides[0, keep])
-        corners.append(seen[0, keep])
-        normals.append(turned[0, keep])
+        owner.append(np.full(len(sides), k, dtype=np.int64))
+        facing.append(sides)
+        corners.append(seen)
+        normals.append(turned)
         kept.append(chosen[keep])
     return _shadows_of(
         np.concatenate(owner) if owner else np.zeros(0, np.int64),
@@ -297,17 +300,23 @@ def _seen(
     tol: Tolerance,
 ) -> tuple[NDArray[np.bool_], NDArray[np.int8], NDArray[np.float64], NDArray[np.float64]]:
     """The triangles (``t x 3 x 3``, unit ``normals``) seen in each view frame of
-    ``frames`` (``f x 3 x 3``, :func:`view_frame`), as ``f x t`` arrays: which are kept
-    (neither within the angle tolerance of parallel to the view nor thinner than the
-    length tolerance once projected), the side each faces (times ``volume``, 0 for a
-    mesh that bounds no volume), and the corners and normals in the frame."""
+    ``frames`` (``f x 3 x 3``, :func:`view_frame`): which are kept (``f x t``: neither
+    within the angle tolerance of parallel to the view nor thinner than the length
+    tolerance once projected), and of those, in the order of ``np.nonzero(keep)``, the
+    side each faces (times ``volume``, 0 for a mesh that bounds no volume), and the
+    corners and normals in the frame."""
     cos = np.matmul(normals, frames[:, 2, :, None])[..., 0]
     # every corner in the view frame once: its first two coordinates on the plane
     seen = np.matmul(triangles, frames.transpose(0, 2, 1)[:, None])
-    width = _shadow_width(seen[..., :2].reshape(-1, 3, 2)).reshape(cos.shape)
-    keep = (np.abs(cos) > tol.mesh_angle) & (width > tol.length)
-    facing = np.sign(cos).astype(np.int8) * volume
-    return keep, facing, seen, np.matmul(normals, frames.transpose(0, 2, 1))
+    keep = (np.abs(cos) > tol.mesh_angle) & (_shadow_width(seen[..., :2]) > tol.length)
+    view, face = np.nonzero(keep)
+    facing = np.sign(cos[keep]).astype(np.int8)
+    facing *= volume[face] if isinstance(volume, np.ndarray) else volume
+    if len(frames) == 1:
+        turned = normals[face] @ frames[0].T
+    else:
+        turned = np.matmul(normals[face, None, :], frames[view].transpose(0, 2, 1))[:, 0]
+    return keep, facing, seen[keep], turned
 
 
 def _shadows_of(
@@ -536,11 +545,11 @@ def witnesses_hold_along(
     place = np.full(keep.shape, -1, dtype=np.int64)
     place[keep] = np.arange(int(keep.sum()))
     view = _shadows_of(
-        np.zeros(int(keep.sum()), dtype=np.int64),
-        facing[keep],
-        seen[keep],
-        turned[keep],
-        np.zeros(int(keep.sum()), dtype=np.int64),
+        np.zeros(len(facing), dtype=np.int64),
+        facing,
+        seen,
+        turned,
+        np.zeros(len(facing), dtype=np.int64),
     )
     back, front = place[:, :count], place[:, count:]
     present = (back >= 0) & (front >= 0)
