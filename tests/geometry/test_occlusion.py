@@ -205,16 +205,24 @@ def test_a_witness_found_along_one_direction_shows_the_block_along_its_neighbour
     assert not occlusion.witnesses_hold(meshes, [(0, 1, face_hook, face_wall)], away, TOL).any()
 
 
-@pytest.mark.parametrize("seed", range(4))
-def test_a_witness_holds_only_where_the_projection_test_blocks(seed):
-    rng = np.random.default_rng(seed)
+def hook_witnesses(
+    rng: np.random.Generator,
+) -> tuple[list[trimesh.Trimesh], list[tuple[int, int, int, int]]]:
+    """A hook and a wall moved at random, and the witnesses the projection test found
+    along eight random directions."""
     hook = cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4])
     wall = cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1])
     meshes = [mesh_of(hook), mesh_of(wall.translate(tuple(rng.uniform(-1, 1, 3))))]
     found = {}
     for d in rng.normal(size=(8, 3)):
         found |= occlusion.blocking_witnesses(shadows(meshes, d, TOL), BOTH, TOL)
-    witnesses = [(i, j, *faces) for (i, j), faces in found.items()]
+    return meshes, [(i, j, *faces) for (i, j), faces in found.items()]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_witness_holds_only_where_the_projection_test_blocks(seed):
+    rng = np.random.default_rng(seed)
+    meshes, witnesses = hook_witnesses(rng)
     held_somewhere = 0
     for d in [UP, DOWN, EAST, *rng.normal(size=(10, 3))]:
         held = occlusion.witnesses_hold(meshes, witnesses, d, TOL)
@@ -229,13 +237,7 @@ def test_witnesses_along_many_directions_hold_where_they_hold_one_direction_at_a
     # the hook's witnesses tested along forty directions at once give, per direction,
     # the verdicts of forty separate tests, and show only blocks of the projection test
     rng = np.random.default_rng(seed)
-    hook = cube([0, 0, 0], [3, 1, 1]) + cube([0, 0, 1], [1, 1, 4])
-    wall = cube([1, -1, 1], [5, 2, 2]) + cube([4, -1, 0], [5, 2, 1])
-    meshes = [mesh_of(hook), mesh_of(wall.translate(tuple(rng.uniform(-1, 1, 3))))]
-    found = {}
-    for d in rng.normal(size=(8, 3)):
-        found |= occlusion.blocking_witnesses(shadows(meshes, d, TOL), BOTH, TOL)
-    witnesses = [(i, j, *faces) for (i, j), faces in found.items()]
+    meshes, witnesses = hook_witnesses(rng)
     directions = np.vstack([UP, DOWN, EAST, rng.normal(size=(37, 3))])
     directions /= np.linalg.norm(directions, axis=1)[:, None]
     frames = np.array([occlusion.view_frame(d) for d in directions])
