@@ -309,10 +309,11 @@ class ExtendedDirections:
         """Per part of ``movers``, blockers in ``among`` along ``k`` known without
         projecting a mesh: those found before, and those shown by the faces that showed
         the pair blocking along other directions
-        (:func:`~assemblykit.blocking.extended.shown_along`). A pair's faces are tested
-        along :data:`SWEPT_DIRECTIONS` candidate directions at once, and again only when
-        the faces kept for it change: a search that proves a set stuck asks along
-        hundreds of directions, mostly of the same pairs."""
+        (:func:`~assemblykit.blocking.extended.shown_along`). Once a pair has been
+        asked along :data:`SWEEP_AFTER` directions, its faces are tested along the run of
+        :data:`SWEPT_DIRECTIONS` candidates around ``k`` at once, and again only for faces
+        kept since (:meth:`_sweep`): a search that proves a set stuck asks along hundreds
+        of directions, mostly of the same pairs."""
         k = self.same_as(k)
         masks = self._witnessed_masks()
         asked = [
