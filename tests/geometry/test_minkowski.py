@@ -93,6 +93,23 @@ def test_a_non_convex_body_has_no_convex_decomposition():
     assert convex_bodies(notch) is None
 
 
+def test_a_ring_is_no_convex_body_and_a_cube_beside_it_does_not_change_that():
+    # a square ring (a plate with a square hole) has a handle: the hull test finds the
+    # hole's points deep inside the hull, and the Euler characteristic says so at once
+    ring = trimesh.creation.box(extents=(4, 4, 1)).difference(
+        trimesh.creation.box(extents=(2, 2, 2))
+    )
+    assert ring.is_watertight and ring.euler_number == 0
+    assert convex_bodies(ring) is None
+    beside = trimesh.creation.box(
+        extents=(1, 1, 1), transform=trimesh.transformations.translation_matrix([6, 0, 0])
+    )
+    assert convex_bodies(trimesh.util.concatenate([ring, beside])) is None
+    # two cubes apart are two convex bodies (Euler characteristic 4, two bodies)
+    apart = trimesh.util.concatenate([beside, trimesh.creation.box(extents=(1, 1, 1))])
+    assert apart.euler_number == 4 and len(convex_bodies(apart) or []) == 2
+
+
 def test_overlap_depth_is_the_largest_ball_inside_both_hulls():
     # unit cubes sharing a 0.2-thick slab: a ball of radius 0.1 fits in both
     assert overlap_depth(corners([0, 0, 0], [1, 1, 1]), corners([0.8, 0, 0], [1.8, 1, 1])) == (

@@ -53,6 +53,11 @@ def convex_bodies(
     planar (COMPAS vaults) stay on the exact cone route, and treating them as their hull
     moves their surface by at most the tolerance."""
     tol = tol or current()
+    # a convex body's closed surface is a sphere (Euler characteristic 2): a closed mesh
+    # whose bodies have handles (a plate with holes) is no union of convex bodies, and
+    # neither split nor hull is needed to say so
+    if mesh.is_watertight and mesh.euler_number < 2 * mesh.body_count:
+        return None
     bodies = [mesh] if mesh.body_count < 2 else mesh.split(only_watertight=False)
     # a shell facing inwards bounds a cavity, not a solid: the part is not convex (a
     # body of no volume, a sheet a boolean left, has no centre of mass: not an error)
