@@ -186,7 +186,7 @@ def projected_arcs(
         plain = _may_block(cache, d, [pair for pair in plain if pair not in known], tol)
     else:
         plain = _may_block(cache, d, plain, tol)
-        witnessed = _witnessed(assembly, d, plain, tol)
+        witnessed = shown_pairs(assembly, d, plain, tol)
         arcs |= witnessed
         plain = [pair for pair in plain if pair not in witnessed]
     if first_only:
@@ -217,7 +217,7 @@ def shown_arcs(
     cache = BlockingCache.of(assembly).obstacles
     others = list(blockers)
     pairs = [(m, b) for m in movers for b in others if (m, b) in cache.witnesses]
-    return _witnessed(assembly, d / np.linalg.norm(d), pairs, tol)
+    return shown_pairs(assembly, d / np.linalg.norm(d), pairs, tol)
 
 
 def _may_block(
@@ -235,10 +235,10 @@ def _may_block(
     return [pair for pair, kept in zip(pairs, keep.tolist(), strict=True) if kept]
 
 
-def _witnessed(
+def shown_pairs(
     assembly: Assembly, direction: NDArray[np.float64], pairs: list[tuple[str, str]], tol: Tolerance
 ) -> set[tuple[str, str]]:
-    """The pairs (moving, blocker) of ``pairs`` that block along ``direction`` as shown by
+    """The pairs (moving, blocker) of ``pairs`` that block along the unit ``direction`` as shown by
     some two faces that showed it along another direction (kept in the assembly's
     :class:`~assemblykit.blocking.obstacles.Obstacles`, a few per pair): a few triangles
     projected instead of two meshes. A part blocked along one direction mostly is along

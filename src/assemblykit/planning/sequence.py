@@ -61,7 +61,7 @@ from assemblykit.blocking.directions import (
     several,
     union_of,
 )
-from assemblykit.blocking.extended import extended_arcs, shown_along
+from assemblykit.blocking.extended import extended_arcs, shown_along, shown_pairs
 from assemblykit.deprecation import moved
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.occlusion import view_frame
@@ -330,13 +330,10 @@ class ExtendedDirections:
         shown = [(i, j) for i, j in swept if self._sweeps[(i, j, chunk)][1][at]]
         once = [pair for pair in asked if self._asked[pair] <= SWEEP_AFTER]
         if once:
-            witnesses = BlockingCache.of(self.assembly).obstacles.witnesses
-            named = {(self.names[i], self.names[j]): (i, j) for i, j in once}
-            frame = view_frame(self.directions[k] / np.linalg.norm(self.directions[k]))
-            found = shown_along(
-                self.assembly, frame[None], {pair: witnesses[pair] for pair in named}, self.tol
-            )
-            shown += [named[pair] for pair, along in found.items() if along[0]]
+            unit = self.directions[k] / np.linalg.norm(self.directions[k])
+            named = [(self.names[i], self.names[j]) for i, j in once]
+            found = shown_pairs(self.assembly, unit, named, self.tol)
+            shown += [(self.index[a], self.index[b]) for a, b in found]
         for i, j in shown:
             self._blocking[(k, i)] = self._blocking.get((k, i), 0) | 1 << j
         return {i: self._blocking.get((k, i), 0) & among & ~(1 << i) for i in bits(movers)}
