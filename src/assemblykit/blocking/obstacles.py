@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import itertools
 
-import manifold3d
 import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.blocking.lattice import lattice_cells
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.interference import interference_threshold, shared_volume, solid
 from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
 from assemblykit.geometry.occlusion import hull_vertices, triangle_spheres

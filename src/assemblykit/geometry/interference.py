@@ -12,12 +12,12 @@ from __future__ import annotations
 from collections.abc import Collection
 from typing import TYPE_CHECKING
 
-import manifold3d
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
 from assemblykit.errors import GeometryError
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.contacts import candidate_pairs
 from assemblykit.tolerance import Tolerance, current
 

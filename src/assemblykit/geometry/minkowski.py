@@ -21,7 +21,6 @@ convex pieces along the planes of its own faces.
 
 from __future__ import annotations
 
-import manifold3d
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
@@ -29,6 +28,7 @@ from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, QhullError
 
 from assemblykit.errors import GeometryError
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.interference import solid
 from assemblykit.tolerance import Tolerance, current
 

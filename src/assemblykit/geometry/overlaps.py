@@ -32,12 +32,12 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
 
-import manifold3d
 import networkx as nx
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.interference import interference_threshold, interferences, solid
 from assemblykit.geometry.occlusion import blocking_witnesses, shadows
 from assemblykit.model.assembly import Assembly, Overlap, Part

@@ -21,11 +21,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import manifold3d
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.interference import solid
 
 ROUNDS = 8

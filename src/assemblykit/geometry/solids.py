@@ -10,12 +10,12 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import manifold3d
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
 from assemblykit.errors import GeometryError, SchemaError
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.interference import solid
 
 Vector3 = tuple[float, float, float]

@@ -37,12 +37,12 @@ from dataclasses import dataclass
 from enum import StrEnum
 from functools import cached_property
 
-import manifold3d
 import numpy as np
 import shapely
 import trimesh
 
 from assemblykit.algebra import Coset, Kind, se3
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.interference import interference_threshold, solid, solids_interfere
 from assemblykit.geometry.solids import placed
 from assemblykit.tolerance import Tolerance

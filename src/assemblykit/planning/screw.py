@@ -49,13 +49,13 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-import manifold3d
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
 from assemblykit.algebra import se3
 from assemblykit.blocking.rigid import RigidBlockingGraph
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.geometry.interference import interference_threshold, solid
 from assemblykit.model.assembly import Assembly
