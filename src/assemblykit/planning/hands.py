@@ -31,6 +31,7 @@ used, ``None`` when ``max_hands`` do not suffice.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -145,14 +146,14 @@ class _HandsSearch:
         """Velocities that take ``groups`` apart, group 0 fixed, or ``None``: the last
         group at unit speed along one of its free directions, each other moving group
         along one of its own with a speed ratio against the last (module docstring),
-        every two moving groups checked."""
+        every two moving groups checked. A group that leaves the fixed one along no
+        direction is found before the free directions of the others are listed."""
         directions = self.directions
-        options = []
-        for g in groups[1:]:
-            ks = [k for k in range(len(directions)) if self.free(g, groups[0], k)]
-            if not ks:
-                return None
-            options.append(ks)
+        candidates = range(len(directions))
+        leaves = functools.cache(lambda g, k: self.free(g, groups[0], k))
+        if not all(any(leaves(g, k) for k in candidates) for g in groups[1:]):
+            return None
+        options = [[k for k in candidates if leaves(g, k)] for g in groups[1:]]
         for k_last in options[-1]:
             chosen = self._extend(groups, options, [], directions[k_last])
             if chosen is not None:
