@@ -6,12 +6,13 @@ translations: the stages of the ``plan`` command, each timed once.
 
 Printed per file: parts, the loader's warnings and skipped items, the interfering pairs
 and what was done about them, the plan (feasible or the stuck parts, steps), the CPU
-seconds of each stage, the wall clock seconds of all of them (manifold3d's booleans use
-every core; ``taskset -c 0`` gives the figures of one core) and the peak resident memory
-of the process so far, next to the
-targets: a file of up to 34 parts loaded, contacts and plan in <= 10 CPU s and <= 1 GB,
-144 parts in <= 30 CPU s. The gripper is planned to the end, or for its first
-``--gripper-steps`` steps, the parts not yet taken apart counted as unfinished.
+seconds of each stage (of every thread of the process: manifold3d's booleans run on one
+thread unless ``ASSEMBLYKIT_BOOLEAN_THREADS=all``, docs/geometry.md, "The threads of
+the booleans"), the wall clock seconds of all of them and the peak resident memory of
+the process so far, next to the targets: a file of up to 34 parts loaded, contacts and
+plan in <= 10 CPU s and <= 1 GB, 144 parts in <= 30 CPU s. The gripper is planned to the
+end, or for its first ``--gripper-steps`` steps, the parts not yet taken apart counted
+as unfinished.
 
 Two irises are drawn here as a CAD user draws one (:func:`iris`): a base ring, a pivot
 pin per blade at its hole's diameter, flat blades in one layer each drawn over its
@@ -53,8 +54,7 @@ def timed_stage(
     stage: str, run: Callable[[], T], times: dict[str, float], walls: dict[str, float]
 ) -> T:
     """Run ``run()``, recording its CPU seconds under ``stage`` in ``times`` and its wall
-    clock seconds in ``walls`` (manifold3d's booleans run on every core: their CPU time
-    is the sum over the threads)."""
+    clock seconds in ``walls`` (the CPU time is the sum over the process's threads)."""
     start, wall = time.process_time(), time.perf_counter()
     result = run()
     times[stage] = time.process_time() - start
