@@ -5,19 +5,16 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import shapely
 import trimesh
 
-from assemblykit.geometry import contacts
 from assemblykit.geometry.contacts import (
     assembly_contacts,
     assembly_curved_surfaces,
     assembly_surfaces,
-    candidate_pairs,
     find_contacts,
     near_curved_surfaces,
 )
@@ -94,14 +91,6 @@ def test_only_restricts_to_the_contacts_of_one_part():
     )
     assert [c.pair for c in find_contacts(parts)] == [("a", "b"), ("b", "c")]
     assert [c.pair for c in find_contacts(parts, only="c")] == [("b", "c")]
-
-
-def test_broad_phase_pairs_boxes_that_overlap_once_inflated():
-    bounds = np.array(
-        [[[0, 0, 0], [1, 1, 1]], [[1, 0, 0], [2, 1, 1]], [[5, 5, 5], [6, 6, 6]]], float
-    )
-    assert candidate_pairs(bounds, 1e-9).tolist() == [[0, 1]]
-    assert candidate_pairs(bounds, 1e-9, only=2).tolist() == []
 
 
 def test_shaft_in_a_hole_from_meshes_is_a_cylindrical_contact():
@@ -349,36 +338,3 @@ def test_a_plate_on_a_finely_meshed_plate_touches_on_their_common_square(size):
     np.testing.assert_allclose(patch.polygon.max(axis=0), [9, 8, 1], atol=1e-9)
     square = shapely.Polygon(patch.polygon[:, :2])
     assert square.symmetric_difference(shapely.box(3, 2, 9, 8)).area < 1e-9
-
-
-@pytest.mark.parametrize("block", [1, 7, 1 << 21])
-def test_facing_groups_are_every_pair_of_boxes_that_meet_near_both_parts(block, monkeypatch):
-    # random group boxes on four parts: the pairs found are those a comparison of every
-    # group of the first part with every group of the second finds, in the stated order
-    monkeypatch.setattr(contacts, "_BOX_BLOCK", block)
-    rng = np.random.default_rng(3)
-    owner = rng.integers(0, 4, 300)
-    lo = rng.uniform(0, 10, (300, 3)) + owner[:, None] * 2.0
-    hi = lo + rng.uniform(0, 2, (300, 3))
-    seg = SimpleNamespace(lo=lo, hi=hi)
-    usable = rng.random(300) < 0.8
-    part_lo = np.array([lo[owner == p].min(axis=0) for p in range(4)])
-    part_hi = np.array([hi[owner == p].max(axis=0) for p in range(4)])
-    pairs = np.array([[0, 1], [2, 1], [1, 3]])
-    margin = 0.05
-    g, h = contacts.facing_groups(seg, owner, usable, part_lo, part_hi, pairs, margin)
-
-    def meet(a_lo, a_hi, b_lo, b_hi):
-        return bool(np.all(a_lo <= b_hi + margin) and np.all(b_lo <= a_hi + margin))
-
-    expected = [
-        (a, b)
-        for p, q in pairs
-        for a in np.flatnonzero(usable & (owner == p))
-        for b in np.flatnonzero(usable & (owner == q))
-        if meet(lo[a], hi[a], lo[b], hi[b])
-        and meet(lo[a], hi[a], part_lo[q], part_hi[q])
-        and meet(lo[b], hi[b], part_lo[p], part_hi[p])
-    ]
-    assert list(zip(g.tolist(), h.tolist(), strict=True)) == expected
-    assert len(expected) > 50
