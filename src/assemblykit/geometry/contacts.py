@@ -24,8 +24,9 @@ parts (:meth:`GeometryMemo.restricted`, called by ``Assembly.subset`` and ``with
 taking parts away costs nothing, and adding one costs only that part's contacts.
 
 The contacts found are the values of :mod:`~assemblykit.geometry.contact_values`
-(:class:`Contact`, :class:`Contacts`, :class:`PlanarPatch`, :class:`CurvedPatch`), which
-this module names too.
+(:class:`Contact`, :class:`Contacts`, :class:`PlanarPatch`, :class:`CurvedPatch`). This
+module names them too, with the public functions and constants of the broad phase, the
+narrow phase and snapping (``__all__``), so that each can be imported from here.
 """
 
 from __future__ import annotations
@@ -64,11 +65,7 @@ from assemblykit.geometry.narrow_phase import (
     planar_patches,
     surface_size,
 )
-from assemblykit.geometry.recognition import (
-    recognise_curved,
-    recognise_planes,
-    segment,
-)
+from assemblykit.geometry.recognition import recognise_curved, recognise_planes, segment
 from assemblykit.geometry.snapping import snap_classes, snapped
 from assemblykit.model.assembly import Assembly
 from assemblykit.model.surfaces import Surface
