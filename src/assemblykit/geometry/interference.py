@@ -18,7 +18,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from assemblykit.errors import GeometryError
-from assemblykit.geometry.contacts import candidate_pairs
+from assemblykit.geometry.broad_phase import candidate_pairs
 from assemblykit.tolerance import Tolerance, current
 
 if TYPE_CHECKING:
