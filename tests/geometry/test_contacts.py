@@ -5,19 +5,16 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import shapely
 import trimesh
 
-from assemblykit.geometry import contacts
 from assemblykit.geometry.contacts import (
     assembly_contacts,
     assembly_curved_surfaces,
     assembly_surfaces,
-    candidate_pairs,
     find_contacts,
     near_curved_surfaces,
 )
@@ -94,14 +91,6 @@ def test_only_restricts_to_the_contacts_of_one_part():
     )
     assert [c.pair for c in find_contacts(parts)] == [("a", "b"), ("b", "c")]
     assert [c.pair for c in find_contacts(parts, only="c")] == [("b", "c")]
-
-
-def test_broad_phase_pairs_boxes_that_overlap_once_inflated():
-    bounds = np.array(
-        [[[0, 0, 0], [1, 1, 1]], [[1, 0, 0], [2, 1, 1]], [[5, 5, 5], [6, 6, 6]]], float
-    )
-    assert candidate_pairs(bounds, 1e-9).tolist() == [[0, 1]]
-    assert candidate_pairs(bounds, 1e-9, only=2).tolist() == []
 
 
 def test_shaft_in_a_hole_from_meshes_is_a_cylindrical_contact():
@@ -234,84 +223,6 @@ def test_the_cross_vaults_crown_joints_are_sunk_beyond_its_precision():
         assert found[pair] == pytest.approx(ref[pair], rel=1e-6)
 
 
-def _square(half: float) -> np.ndarray:
-    return np.array([[-half, -half, 0], [half, -half, 0], [half, half, 0], [-half, half, 0]])
-
-
-@pytest.mark.parametrize(("scatter", "snapped_to"), [(1e-5, 0), (0.0, 1)])
-def test_a_normal_snaps_when_turning_it_moves_within_the_scatter(scatter, snapped_to):
-    from assemblykit.geometry.contacts import snap_classes
-
-    # two unit squares, normals 2e-5 rad apart (about x): turning the second onto the
-    # first moves its edge at y = +-0.5 by 1e-5, within twice their scatter (4e-5) and
-    # the tolerance (1e-4); faces without scatter are exact and keep their normals
-    tilt = 2e-5
-    directions = np.array([[0, 0, 1.0], [0, -np.sin(tilt), np.cos(tilt)]])
-    tol = Tolerance(scale=1.0, rel_length=1e-4)
-    leader, sign = snap_classes(
-        directions, [_square(0.5), _square(0.5)], np.array([scatter, scatter]), tol
-    )
-    assert leader.tolist() == [0, snapped_to] and sign.tolist() == [1.0, 1.0]
-
-
-def test_a_normal_turned_further_than_the_tolerance_leads_its_own_class():
-    from assemblykit.geometry.contacts import snap_classes
-
-    # 4e-4 rad over a half-width of 0.5 moves the edge by 2e-4 > 1e-4
-    tilt = 4e-4
-    directions = np.array([[0, 0, 1.0], [0, -np.sin(tilt), -np.cos(tilt)]])
-    tol = Tolerance(scale=1.0, rel_length=1e-4)
-    leader, _ = snap_classes(directions, [_square(0.5)] * 2, np.array([1e-4, 1e-4]), tol)
-    assert leader.tolist() == [0, 1]
-
-
-def _snap_one_leader_at_a_time(directions, spreads, scatter, tol):
-    """snap_classes as its docstring states it, each patch compared with every leader."""
-    width = [np.linalg.svd(p, compute_uv=False)[1] / np.sqrt(len(p)) for p in spreads]
-    leader, sign, leaders = list(range(len(directions))), [1.0] * len(directions), []
-    for i in np.argsort(-np.array(width), kind="stable").tolist():
-        best = None
-        for k in leaders:
-            facing = -1.0 if directions[k] @ directions[i] < 0 else 1.0
-            turn = np.cross(directions[i], facing * directions[k])
-            sine = np.linalg.norm(turn)
-            if sine == 0:
-                continue
-            lever = np.linalg.norm(np.cross(turn / sine, spreads[i]), axis=1).max()
-            if sine * lever <= min(2 * (scatter[i] + scatter[k]), tol.length) and (
-                best is None or sine < best[0]
-            ):
-                best = (sine, k, facing)
-        if best is None:
-            leaders.append(i)
-        else:
-            leader[i], sign[i] = best[1], best[2]
-    return leader, sign
-
-
-def test_snapping_compares_each_patch_with_every_leader_as_stated():
-    """Patches on the three axes, many with exactly one direction (exact faces, which
-    the search keeps apart as leaders of one line) and some tilted by 1e-7 with scatter:
-    the classes equal those of comparing each patch with every leader one by one."""
-    from assemblykit.geometry.contacts import snap_classes
-
-    rng = np.random.default_rng(7)
-    tol = Tolerance(scale=1.0, rel_length=1e-4)
-    joined = 0
-    for _ in range(25):
-        n = 40
-        axes = np.vstack([np.eye(3), -np.eye(3)])[rng.integers(0, 6, n)]
-        directions = axes + rng.choice([0.0, 1e-7], n)[:, None] * rng.normal(size=(n, 3))
-        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-        spreads = [rng.normal(size=(4, 3)) for _ in range(n)]
-        scatter = rng.choice([0.0, 1e-6, 1e-5], n)
-        leader, sign = snap_classes(directions, spreads, scatter, tol)
-        expected = _snap_one_leader_at_a_time(directions, spreads, scatter, tol)
-        assert (leader.tolist(), sign.tolist()) == expected
-        joined += int((leader != np.arange(n)).sum())
-    assert joined > 400
-
-
 def test_the_pieces_of_one_face_make_one_patch():
     # part a is two boxes side by side with a crack of 1e-9 (far below the tolerance,
     # 1e-6 x 2.45) between them: two coplanar faces under box c, joined into one patch,
@@ -349,36 +260,3 @@ def test_a_plate_on_a_finely_meshed_plate_touches_on_their_common_square(size):
     np.testing.assert_allclose(patch.polygon.max(axis=0), [9, 8, 1], atol=1e-9)
     square = shapely.Polygon(patch.polygon[:, :2])
     assert square.symmetric_difference(shapely.box(3, 2, 9, 8)).area < 1e-9
-
-
-@pytest.mark.parametrize("block", [1, 7, 1 << 21])
-def test_facing_groups_are_every_pair_of_boxes_that_meet_near_both_parts(block, monkeypatch):
-    # random group boxes on four parts: the pairs found are those a comparison of every
-    # group of the first part with every group of the second finds, in the stated order
-    monkeypatch.setattr(contacts, "_BOX_BLOCK", block)
-    rng = np.random.default_rng(3)
-    owner = rng.integers(0, 4, 300)
-    lo = rng.uniform(0, 10, (300, 3)) + owner[:, None] * 2.0
-    hi = lo + rng.uniform(0, 2, (300, 3))
-    seg = SimpleNamespace(lo=lo, hi=hi)
-    usable = rng.random(300) < 0.8
-    part_lo = np.array([lo[owner == p].min(axis=0) for p in range(4)])
-    part_hi = np.array([hi[owner == p].max(axis=0) for p in range(4)])
-    pairs = np.array([[0, 1], [2, 1], [1, 3]])
-    margin = 0.05
-    g, h = contacts.facing_groups(seg, owner, usable, part_lo, part_hi, pairs, margin)
-
-    def meet(a_lo, a_hi, b_lo, b_hi):
-        return bool(np.all(a_lo <= b_hi + margin) and np.all(b_lo <= a_hi + margin))
-
-    expected = [
-        (a, b)
-        for p, q in pairs
-        for a in np.flatnonzero(usable & (owner == p))
-        for b in np.flatnonzero(usable & (owner == q))
-        if meet(lo[a], hi[a], lo[b], hi[b])
-        and meet(lo[a], hi[a], part_lo[q], part_hi[q])
-        and meet(lo[b], hi[b], part_lo[p], part_hi[p])
-    ]
-    assert list(zip(g.tolist(), h.tolist(), strict=True)) == expected
-    assert len(expected) > 50

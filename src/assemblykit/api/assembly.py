@@ -9,7 +9,8 @@ import numpy as np
 
 from assemblykit.blocking import polygons as polygon_model
 from assemblykit.features.primitives import Feature
-from assemblykit.geometry.contacts import Contacts, assembly_contacts, assembly_surfaces
+from assemblykit.geometry.contact_values import Contacts
+from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.io import assembly as assembly_files
 from assemblykit.io import polygons as polygon_files
 from assemblykit.model import assembly as assembly_model

@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.errors import FeatureError
-from assemblykit.geometry.contacts import Contact, CurvedPatch
+from assemblykit.geometry.contact_values import Contact, CurvedPatch
 from assemblykit.geometry.curved import CONE_AZIMUTHS, spread
 
 

@@ -22,7 +22,8 @@ from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
 from assemblykit.errors import GeometryError, UnknownNameError
-from assemblykit.geometry.contacts import Contact, PlanarPatch, assembly_contacts
+from assemblykit.geometry.contact_values import Contact, PlanarPatch
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.tolerance import Tolerance, current
 
 

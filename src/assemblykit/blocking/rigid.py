@@ -42,7 +42,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
-from assemblykit.geometry.contacts import Contact, PlanarPatch
+from assemblykit.geometry.contact_values import Contact, PlanarPatch
 from assemblykit.graphs import component_labels
 from assemblykit.tolerance import Tolerance
 

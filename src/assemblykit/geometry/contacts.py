@@ -1,23 +1,18 @@
-"""Contacts between the parts of an assembly: the value types.
+"""Contacts between the parts of an assembly: how they are found, and kept with it.
 
-A :class:`Contact` joins two parts ``a`` and ``b`` that touch. It holds the planar
-patches where their faces coincide with opposite normals, and the curved patches where
-cylinders, cones or spheres coincide. Liu 1997 and Wilson & Latombe 1992 start from exactly this:
-"the specification of the contact surfaces between parts".
-
-The functions below find them (:func:`find_contacts`): a broad phase over the parts'
-bounding boxes (an R-tree, boxes inflated by the length tolerance) keeps only pairs
-that may touch, so the cost grows with the number of touching pairs; then, vectorised
-over all candidate pairs at once, the coplanar groups of facets
-(:func:`~assemblykit.geometry.recognition.segment`) of one part are matched with the
-groups of the other that lie in the same plane with the opposite normal, and their
-overlap is measured by shapely in that plane. Curved contacts are coaxial cylinders
-and cones and concentric spheres of equal size, one convex and one concave, read from
+The functions below find them (:func:`find_contacts`): after the broad phase
+(:mod:`~assemblykit.geometry.broad_phase`: the pairs of parts whose bounding boxes meet,
+inflated by the length tolerance), the narrow phase
+(:mod:`~assemblykit.geometry.narrow_phase`), vectorised over all candidate pairs at
+once, makes the planar patches where coplanar groups of facets of the two parts lie in
+one plane with opposite normals, and the curved patches where coaxial cylinders and
+cones or concentric spheres of equal size coincide. The curved surfaces are read from
 the parts' exact surfaces, or recognised on each part's triangles within reach of the
 other's box (:func:`near_curved_surfaces`: per pair, so a pair's contacts depend on its
-two parts alone); each keeps only the part of the surface of revolution both parts
-cover, as the normals there (:mod:`assemblykit.geometry.curved`). A coplanar group with
-a face on such a surface is a facet of it, not a planar face, and makes no planar patch.
+two parts alone). A coplanar group with a face on such a surface is a facet of it, not
+a planar face, and makes no planar patch. Last, the directions of the patches found are
+snapped (:mod:`~assemblykit.geometry.snapping`): noisy normals of one direction become
+one direction.
 
 What is found is kept with the assembly: :func:`assembly_contacts` (contacts per
 tolerance) and :func:`assembly_surfaces` (surfaces per part and tolerance) fill a
@@ -28,759 +23,82 @@ assembly, two assemblies never share one, and a sub-assembly keeps what concerns
 parts (:meth:`GeometryMemo.restricted`, called by ``Assembly.subset`` and ``with_part``):
 taking parts away costs nothing, and adding one costs only that part's contacts.
 
-Convention: every normal stored here is the outward normal of part ``a``'s surface, so
-it points from ``a`` into ``b``. Translating ``a`` infinitesimally along ``d`` pushes
-into ``b`` across a planar patch iff ``d . normal > 0`` (Wilson & Latombe 1992, DBG arcs).
+The contacts found are the values of :mod:`~assemblykit.geometry.contact_values`
+(:class:`Contact`, :class:`Contacts`, :class:`PlanarPatch`, :class:`CurvedPatch`). This
+module names them too, with the public functions and constants of the broad phase, the
+narrow phase and snapping (``__all__``), so that each can be imported from here.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Iterable, Sequence, Set
-from dataclasses import dataclass, field, replace
+from collections.abc import Set
+from dataclasses import dataclass, field
 from functools import singledispatch
-from typing import Any, Literal
 
 import numpy as np
-import shapely
-import trimesh
 from numpy.typing import NDArray
-from rtree import index
 
-from assemblykit.algebra.se3 import axis_basis
 from assemblykit.deprecation import moved
-from assemblykit.geometry.curved import (
-    ARC_STEP,
-    CONE_AZIMUTHS,
-    TURN,
-    arc_angles,
-    axis_frame,
-    cone_generators,
-    covered_arcs,
-    generating_arc,
-    intersect_arcs,
-    revolution_normals,
-    sphere_region,
+from assemblykit.geometry.broad_phase import (
+    PartStack,
+    boxes_overlap,
+    candidate_pairs,
+    facing_groups,
+    stack_parts,
 )
-from assemblykit.geometry.recognition import (
-    Segmentation,
-    recognise_curved,
-    recognise_planes,
-    segment,
+from assemblykit.geometry.contact_values import (
+    Contact,
+    Contacts,
+    CurvedKind,
+    CurvedPatch,
+    PlanarPatch,
 )
+from assemblykit.geometry.narrow_phase import (
+    OUTLINE_PAIRS,
+    OVERLAP_CHUNK,
+    curved_contact,
+    direction_reach,
+    group_deviation,
+    group_overlaps,
+    may_fit,
+    planar_matches,
+    planar_patches,
+    surface_size,
+)
+from assemblykit.geometry.recognition import recognise_curved, recognise_planes, segment
+from assemblykit.geometry.snapping import snap_classes, snapped
 from assemblykit.model.assembly import Assembly
 from assemblykit.model.surfaces import Surface
-from assemblykit.ragged import group_of, group_starts, ranges
 from assemblykit.tolerance import Tolerance
 
-CurvedKind = Literal["cylindrical", "conical", "spherical"]
-
-
-@dataclass(frozen=True, eq=False)
-class PlanarPatch:
-    """One planar contact polygon: ``polygon`` (k x 3, world, counter-clockwise seen
-    from the tip of ``normal``), its ``area``, and ``normal`` pointing from ``a`` into ``b``."""
-
-    normal: NDArray[np.float64]
-    polygon: NDArray[np.float64]
-    area: float
-    scatter: float = 0.0
-    """How far the vertices of the two faces lie from their planes: the noise that makes
-    the normal unsure (0 for exact faces)."""
-
-    @property
-    def centroid(self) -> NDArray[np.float64]:
-        """Mean of the polygon's vertices (a point on the contact plane)."""
-        return np.asarray(self.polygon.mean(axis=0), dtype=np.float64)
-
-    def __repr__(self) -> str:
-        from assemblykit import formatting as fmt
-
-        return fmt.summary(
-            "PlanarPatch",
-            f"area {fmt.number(self.area)}",
-            f"normal {fmt.direction(self.normal)}",
-            fmt.count(len(self.polygon), "vertex", "vertices"),
-        )
-
-
-@dataclass(frozen=True, eq=False)
-class CurvedPatch:
-    """A curved contact: coaxial cylinders or cones, or concentric spheres.
-
-    ``center`` is a point on the axis (cylinder), the apex (cone) or the centre
-    (sphere); ``axis`` is the unit axis (``None`` for spheres); ``radius`` the common
-    radius (cylinders, spheres) and ``half_angle`` the cone's half-angle.
-    ``inner`` names the part that is inside (the shaft or ball). ``extent`` is the axial
-    interval ``(s0, s1)`` of the contact, measured from ``center`` along ``axis``.
-    ``normals`` (k x 3) are unit outward normals of the inner part on the part of the
-    surface where the two really touch, whose non-negative combinations are every normal
-    there (:mod:`assemblykit.geometry.curved`: a half-round groove gives a half circle of
-    normals, a shallow cup a cap); ``None`` is the whole surface of revolution.
-    ``points`` holds the contact region's vertices in world coordinates (for drawing).
-    """
-
-    kind: CurvedKind
-    center: NDArray[np.float64]
-    axis: NDArray[np.float64] | None
-    radius: float
-    inner: str
-    extent: tuple[float, float] | None = None
-    half_angle: float = 0.0
-    points: NDArray[np.float64] | None = None
-    normals: NDArray[np.float64] | None = None
-
-    def __repr__(self) -> str:
-        from assemblykit import formatting as fmt
-
-        axis = "" if self.axis is None else f"axis {fmt.direction(self.axis)}"
-        size = (
-            f"half-angle {fmt.number(self.half_angle)}"
-            if self.kind == "conical"
-            else f"radius {fmt.number(self.radius)}"
-        )
-        return fmt.summary("CurvedPatch", self.kind, axis, size, f"inner {self.inner}")
-
-    def normal_cone(self) -> NDArray[np.float64]:
-        """Unit outward normals of the inner part generating the cone of the patch's
-        normals (Wilson & Latombe 1992, "Infinitesimal translations": the inner part is blocked
-        along ``d`` iff ``n . d > 0`` for one of them): ``normals``, or for the whole surface
-        the four directions ``±e1, ±e2`` across a cylinder's axis, the six signed axes
-        for a sphere, ``CONE_AZIMUTHS`` normals around a cone."""
-        if self.normals is not None:
-            return np.asarray(self.normals, dtype=np.float64).reshape(-1, 3)
-        if self.kind == "spherical" or self.axis is None:
-            return np.vstack([np.eye(3), -np.eye(3)])
-        axis = np.asarray(self.axis, dtype=np.float64)
-        if self.kind == "cylindrical":
-            return revolution_normals(axis, arc_angles(np.array([[0.0, TURN]]), ARC_STEP))
-        angles = arc_angles(np.array([[0.0, TURN]]), TURN / CONE_AZIMUTHS)
-        return revolution_normals(axis, angles, self.half_angle)
-
-    def samples(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Points of the patch with the inner part's outward unit normals there: each
-        normal of :meth:`normal_cone` at both ends of the axial extent (cylinders,
-        cones), or at ``center + radius n`` (spheres). The constraints of the unilateral
-        and rigid readings at these points are those of the whole patch (module
-        docstring of :mod:`assemblykit.geometry.curved`)."""
-        normals = self.normal_cone()
-        center = np.asarray(self.center, dtype=np.float64)
-        if self.kind == "spherical" or self.axis is None:
-            return center + self.radius * normals, normals
-        axis = np.asarray(self.axis, dtype=np.float64)
-        axis = axis / np.linalg.norm(axis)
-        # the direction away from the axis where each normal holds
-        radial = normals + math.sin(self.half_angle) * axis
-        radial /= np.linalg.norm(radial, axis=1, keepdims=True)
-        ends = self.extent if self.extent is not None else (0.0, 0.0)
-        rings = []
-        for s in ends:
-            r = self.radius if self.kind == "cylindrical" else abs(s) * math.tan(self.half_angle)
-            rings.append(center + s * axis + r * radial)
-        return np.vstack(rings), np.vstack([normals, normals])
-
-
-@dataclass(frozen=True, eq=False)
-class Contact:
-    """All contact surfaces between parts ``a`` and ``b``."""
-
-    a: str
-    b: str
-    planar: tuple[PlanarPatch, ...] = ()
-    curved: tuple[CurvedPatch, ...] = ()
-
-    @property
-    def area(self) -> float:
-        """Summed area of the planar patches."""
-        return float(sum(p.area for p in self.planar))
-
-    @property
-    def pair(self) -> tuple[str, str]:
-        """The two part names, ``(a, b)``."""
-        return (self.a, self.b)
-
-    def __repr__(self) -> str:
-        from assemblykit import formatting as fmt
-
-        planar = (
-            f"{fmt.count(len(self.planar), 'planar patch', 'planar patches')}, "
-            f"area {fmt.number(self.area)}"
-            if self.planar
-            else ""
-        )
-        curved = (
-            f"{fmt.count(len(self.curved), 'curved patch', 'curved patches')}: "
-            + ", ".join(p.kind for p in self.curved)
-            if self.curved
-            else ""
-        )
-        return fmt.summary("Contact", self.a, self.b, planar, curved)
-
-
-class Contacts(list[Contact]):
-    """The contacts of an assembly, one :class:`Contact` per touching pair (docs/geometry.md,
-    "The contact model"): a list that prints as one line and shows as a table in notebooks,
-    each pair's planar patches with their area and normals (from ``a`` into ``b``), and
-    its curved patches by kind.
-
-    >>> Contacts([Contact("peg", "block")])
-    Contacts(1 touching pair, 0 planar patches, 0 curved patches)
-    >>> Contacts()._repr_html_()[:40]
-    '<p>Contacts(0 touching pairs, 0 planar p'
-    """
-
-    def __repr__(self) -> str:
-        from assemblykit import formatting as fmt
-
-        planar = sum(len(c.planar) for c in self)
-        curved = sum(len(c.curved) for c in self)
-        return fmt.summary(
-            "Contacts",
-            fmt.count(len(self), "touching pair"),
-            fmt.count(planar, "planar patch", "planar patches"),
-            fmt.count(curved, "curved patch", "curved patches"),
-        )
-
-    def _repr_html_(self) -> str:
-        """The touching pairs as a table (notebooks)."""
-        from assemblykit import formatting as fmt
-
-        rows = [
-            (
-                c.a,
-                c.b,
-                str(len(c.planar)),
-                fmt.number(c.area) if c.planar else "",
-                fmt.name_list(sorted({fmt.direction(p.normal) for p in c.planar})),
-                ", ".join(p.kind for p in c.curved),
-            )
-            for c in self
-        ]
-        headers = ("a", "b", "planar patches", "area", "normals (a into b)", "curved")
-        return fmt.html_summary(repr(self), headers, rows)
-
-
-def _cross_join(
-    left_owner: NDArray[np.int64], right_owner: NDArray[np.int64], n_owners: int
-) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """All pairs ``(i, j)`` of entries with the same owner; owners must be sorted."""
-    right_count = np.bincount(right_owner, minlength=n_owners)
-    right_start = group_starts(right_count)
-    per_left = right_count[left_owner]
-    left = group_of(per_left)
-    right = ranges(right_start[left_owner], per_left)
-    return left, right
-
-
-def candidate_pairs(
-    bounds: NDArray[np.float64], margin: float, only: int | None = None
-) -> NDArray[np.int64]:
-    """Pairs ``(i, j)``, ``i < j``, of boxes (``n x 2 x 3``) that overlap once inflated by
-    ``margin`` (one bulk R-tree query); with ``only``, just the pairs involving it."""
-    lo, hi = bounds[:, 0] - margin, bounds[:, 1] + margin
-    tree = index.Index(
-        ((i, tuple(box), None) for i, box in enumerate(np.hstack([lo, hi]))),
-        properties=index.Property(dimension=3),
-    )
-    queries = np.arange(len(bounds)) if only is None else np.array([only])
-    if len(bounds) == 0:
-        return np.zeros((0, 2), dtype=np.int64)
-    found, counts = tree.intersection_v(
-        np.ascontiguousarray(lo[queries]), np.ascontiguousarray(hi[queries])
-    )
-    pairs = np.column_stack([np.repeat(queries, counts.astype(np.int64)), found.astype(np.int64)])
-    pairs = np.sort(pairs[pairs[:, 0] != pairs[:, 1]], axis=1)
-    return np.unique(pairs, axis=0) if len(pairs) else np.zeros((0, 2), dtype=np.int64)
-
-
-def _boxes_overlap(
-    lo_a: NDArray[np.float64],
-    hi_a: NDArray[np.float64],
-    lo_b: NDArray[np.float64],
-    hi_b: NDArray[np.float64],
-    margin: float,
-) -> NDArray[np.bool_]:
-    return np.all((lo_a <= hi_b + margin) & (lo_b <= hi_a + margin), axis=-1)
-
-
-@dataclass(frozen=True)
-class PartStack:
-    """All parts' triangles in one array (vertex indices offset per part): ``part`` is
-    each face's part index, ``face_start`` each part's first face."""
-
-    vertices: NDArray[np.float64]
-    faces: NDArray[np.int64]
-    part: NDArray[np.int64]
-    face_start: NDArray[np.int64]
-
-
-def stack_parts(meshes: Iterable[trimesh.Trimesh]) -> PartStack:
-    """The triangles of ``meshes`` (the parts of an assembly, in order) in one
-    :class:`PartStack`."""
-    meshes = list(meshes)
-    n_vertices = np.array([len(m.vertices) for m in meshes], dtype=np.int64)
-    n_faces = np.array([len(m.faces) for m in meshes], dtype=np.int64)
-    vertex_start = group_starts(n_vertices)
-    faces = np.concatenate(
-        [np.asarray(m.faces, dtype=np.int64) + s for m, s in zip(meshes, vertex_start, strict=True)]
-    )
-    vertices = np.concatenate([np.asarray(m.vertices, dtype=np.float64) for m in meshes])
-    return PartStack(vertices, faces, group_of(n_faces), group_starts(n_faces))
-
-
-def facing_groups(
-    seg: Segmentation,
-    group_part: NDArray[np.int64],
-    usable: NDArray[np.bool_],
-    part_lo: NDArray[np.float64],
-    part_hi: NDArray[np.float64],
-    pairs: NDArray[np.int64],
-    margin: float,
-) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """Usable group pairs ``(g, h)``, ``g`` of the first part of a pair and ``h`` of the
-    second, whose bounding boxes overlap each other's part and each other (inflated by
-    ``margin``), in the order of the pairs, then of ``g``, then of ``h``. Per pair of
-    parts, only the groups whose box meets the other part's box are compared, all of
-    one side against all of the other at once: the work follows the groups near the
-    other part (a threaded screw's thousands of facets against a plate's hole), not
-    every group of either part."""
-    candidates = np.flatnonzero(usable)
-    owners = group_part[candidates]
-    order = np.argsort(owners, kind="stable")
-    candidates, owners = candidates[order], owners[order]
-    count = len(part_lo)
-    starts = np.searchsorted(owners, np.arange(count + 1))
-    firsts, seconds = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
-    for p, q in pairs.tolist():
-        g = _near_box(seg, candidates[starts[p] : starts[p + 1]], part_lo[q], part_hi[q], margin)
-        h = _near_box(seg, candidates[starts[q] : starts[q + 1]], part_lo[p], part_hi[p], margin)
-        if not len(g) or not len(h):
-            continue
-        for lo in range(0, len(g), max(1, _BOX_BLOCK // len(h))):
-            rows = g[lo : lo + max(1, _BOX_BLOCK // len(h))]
-            meets = _boxes_overlap(
-                seg.lo[rows, None], seg.hi[rows, None], seg.lo[None, h], seg.hi[None, h], margin
-            )
-            i, j = np.nonzero(meets)
-            firsts.append(rows[i])
-            seconds.append(h[j])
-    return np.concatenate(firsts), np.concatenate(seconds)
-
-
-_BOX_BLOCK = 1 << 21
-"""How many pairs of group boxes :func:`facing_groups` compares in one array."""
-
-
-def _near_box(
-    seg: Segmentation,
-    groups: NDArray[np.int64],
-    lo: NDArray[np.float64],
-    hi: NDArray[np.float64],
-    margin: float,
-) -> NDArray[np.int64]:
-    """The groups whose box (inflated by ``margin``) meets the box ``lo, hi``."""
-    return groups[_boxes_overlap(seg.lo[groups], seg.hi[groups], lo, hi, margin)]
-
-
-def _planar_matches(
-    stack: PartStack,
-    seg: Segmentation,
-    group_part: NDArray[np.int64],
-    usable: NDArray[np.bool_],
-    part_lo: NDArray[np.float64],
-    part_hi: NDArray[np.float64],
-    pairs: NDArray[np.int64],
-    tol: Tolerance,
-) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """Facing group pairs (:func:`facing_groups`) that are flat, have opposite normals
-    and are coplanar: all vertices of one of them lie within the length tolerance of
-    the other's plane (so the contact region, inside both, is within the tolerance)."""
-    margin = tol.length
-    g, h = facing_groups(seg, group_part, usable, part_lo, part_hi, pairs, margin)
-    n_g, n_h = seg.normal[g], seg.normal[h]
-    gap = seg.point[h] - seg.point[g]
-    # a centroid is within the largest vertex distance, so this keeps every true match
-    near_plane = np.minimum(
-        np.abs(np.einsum("ij,ij->i", n_g, gap)), np.abs(np.einsum("ij,ij->i", n_h, gap))
-    )
-    ok = (np.einsum("ij,ij->i", n_g, n_h) < 0) & (near_plane <= margin)
-    g, h = g[ok], h[ok]
-    close = (
-        np.minimum(group_deviation(stack, seg, h, g), group_deviation(stack, seg, g, h)) <= margin
-    )
-    return g[close], h[close]
-
-
-def group_deviation(
-    stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64]
-) -> NDArray[np.float64]:
-    """Per pair, the largest distance of a vertex of group ``g[k]`` from the plane of
-    group ``h[k]``."""
-    size = seg.start[g + 1] - seg.start[g]
-    owner = group_of(size)
-    corners = stack.vertices[stack.faces[seg.order[ranges(seg.start[g], size)]]]
-    offsets = np.einsum("fkj,fj->fk", corners - seg.point[h][owner, None], seg.normal[h][owner])
-    deviation = np.zeros(len(g))
-    np.maximum.at(deviation, owner, np.abs(offsets).max(axis=1))
-    return deviation
-
-
-def _triangles_2d(
-    corners: NDArray[np.float64], u: NDArray[np.float64], v: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    return np.stack([np.einsum("tkj,tj->tk", corners, u), np.einsum("tkj,tj->tk", corners, v)], -1)
-
-
-OVERLAP_CHUNK = 1 << 20
-"""How many triangle pairs :func:`group_overlaps` projects and intersects at once: the
-pairs of large coplanar groups (a plate on a plate) run to millions, and their 2D
-triangles, boxes and polygons are made chunk by chunk to bound the memory they take."""
-
-OUTLINE_PAIRS = 4096
-"""Group pairs of more triangle pairs than this are intersected outline to outline (the
-union of each group's triangles, which tile it), at a cost that follows the triangles'
-count rather than its product: two plates' faces of thousands of triangles each."""
-
-
-def group_overlaps(
-    stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], margin: float
-) -> tuple[NDArray[np.int64], NDArray[Any], NDArray[np.float64], NDArray[np.float64]]:
-    """Where the triangles of groups ``g[k]`` and ``h[k]`` overlap, projected on the plane
-    of ``g[k]`` with the frame ``(u[k], v[k])``: the non-empty intersections of triangle
-    pairs whose 2D boxes overlap by more than ``margin`` (shapely, vectorised, over
-    chunks of about ``OVERLAP_CHUNK`` triangle pairs), each with its ``owner`` ``k``
-    (in order); for a pair of more than ``OUTLINE_PAIRS`` triangle pairs, the one
-    intersection of the two groups' outlines. Returns ``owner, pieces, u, v``."""
-    u, v = axis_basis(seg.normal[g]) if len(g) else (np.zeros((0, 3)), np.zeros((0, 3)))
-    work = (seg.start[g + 1] - seg.start[g]) * (seg.start[h + 1] - seg.start[h])
-    small, large = np.flatnonzero(work <= OUTLINE_PAIRS), np.flatnonzero(work > OUTLINE_PAIRS)
-    by_triangle = _triangle_pieces(stack, seg, g[small], h[small], u[small], v[small], margin)
-    by_outline = _outline_pieces(stack, seg, g[large], h[large], u[large], v[large])
-    owner = np.concatenate([small[by_triangle[0]], large[by_outline[0]]])
-    order = np.argsort(owner, kind="stable")
-    return owner[order], np.concatenate([by_triangle[1], by_outline[1]])[order], u, v
-
-
-def _triangle_pieces(
-    stack: PartStack,
-    seg: Segmentation,
-    g: NDArray[np.int64],
-    h: NDArray[np.int64],
-    u: NDArray[np.float64],
-    v: NDArray[np.float64],
-    margin: float,
-) -> tuple[NDArray[np.int64], NDArray[Any]]:
-    """:func:`group_overlaps` triangle by triangle, chunk by chunk."""
-    work = np.cumsum((seg.start[g + 1] - seg.start[g]) * (seg.start[h + 1] - seg.start[h]))
-    cuts = np.searchsorted(
-        work, np.arange(OVERLAP_CHUNK, int(work[-1]) if len(g) else 0, OVERLAP_CHUNK)
-    )
-    owners, pieces = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=object)]
-    for chunk in np.split(np.arange(len(g), dtype=np.int64), np.unique(cuts + 1)):
-        found = _chunk_overlaps(stack, seg, g, h, chunk, u, v, margin)
-        owners.append(found[0])
-        pieces.append(found[1])
-    return np.concatenate(owners), np.concatenate(pieces)
-
-
-def _outline_pieces(
-    stack: PartStack,
-    seg: Segmentation,
-    g: NDArray[np.int64],
-    h: NDArray[np.int64],
-    u: NDArray[np.float64],
-    v: NDArray[np.float64],
-) -> tuple[NDArray[np.int64], NDArray[Any]]:
-    """:func:`group_overlaps` outline to outline: each group's outline made once in
-    its frame (``g``'s) and intersected; the pairs whose overlap has an area."""
-    if not len(g):
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=object)
-    unique, first = np.unique(g, return_index=True)
-    outline_g = _outlines(stack, seg, unique, u[first], v[first])
-    shared = shapely.intersection(
-        outline_g[np.searchsorted(unique, g)], _outlines(stack, seg, h, u, v)
-    )
-    owner = np.flatnonzero(shapely.area(shared) > 0)
-    return owner, shared[owner]
-
-
-def _outlines(
-    stack: PartStack,
-    seg: Segmentation,
-    groups: NDArray[np.int64],
-    u: NDArray[np.float64],
-    v: NDArray[np.float64],
-) -> NDArray[Any]:
-    """Per group, the union of its triangles projected with the frame ``(u, v)``."""
-    size = seg.start[groups + 1] - seg.start[groups]
-    owner = group_of(size)
-    faces = seg.order[ranges(seg.start[groups], size)]
-    triangles = shapely.polygons(
-        _triangles_2d(stack.vertices[stack.faces[faces]], u[owner], v[owner])
-    )
-    outlines = np.empty(len(groups), dtype=object)
-    outlines[:] = [shapely.union_all(t) for t in np.split(triangles, np.cumsum(size)[:-1])]
-    return outlines
-
-
-def _chunk_overlaps(
-    stack: PartStack,
-    seg: Segmentation,
-    g: NDArray[np.int64],
-    h: NDArray[np.int64],
-    match: NDArray[np.int64],
-    u: NDArray[np.float64],
-    v: NDArray[np.float64],
-    margin: float,
-) -> tuple[NDArray[np.int64], NDArray[Any]]:
-    """:func:`group_overlaps` for the group pairs ``match`` (consecutive indices)."""
-    if not len(match):
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=object)
-    size_g = seg.start[g[match] + 1] - seg.start[g[match]]
-    size_h = seg.start[h[match] + 1] - seg.start[h[match]]
-    owner_a = np.repeat(match, size_g)
-    faces_a = seg.order[ranges(seg.start[g[match]], size_g)]
-    owner_b = np.repeat(match, size_h)
-    faces_b = seg.order[ranges(seg.start[h[match]], size_h)]
-    i, j = _cross_join(owner_a - match[0], owner_b - match[0], len(match))
-    owner = owner_a[i]
-    tri_a = _triangles_2d(stack.vertices[stack.faces[faces_a[i]]], u[owner], v[owner])
-    tri_b = _triangles_2d(stack.vertices[stack.faces[faces_b[j]]], u[owner], v[owner])
-    width = np.minimum(tri_a.max(axis=1), tri_b.max(axis=1)) - np.maximum(
-        tri_a.min(axis=1), tri_b.min(axis=1)
-    )
-    keep = np.all(width > margin, axis=1)
-    pieces = shapely.intersection(shapely.polygons(tri_a[keep]), shapely.polygons(tri_b[keep]))
-    owner = owner[keep]
-    solid = shapely.area(pieces) > 0
-    return owner[solid], pieces[solid]
-
-
-def _planar_patches(
-    stack: PartStack, seg: Segmentation, g: NDArray[np.int64], h: NDArray[np.int64], tol: Tolerance
-) -> tuple[NDArray[np.int64], list[PlanarPatch]]:
-    """The contact polygons of the matched group pairs ``(g[k], h[k])``: the union of
-    their triangles' overlaps in ``g[k]``'s plane (:func:`group_overlaps`), one
-    polygon per connected piece wider than the tolerance, at the mean height of the two
-    planes, counter-clockwise about ``g[k]``'s normal. Returns each patch's ``k``."""
-    owner, pieces, u, v = group_overlaps(stack, seg, g, h, tol.length)
-    matched, slot = np.unique(owner, return_inverse=True)
-    rank = np.arange(len(owner)) - np.searchsorted(owner, owner)
-    table = np.full((len(matched), int(rank.max()) + 1 if len(rank) else 0), None, dtype=object)
-    table[slot, rank] = pieces
-    merged = shapely.union_all(table, axis=1) if len(matched) else np.array([], dtype=object)
-    merged = _closed(merged, tol.length)
-    polygons, which = shapely.get_parts(merged, return_index=True)
-    polygons = shapely.simplify(polygons, 0.0)
-    wide = shapely.is_valid(polygons) & (shapely.get_type_id(polygons) == 3)
-    wide &= shapely.area(polygons) > tol.length * shapely.length(polygons) / 2
-    polygons, k = polygons[wide], matched[which[wide]]
-    rings = shapely.get_exterior_ring(shapely.orient_polygons(polygons))
-    coords, ring = shapely.get_coordinates(rings, return_index=True)
-    # each ring repeats its first vertex last
-    last = np.r_[ring[1:] != ring[:-1], True][: len(ring)]
-    coords, ring = coords[~last], ring[~last]
-    normal = seg.normal[g]
-    height = (
-        np.einsum("ij,ij->i", normal, seg.point[g]) + np.einsum("ij,ij->i", normal, seg.point[h])
-    ) / 2
-    at = k[ring]
-    world = coords[:, :1] * u[at] + coords[:, 1:] * v[at] + height[at, None] * normal[at]
-    bounds = np.searchsorted(ring, np.arange(len(polygons) + 1))
-    areas = shapely.area(polygons)
-    scatter = (
-        np.zeros(len(g))
-        if seg.deviation is None
-        else np.maximum(seg.deviation[g], seg.deviation[h])
-    )
-    patches = [
-        PlanarPatch(
-            normal=normal[k[n]].copy(),
-            polygon=world[bounds[n] : bounds[n + 1]],
-            area=float(areas[n]),
-            scatter=float(scatter[k[n]]),
-        )
-        for n in range(len(polygons))
-    ]
-    return k, patches
-
-
-def _openings(shapes: NDArray[Any]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """Per (multi)polygon, how many pieces and how many holes it has."""
-    parts, which = shapely.get_parts(shapes, return_index=True)
-    holes = np.bincount(which, weights=shapely.get_num_interior_rings(parts), minlength=len(shapes))
-    return shapely.get_num_geometries(shapes), holes.astype(np.int64)
-
-
-def _closed(shapes: NDArray[Any], width: float) -> NDArray[Any]:
-    """``shapes`` (polygons) with cracks and holes narrower than ``width`` closed: vertex
-    noise leaves such cracks between the pieces of one face. A morphological closing
-    (square corners kept) is used where it joins something; elsewhere the exact shape
-    stays."""
-    shapes = np.asarray(shapes, dtype=object)
-    closed = shapely.buffer(
-        shapely.buffer(shapes, width, join_style="mitre"), -width, join_style="mitre"
-    )
-    (pieces, holes), (closed_pieces, closed_holes) = _openings(shapes), _openings(closed)
-    joins = (closed_pieces < pieces) | ((closed_pieces == pieces) & (closed_holes < holes))
-    return np.where(joins, closed, shapes)
-
-
-def _axial_overlap(
-    first: Surface, second: Surface, axis: NDArray[np.float64], origin: NDArray[np.float64]
-) -> tuple[float, float]:
-    """The common interval of two surfaces' extents, measured along ``axis`` from ``origin``."""
-
-    def span(s: Surface) -> tuple[float, float]:
-        assert s.axis is not None  # surfaces with an extent along an axis have one
-        base = float((s.point - origin) @ axis)
-        ends = [base + e * float(s.axis @ axis) for e in s.extent]
-        return min(ends), max(ends)
-
-    (lo_a, hi_a), (lo_b, hi_b) = span(first), span(second)
-    return max(lo_a, lo_b), min(hi_a, hi_b)
-
-
-def _boundary(
-    points: NDArray[np.float64],
-    axis: NDArray[np.float64],
-    origin: NDArray[np.float64],
-    lo: float,
-    hi: float,
-    tol: Tolerance,
-) -> NDArray[np.float64]:
-    along = (points - origin) @ axis
-    ends = (np.abs(along - lo) <= tol.length) | (np.abs(along - hi) <= tol.length)
-    return np.unique(points[ends], axis=0)
-
-
-def _may_fit(
-    first: Sequence[Surface], second: Sequence[Surface], tol: Tolerance
-) -> list[tuple[int, int]]:
-    """The pairs ``(i, j)`` of surfaces ``first[i]``, ``second[j]`` that :func:`curved_contact`
-    may find in contact, in the order of ``i`` then ``j``: the same kind of surface of
-    revolution (cylinder, cone, sphere), one convex and one concave, and for cylinders
-    and spheres radii equal within the length tolerance. The others it would turn down
-    by these tests alone; a hundred curved surfaces of one part near a hundred of
-    another are so compared in one array operation."""
-    if not first or not second:
-        return []
-
-    def columns(
-        surfaces: Sequence[Surface],
-    ) -> tuple[NDArray[np.str_], NDArray[np.bool_], NDArray[np.float64]]:
-        return (
-            np.array([s.kind for s in surfaces]),
-            np.array([s.convex for s in surfaces], dtype=bool),
-            np.array([s.radius for s in surfaces], dtype=np.float64),
-        )
-
-    (kind_a, convex_a, radius_a), (kind_b, convex_b, radius_b) = columns(first), columns(second)
-    fits = (kind_a[:, None] == kind_b[None, :]) & (convex_a[:, None] != convex_b[None, :])
-    fits &= np.isin(kind_a, ("cylinder", "cone", "sphere"))[:, None]
-    radial = np.isin(kind_a, ("cylinder", "sphere"))[:, None]
-    fits &= ~radial | (np.abs(radius_a[:, None] - radius_b[None, :]) <= tol.length)
-    return [(int(i), int(j)) for i, j in np.argwhere(fits)]
-
-
-def curved_contact(
-    first: Surface,
-    second: Surface,
-    names: tuple[str, str],
-    triangles: tuple[NDArray[np.float64], NDArray[np.float64]],
-    tol: Tolerance,
-) -> CurvedPatch | None:
-    """The curved contact of two surfaces of parts ``names``, or ``None``: equal coaxial
-    cylinders or cones, or equal concentric spheres, one convex and one concave, whose
-    axial extents overlap by more than the length tolerance (Liu 1997 §2: a shaft fits
-    a hole, a ball a socket) and that share more than a line. ``triangles``: each
-    surface's triangles (t x 3 x 3, world), which tell the part of the surface of
-    revolution both cover (:mod:`assemblykit.geometry.curved`; Wilson & Latombe 1992 builds the
-    blocking constraints from the normals of that part only)."""
-    if first.kind != second.kind or first.convex == second.convex:
-        return None
-    inner = names[0] if first.convex else names[1]
-    if first.kind == "sphere":
-        same_centre = np.linalg.norm(first.point - second.point) <= tol.length
-        if not (same_centre and abs(first.radius - second.radius) <= tol.length):
-            return None
-        region = sphere_region(triangles, first.point, tol)
-        if len(region) == 0:
-            return None
-        normals = cone_generators(region - first.point, tol)
-        return CurvedPatch(
-            "spherical", first.point, None, first.radius, inner, points=region, normals=normals
-        )
-    if first.kind not in ("cylinder", "cone"):
-        return None
-    axis = first.axis
-    assert axis is not None and second.axis is not None
-    aligned = float(axis @ second.axis)
-    # a direction fitted on a mesh is as sure as the tolerance over the surface's size:
-    # the smaller surface, turned onto the other's axis, moves by at most the tolerance
-    reach = direction_reach(tol, min(surface_size(first), surface_size(second)))
-    if np.linalg.norm(np.cross(axis, second.axis)) > reach:
-        return None
-    offset = second.point - first.point
-    if first.kind == "cone" and (
-        aligned < 0
-        or np.linalg.norm(offset) > tol.length
-        or abs(first.half_angle - second.half_angle) > reach
-    ):
-        return None
-    if first.kind == "cylinder" and abs(first.radius - second.radius) > tol.length:
-        return None
-    lo, hi = _axial_overlap(first, second, axis, first.point)
-    if hi - lo <= tol.length:
-        return None
-    # the second axis stays within the tolerance of the first along their common part
-    along = (np.array([lo, hi]) - offset @ axis) / aligned
-    ends = offset + np.outer(along, second.axis)
-    if np.max(np.linalg.norm(ends - np.outer(ends @ axis, axis), axis=1)) > tol.length:
-        return None
-    every = np.vstack([t.reshape(-1, 3) for t in triangles])
-    rel = every - first.point
-    widest = float(np.max(np.linalg.norm(rel - np.outer(rel @ axis, axis), axis=1)))
-    # the azimuth a length tolerance subtends on the widest circle of the surfaces
-    gap = tol.length / widest
-    arcs = intersect_arcs(
-        covered_arcs(triangles[0], first.point, axis, gap),
-        covered_arcs(triangles[1], first.point, axis, gap),
-        gap,
-    )
-    if len(arcs) == 0:
-        return None
-    kind: CurvedKind = "cylindrical" if first.kind == "cylinder" else "conical"
-    if kind == "cylindrical":
-        normals = revolution_normals(axis, arc_angles(generating_arc(arcs, gap), ARC_STEP))
-    else:
-        angles = arc_angles(arcs, TURN / CONE_AZIMUTHS)
-        normals = revolution_normals(axis, angles, first.half_angle)
-    centre = first.point + lo * axis if kind == "cylindrical" else first.point
-    extent = (0.0, hi - lo) if kind == "cylindrical" else (lo, hi)
-    return CurvedPatch(
-        kind,
-        centre,
-        axis,
-        (first.radius + second.radius) / 2,
-        inner,
-        extent=extent,
-        half_angle=first.half_angle,
-        points=_boundary(every, axis, first.point, lo, hi, tol),
-        normals=normals,
-    )
-
-
-def direction_reach(tol: Tolerance, size: float) -> float:
-    """The largest angle between two directions of a surface of diameter ``size`` that the
-    tolerance cannot tell apart: turning it by ``tol.length / size`` moves none of its
-    points further than the length tolerance (never below the angle tolerance)."""
-    return max(tol.angle, tol.length / max(size, tol.length))
-
-
-def surface_size(surface: Surface) -> float:
-    """The diameter of a curved surface: the diagonal of its axial extent and diameter."""
-    return math.hypot(surface.extent[1] - surface.extent[0], 2.0 * surface.radius)
+__all__ = [
+    "OUTLINE_PAIRS",
+    "OVERLAP_CHUNK",
+    "WHOLE_SHARE",
+    "Contact",
+    "Contacts",
+    "CurvedKind",
+    "CurvedPatch",
+    "GeometryMemo",
+    "PartStack",
+    "PlanarPatch",
+    "assembly_contacts",
+    "assembly_curved_surfaces",
+    "assembly_surfaces",
+    "candidate_pairs",
+    "curved_contact",
+    "direction_reach",
+    "facing_groups",
+    "find_contacts",
+    "group_deviation",
+    "group_overlaps",
+    "memo_of",
+    "near_curved_surfaces",
+    "snap_classes",
+    "snapped",
+    "stack_parts",
+    "surface_size",
+]
 
 
 def _surface_triangles(assembly: Assembly, name: str, surface: Surface) -> NDArray[np.float64]:
@@ -803,8 +121,8 @@ def find_contacts(
     """The contacts between the touching parts of ``assembly``, in part order (module
     docstring); with ``only``, just the contacts of that part. ``tol`` is a policy that
     :meth:`Assembly.tolerance` scales to the model. Directions are snapped
-    (:func:`snapped`) within the policy alone: a measured joint mismatch says where
-    faces may meet, not that their directions are one."""
+    (:func:`~assemblykit.geometry.snapping.snapped`) within the policy alone: a measured
+    joint mismatch says where faces may meet, not that their directions are one."""
     policy = assembly.policy_tolerance(tol)
     tol = assembly.tolerance(tol)
     names = list(assembly.parts)
@@ -829,7 +147,7 @@ def find_contacts(
                 surfaces[k, other] = near_curved_surfaces(assembly, names[k], names[other], tol)
 
     group_part = stack.part[seg.order[seg.start[:-1]]]
-    g, h = _planar_matches(stack, seg, group_part, seg.flat, part_lo, part_hi, pairs, tol)
+    g, h = planar_matches(stack, seg, group_part, seg.flat, part_lo, part_hi, pairs, tol)
     # a coplanar group with a face on a curved surface of its part (where that part may
     # touch the other) is a facet of that surface, not a planar face
     groups_on: dict[Surface, NDArray[np.int64]] = {}
@@ -849,7 +167,7 @@ def find_contacts(
             (ph * len(names) + pg) * len(seg.flat) + h, keys
         )
         g, h = g[~facet], h[~facet]
-    k, patches = _planar_patches(stack, seg, g, h, tol)
+    k, patches = planar_patches(stack, seg, g, h, tol)
     planar: dict[tuple[int, int], list[PlanarPatch]] = {}
     for m, flat in zip(k, patches, strict=True):
         planar.setdefault((int(group_part[g[m]]), int(group_part[h[m]])), []).append(flat)
@@ -866,7 +184,7 @@ def find_contacts(
     curved: dict[tuple[int, int], list[CurvedPatch]] = {}
     for a, b in pairs.tolist():
         first, second = surfaces.get((a, b), ()), surfaces.get((b, a), ())
-        for i, j in _may_fit(first, second, tol):
+        for i, j in may_fit(first, second, tol):
             both = (triangles_of(a, b, i), triangles_of(b, a, j))
             patch = curved_contact(first[i], second[j], (names[a], names[b]), both, tol)
             if patch is not None:
@@ -979,7 +297,7 @@ def near_curved_surfaces(
         first, second, third = np.asarray(part.mesh.triangles, dtype=np.float64).transpose(1, 0, 2)
         low = np.minimum(np.minimum(first, second), third)
         high = np.maximum(np.maximum(first, second), third)
-        reach = np.flatnonzero(_boxes_overlap(low, high, lo, hi, key[2].length))
+        reach = np.flatnonzero(boxes_overlap(low, high, lo, hi, key[2].length))
         memo[key] = (
             assembly_curved_surfaces(assembly, name, tol)
             if len(reach) > WHOLE_SHARE * len(first)
@@ -1018,181 +336,6 @@ def _mesh_contacts(assembly: Assembly, tol: Tolerance | None = None) -> Contacts
                 ]
                 added.add(name)
         memo[key] = (frozenset(assembly.parts), found)
-    return found
-
-
-def _spread(patch: PlanarPatch | CurvedPatch) -> NDArray[np.float64]:
-    """Points of a patch relative to its middle that bound where turning its direction
-    moves it: a planar polygon's vertices; a cylinder's or cone's end circles, sampled
-    at four azimuths each."""
-    if isinstance(patch, PlanarPatch):
-        return patch.polygon - patch.polygon.mean(axis=0)
-    assert patch.axis is not None
-    axis = patch.axis / np.linalg.norm(patch.axis)
-    e1, e2 = axis_frame(axis)
-    lo, hi = patch.extent if patch.extent is not None else (0.0, 0.0)
-    ends = []
-    for t in (lo, hi):
-        r = patch.radius if patch.kind == "cylindrical" else abs(t) * math.tan(patch.half_angle)
-        ends += [t * axis + r * e for e in (e1, -e1, e2, -e2)]
-    ends_array = np.array(ends)
-    return ends_array - ends_array.mean(axis=0)
-
-
-def snap_classes(
-    directions: NDArray[np.float64],
-    spreads: list[NDArray[np.float64]],
-    scatter: NDArray[np.float64],
-    tol: Tolerance,
-) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-    """Per unit direction (rows) of a patch whose points relative to its middle are
-    ``spreads[i]`` and whose faces' vertices lie up to ``scatter[i]`` from their planes,
-    the index of the direction it is snapped to and the sign (+1, -1) that turns that
-    one into it. Each direction, widest patch first (by the second largest extent of its
-    points: a long thin strip's normal is unsure), joins the leader nearest to it if
-    turning the patch onto it (about their common perpendicular, through the patch's
-    middle) moves no point further than the two patches' scatter, and never further
-    than the length tolerance; else it leads. Exact faces (no scatter) keep their
-    directions: their differences are the geometry's, not noise. Snapping moves each
-    patch within the tolerance, whatever the others' sizes."""
-    width = np.array(
-        [
-            np.linalg.svd(p, compute_uv=False)[1] / math.sqrt(len(p)) if len(p) > 1 else 0.0
-            for p in spreads
-        ]
-    )
-    order = np.argsort(-width, kind="stable")
-    leader = np.arange(len(directions), dtype=np.int64)
-    sign = np.ones(len(directions))
-    # leaders along one line (the same direction up to its sign) turn a patch alike: a
-    # patch is compared with each line once, then with the leaders of the lines it may
-    # join (only their scatter differs). Exact faces that share a direction do not join
-    # (they turn by nothing), so a box packing has thousands of leaders on three lines.
-    lines = np.zeros((0, 3))
-    members: list[list[int]] = []
-    loosest: list[float] = []
-    line_of: dict[tuple[float, ...], int] = {}
-    position: dict[int, int] = {}
-    for i in order.tolist():
-        d = directions[i]
-        if len(lines):
-            facing = np.where(lines @ d < 0, -1.0, 1.0)
-            turn = np.cross(d, lines * facing[:, None])
-            sines = np.linalg.norm(turn, axis=1)
-            hinge = turn / np.maximum(sines, np.finfo(float).tiny)[:, None]
-            # how far each point is from each turning axis through the middle
-            lever = np.linalg.norm(np.cross(hinge[:, None, :], spreads[i][None]), axis=2)
-            moved = sines * (lever.max(axis=1) if lever.size else 0.0)
-            near = (moved <= np.minimum(2.0 * (scatter[i] + np.array(loosest)), tol.length)) & (
-                sines > 0
-            )
-            best: tuple[float, int, int] | None = None
-            for u in np.flatnonzero(near).tolist():
-                group = members[u]
-                allowed = np.minimum(2.0 * (scatter[i] + scatter[group]), tol.length)
-                first = group[int(np.argmax(moved[u] <= allowed))]
-                if best is None or (sines[u], position[first]) < best[:2]:
-                    best = (float(sines[u]), position[first], first)
-            if best is not None:
-                leader[i] = best[2]
-                sign[i] = -1.0 if directions[best[2]] @ d < 0 else 1.0
-                continue
-        position[i] = len(position)
-        key = _line_key(d)
-        if key not in line_of:
-            line_of[key] = len(members)
-            lines = np.vstack([lines, d])
-            members.append([])
-            loosest.append(-np.inf)
-        u = line_of[key]
-        members[u].append(i)
-        loosest[u] = max(loosest[u], float(scatter[i]))
-    return leader, sign
-
-
-def _line_key(d: NDArray[np.float64]) -> tuple[float, ...]:
-    """The line of direction ``d``: ``d`` or ``-d``, whichever has its first nonzero
-    coordinate positive (zeros unsigned)."""
-    nonzero = np.flatnonzero(d)
-    line = -d if len(nonzero) and d[nonzero[0]] < 0 else d
-    return tuple(np.where(line == 0, 0.0, line).tolist())
-
-
-def snapped(contacts: list[Contact], tol: Tolerance) -> list[Contact]:
-    """``contacts`` with every planar normal and curved axis that is parallel, within the
-    tolerance, to that of a larger patch replaced by it (:func:`snap_classes`), then
-    the planar patches of one face joined (:func:`_joined`): noisy normals of one
-    direction become one direction, and what compares them afterwards (motion groups,
-    blocking arrangements) sees it exactly."""
-    patches: list[PlanarPatch | CurvedPatch] = [p for c in contacts for p in c.planar]
-    patches += [p for c in contacts for p in c.curved if p.axis is not None]
-    if not patches:
-        return contacts
-    directions = np.array(
-        [p.normal if isinstance(p, PlanarPatch) else p.axis for p in patches], dtype=np.float64
-    )
-    # a fitted axis is as sure as the tolerance its surface was fitted to
-    scatter = np.array([p.scatter if isinstance(p, PlanarPatch) else tol.length for p in patches])
-    leader, sign = snap_classes(directions, [_spread(p) for p in patches], scatter, tol)
-    new = directions[leader] * sign[:, None]
-    turned: dict[int, Any] = {
-        id(p): _turned(p, new[k]) if isinstance(p, PlanarPatch) else replace(p, axis=new[k].copy())
-        for k, p in enumerate(patches)
-    }
-    return [
-        replace(
-            c,
-            planar=_joined([turned[id(p)] for p in c.planar], tol),
-            curved=tuple(turned.get(id(p), p) for p in c.curved),
-        )
-        for c in contacts
-    ]
-
-
-def _turned(patch: PlanarPatch, normal: NDArray[np.float64]) -> PlanarPatch:
-    """``patch`` turned about its middle onto the plane of normal ``normal``."""
-    middle = patch.centroid
-    polygon = patch.polygon - np.outer((patch.polygon - middle) @ normal, normal)
-    return replace(patch, normal=normal.copy(), polygon=polygon)
-
-
-def _joined(patches: list[PlanarPatch], tol: Tolerance) -> tuple[PlanarPatch, ...]:
-    """Planar ``patches`` of one contact with one (snapped) normal and heights within the
-    tolerance joined where they touch or overlap (:func:`_closed`): the pieces of one
-    face that vertex noise split into several coplanar groups."""
-    joined: list[PlanarPatch] = []
-    by_normal: dict[tuple[float, ...], list[PlanarPatch]] = {}
-    for patch in patches:
-        by_normal.setdefault(tuple(patch.normal.tolist()), []).append(patch)
-    for same in by_normal.values():
-        normal = same[0].normal
-        heights = np.array([float(normal @ p.centroid) for p in same])
-        order = np.argsort(heights, kind="stable")
-        layers = np.split(order, np.flatnonzero(np.diff(heights[order]) > tol.length) + 1)
-        for layer in layers:
-            if len(layer) == 1:
-                joined.append(same[int(layer[0])])
-                continue
-            joined.extend(_layer_patches([same[int(k)] for k in layer], normal, tol))
-    return tuple(joined)
-
-
-def _layer_patches(
-    patches: list[PlanarPatch], normal: NDArray[np.float64], tol: Tolerance
-) -> list[PlanarPatch]:
-    """The union of coplanar ``patches`` (normal ``normal``) as patches, one per piece."""
-    u, v = (w[0] for w in axis_basis(normal[None]))
-    height = float(np.mean([normal @ p.centroid for p in patches]))
-    flat = [shapely.Polygon(np.column_stack([p.polygon @ u, p.polygon @ v])) for p in patches]
-    union = _closed(np.array([shapely.union_all(flat)], dtype=object), tol.length)[0]
-    pieces = shapely.get_parts(shapely.orient_polygons(union))
-    found = []
-    for piece in pieces[~shapely.is_empty(pieces)]:
-        ring = shapely.get_coordinates(piece.exterior)[:-1]
-        polygon = ring[:, :1] * u + ring[:, 1:] * v + height * normal
-        found.append(
-            PlanarPatch(normal.copy(), polygon, float(piece.area), max(p.scatter for p in patches))
-        )
     return found
 
 

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from assemblykit.errors import GeometryError
 from assemblykit.geometry.booleans import manifold3d
-from assemblykit.geometry.contacts import candidate_pairs
+from assemblykit.geometry.broad_phase import candidate_pairs
 from assemblykit.tolerance import Tolerance, current
 
 if TYPE_CHECKING:

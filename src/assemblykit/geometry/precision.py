@@ -45,13 +45,8 @@ import shapely
 import trimesh
 from numpy.typing import NDArray
 
-from assemblykit.geometry.contacts import (
-    candidate_pairs,
-    facing_groups,
-    group_deviation,
-    group_overlaps,
-    stack_parts,
-)
+from assemblykit.geometry.broad_phase import candidate_pairs, facing_groups, stack_parts
+from assemblykit.geometry.narrow_phase import group_deviation, group_overlaps
 from assemblykit.geometry.recognition import segment
 from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import Assembly, Precision

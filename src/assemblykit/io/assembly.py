@@ -19,7 +19,8 @@ from pathlib import Path
 from typing import Any
 
 from assemblykit.errors import GeometryError, InputError
-from assemblykit.geometry.contacts import Contact, assembly_contacts, assembly_surfaces
+from assemblykit.geometry.contact_values import Contact
+from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.geometry.precision import mesh_precision
 from assemblykit.io.documents import read_json, read_text
 from assemblykit.io.meshes import MESH_SUFFIXES, load_manifest, load_mesh_folder, read_mesh

@@ -42,7 +42,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from assemblykit.errors import GeometryError, SchemaError
-from assemblykit.geometry.contacts import candidate_pairs
+from assemblykit.geometry.broad_phase import candidate_pairs
 from assemblykit.geometry.precision import combined, mesh_precision, pose_precision
 from assemblykit.geometry.settling import settle as settle_parts
 from assemblykit.geometry.solids import placed

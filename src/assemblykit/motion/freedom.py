@@ -34,7 +34,8 @@ from assemblykit.algebra import Kind, SymmetryGroup, intersect_groups, se3
 from assemblykit.errors import UnknownNameError
 from assemblykit.features import compound_group
 from assemblykit.features.primitives import Ball, Cone, Feature, Hole, Plane, Shaft, Socket
-from assemblykit.geometry.contacts import Contact, CurvedPatch, assembly_contacts
+from assemblykit.geometry.contact_values import Contact, CurvedPatch
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.model.assembly import Assembly
 from assemblykit.motion.unilateral import UnilateralReading, unilateral_readings
 from assemblykit.tolerance import Tolerance

@@ -55,7 +55,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.algebra import SymmetryGroup, se3
-from assemblykit.geometry.contacts import CurvedPatch, assembly_contacts
+from assemblykit.geometry.contact_values import CurvedPatch
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.overlaps import ring_radius
 from assemblykit.model.assembly import Assembly
 from assemblykit.tolerance import Tolerance

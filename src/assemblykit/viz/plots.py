@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from matplotlib.cm import ScalarMappable
     from matplotlib.figure import Figure
 
-    from assemblykit.geometry.contacts import Contact
+    from assemblykit.geometry.contact_values import Contact
     from assemblykit.model.assembly import Assembly
 
 
