@@ -203,26 +203,47 @@ unit_axes = st.tuples(*(st.floats(-1.0, 1.0) for _ in range(3))).filter(
 )
 
 
-@given(unit_axes)
+@given(unit_axes, st.booleans())
 @settings(max_examples=200, deadline=None)
-def test_axis_basis_is_orthonormal_and_right_handed(v):
+def test_axis_basis_is_orthonormal_and_right_handed(v, turned):
     n = se3.unit(np.array(v))
-    u, w = se3.axis_basis(n)
+    u, w = se3.axis_basis(n, turned=turned)
     frame = np.column_stack([u, w, n])
     np.testing.assert_allclose(frame.T @ frame, np.eye(3), atol=1e-12)
     assert np.linalg.det(frame) == pytest.approx(1.0)
 
 
-@given(seeds)
+@given(seeds, st.booleans())
 @settings(max_examples=50, deadline=None)
-def test_axis_basis_of_rows_is_the_basis_of_each_row(seed):
+def test_axis_basis_of_rows_is_the_basis_of_each_row(seed, turned):
     rows = np.random.default_rng(seed).normal(size=(5, 3))
     rows /= np.linalg.norm(rows, axis=1, keepdims=True)
-    u, w = se3.axis_basis(rows)
+    u, w = se3.axis_basis(rows, turned=turned)
     for i, n in enumerate(rows):
-        one_u, one_w = se3.axis_basis(n)
+        one_u, one_w = se3.axis_basis(n, turned=turned)
         np.testing.assert_allclose(u[i], one_u, atol=1e-15)
         np.testing.assert_allclose(w[i], one_w, atol=1e-15)
+
+
+@given(unit_axes)
+@settings(max_examples=200, deadline=None)
+def test_turned_axis_basis_is_the_frame_turned_half_a_turn_about_the_axis(v):
+    n = se3.unit(np.array(v))
+    u, w = se3.axis_basis(n, turned=True)
+    plain_u, plain_w = se3.axis_basis(n)
+    np.testing.assert_array_equal(u, -plain_u)
+    np.testing.assert_array_equal(w, -plain_w)
+
+
+def test_turned_axis_basis_keeps_the_signs_of_zero_of_the_cross_products():
+    # along a coordinate axis the plain frame negated has -0.0 where n x e has 0.0
+    for n in np.vstack([np.eye(3), -np.eye(3)]):
+        least = np.eye(3)[int(np.argmin(np.abs(n)))]
+        u, w = se3.axis_basis(n, turned=True)
+        expected_u = np.cross(n, least)
+        expected_u /= np.linalg.norm(expected_u)
+        np.testing.assert_array_equal(np.signbit(u), np.signbit(expected_u))
+        np.testing.assert_array_equal(np.signbit(w), np.signbit(np.cross(n, expected_u)))
 
 
 @given(seeds)

@@ -393,19 +393,22 @@ def random_transform(rng: np.random.Generator, scale: float = 10.0) -> NDArray[n
 
 
 def axis_basis(
-    axes: NDArray[np.float64],
+    axes: NDArray[np.float64], *, turned: bool = False
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Unit vectors ``u, v`` completing each unit axis ``n`` to the right-handed frame
     ``(u, v, n)``, for one axis (shape (3,)) or for rows (shape (m, 3)): ``u`` along
     ``e x n`` for the coordinate axis ``e`` least aligned with ``n`` (the first on ties),
-    ``v = n x u``."""
+    ``v = n x u``. ``turned``: that frame turned half a turn about ``n``, ``u`` along
+    ``n x e`` and ``v = n x u``, each the cross product itself (negating the other
+    frame's vectors gives the same values but not always the same signs of zero)."""
     n = np.asarray(axes, dtype=np.float64)
     least = np.eye(3)[np.argmin(np.abs(n), axis=-1)]
+    first, second = (n, least) if turned else (least, n)
     if n.ndim == 1:
-        u = cross(least, n)
+        u = cross(first, second)
         u /= np.linalg.norm(u)
         return u, cross(n, u)
-    u = np.cross(least, n)
+    u = np.cross(first, second)
     u /= np.linalg.norm(u, axis=-1, keepdims=True)
     return u, np.cross(n, u)
 

@@ -40,6 +40,7 @@ import numpy as np
 import shapely
 from numpy.typing import NDArray
 
+from assemblykit.algebra import se3
 from assemblykit.blocking.arrangement import snap_normals
 from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.constraints import infinitesimal_terms, positively_spanning
@@ -317,13 +318,6 @@ class CircleCells:
     inside: NDArray[np.bool_]
 
 
-def _circle_frame(m: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Unit vectors ``u, v`` spanning the great circle of the unit normal ``m``."""
-    u = np.cross(m, np.eye(3)[int(np.argmin(np.abs(m)))])
-    u /= np.linalg.norm(u)
-    return u, np.cross(m, u)
-
-
 @dataclass(frozen=True, eq=False)
 class _Arcs:
     """Arcs of one great circle: start angles, lengths, the cone of each and the cone
@@ -395,7 +389,9 @@ def _cells_of_circle(
     angle tolerance, and the arcs of each set holding each cell are counted in one
     sweep around the circle (an arc adds one after its start, removes one at its end:
     a point where an arc ends or starts is outside it, the arcs being open)."""
-    u, v = _circle_frame(m)
+    # the cells are found round the circle from u: their order and directions
+    # depend on the frame's turn
+    u, v = se3.axis_basis(m, turned=True)
     found = [_arcs_on_circle(c, u, v, tol) for c in sets]
     whole = np.array([f.whole for f in found], dtype=bool)
     start = np.concatenate([f.start for f in found])
@@ -519,7 +515,8 @@ def _abutting_circles(cones: NDArray[np.float64], tol: Tolerance) -> NDArray[np.
         one_side = sides[:, 0] != sides[:, 1]  # a cone on both sides is empty
         ks, upper = ks[one_side], sides[one_side, 0]
         facets = np.where((of_row[ks] == c)[..., None], 0.0, cones[ks])
-        u, v = _circle_frame(leaders[c])
+        # the arcs' angles are measured from u: the other turn would round them otherwise
+        u, v = se3.axis_basis(leaders[c], turned=True)
         arcs = _arcs_on_circle(facets, u, v, tol, closed=True)
         above = upper[arcs.cone]
         first = _Arcs(arcs.start[above], arcs.length[above], arcs.cone[above], arcs.bounds, False)

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 
+from assemblykit.algebra import se3
 from assemblykit.errors import GeometryError, UnknownNameError
 from assemblykit.geometry.contact_values import Contact, PlanarPatch
 from assemblykit.geometry.contacts import assembly_contacts
@@ -97,10 +98,10 @@ def section_polygons(
     polygons in one frame of that plane (the largest region of each part)."""
     n = np.asarray(normal, dtype=np.float64)
     n = n / np.linalg.norm(n)
-    e1 = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
-    e1 /= np.linalg.norm(e1)
+    # the polygons' coordinates are in the plane's frame: its turn is part of the answer
+    e1, e2 = se3.axis_basis(n, turned=True)
     to_2d = np.eye(4)
-    to_2d[:3, :3] = np.vstack([e1, np.cross(n, e1), n])
+    to_2d[:3, :3] = np.vstack([e1, e2, n])
     to_2d[:3, 3] = -to_2d[:3, :3] @ np.asarray(origin, dtype=np.float64)
     polygons = {}
     for name, mesh in meshes.items():

@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, QhullError
 
+from assemblykit.algebra import se3
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
 from assemblykit.geometry.contact_values import Contact, PlanarPatch
@@ -55,9 +56,8 @@ RIGID_MAX_HYPERPLANES = 12
 def _patch_hull_points(patch: PlanarPatch) -> NDArray[np.float64]:
     poly = np.asarray(patch.polygon, dtype=np.float64).reshape(-1, 3)
     n = np.asarray(patch.normal, dtype=np.float64)
-    e1 = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(n / np.linalg.norm(n), e1)
+    # the hull's first vertex depends on the frame's turn: it orders the contact points
+    e1, e2 = se3.axis_basis(n / np.linalg.norm(n), turned=True)
     try:
         hull = ConvexHull(np.column_stack([poly @ e1, poly @ e2]))
     except QhullError:

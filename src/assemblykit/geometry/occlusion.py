@@ -53,9 +53,9 @@ def view_frame(direction: ArrayLike) -> NDArray[np.float64]:
     """Rows ``e1, e2, d``: an orthonormal frame whose third axis is the unit ``direction``."""
     d = np.asarray(direction, dtype=np.float64).ravel()
     d = d / np.linalg.norm(d)
-    e1 = se3.cross(d, np.eye(3)[int(np.argmin(np.abs(d)))])
-    e1 /= np.linalg.norm(e1)
-    return np.array([e1, se3.cross(d, e1), d])
+    # the frame is returned: shadows' coordinates, boxes and depths are kept in it
+    e1, e2 = se3.axis_basis(d, turned=True)
+    return np.array([e1, e2, d])
 
 
 @dataclass(frozen=True, eq=False)

@@ -37,6 +37,7 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
+from assemblykit.algebra import se3
 from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.interference import interference_threshold, interferences, solid
 from assemblykit.geometry.occlusion import blocking_witnesses, shadows
@@ -293,9 +294,8 @@ def _extruded_shadow(
 ) -> manifold3d.Manifold:
     """The prism of the shadow of ``shared`` along ``axis``, ``length`` long each way
     from the centre of ``shared``'s bounding box."""
-    u = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
-    u /= np.linalg.norm(u)
-    v = np.cross(axis, u)
+    # the shadow's polygons, and so the prism's mesh, are drawn in this frame
+    u, v = se3.axis_basis(axis, turned=True)
     flat = np.asarray(shared.vertices) @ np.column_stack([u, v])
     triangles = flat[np.asarray(shared.faces)]
     a, b = triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]
@@ -511,9 +511,8 @@ def _thread_tube(hole: Surface, shared: trimesh.Trimesh, length: float) -> manif
     ring = manifold3d.CrossSection.circle(outer, SEGMENTS) - manifold3d.CrossSection.circle(
         inner, SEGMENTS
     )
-    u = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
-    u /= np.linalg.norm(u)
-    v = np.cross(axis, u)
+    # the circles' first vertices lie along u: the tube's facets turn with the frame
+    u, v = se3.axis_basis(axis, turned=True)
     start = hole.point - length * axis
     return manifold3d.Manifold.extrude(ring, 2 * length).transform(
         np.column_stack([u, v, axis, start])

@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
+from assemblykit.algebra import se3
 from assemblykit.blocking.arrangement import Arrangement
 from assemblykit.blocking.dbg import DirectionalBlockingGraph
 from assemblykit.blocking.extended import all_convex
@@ -1061,11 +1062,8 @@ def _around(
     """``points`` in turn counter-clockwise around ``centre`` (seen from outside)."""
     if len(points) == 0:
         return ()
-    c = centre / np.linalg.norm(centre)
-    away = np.eye(3)[int(np.argmin(np.abs(c)))]
-    e1 = np.cross(c, away)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(c, e1)
+    # the angles run from -e1: the frame's turn decides which point comes first
+    e1, e2 = se3.axis_basis(centre / np.linalg.norm(centre), turned=True)
     angles = np.arctan2(points @ e2, points @ e1)
     return tuple(np.asarray(points[k], dtype=np.float64) for k in np.argsort(angles, kind="stable"))
 
