@@ -6,9 +6,18 @@ from __future__ import annotations
 import networkx as nx
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from assemblykit.blocking.constraints import BlockingTerm
-from assemblykit.blocking.directions import DirectionTable, row_mask, several, term_slots
+from assemblykit.blocking.directions import (
+    BlockedRows,
+    DirectionTable,
+    mask_vector,
+    row_mask,
+    several,
+    term_slots,
+)
 from assemblykit.tolerance import Tolerance
 
 
@@ -24,11 +33,42 @@ def test_free_parts_of_shrinking_sets_match_a_fresh_count():
         for _ in range(20)
     ]
     tab = table_from(names, rng.normal(size=(20, 3)), arcs)
+    rows = BlockedRows(tab)
     members = (1 << 8) - 1
     while members:
         fresh = table_from(names, tab.directions, arcs)
+        np.testing.assert_array_equal(
+            rows.free_bits(members, members), fresh.free_bits(members, members)
+        )
         np.testing.assert_array_equal(tab.free_parts(members), fresh.free_parts(members))
         members &= ~(1 << int(rng.choice([i for i in range(8) if members >> i & 1])))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**16),
+    asked=st.lists(st.tuples(st.integers(0, 2**12 - 1), st.integers(0, 2**12 - 1)), max_size=12),
+)
+def test_the_memory_of_blocked_rows_answers_any_sets_as_a_fresh_table(seed, asked):
+    """Sets asked in any order (shrinking, growing, unrelated) get from the memory the
+    rows the table computes from scratch."""
+    rng = np.random.default_rng(seed)
+    names = tuple(f"p{i}" for i in range(12))
+    arcs = [
+        [(i, j) for i in range(12) for j in range(12) if i != j and rng.random() < 0.2]
+        for _ in range(9)
+    ]
+    tab = table_from(names, rng.normal(size=(9, 3)), arcs)
+    rows = BlockedRows(tab)
+    for members, movers in asked:
+        np.testing.assert_array_equal(
+            rows.free_bits(members, movers), tab.free_bits(members, movers)
+        )
+
+
+@given(mask=st.integers(0, 2**80), count=st.integers(0, 90))
+def test_a_mask_as_a_vector_holds_its_first_bits(mask, count):
+    assert mask_vector(mask, count).tolist() == [bool(mask >> i & 1) for i in range(count)]
 
 
 def test_free_bits_past_one_byte_count_the_free_movers_of_shrinking_sets():
@@ -39,6 +79,7 @@ def test_free_bits_past_one_byte_count_the_free_movers_of_shrinking_sets():
         for _ in range(30)
     ]
     tab = table_from(names, rng.normal(size=(30, 3)), arcs)
+    rows = BlockedRows(tab)
     members = (1 << 19) - 1
     while several(members):
         movers = members & int(rng.integers(1 << 19))
@@ -48,7 +89,7 @@ def test_free_bits_past_one_byte_count_the_free_movers_of_shrinking_sets():
                 blocked[k, i] |= bool(members >> j & 1)
         chosen = np.array([bool(movers >> i & 1) for i in range(19)])
         expected = ~blocked & chosen
-        bits = tab.free_bits(members, movers)
+        bits = rows.free_bits(members, movers)
         assert [row_mask(row) for row in bits] == [
             sum(1 << int(i) for i in np.flatnonzero(row)) for row in expected
         ]

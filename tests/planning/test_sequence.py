@@ -11,7 +11,13 @@ import pytest
 import trimesh
 
 from assemblykit.blocking import tables
-from assemblykit.blocking.directions import DirectionTable, local_table, mask_of, several
+from assemblykit.blocking.directions import (
+    BlockedRows,
+    DirectionTable,
+    local_table,
+    mask_of,
+    several,
+)
 from assemblykit.blocking.extended import extended_dbg, extended_free
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.blocking.tables import translation_table
@@ -585,11 +591,11 @@ def test_a_narrower_is_asked_about_the_groups_of_at_most_sixteen_directions():
         asked.append(sets)
         return []
 
-    assert _choose_removal(tab, tab, 0b111, (1.0, 1.0, 9.0), None, reject) is None
+    assert _choose_removal(BlockedRows(tab), tab, 0b111, (1.0, 1.0, 9.0), None, reject) is None
     assert asked == [[0b011]] * GROUP_REJECTIONS
     assert GROUP_REJECTIONS == 16
     # without a narrower the pair leaves
-    assert _choose_removal(tab, tab, 0b111, (1.0, 1.0, 9.0), None) == (0, [0b011])
+    assert _choose_removal(BlockedRows(tab), tab, 0b111, (1.0, 1.0, 9.0), None) == (0, [0b011])
 
 
 def test_a_narrower_is_not_asked_along_directions_that_cannot_win():
@@ -606,7 +612,8 @@ def test_a_narrower_is_not_asked_along_directions_that_cannot_win():
         asked.append(k)
         return sets[:1]
 
-    assert _choose_removal(tab, tab, 0b1111, (1.0, 1.0, 1.0, 9.0), None, first) == (1, [0b0001])
+    volumes = (1.0, 1.0, 1.0, 9.0)
+    assert _choose_removal(BlockedRows(tab), tab, 0b1111, volumes, None, first) == (1, [0b0001])
     assert asked == [0, 1]
 
 
@@ -632,7 +639,7 @@ def test_parts_a_narrower_already_rejected_get_no_extended_blocking():
         sorted, admits, lambda members: sum(m for m, ok in judged.items() if not ok)
     )
     volumes = (1.0, 1.0, 1.0, 9.0)
-    assert _choose_removal(tab, Spy(), 0b1111, volumes, None, narrow) == (1, [0b0100])  # type: ignore[arg-type]
+    assert _choose_removal(BlockedRows(tab), Spy(), 0b1111, volumes, None, narrow) == (1, [0b0100])  # type: ignore[arg-type]
     assert tested == [0b0011, 0b0100]
     assert judged == {0b0001: False, 0b0010: False, 0b0100: True}
 

@@ -14,7 +14,7 @@ directions. Sets of parts are Python integers, bit ``i`` for the ``i``-th part
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import networkx as nx
 import numpy as np
@@ -42,9 +42,6 @@ class DirectionTable:
     slots: NDArray[np.bool_]
     moving: NDArray[np.int64]
     blocker: NDArray[np.int64]
-    _last: dict[str, tuple[int, NDArray[np.uint8]]] = field(
-        default_factory=dict, compare=False, repr=False
-    )
 
     @classmethod
     def from_arcs(
@@ -64,7 +61,7 @@ class DirectionTable:
 
     def vector(self, members: int) -> NDArray[np.bool_]:
         """The set ``members`` as a boolean vector over ``names``."""
-        return np.array([bool(members >> i & 1) for i in range(len(self.names))], dtype=bool)
+        return mask_vector(members, len(self.names))
 
     def _active(self, members: int) -> NDArray[np.int64]:
         inside = self.vector(members)
@@ -77,40 +74,44 @@ class DirectionTable:
 
     def free_bits(self, members: int, movers: int) -> NDArray[np.uint8]:
         """Per direction, the parts of ``movers`` with no blocker in ``members``, packed
-        (bit ``i`` of row ``k`` read little-endian, as :func:`row_mask` does).
+        (bit ``i`` of row ``k`` read little-endian, as :func:`row_mask` does). A search
+        that asks of shrinking sets keeps a :class:`BlockedRows` instead."""
+        return self.free_of(self.blocked_bits(members), members, movers)
 
-        The search asks this of shrinking sets: when ``members`` is a subset of the set
-        asked last, only the parts that had a blocker among the parts since removed are
-        recomputed."""
+    def free_of(self, blocked: NDArray[np.uint8], members: int, movers: int) -> NDArray[np.uint8]:
+        """:meth:`free_bits` from the rows of :meth:`blocked_bits` for ``members``."""
+        return ~blocked & np.packbits(self.vector(movers & members), bitorder="little")
+
+    def blocked_bits(self, members: int) -> NDArray[np.uint8]:
+        """Per direction, the parts of ``members`` with a blocker in ``members``, packed
+        as :meth:`free_bits` packs them."""
+        unpacked = np.zeros((len(self.directions), len(self.names)), dtype=bool)
+        columns = self._active(members)
+        if len(columns):
+            owners = self.moving[columns]
+            starts = np.flatnonzero(np.r_[True, owners[1:] != owners[:-1]])
+            # every slot is active in the first call: no copy of the table then
+            active = self.slots if len(columns) == self.slots.shape[1] else self.slots[:, columns]
+            # maximum over 0/1 bytes is logical or, and much faster along rows
+            unpacked[:, owners[starts]] = np.maximum.reduceat(
+                active.view(np.uint8), starts, axis=1
+            ).view(bool)
+        return np.packbits(unpacked, axis=1, bitorder="little")
+
+    def blocked_after_removing(
+        self, blocked: NDArray[np.uint8], members: int, removed: int
+    ) -> None:
+        """Turn ``blocked``, the rows of :meth:`blocked_bits` for ``members | removed``,
+        into those for ``members``, in place: only the parts of ``members`` that had a
+        blocker in ``removed`` are measured again."""
         inside = self.vector(members)
-        last = self._last.get("blocked")
-        if last is not None and last[0] & members == members:
-            removed = self.vector(last[0] & ~members)
-            blocked = last[1]
-            for i in np.unique(self.moving[removed[self.blocker]]):
-                if inside[i]:
-                    column = self._blocked_part(int(i), inside).astype(np.uint8)
-                    byte, bit = divmod(int(i), 8)
-                    blocked[:, byte] &= np.uint8(~(1 << bit) & 0xFF)
-                    blocked[:, byte] |= column << np.uint8(bit)
-        else:
-            unpacked = np.zeros((len(self.directions), len(self.names)), dtype=bool)
-            columns = self._active(members)
-            if len(columns):
-                owners = self.moving[columns]
-                starts = np.flatnonzero(np.r_[True, owners[1:] != owners[:-1]])
-                # every slot is active in the first call: no copy of the table then
-                active = (
-                    self.slots if len(columns) == self.slots.shape[1] else self.slots[:, columns]
-                )
-                # maximum over 0/1 bytes is logical or, and much faster along rows
-                unpacked[:, owners[starts]] = np.maximum.reduceat(
-                    active.view(np.uint8), starts, axis=1
-                ).view(bool)
-            blocked = np.packbits(unpacked, axis=1, bitorder="little")
-        self._last["blocked"] = (members, blocked)
-        chosen = np.packbits(self.vector(movers & members), bitorder="little")
-        return ~blocked & chosen
+        gone = self.vector(removed)
+        for i in np.unique(self.moving[gone[self.blocker]]):
+            if inside[i]:
+                column = self._blocked_part(int(i), inside).astype(np.uint8)
+                byte, bit = divmod(int(i), 8)
+                blocked[:, byte] &= np.uint8(~(1 << bit) & 0xFF)
+                blocked[:, byte] |= column << np.uint8(bit)
 
     def _blocked_part(self, i: int, inside: NDArray[np.bool_]) -> NDArray[np.bool_]:
         """Per direction, whether part ``i`` has a blocker among ``inside``."""
@@ -204,6 +205,30 @@ class DirectionTable:
         for s in np.flatnonzero(self.slots[k]):
             masks[self.moving[s]] |= 1 << int(self.blocker[s])
         return tuple(masks)
+
+
+@dataclass(eq=False)
+class BlockedRows:
+    """The memory a search keeps of :meth:`DirectionTable.blocked_bits` for the set it
+    asked last: the greedy search asks of shrinking sets (a step takes parts away), and
+    when a set is a subset of the one asked last, only the parts that had a blocker
+    among the parts since removed are measured again
+    (:meth:`DirectionTable.blocked_after_removing`). Owned by the search, for one table:
+    a table with more directions needs a memory of its own."""
+
+    table: DirectionTable
+    members: int = 0
+    blocked: NDArray[np.uint8] | None = None
+
+    def free_bits(self, members: int, movers: int) -> NDArray[np.uint8]:
+        """:meth:`DirectionTable.free_bits`, from the rows kept for the set asked last
+        where ``members`` is a subset of it."""
+        if self.blocked is not None and self.members & members == members:
+            self.table.blocked_after_removing(self.blocked, members, self.members & ~members)
+        else:
+            self.blocked = self.table.blocked_bits(members)
+        self.members = members
+        return self.table.free_of(self.blocked, members, movers)
 
 
 def local_table(
@@ -312,6 +337,13 @@ def union_of(masks: Iterable[int]) -> int:
     for mask in masks:
         total |= mask
     return total
+
+
+def mask_vector(mask: int, count: int) -> NDArray[np.bool_]:
+    """The bit mask ``mask`` as a boolean vector of its first ``count`` bits."""
+    size = max(count, mask.bit_length(), 1)
+    packed = np.frombuffer(mask.to_bytes((size + 7) // 8, "little"), dtype=np.uint8)
+    return np.unpackbits(packed, count=count, bitorder="little").astype(bool)
 
 
 def row_mask(row: NDArray[np.uint8]) -> int:

@@ -42,6 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
+from assemblykit.blocking.directions import mask_vector
 from assemblykit.errors import GeometryError
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.minkowski import convex_pieces
@@ -218,7 +219,7 @@ class _MeshSearch(MultiMoveSearch):
             return self._separating(members, mask, k), ()
         children = []
         for mask, k, t in moves:
-            moved = np.array([mask >> i & 1 for i in range(len(members))], dtype=bool)
+            moved = mask_vector(mask, len(members))
             after = offsets.copy()
             after[np.array(members)[moved]] += t * self.directions[k]
             after -= after[members[0]]

@@ -53,6 +53,7 @@ from assemblykit.blocking.arrangement import snap_normals
 from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.dbg import blocking_components
 from assemblykit.blocking.directions import (
+    BlockedRows,
     DirectionTable,
     bits,
     count_bits,
@@ -934,7 +935,7 @@ def _group_bounds(
 
 
 def _choose_removal(
-    translations: DirectionTable,
+    rows: BlockedRows,
     extended: DirectionTable | ExtendedDirections,
     members: int,
     volumes: Sequence[float],
@@ -943,7 +944,8 @@ def _choose_removal(
     up: NDArray[np.float64] | None = None,
     fixed: int = 0,
 ) -> tuple[int, list[int]] | None:
-    """The direction index and the free sets of Γ_e it removes from ``members``.
+    """The direction index and the free sets of Γ_e it removes from ``members``, Γ_t
+    being the table of ``rows`` (the search's memory of it).
 
     Single parts first: where Γ_t lets single parts leave (counted for all directions at
     once), only those parts are tested against Γ_e. When none leaves alone, the sink
@@ -954,9 +956,10 @@ def _choose_removal(
     directions, no more groups are tried. No set holding a ``fixed`` part is moved: with
     the base, they are one immovable body (docs/planning.md, "Fixed parts").
     """
+    translations = rows.table
     base = base_part(members, volumes)
     anchor = (1 << base) | (fixed & members)
-    free = translations.free_bits(members, members & ~anchor)
+    free = rows.free_bits(members, members & ~anchor)
     counts = np.bitwise_count(free).sum(axis=1, dtype=np.int64)
     rejected = 0
 
@@ -1095,6 +1098,8 @@ class Search:
     nothing (:func:`fit_axes`)."""
     unfinished: list[int] = field(default_factory=list)
     """The sets not taken apart because :attr:`max_steps` was reached (bit masks)."""
+    rows: BlockedRows | None = field(default=None, init=False, repr=False)
+    """The search's memory of Γ_t's blocked parts for the set it asked last."""
 
     def _choose(self, members: int, previous: int | None) -> tuple[int, list[int]] | None:
         """The next removal from ``members``: each narrower in turn, then the same again
@@ -1106,7 +1111,7 @@ class Search:
                 return None
             for narrow in narrowers:
                 choice = _choose_removal(
-                    self.translations,
+                    self._blocked_rows(),
                     self.extended,
                     members,
                     self.volumes,
@@ -1118,6 +1123,13 @@ class Search:
                 if choice is not None:
                     return choice
         return None
+
+    def _blocked_rows(self) -> BlockedRows:
+        """The search's memory of Γ_t's blocked parts (:class:`BlockedRows`), for the
+        table of candidate directions it has now."""
+        if self.rows is None or self.rows.table is not self.translations:
+            self.rows = BlockedRows(self.translations)
+        return self.rows
 
     def _refined(self, members: int) -> bool:
         """Add the directions of the exact free sets of ``members`` (:func:`exact_candidates`)
