@@ -49,7 +49,8 @@ WORLD: Node = ("world", "")
 
 @dataclass(frozen=True)
 class Link:
-    """A coset link ``source → target``: ``inv(L_source) @ L_target`` lies in ``value``.
+    """A coset link ``source → target``: ``inv(L_source) @ L_target`` lies in ``value``
+    (an :class:`~assemblykit.algebra.cosets.EmptySet` when no pose satisfies it).
 
     ``labels`` name the relations or actions it came from; ``make_residual`` builds the
     same condition as a residual function of ``X``, only when the numeric path needs it.
@@ -60,7 +61,7 @@ class Link:
 
     source: Node
     target: Node
-    value: Any
+    value: Coset | EmptySet
     labels: tuple[str, ...]
     make_residual: Callable[[], Callable[[np.ndarray], np.ndarray]]
     key: Hashable = None

@@ -229,13 +229,14 @@ class Reducer:
         ``cache`` maps the links' keys (their geometry in body coordinates) to the result,
         so a repeated part (a stack of equal cubes) costs one intersection in all."""
         valid = [link for link in links if not isinstance(link.value, EmptySet)]
+        cosets = [link.value for link in links if isinstance(link.value, Coset)]
         for link in links:
             if isinstance(link.value, EmptySet):
                 self.add(link)
         if not valid:
             return
         head = valid[0]
-        if len(valid) == 1 or any(link.value.group.lattice for link in valid):
+        if len(valid) == 1 or any(coset.group.lattice for coset in cosets):
             for link in valid:
                 self.add(link)
             return
@@ -245,8 +246,8 @@ class Reducer:
         if cached is None:
             cached = _intersect_parallel(
                 [
-                    link.value if same else link.value.inverse()
-                    for link, same in zip(valid, forward, strict=True)
+                    coset if same else coset.inverse()
+                    for coset, same in zip(cosets, forward, strict=True)
                 ],
                 self.tol,
             )
