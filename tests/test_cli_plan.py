@@ -100,6 +100,51 @@ def test_plan_of_a_polygon_file_is_planar(capsys):
     assert code == 2 and "2D polygon" in err
 
 
+@pytest.mark.parametrize("moves", ["multi", "rigid"])
+@pytest.mark.parametrize(
+    ("option", "said"),
+    [
+        (["--html", "r.html"], "--html and --png draw translation plans: not with --moves"),
+        (["--png", "r.png"], "--html and --png draw translation plans: not with --moves"),
+        (["--gravity", "-z"], "--max-steps plan translations: not with --moves"),
+        (["--one-at-a-time"], "--max-steps plan translations: not with --moves"),
+        (["--max-steps", "2"], "--max-steps plan translations: not with --moves"),
+        (["--out", "p.json"], "--out and --gltf export translation plans: not with --moves"),
+        (["--gltf", "p.glb"], "--out and --gltf export translation plans: not with --moves"),
+    ],
+)
+def test_options_of_translation_plans_are_refused_by_the_other_modes(
+    capsys, tmp_path, moves, option, said
+):
+    """Each option that only a plan of single translations takes is refused, in one
+    line naming it and the mode, before anything is loaded or written."""
+    args = [
+        str(tmp_path / a) if a.endswith((".html", ".png", ".json", ".glb")) else a for a in option
+    ]
+    code, out, err = run(capsys, "plan", str(DEMO), "--moves", moves, *args)
+    assert code == 2 and out == ""
+    assert f"{said} {moves}" in err and len(err.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        (["--moves", "multi"], "--moves multi moves 3D parts: not for a 2D polygon assembly"),
+        (["--moves", "rigid"], "--moves rigid turns 3D parts: not for a 2D polygon assembly"),
+        (["--gltf", "p.glb"], "--gltf draws meshes: not for a 2D polygon assembly"),
+        (["--html", "r.html"], "--html and --png draw meshes: not for a 2D polygon assembly"),
+    ],
+)
+def test_what_moves_or_draws_meshes_is_refused_for_polygons(capsys, tmp_path, args, said):
+    args = [str(tmp_path / a) if "." in a else a for a in args]
+    polygons = str(PLANAR / "hook.yaml")
+    code, out, err = run(capsys, "plan", polygons, *args)
+    assert code == 2 and out == ""
+    assert said in err and "hook.yaml" in err and len(err.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_plan_reports_the_hands_a_planar_interlock_needs(capsys):
     code, out, err = run(capsys, "plan", str(PLANAR / "three_hands.yaml"), "--json")
     assert code == 0, err

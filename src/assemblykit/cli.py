@@ -18,6 +18,7 @@ import re
 import sys
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal, NoReturn, Protocol
 
 import click
@@ -425,9 +426,63 @@ def _plan_input(
     return assembly_or_polygons(path, tol, as_written, partial)
 
 
+@dataclass(frozen=True)
+class PlanMode:
+    """A way the ``plan`` command plans (``--moves``), and the options it takes. Only
+    plans of single translations (``monotone``) take the options of that search
+    (:data:`TRANSLATION_OPTIONS`) and plan polygons in the plane; the others move 3D
+    parts, and what it moves them by is its ``motion`` (said when it is given polygons)."""
+
+    name: str
+    translations: bool
+    motion: str = "moves"
+
+    def check_options(self, given: set[str]) -> None:
+        """:class:`InputError` naming the first group of ``given`` options this mode does
+        not take."""
+        if self.translations:
+            return
+        for options, use in TRANSLATION_OPTIONS:
+            if given & set(options):
+                raise InputError(f"{_listed(options)} {use}: not with --moves {self.name}")
+
+    def check_plane(self, given: set[str], source: str) -> None:
+        """:class:`InputError` naming ``source`` when this mode, with the ``given``
+        options, cannot plan it, an assembly of polygons in the plane."""
+        said = "not for a 2D polygon assembly"
+        if not self.translations:
+            raise InputError(f"--moves {self.name} {self.motion} 3D parts: {said}", source=source)
+        for options in PLANE_REFUSED:
+            if given & set(options):
+                verb = "draws" if len(options) == 1 else "draw"
+                raise InputError(f"{_listed(options)} {verb} meshes: {said}", source=source)
+
+
+TRANSLATION_OPTIONS = (
+    (("--html", "--png"), "draw translation plans"),
+    (("--gravity", "--one-at-a-time", "--max-steps"), "plan translations"),
+    (("--out", "--gltf"), "export translation plans"),
+)
+"""The options of ``plan`` that only plans of single translations take, and what they do."""
+
+PLANE_REFUSED = (("--gltf",), ("--html", "--png"))
+"""The options of ``plan`` that draw meshes, which an assembly of polygons has not."""
+
+PLAN_MODES = {
+    "monotone": PlanMode("monotone", translations=True),
+    "multi": PlanMode("multi", translations=False),
+    "rigid": PlanMode("rigid", translations=False, motion="turns"),
+}
+"""The ways of ``plan --moves``."""
+
+
+def _listed(options: tuple[str, ...]) -> str:
+    """``a``, ``a and b``, ``a, b and c``."""
+    return options[0] if len(options) == 1 else f"{', '.join(options[:-1])} and {options[-1]}"
+
+
 def _multi_move_plan(
     loaded: Any,
-    path: str,
     tol: Tolerance,
     max_states: int | None,
     progress: Callable[[str, int, int], None],
@@ -441,8 +496,6 @@ def _multi_move_plan(
     from assemblykit.planning.multimove_mesh import plan_meshes
 
     limit = MAX_STATES if max_states is None else max_states
-    if loaded.dimension == 2:
-        raise InputError("--moves multi moves 3D parts: not for a 2D polygon assembly", source=path)
     if not isinstance(loaded, VoxelAssembly):
         return plan_meshes(loaded, tol, max_states=limit, progress=progress, fixed=fixed)
     puzzle = loaded.puzzle
@@ -646,19 +699,21 @@ def plan_cmd(
     """
     from assemblykit.planning.planner import plan
 
-    if moves != "monotone" and (html is not None or png is not None):
-        raise InputError(f"--html and --png draw translation plans: not with --moves {moves}")
-    if moves != "monotone" and (gravity is not None or one_at_a_time or max_steps is not None):
-        raise InputError(
-            f"--gravity, --one-at-a-time and --max-steps plan translations, not --moves {moves}"
-        )
-
+    mode = PLAN_MODES[moves]
+    given = {
+        "--html": html is not None,
+        "--png": png is not None,
+        "--out": out is not None,
+        "--gltf": gltf is not None,
+        "--gravity": gravity is not None,
+        "--one-at-a-time": one_at_a_time,
+        "--max-steps": max_steps is not None,
+    }
+    mode.check_options({option for option, on in given.items() if on})
     if html is not None:
         checked_output(html, "--html", HTML_SUFFIXES)
     if png is not None:
         checked_output(png, "--png", PNG_SUFFIXES)
-    if moves != "monotone" and (out is not None or gltf is not None):
-        raise InputError(f"--out and --gltf export translation plans: not with --moves {moves}")
     from assemblykit.io.exports import GLTF_SUFFIXES, PLAN_SUFFIXES
 
     if out is not None:
@@ -685,17 +740,13 @@ def plan_cmd(
             )
         elif join or join_interfering:
             raise InputError("--join and --join-interfering need 3D parts")
-        if loaded.dimension == 2 and gltf is not None:
-            raise InputError("--gltf draws meshes: not for a 2D polygon assembly")
-        if loaded.dimension == 2 and (html is not None or png is not None):
-            raise InputError("--html and --png draw meshes: not for a 2D polygon assembly")
+        if loaded.dimension == 2:
+            mode.check_plane({option for option, on in given.items() if on}, assembly)
         if moves == "multi":
-            result = _multi_move_plan(loaded, assembly, tol, max_states, update, fixed)
+            result = _multi_move_plan(loaded, tol, max_states, update, fixed)
         elif moves == "rigid":
             from assemblykit.planning.screw import plan_with_screws
 
-            if loaded.dimension == 2:
-                raise InputError("--moves rigid turns 3D parts: not for a 2D polygon assembly")
             result = plan_with_screws(loaded, tol, fixed=fixed)
         else:
             monotone = plan(
