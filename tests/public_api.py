@@ -166,6 +166,7 @@ PUBLIC_NAMES: tuple[str, ...] = (
     "assemblykit.blocking.cache",
     "assemblykit.blocking.cache.BlockingCache",
     "assemblykit.blocking.dbg.DirectionalBlockingGraph.free_subassemblies",
+    "assemblykit.blocking.directions.DirectionTable.distinct_directions",
     "assemblykit.blocking.ndbg.NonDirectionalBlockingGraph.dbg",
     "assemblykit.blocking.ndbg.NonDirectionalBlockingGraph.direction_table",
     "assemblykit.blocking.ndbg.NonDirectionalBlockingGraph.unique_dbgs",
@@ -211,6 +212,9 @@ DEPRECATED: dict[str, str] = {
     "assemblykit.algebra.SymmetryGroup.intersect": "assemblykit.algebra.intersect_groups",
     "assemblykit.blocking.queries.separable_by_translations": (
         "assemblykit.planning.planner.separable_by_translations"
+    ),
+    "assemblykit.planning.sequence.distinct_directions": (
+        "assemblykit.blocking.directions.DirectionTable.distinct_directions"
     ),
     "assemblykit.planning.sequence.plan": "assemblykit.planning.planner.plan",
     "assemblykit.planning.sequence.separable_by_translations": (

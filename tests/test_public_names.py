@@ -15,6 +15,7 @@ import pytest
 
 import assemblykit
 from assemblykit.algebra import SymmetryGroup, intersect_groups
+from assemblykit.blocking.directions import DirectionTable
 from assemblykit.io.polygons import load_polygons
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.model.packings import box_mesh
@@ -120,6 +121,14 @@ def separable_cases() -> list[tuple[tuple[Any, ...], str]]:
     ]
 
 
+def direction_tables() -> list[tuple[tuple[Any, ...], str]]:
+    """Tables of DBGs and the direction kept per distinct DBG (the one closest to a
+    coordinate axis): two directions with one DBG and a third with another."""
+    directions = [[0.6, 0.0, 0.8], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]
+    table = DirectionTable.from_arcs(("a", "b"), directions, [[(0, 1)], [(0, 1)], []])
+    return [((table,), "[1, 2]")]
+
+
 def plan_cases() -> list[tuple[tuple[Any, ...], str]]:
     """Plans of two boxes, the planar hook and the bottle."""
     return [
@@ -135,6 +144,7 @@ def plan_cases() -> list[tuple[tuple[Any, ...], str]]:
 EXAMPLES: dict[str, Callable[[], list[tuple[tuple[Any, ...], str]]]] = {
     "assemblykit.algebra.SymmetryGroup.intersect": group_pairs,
     "assemblykit.blocking.queries.separable_by_translations": separable_cases,
+    "assemblykit.planning.sequence.distinct_directions": direction_tables,
     "assemblykit.planning.sequence.plan": plan_cases,
     "assemblykit.planning.sequence.separable_by_translations": separable_cases,
 }

@@ -148,3 +148,19 @@ def test_free_set_sizes_count_the_sink_components_but_the_kept_ones():
         ]
         members &= ~(1 << keep)
     assert table_from(names, np.eye(3), [[], [], []]).free_set_sizes(0b111, 0).tolist() == [2] * 3
+
+
+def test_a_pair_blocked_both_ways_everywhere_is_held_and_no_other():
+    names = ("a", "b", "c")
+    both = [(0, 1), (1, 0)]
+    arcs = [[*both, (2, 0)], [*both], [*both, (0, 2), (2, 0)]]
+    tab = table_from(names, np.eye(3), arcs)
+    assert tab.held_pair(0b111) == 0b011
+    assert tab.held_pair(0b101) == 0  # a and c are apart along the second direction
+    assert table_from(names, np.eye(3), [[(0, 1)], [(1, 0)], []]).held_pair(0b111) == 0
+
+
+def test_one_direction_per_distinct_dbg_the_closest_to_an_axis():
+    directions = [[0.6, 0.0, 0.8], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.8, 0.6, 0.0]]
+    tab = table_from(("a", "b"), directions, [[(0, 1)], [(0, 1)], [], []])
+    assert tab.distinct_directions() == [1, 2]

@@ -199,6 +199,27 @@ class DirectionTable:
             self.blocker,
         )
 
+    def distinct_directions(self) -> list[int]:
+        """One direction per distinct DBG: the one closest to a coordinate axis."""
+        _, inverse = np.unique(self.slots, axis=0, return_inverse=True)
+        inverse = inverse.ravel()
+        order = np.lexsort((-np.abs(self.directions).max(axis=1), inverse))
+        return sorted(order[np.r_[True, inverse[order][1:] != inverse[order][:-1]]].tolist())
+
+    def held_pair(self, members: int) -> int:
+        """The first pair of ``members`` (in index order) blocked both ways along every
+        direction, as a mask; 0 when there is none. No translation separates such a
+        pair."""
+        everywhere = self.slots.all(axis=0)
+        inside = self.vector(members)
+        arcs = {
+            (int(i), int(j))
+            for i, j in zip(self.moving[everywhere], self.blocker[everywhere], strict=True)
+            if inside[i] and inside[j]
+        }
+        pairs = sorted((i, j) for i, j in arcs if i < j and (j, i) in arcs)
+        return (1 << pairs[0][0]) | (1 << pairs[0][1]) if pairs else 0
+
     def masks(self, k: int) -> tuple[int, ...]:
         """Per part, the bit mask of its blockers along direction ``k``."""
         masks = [0] * len(self.names)

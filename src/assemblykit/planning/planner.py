@@ -41,7 +41,6 @@ from assemblykit.planning.sequence import (
     Step,
     and_or_graph,
     base_part,
-    distinct_directions,
     exact_candidates,
     fit_axes,
     least_interlocked,
@@ -380,7 +379,7 @@ def finish_plan(
     and_or = None
     if 1 < len(names) <= max_and_or_parts:
         # one direction per distinct DBG of Γ_t, and those the search already swept
-        directions = set(distinct_directions(translations)) | extended.evaluated
+        directions = set(translations.distinct_directions()) | extended.evaluated
         and_or = and_or_graph(extended.table(directions))
     hands = Hands(min(2, len(names)), max_hands)
     if search.locked and max_hands > 2:

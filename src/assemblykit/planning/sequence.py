@@ -833,14 +833,6 @@ class AssemblyStep:
         }
 
 
-def distinct_directions(table: DirectionTable) -> list[int]:
-    """One direction per distinct DBG of ``table``: the one closest to a coordinate axis."""
-    _, inverse = np.unique(table.slots, axis=0, return_inverse=True)
-    inverse = inverse.ravel()
-    order = np.lexsort((-np.abs(table.directions).max(axis=1), inverse))
-    return sorted(order[np.r_[True, inverse[order][1:] != inverse[order][:-1]]].tolist())
-
-
 def separable(table: DirectionTable, members: int) -> bool:
     """True when some direction of ``table`` frees a proper, non-empty part of ``members``
     (a DBG that is not strongly connected: Wilson & Latombe 1992, "Directional Blocking
@@ -1247,7 +1239,7 @@ def least_interlocked(translations: DirectionTable, extended: Any, members: int)
     directions where Γ_t separates the rest, and only until one separates it. A pair
     that Γ_t blocks both ways along every direction (parts left interfering:
     :func:`~assemblykit.blocking.tables.with_obstacles`) is such a subset at once."""
-    held = _held_pair(translations, members)
+    held = translations.held_pair(members)
     if held:
         return held
     core = members
@@ -1269,23 +1261,6 @@ def least_interlocked(translations: DirectionTable, extended: Any, members: int)
         return subset
 
     return drop(core)
-
-
-def _held_pair(translations: DirectionTable, members: int) -> int:
-    """The first pair of ``members`` (in index order) that Γ_t blocks both ways along
-    every direction of ``translations``, as a mask; 0 when there is none. No translation
-    separates such a pair."""
-    everywhere = translations.slots.all(axis=0)
-    inside = translations.vector(members)
-    arcs = {
-        (int(i), int(j))
-        for i, j in zip(
-            translations.moving[everywhere], translations.blocker[everywhere], strict=True
-        )
-        if inside[i] and inside[j]
-    }
-    pairs = sorted((i, j) for i, j in arcs if i < j and (j, i) in arcs)
-    return (1 << pairs[0][0]) | (1 << pairs[0][1]) if pairs else 0
 
 
 def _connected_as_shown(translations: DirectionTable, extended: Any, k: int, members: int) -> bool:
@@ -1464,6 +1439,7 @@ def _voxel_lock(assembly: Assembly) -> Callable[[list[str]], bool]:
 __getattr__ = moved(
     __name__,
     {
+        "distinct_directions": "assemblykit.blocking.directions:DirectionTable.distinct_directions",
         "plan": "assemblykit.planning.planner",
         "separable_by_translations": "assemblykit.planning.planner",
     },
