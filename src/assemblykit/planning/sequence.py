@@ -46,13 +46,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.blocking.dbg import blocking_components
 from assemblykit.blocking.directions import (
     BlockedRows,
     DirectionTable,
     bits,
     count_bits,
-    mask_of,
     row_mask,
     several,
     union_of,
@@ -66,6 +64,7 @@ from assemblykit.planning.extended_directions import (
     SWEPT_DIRECTIONS,
     ExtendedDirections,
 )
+from assemblykit.planning.free_sets import closed_under, separable, sinks
 from assemblykit.planning.plan_values import (
     AndOrGraph,
     AndOrNode,
@@ -115,6 +114,9 @@ __all__ = [
     "separable",
 ]
 
+_sinks = sinks
+""":func:`~assemblykit.planning.free_sets.sinks`, by the name it has here."""
+
 Progress = Callable[[str, int, int], None]
 Narrow = Callable[[int, int, list[int]], list[int]]
 """``narrow(members, k, sets)``: the free sets (bit masks) of direction ``k`` to move."""
@@ -148,29 +150,6 @@ class FirstAdmitted:
         return next(([m] for m in self.order(sets) if self.admits(members, m)), [])
 
 
-def separable(table: DirectionTable, members: int) -> bool:
-    """True when some direction of ``table`` frees a proper, non-empty part of ``members``
-    (a DBG that is not strongly connected: Wilson & Latombe 1992, "Directional Blocking
-    Graph")."""
-    if not several(members):
-        return False
-    if table.free_parts(members).any():
-        return True
-    return bool(table.separating(members).any())
-
-
-def _sinks(source: DirectionTable | ExtendedDirections, k: int, members: int) -> list[int]:
-    """The minimal free sets of ``members`` along direction ``k``: the sink strong
-    components of its DBG, as bit masks (Wilson & Latombe 1992, "Directional Blocking
-    Graph")."""
-    condensed = blocking_components(source.graph(k, members))
-    return [
-        mask_of(condensed.nodes[c]["members"])
-        for c in condensed.nodes
-        if condensed.out_degree(c) == 0
-    ]
-
-
 def _free_closures(
     translations: DirectionTable,
     extended: ExtendedDirections,
@@ -200,10 +179,10 @@ def _free_closures(
     anchor = (1 << base) | fixed
 
     def closure(start: int, blockers: Callable[[int], dict[int, int]]) -> int:
-        return _closure(start, blockers, necessary, members, lambda closed: closed & anchor)
+        return closed_under(start, blockers, necessary, members, lambda closed: closed & anchor)
 
     closures = set()
-    for start in _sinks(translations, k, members):
+    for start in sinks(translations, k, members):
         if closure(start, lambda parts: extended.shown_blockers(k, parts, members)) & anchor:
             continue
         if closure(start, lambda parts: extended.known_blockers(k, parts, members)) & anchor:
@@ -290,7 +269,7 @@ def _choose_removal(
         if isinstance(extended, ExtendedDirections):
             found = _free_closures(translations, extended, k, members, base, anchor)
         else:
-            found = _removal(_sinks(extended, k, members), members, volumes, fixed)
+            found = _removal(sinks(extended, k, members), members, volumes, fixed)
         kept = chosen(k, found)
         rejected += bool(found) and not kept
         return kept
@@ -593,29 +572,9 @@ def _connected_as_shown(translations: DirectionTable, extended: Any, k: int, mem
         return extended.shown_blockers(k, parts, members)
 
     return all(
-        _closure(start, shown, necessary, members, lambda closed: closed == members) == members
-        for start in _sinks(translations, k, members)
+        closed_under(start, shown, necessary, members, lambda closed: closed == members) == members
+        for start in sinks(translations, k, members)
     )
-
-
-def _closure(
-    start: int,
-    blockers: Callable[[int], dict[int, int]],
-    necessary: Sequence[int],
-    members: int,
-    enough: Callable[[int], object],
-) -> int:
-    """``start`` closed under the arcs ``blockers`` gives (per part of a set, the mask of
-    its blockers) and Γ_t's (``necessary``, per part) within ``members``: everything
-    their blockers, and theirs, reach; it stops early once ``enough`` holds of it."""
-    closed = frontier = start
-    while frontier and not enough(closed):
-        blocked = 0
-        for i, mask in blockers(frontier).items():
-            blocked |= mask | necessary[i] & members
-        frontier = blocked & ~closed
-        closed |= frontier
-    return closed
 
 
 __getattr__ = moved(
