@@ -68,7 +68,7 @@ class ExtendedDirections:
     off, and late in a plan the few parts left are projected, not all of them. Parts
     that are not unions of convex bodies go to the projection test
     (:mod:`assemblykit.geometry.occlusion`), whose cost is projecting the meshes around
-    them: a closure (:func:`~assemblykit.planning.sequence._free_closures`) asks about a
+    them: a closure (:func:`~assemblykit.planning.search._free_closures`) asks about a
     few more parts at a time, dozens of times along one direction, so it has all such
     parts of the set tested there at once (``whole``), and the meshes are projected
     once. Convex parts' cones are cheap to read and are tested only when asked about (a
@@ -224,9 +224,8 @@ class ExtendedDirections:
         one where it was tested along ``k``): besides those, the parts that blocked it
         last along other directions are tested along ``k``, alone, until one of them
         blocks it (a few projected meshes). A closure under these arcs is within the
-        closure under all of them
-        (:func:`~assemblykit.planning.sequence._free_closures`): one blocker on the way
-        to the base proves what all of them would."""
+        closure under all of them (:func:`~assemblykit.planning.search._free_closures`):
+        one blocker on the way to the base proves what all of them would."""
         k = self.same_as(k)
         asked = [
             i for i in bits(movers) if not self._knows(k, i, among) and (k, i) not in self._hinted

@@ -8,7 +8,7 @@ components (:func:`sinks`), and a set free in it holds everything its parts' blo
 and theirs, reach (:func:`closed_under`). Blocking is pairwise (whether P_j blocks P_i
 along d does not depend on the other parts), so the DBG of a subassembly is the
 induced subgraph of the assembly's DBG: the closures of Γ_t's sinks under the arcs of
-Γ_e found so far give the search its removals (:mod:`~assemblykit.planning.sequence`)
+Γ_e found so far give the search its removals (:mod:`~assemblykit.planning.search`)
 and the interlocked sets their names (:mod:`~assemblykit.planning.interlocked_sets`)
 without Γ_e's whole DBG.
 """

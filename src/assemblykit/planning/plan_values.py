@@ -17,7 +17,7 @@ which parts are interlocked.
   (docs/planning.md, "The ground").
 
 Each has its JSON form (docs/planning.md, "JSON"). The search that finds the steps is
-:mod:`~assemblykit.planning.sequence`.
+:mod:`~assemblykit.planning.search`.
 """
 
 from __future__ import annotations
