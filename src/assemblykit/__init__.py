@@ -109,8 +109,8 @@ _PUBLIC = {
     "MotionReport": "assemblykit.motion.freedom",
     "DirectionalBlockingGraph": "assemblykit.blocking.dbg",
     "NonDirectionalBlockingGraph": "assemblykit.blocking.ndbg",
-    "Plan": "assemblykit.planning.sequence",
-    "Step": "assemblykit.planning.sequence",
+    "Plan": "assemblykit.planning.plan_values",
+    "Step": "assemblykit.planning.plan_values",
     "MatingProblem": "assemblykit.mating.problem",
     "MatingResult": "assemblykit.mating.search",
 }

@@ -19,8 +19,9 @@ from typing import TYPE_CHECKING, Any, cast
 
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.report import jsonable
+from assemblykit.planning.plan_values import Plan
 from assemblykit.planning.planner import plan
-from assemblykit.planning.sequence import Plan, Progress
+from assemblykit.planning.search import Progress
 from assemblykit.tolerance import Tolerance
 from assemblykit.viz.viewer import ReportTable, write_report
 

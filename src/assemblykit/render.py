@@ -50,8 +50,8 @@ if TYPE_CHECKING:
     from assemblykit.motion.relational import TaskMotionReport
     from assemblykit.planning.interlocking import Interlocking
     from assemblykit.planning.multimove import MultiMovePlan, Separation
+    from assemblykit.planning.plan_values import Hands, Plan
     from assemblykit.planning.screw import ScrewPlan
-    from assemblykit.planning.sequence import Hands, Plan
 
 
 @functools.singledispatch
@@ -594,8 +594,8 @@ def _register_blocking() -> None:
 def _register_planning() -> None:
     from assemblykit.planning.interlocking import Interlocking
     from assemblykit.planning.multimove import MultiMovePlan
+    from assemblykit.planning.plan_values import Hands, Plan
     from assemblykit.planning.screw import ScrewPlan
-    from assemblykit.planning.sequence import Hands, Plan
 
     render.register(Plan, _plan)
     render.register(Interlocking, _interlocking)

@@ -38,7 +38,6 @@ from assemblykit.planning.sequence import (
     _sinks,
     and_or_graph,
     base_part,
-    fit_axes,
     least_interlocked,
     minimal_interlocked,
     separable,
@@ -215,52 +214,6 @@ def assert_free_by_cones(assembly: Assembly, result: Plan) -> None:
         members = (*step.parts, *step.rest)
         dbg = extended_dbg(assembly, step.direction, members, tol)
         assert dbg.is_free(frozenset(step.parts)), step
-
-
-def test_pairs_tested_for_one_subassembly_serve_the_others():
-    # blocking is pairwise: the DBG asked of a set, after its supersets or subsets were
-    # asked, is the one computed from scratch
-    assembly = shared_assembly(DEMO)
-    names = tuple(assembly.names)
-    tol = assembly.tolerance()
-    directions = np.array([UP, DOWN, [1.0, 0.0, 0.0], [0.0, 0.6, 0.8]])
-    extended = ExtendedDirections(assembly, directions, tol)
-    rng = np.random.default_rng(3)
-    everything = (1 << len(names)) - 1
-    for _ in range(12):
-        k = int(rng.integers(len(directions)))
-        members = int(rng.integers(1, everything + 1)) | 1
-        chosen = tuple(names[i] for i in range(len(names)) if members >> i & 1)
-        expected = extended_dbg(assembly, directions[k], chosen, tol).arcs
-        got = {(names[i], names[j]) for i, j in extended.graph(k, members).edges}
-        assert got == expected
-    # a single part asked alone is tested against the members given, no more
-    fresh = ExtendedDirections(assembly, directions, tol)
-    cover = names.index("cover")
-    held = fresh.blockers(0, 1 << cover, everything)
-    assert held == {cover: 0}  # the cover lifts off
-    assert fresh.evaluated == {0}
-
-
-def test_parts_leaving_along_many_directions_in_turn_are_those_of_the_extended_dbgs():
-    # a search over many directions (a proof that a set is stuck) has the faces that
-    # showed each pair blocking tested along a run of directions at once: who leaves
-    # along each direction is still who leaves in the DBG computed from scratch
-    assembly = shared_assembly(DEMO)
-    names = tuple(assembly.names)
-    tol = assembly.tolerance()
-    rng = np.random.default_rng(5)
-    directions = np.vstack([np.eye(3), -np.eye(3), rng.normal(size=(4, 3))])
-    extended = ExtendedDirections(assembly, directions, tol)
-    everything = (1 << len(names)) - 1
-    left = 0
-    for k in range(len(directions)):
-        arcs = extended_dbg(assembly, directions[k], names, tol).arcs
-        held = {names.index(a) for a, _ in arcs}
-        expected = mask_of(i for i in range(len(names)) if i not in held)
-        assert extended.leaving(k, everything, everything) == expected, k
-        left += expected.bit_count()
-    assert 0 < left < len(names) * len(directions)
 
 
 def test_parts_leaving_and_groups_along_directions_visited_in_turn_are_the_extended_dbgs():
@@ -684,26 +637,6 @@ def test_a_chain_of_plates_drawn_overlapping_leaves_as_one_and_names_an_interfer
         ("b", "c"),
     }
     assert_steps_clear(prepared, result)
-
-
-def test_the_axes_tried_when_sampled_directions_free_nothing_are_the_fits_and_coordinates():
-    # a pin of radius 1 tilted 30 degrees about x in a block's hole of its radius: its
-    # fit's axis (0, -sin 30, cos 30), both ways, joins the coordinate axes; no other
-    # contact is curved
-    tilt = trimesh.transformations.rotation_matrix(np.pi / 6, [1, 0, 0])
-    drill = trimesh.creation.cylinder(1.0, 20, sections=48)
-    drill.apply_transform(tilt)
-    block = trimesh.boolean.difference([box((8, 8, 4), (-4, -4, -2)), drill], engine="manifold")
-    pin = trimesh.creation.cylinder(1.0, 8, sections=48)
-    pin.apply_transform(tilt)
-    assembly = Assembly([Part("block", block), Part("pin", pin)])
-    axes = fit_axes(assembly, assembly.tolerance(None))
-    axis = np.array([0.0, -0.5, np.sqrt(3) / 2])
-    expected = np.vstack([np.eye(3), axis, -np.eye(3), -axis])
-    assert len(axes) == len(expected)
-    for direction in expected:
-        assert np.abs(axes @ direction).max() == pytest.approx(1.0, abs=1e-9)
-        assert (axes @ direction).max() == pytest.approx(1.0, abs=1e-9)
 
 
 def test_a_direction_a_hair_off_an_axis_is_taken_along_the_axis(monkeypatch):

@@ -31,7 +31,7 @@ from assemblykit.viz.explode import explosion
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
-    from assemblykit.planning.sequence import Plan, Step
+    from assemblykit.planning.plan_values import Plan, Step
     from assemblykit.tolerance import Tolerance
 
 PLAN_SUFFIXES = (".json", ".csv")
@@ -69,7 +69,7 @@ def step_rows(plan: Plan, tol: Tolerance | None = None) -> list[dict[str, Any]]:
     """One dictionary per step with the :data:`CSV_COLUMNS` as keys.
 
     >>> import numpy as np
-    >>> from assemblykit.planning.sequence import Plan, Step
+    >>> from assemblykit.planning.plan_values import Plan, Step
     >>> step = Step(("lid",), np.array([0.0, 0.0, 1.0]), ("base",), (("base", "lid"),))
     >>> row = step_rows(Plan(("base", "lid"), (step,), (), None, 1))[0]
     >>> row["parts"], row["direction"], row["held_in_place"], row["assembly_order"]

@@ -44,7 +44,9 @@ from assemblykit.blocking.extended import all_convex, extended_arcs
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 from assemblykit.blocking.polygons import PolygonAssembly
-from assemblykit.planning.sequence import ExtendedDirections, Hands, HandsMove, Search
+from assemblykit.planning.extended_directions import ExtendedDirections
+from assemblykit.planning.plan_values import Hands, HandsMove
+from assemblykit.planning.search import Search
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:

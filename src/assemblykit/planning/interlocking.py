@@ -63,7 +63,7 @@ from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import Assembly
-from assemblykit.planning.sequence import EXACT_GROUP_PARTS
+from assemblykit.planning.candidates import EXACT_GROUP_PARTS
 from assemblykit.tolerance import Tolerance, order_key
 
 Verdict = Literal["interlocking", "recursively interlocking", "not interlocking"]

@@ -1,5 +1,5 @@
 """Planning for polygon assemblies (Wilson & Latombe 1992, "2D case"): the tables the planner of
-:mod:`assemblykit.planning.sequence` searches, and Γ_g restricted to the plane.
+:mod:`assemblykit.planning.search` searches, and Γ_g restricted to the plane.
 
 In the plane Γ_e is exact for every polygon (:mod:`assemblykit.blocking.planar`), so
 the candidate directions are the regions of one arrangement of S¹: the points and open
@@ -23,7 +23,7 @@ from assemblykit.blocking.directions import DirectionTable, mask_of
 from assemblykit.blocking.rigid import RIGID_MAX_SIZE, RigidBlockingGraph, wrenches
 from assemblykit.blocking.tables import planar_direction_tables
 from assemblykit.geometry.contacts import assembly_contacts
-from assemblykit.planning.sequence import Progress, Search
+from assemblykit.planning.search import Progress, Search
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
@@ -36,8 +36,9 @@ _PLANAR_TWIST_BOUNDS = [(0.0, 0.0), (0.0, 0.0), (-1.0, 1.0), (-1.0, 1.0), (-1.0,
 @dataclass(frozen=True, eq=False)
 class PlanarExtended(DirectionTable):
     """Γ_e of polygons along every candidate direction, exact and complete (module
-    docstring): what :class:`assemblykit.planning.sequence.ExtendedDirections` computes
-    pair by pair in 3D is known here for every direction at once."""
+    docstring): what
+    :class:`assemblykit.planning.extended_directions.ExtendedDirections` computes pair
+    by pair in 3D is known here for every direction at once."""
 
     def table(self, indices: Iterable[int], members: int | None = None) -> DirectionTable:
         """The DBGs among ``members`` (default: all parts) along the directions

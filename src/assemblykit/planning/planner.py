@@ -1,5 +1,5 @@
 """The disassembly planner (Wilson & Latombe 1992): the greedy search over the candidate directions
-of :mod:`assemblykit.planning.sequence`, in the plane for polygons
+of :mod:`assemblykit.planning.search`, in the plane for polygons
 (:mod:`assemblykit.planning.planar`), under gravity
 (:mod:`assemblykit.planning.stability`), and the plan it gives: the sets left
 interlocked, classified with Γ_t and Γ_g, the AND/OR graph of a small assembly and the
@@ -22,31 +22,20 @@ from assemblykit.blocking.tables import translation_slots, translation_table, wi
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.geometry.interference import enclosures, interferences
 from assemblykit.model.assembly import Assembly
+from assemblykit.planning.candidates import exact_candidates, fit_axes
 from assemblykit.planning.equilibrium import equilibrium_model
 from assemblykit.planning.equilibrium_memory import EquilibriumMemory
+from assemblykit.planning.extended_directions import ExtendedDirections
 from assemblykit.planning.fasteners import bolts_after_nuts, step_fastener
+from assemblykit.planning.free_sets import separable
 from assemblykit.planning.gravity import Gravity, GravityReport, gravity_direction
 from assemblykit.planning.hands import hands_needed
+from assemblykit.planning.interlocked_sets import least_interlocked
 from assemblykit.planning.judge import StateJudge
 from assemblykit.planning.multimove import moving_groups
+from assemblykit.planning.plan_values import Hands, Interlock, Plan, Step, and_or_graph
 from assemblykit.planning.planar import planar_rigid_may_free, planar_search
-from assemblykit.planning.sequence import (
-    ExtendedDirections,
-    FirstAdmitted,
-    Hands,
-    Interlock,
-    Plan,
-    Progress,
-    Search,
-    Step,
-    and_or_graph,
-    base_part,
-    exact_candidates,
-    fit_axes,
-    least_interlocked,
-    one_set,
-    separable,
-)
+from assemblykit.planning.search import FirstAdmitted, Progress, Search, base_part, one_set
 from assemblykit.tolerance import Tolerance
 
 UP = (0.0, 0.0, 1.0)
@@ -246,7 +235,7 @@ def anchored_volumes(
     names: Sequence[str], volumes: Sequence[float], fixed: Iterable[str]
 ) -> tuple[float, ...]:
     """``volumes`` with every ``fixed`` part's raised by the total, so that the base
-    (:func:`~assemblykit.planning.sequence.base_part`) of a set holding one is a fixed
+    (:func:`~assemblykit.planning.search.base_part`) of a set holding one is a fixed
     part (docs/planning.md, "Fixed parts")."""
     anchored = set(fixed)
     total = sum(volumes)

@@ -61,8 +61,8 @@ from assemblykit.geometry.interference import interference_threshold, solid
 from assemblykit.model.assembly import Assembly
 from assemblykit.model.surfaces import Surface
 from assemblykit.planning.fasteners import ISO_COARSE_PITCH, MILLIMETRES
+from assemblykit.planning.plan_values import Plan
 from assemblykit.planning.planner import plan
-from assemblykit.planning.sequence import Plan
 from assemblykit.tolerance import Tolerance
 
 MAX_ANGLE = math.pi / 2

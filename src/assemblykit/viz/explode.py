@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
-    from assemblykit.planning.sequence import Plan
+    from assemblykit.planning.plan_values import Plan
 
 EXPLODE_CLEARANCE = 1.25
 """A step moves its parts by this multiple of their extent along the step's direction."""
@@ -97,7 +97,7 @@ def explosion(
 
     >>> import numpy as np, trimesh
     >>> from assemblykit.model.assembly import Assembly, Part
-    >>> from assemblykit.planning.sequence import Plan, Step
+    >>> from assemblykit.planning.plan_values import Plan, Step
     >>> base = trimesh.creation.box(extents=(4, 4, 1))
     >>> lid = trimesh.creation.box(extents=(2, 2, 2)).apply_translation((0, 0, 1.5))
     >>> assembly = Assembly([Part("base", base), Part("lid", lid)])

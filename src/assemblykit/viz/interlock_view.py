@@ -16,7 +16,7 @@ import plotly.io as pio
 from assemblykit import formatting as fmt
 from assemblykit.model.assembly import Assembly
 from assemblykit.planning.interlocking import Interlocking
-from assemblykit.planning.sequence import Plan
+from assemblykit.planning.plan_values import Plan
 from assemblykit.viz.viewer import ARROW_COLOR, STYLE, ReportTable, figure
 
 

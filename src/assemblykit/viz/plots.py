@@ -72,7 +72,7 @@ def plot_contacts(
 
 
 if TYPE_CHECKING:
-    from assemblykit.planning.sequence import Plan
+    from assemblykit.planning.plan_values import Plan
 
 
 STORYBOARD_PANELS = 6

@@ -42,7 +42,7 @@ from assemblykit.viz.explode import Explosion, explosion
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
-    from assemblykit.planning.sequence import Plan, Step
+    from assemblykit.planning.plan_values import Plan, Step
     from assemblykit.tolerance import Tolerance
 
 PALETTE = qualitative.Plotly + qualitative.Dark24  # hex strings: valid for matplotlib too
