@@ -267,3 +267,32 @@ def test_a_fault_of_assemblykit_is_recorded_as_one_not_as_bad_input(tmp_path, mo
         "error": "internal error: ZeroDivisionError: division by zero",
         "internal": True,
     }
+
+
+THREADS_PYTHON = """#!/bin/sh
+# a worker that answers each request with the thread counts its environment sets
+while IFS= read -r line; do
+  openblas=$OPENBLAS_NUM_THREADS omp=$OMP_NUM_THREADS
+  echo '{"status": "ok", "result": {"openblas": "'"$openblas"'", "omp": "'"$omp"'"}}'
+done
+"""
+
+
+@pytest.mark.parametrize("asked", [None, "2"])
+def test_workers_run_their_numerical_libraries_on_one_thread_unless_told(
+    tmp_path, monkeypatch, asked
+):
+    script = tmp_path / "bin" / "python"
+    script.parent.mkdir()
+    script.write_text(THREADS_PYTHON)
+    script.chmod(0o755)
+    monkeypatch.setattr(sys, "executable", str(script))
+    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
+        monkeypatch.delenv(name, raising=False)
+    if asked is not None:
+        monkeypatch.setenv("OPENBLAS_NUM_THREADS", asked)
+    (tmp_path / "a.yaml").write_text("a")
+    out = tmp_path / "results.jsonl"
+    run_batch([tmp_path / "a.yaml"], out, workers=2)
+    [record] = whole_lines(out)
+    assert record["result"] == {"openblas": asked or "1", "omp": "1"}

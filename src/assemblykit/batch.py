@@ -70,6 +70,17 @@ Key = tuple[str, str, str]
 INTERRUPTED_CODES = (130, -signal.SIGINT)
 """Exit codes of a child ended by Ctrl-C (it exits 130; killed by SIGINT, -2)."""
 
+ONE_THREAD: dict[str, str] = {
+    "OMP_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+}
+"""The environment a worker's numerical libraries start with, unless the batch's own
+environment sets these variables: one thread each, as Dask starts its workers
+(``distributed.nanny.pre-spawn-environ``). The workers are the batch's parallelism; a
+linear algebra library's own threads would only compete with the other workers, and
+OpenBLAS's keep spinning after each call, taking the core another worker needs."""
+
 
 @dataclass(frozen=True)
 class Job:
@@ -170,7 +181,8 @@ class _Children:
             if self._stopping:
                 raise _Stopped(command[-1])
             pipes: dict[str, Any] = {"stdout": subprocess.PIPE, "stderr": subprocess.PIPE}
-            child = subprocess.Popen(command, text=True, **{**pipes, **streams})
+            env = {**ONE_THREAD, **os.environ}
+            child = subprocess.Popen(command, text=True, env=env, **{**pipes, **streams})
             self._running.add(child)
             return child
 
