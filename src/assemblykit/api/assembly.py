@@ -144,5 +144,5 @@ def load_assembly(
         return PolygonAssembly(drawn.polygons, drawn.source)
     loaded = assembly_files.load_assembly(path, tol, settle)
     made = Assembly.like(loaded, scale=loaded.scale)
-    made.memo = loaded.memo
+    made.memo = loaded.memo.restricted(set(loaded.parts))
     return made
