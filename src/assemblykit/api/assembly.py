@@ -82,7 +82,7 @@ class PolygonAssembly(polygon_model.PolygonAssembly):
         if isinstance(found, Contacts):
             return found
         shown = Contacts(found)
-        self._contacts[self.tolerance(tol)] = shown
+        self.memo.of(polygon_model.PolygonContacts).found[self.tolerance(tol)] = shown
         return shown
 
 

@@ -46,8 +46,9 @@ class Precision:
 
 class Store(Protocol):
     """One kind of data derived from an assembly's parts, kept in its :class:`Memo`
-    (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts and surfaces). Its
-    class is created with no arguments, empty."""
+    (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts and surfaces;
+    :class:`assemblykit.blocking.polygons.PolygonContacts`: contact segments of
+    polygons). Its class is created with no arguments, empty."""
 
     def restricted(self, names: Set[str]) -> Store | None:
         """What of it still holds for the parts ``names`` alone (the same part objects):
