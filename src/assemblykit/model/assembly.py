@@ -16,7 +16,8 @@ Each assembly keeps what was derived from it in its :attr:`Assembly.memo`, a
 :meth:`Memo.of`. So derived data lives exactly as long as its assembly, two assemblies
 never share a store, and nothing outside the assembly holds it. A sub-assembly starts
 with :meth:`Memo.restricted`: what each store still holds for the parts it keeps
-(contacts among them), the rest dropped.
+(contacts among them), the rest dropped. Every kind of assembly (:class:`AssemblyLike`:
+meshes, voxels, polygons in the plane) carries a memo so.
 """
 
 from __future__ import annotations
@@ -47,8 +48,9 @@ class Precision:
 class Store(Protocol):
     """One kind of data derived from an assembly's parts, kept in its :class:`Memo`
     (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts and surfaces;
-    :class:`assemblykit.blocking.polygons.PolygonContacts`: contact segments of
-    polygons). Its class is created with no arguments, empty."""
+    :class:`assemblykit.blocking.cache.BlockingCache`: blocking terms, graphs and
+    obstacles; :class:`assemblykit.blocking.polygons.PolygonContacts`: contact segments
+    of polygons). Its class is created with no arguments, empty."""
 
     def restricted(self, names: Set[str]) -> Store | None:
         """What of it still holds for the parts ``names`` alone (the same part objects):
@@ -103,7 +105,13 @@ class AssemblyLike(Protocol):
     """What every assembly offers, whatever its parts are (meshes, voxels, polygons in
     the plane): their names in order, the space they move in (``dimension``: 3, or 2
     for polygons) and the tolerance policy scaled to the drawing. Code that works for
-    every kind reads these, not the class."""
+    every kind reads these, not the class. Each carries the :class:`Memo` of what was
+    derived from it (``memo``)."""
+
+    @property
+    def memo(self) -> Memo:
+        """What was derived from its parts, one store per kind."""
+        ...
 
     @property
     def names(self) -> list[str]:
