@@ -155,6 +155,12 @@ PUBLIC_NAMES: tuple[str, ...] = (
     "assemblykit.geometry.overlaps.joined",
     "assemblykit.geometry.overlaps.resolve_overlaps",
     "assemblykit.model.assembly.Overlap",
+    # the caching rule (docs/architecture.md, "Caching")
+    "assemblykit.model.assembly.Memo",
+    "assemblykit.model.assembly.Memo.of",
+    "assemblykit.model.assembly.Memo.restricted",
+    "assemblykit.model.assembly.Store",
+    "assemblykit.blocking.polygons.PolygonContacts",
     "assemblykit.geometry.precision",
     # motion and mating (docs/motion.md, docs/mating.md)
     "assemblykit.mating.search.MatingResult.or_and",

@@ -2,25 +2,26 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
 from assemblykit.geometry.contacts import Contact, CurvedPatch, PlanarPatch, assembly_contacts
-from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.assembly import Assembly, Memo, Part
 from assemblykit.tolerance import Tolerance, current
 from datasets import dataset
 
 
 @dataclass(eq=False)
 class ContactAssembly:
-    """Just what the blocking graphs read: part names and contacts."""
+    """Just what the blocking graphs read: part names, contacts and a memo."""
 
     names: list[str]
     given: list[Contact]
     dimension: int = 3
+    memo: Memo = field(default_factory=Memo)
 
     def contacts(self, tol: Tolerance | None = None) -> list[Contact]:
         return self.given

@@ -13,7 +13,7 @@ from shapely.ops import unary_union
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 from assemblykit.blocking.planar import blocked_normals, convex_pieces
-from assemblykit.blocking.polygons import PolygonAssembly, counter_clockwise
+from assemblykit.blocking.polygons import PolygonAssembly, PolygonContacts, counter_clockwise
 from assemblykit.errors import GeometryError
 from assemblykit.io.polygons import load_polygons
 from assemblykit.tolerance import Tolerance
@@ -120,3 +120,15 @@ def test_clockwise_points_are_turned_and_self_crossing_ones_refused():
     bow_tie = np.array([[0, 0], [1, 1], [1, 0], [0, 1]], dtype=float)
     with pytest.raises(GeometryError, match=r"parts\.tie"):
         counter_clockwise(bow_tie, "tie", "f.yaml")
+
+
+def test_polygon_contacts_are_kept_in_the_memo_and_restricted():
+    hands = load_polygons(PLANAR / "three_hands.yaml")
+    found = hands.contacts()
+    assert [c.pair for c in found] == [("base", "bar"), ("base", "block"), ("bar", "block")]
+    assert hands.memo.of(PolygonContacts).found == {hands.tolerance(): found}
+    assert hands.contacts() is found
+    two = hands.subset(["bar", "base"])
+    (kept,) = two.memo.of(PolygonContacts).found.values()
+    assert [c.pair for c in kept] == [("base", "bar")] and kept[0] is found[0]
+    assert len(hands.memo.of(PolygonContacts).found[hands.tolerance()]) == 3

@@ -152,6 +152,15 @@ def test_load_assembly_reads_the_bundled_staircase():
     assert load_burrtools(STAIRCASE).source == str(STAIRCASE)
 
 
+def test_a_puzzle_file_is_read_again_when_its_bytes_change(tmp_path):
+    path = tmp_path / "puzzle.xmpuzzle"
+    path.write_bytes(STAIRCASE.read_bytes())
+    assert load_puzzle(path).names == ["Cage", "Key"]
+    nested = ROOT / "src" / "assemblykit" / "examples" / "interlocking" / "nested_locks.xmpuzzle"
+    path.write_bytes(nested.read_bytes())
+    assert load_puzzle(path).names == load_puzzle(nested).names != ["Cage", "Key"]
+
+
 def replay_stored(puzzle, node, origin: dict[int, np.ndarray]) -> None:
     """Check a stored separation independently: each state moves one set of pieces by
     one lattice vector, with no two pieces sharing a cell at any unit step, until the

@@ -1,14 +1,22 @@
-"""The Assembly model: scale, tolerance, subsets and part changes, and the contacts and
-surfaces the geometry layer keeps in its memo."""
+"""The Assembly model: scale, tolerance, subsets and part changes; its memo, one store per
+kind of derived data, and the contacts and surfaces the geometry layer keeps there."""
 
 from __future__ import annotations
+
+from collections.abc import Set
+from dataclasses import dataclass, field
 
 import numpy as np
 import pytest
 
 from assemblykit.errors import UnknownNameError
-from assemblykit.geometry.contacts import GeometryMemo, assembly_contacts, assembly_surfaces
-from assemblykit.model.assembly import Assembly, Part
+from assemblykit.geometry.contacts import (
+    GeometryMemo,
+    assembly_contacts,
+    assembly_surfaces,
+    memo_of,
+)
+from assemblykit.model.assembly import Assembly, Memo, Part
 from assemblykit.model.packings import box_mesh as box
 from assemblykit.tolerance import Tolerance, using
 
@@ -42,12 +50,60 @@ def test_tolerance_uses_mesh_thresholds_scaled_to_the_model(tower):
         assert tower.tolerance().length == pytest.approx(1e-6 * np.sqrt(11))
 
 
+@dataclass
+class Mentioned:
+    """A store that keeps part names, all of which hold for a subset that has them."""
+
+    names: set[str] = field(default_factory=set)
+
+    def restricted(self, names: Set[str]) -> Mentioned:
+        return Mentioned(self.names & names)
+
+
+class Whole:
+    """A store of what holds for the whole assembly alone."""
+
+    def restricted(self, names: Set[str]) -> None:
+        return None
+
+
+def test_memo_of_makes_one_store_per_kind():
+    memo = Memo()
+    assert len(memo) == 0 and Mentioned not in memo
+    first = memo.of(Mentioned)
+    assert isinstance(first, Mentioned) and first.names == set()
+    assert memo.of(Mentioned) is first
+    other = memo.of(Whole)
+    assert isinstance(other, Whole) and memo.of(Whole) is other
+    assert memo.kinds() == (Mentioned, Whole) and len(memo) == 2
+
+
+def test_every_assembly_starts_with_its_own_empty_memo(tower):
+    again = Assembly(tower.parts)
+    assert len(tower.memo) == 0 and again.memo is not tower.memo
+    tower.memo.of(Mentioned).names.add("a")
+    assert Mentioned not in again.memo
+
+
+def test_restricted_memo_keeps_what_holds_for_the_parts_left():
+    memo = Memo()
+    memo.of(Mentioned).names.update({"a", "b", "c"})
+    memo.of(Whole)
+    kept = memo.restricted({"a", "c"})
+    assert kept.kinds() == (Mentioned,)
+    assert kept.of(Mentioned).names == {"a", "c"}
+    assert memo.of(Mentioned).names == {"a", "b", "c"}
+    assert kept.of(Whole) is not memo.of(Whole)
+
+
 def test_contacts_are_kept_in_the_memo_per_tolerance(tower):
-    assert tower.memo is None
+    assert GeometryMemo not in tower.memo
     first = assembly_contacts(tower)
     assert [c.pair for c in first] == [("a", "b"), ("b", "c")]
     assert assembly_contacts(tower) is first
-    assert isinstance(tower.memo, GeometryMemo) and list(tower.memo.contacts) == [tower.tolerance()]
+    assert tower.memo.kinds() == (GeometryMemo,)
+    assert memo_of(tower) is tower.memo.of(GeometryMemo)
+    assert list(memo_of(tower).contacts) == [tower.tolerance()]
 
 
 def test_subset_keeps_scale_and_cached_contacts(tower):
@@ -55,8 +111,8 @@ def test_subset_keeps_scale_and_cached_contacts(tower):
     sub = tower.subset(["c", "b"])
     assert sub.names == ["b", "c"]
     assert sub.scale == tower.scale
-    assert isinstance(sub.memo, GeometryMemo)
-    ((covered, kept),) = sub.memo.contacts.values()
+    assert GeometryMemo in sub.memo and memo_of(sub) is not memo_of(tower)
+    ((covered, kept),) = memo_of(sub).contacts.values()
     assert covered == {"b", "c"} and [c.pair for c in kept] == [("b", "c")]
     assert assembly_contacts(sub) is kept
     assert [c.pair for c in assembly_contacts(tower.without_part("b"))] == []
@@ -65,8 +121,8 @@ def test_subset_keeps_scale_and_cached_contacts(tower):
 def test_with_part_adds_only_the_new_contacts(tower):
     assembly_contacts(tower)
     grown = tower.without_part("c").with_part(Part("c", box([0, 0, 2], [1, 1, 3])))
-    assert isinstance(grown.memo, GeometryMemo)
-    ((covered, _),) = grown.memo.contacts.values()
+    assert GeometryMemo in grown.memo
+    ((covered, _),) = memo_of(grown).contacts.values()
     assert covered == {"a", "b"}
     assert sorted(c.pair for c in assembly_contacts(grown)) == [("a", "b"), ("b", "c")]
     outside = tower.with_part(Part("d", box([0, 0, 3], [1, 1, 4])))

@@ -82,7 +82,7 @@ class PolygonAssembly(polygon_model.PolygonAssembly):
         if isinstance(found, Contacts):
             return found
         shown = Contacts(found)
-        self._contacts[self.tolerance(tol)] = shown
+        self.memo.of(polygon_model.PolygonContacts).found[self.tolerance(tol)] = shown
         return shown
 
 
@@ -144,5 +144,5 @@ def load_assembly(
         return PolygonAssembly(drawn.polygons, drawn.source)
     loaded = assembly_files.load_assembly(path, tol, settle)
     made = Assembly.like(loaded, scale=loaded.scale)
-    made.memo = loaded.memo
+    made.memo = loaded.memo.restricted(set(loaded.parts))
     return made

@@ -13,6 +13,7 @@ policy counts as touching (:func:`assemblykit.geometry.interference.interference
 from __future__ import annotations
 
 import itertools
+import weakref
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,10 +46,12 @@ of projecting the meshes along each direction."""
 class Obstacles:
     """Convex bodies, hulls, solids, bounding spheres and pairwise cones, back-outs and
     blocking witnesses of one assembly's parts, each computed when first asked for and
-    kept (one per assembly, in its :class:`~assemblykit.blocking.cache.BlockingCache`)."""
+    kept (one per assembly, in the :class:`~assemblykit.blocking.cache.BlockingCache` of
+    its memo). The assembly is held weakly: the obstacles live in its memo, and refer
+    back to it without keeping it alive."""
 
     def __init__(self, assembly: Assembly) -> None:
-        self.assembly = assembly
+        self._owner = weakref.ref(assembly)
         self.pieces: dict[str, list[NDArray[np.float64]] | None] = {}
         self.cones: dict[tuple[str, str, Tolerance], list[NDArray[np.float64]]] = {}
         self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
@@ -66,6 +69,13 @@ class Obstacles:
         bounds = np.array([assembly.parts[n].mesh.bounds for n in names]).reshape(-1, 2, 3)
         self.centers = bounds.mean(axis=1)
         self.radii = np.linalg.norm(bounds[:, 1] - bounds[:, 0], axis=1) / 2
+
+    @property
+    def assembly(self) -> Assembly:
+        """The assembly whose parts these are."""
+        assembly = self._owner()
+        assert assembly is not None, "the assembly of these obstacles is gone"
+        return assembly
 
     def keep_witness(self, pair: tuple[str, str], faces: tuple[int, int]) -> None:
         """Keep ``faces`` first among the witnesses of ``pair`` (:attr:`witnesses`)."""

@@ -7,12 +7,14 @@ where an edge of one lies on an edge of the other with opposite outward normals 
 two overlap with positive length. Each contact segment becomes a :class:`PlanarPatch`
 with its in-plane normal (from part ``a`` into part ``b``), its two endpoints (z = 0) and
 its length as area, so that the NDBG machinery treats the planar case on the circle of
-directions S¹.
+directions S¹. The contacts found are kept per tolerance in the :class:`PolygonContacts`
+store of the assembly's :class:`~assemblykit.model.assembly.Memo`.
 """
 
 from __future__ import annotations
 
 import itertools
+from collections.abc import Set
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -25,17 +27,37 @@ from assemblykit.algebra import se3
 from assemblykit.errors import GeometryError, UnknownNameError
 from assemblykit.geometry.contact_values import Contact, PlanarPatch
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.model.assembly import Memo
 from assemblykit.tolerance import Tolerance, current
 
 
 @dataclass(eq=False)
+class PolygonContacts:
+    """The contact segments of a polygon assembly per tolerance (``found``), a store of
+    its memo (:meth:`PolygonAssembly.contacts`)."""
+
+    found: dict[Tolerance, list[Contact]] = field(default_factory=dict)
+
+    def restricted(self, names: Set[str]) -> PolygonContacts:
+        """The contacts among the polygons ``names`` alone, per tolerance: contacts are
+        found pair by pair, so those of the other pairs still hold."""
+        return PolygonContacts(
+            {
+                tol: [c for c in found if c.a in names and c.b in names]
+                for tol, found in self.found.items()
+            }
+        )
+
+
+@dataclass(eq=False)
 class PolygonAssembly:
-    """Named counter-clockwise polygons (k x 2) in the plane, in assembled position."""
+    """Named counter-clockwise polygons (k x 2) in the plane, in assembled position;
+    ``memo`` keeps what was derived from them (:class:`~assemblykit.model.assembly.Memo`)."""
 
     polygons: dict[str, NDArray[np.float64]]
     source: str | None = None
     dimension: int = 2
-    _contacts: dict[Tolerance, list[Contact]] = field(default_factory=dict, repr=False)
+    memo: Memo = field(default_factory=Memo, repr=False)
 
     @property
     def names(self) -> list[str]:
@@ -56,19 +78,23 @@ class PolygonAssembly:
         return (tol or current()).with_scale(self.scale)
 
     def contacts(self, tol: Tolerance | None = None) -> list[Contact]:
-        """Contact segments between every two polygons (computed once per tolerance)."""
+        """Contact segments between every two polygons (computed once per tolerance, kept
+        in the :class:`PolygonContacts` of its memo)."""
         tol = self.tolerance(tol)
-        if tol not in self._contacts:
-            self._contacts[tol] = edge_contacts(self.polygons, tol)
-        return self._contacts[tol]
+        kept = self.memo.of(PolygonContacts).found
+        if tol not in kept:
+            kept[tol] = edge_contacts(self.polygons, tol)
+        return kept[tol]
 
     def subset(self, names: list[str]) -> PolygonAssembly:
-        """The polygons named."""
+        """The polygons named; its memo keeps what this one's holds for them."""
         missing = set(names) - set(self.polygons)
         if missing:
             raise UnknownNameError(f"no part named {sorted(missing)[0]!r}", source=self.source)
         return PolygonAssembly(
-            {n: self.polygons[n] for n in self.polygons if n in names}, self.source
+            {n: self.polygons[n] for n in self.polygons if n in names},
+            self.source,
+            memo=self.memo.restricted(set(names)),
         )
 
 

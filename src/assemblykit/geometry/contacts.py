@@ -16,12 +16,14 @@ one direction.
 
 What is found is kept with the assembly: :func:`assembly_contacts` (contacts per
 tolerance) and :func:`assembly_surfaces` (surfaces per part and tolerance) fill a
-:class:`GeometryMemo`, an explicit object held in the assembly's ``memo`` slot rather than
-a module global keyed by assembly. The model owns the slot and knows only its protocol
-(``model.assembly.Derived``); this layer fills it. So the memo lives and dies with the
-assembly, two assemblies never share one, and a sub-assembly keeps what concerns its own
-parts (:meth:`GeometryMemo.restricted`, called by ``Assembly.subset`` and ``with_part``):
-taking parts away costs nothing, and adding one costs only that part's contacts.
+:class:`GeometryMemo`, the store of this kind in the assembly's
+:class:`~assemblykit.model.assembly.Memo` (:func:`memo_of`), not a module global keyed by
+assembly. The model owns the memo and knows only the protocol of its stores
+(``model.assembly.Store``); this layer defines and fills the store. So it lives and dies
+with the assembly, two assemblies never share one, and a sub-assembly keeps what
+concerns its own parts (:meth:`GeometryMemo.restricted`, through ``Assembly.subset``
+and ``with_part``): taking parts away costs nothing, and adding one costs only that
+part's contacts.
 
 The contacts found are the values of :mod:`~assemblykit.geometry.contact_values`
 (:class:`Contact`, :class:`Contacts`, :class:`PlanarPatch`, :class:`CurvedPatch`). This
@@ -201,7 +203,7 @@ def find_contacts(
 
 @dataclass(eq=False)
 class GeometryMemo:
-    """What the geometry of an assembly's parts gave, kept in its ``memo`` slot (module
+    """What the geometry of an assembly's parts gave, a store of its memo (module
     docstring): ``contacts`` per tolerance, with the names of the parts they cover,
     ``surfaces`` per part name and tolerance, the ``curved`` ones among them (recognised
     first, without the planes), and the curved surfaces ``near`` per part, other part
@@ -227,10 +229,8 @@ class GeometryMemo:
 
 
 def memo_of(assembly: Assembly) -> GeometryMemo:
-    """The :class:`GeometryMemo` in ``assembly.memo``, an empty one on first use."""
-    if not isinstance(assembly.memo, GeometryMemo):
-        assembly.memo = GeometryMemo()
-    return assembly.memo
+    """The :class:`GeometryMemo` of ``assembly`` (in its memo), an empty one on first use."""
+    return assembly.memo.of(GeometryMemo)
 
 
 def assembly_surfaces(

@@ -33,7 +33,7 @@ import re
 import zlib
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
-from functools import cache
+from functools import lru_cache
 from pathlib import Path
 from typing import Self
 from xml.etree import ElementTree
@@ -144,12 +144,26 @@ class VoxelPuzzle:
         return ".".join(str(n) for n in levels)
 
 
-def _parse(path: Path) -> ElementTree.Element:
+PARSED_KEPT = 16
+"""How many parsed puzzle documents are kept (:func:`_parsed`): a file of many puzzles
+(every six-piece burr) is parsed once for all its solutions."""
+
+
+def _document(path: Path) -> ElementTree.Element:
+    """The parsed XML of the puzzle file at ``path`` (:func:`_parsed` of its bytes)."""
     source = str(path)
     try:
         raw = path.read_bytes()
     except OSError as error:
         raise InputError(f"cannot read the puzzle: {error.strerror}", source=source) from None
+    return _parsed(raw, source)
+
+
+@lru_cache(maxsize=PARSED_KEPT)
+def _parsed(raw: bytes, source: str) -> ElementTree.Element:
+    """The XML document of a puzzle file's bytes ``raw`` (gzip-compressed or not), read
+    from ``source`` (named in errors); kept per bytes and source, the last
+    :data:`PARSED_KEPT` of them (a pure function of immutable values)."""
     try:
         with gzip.GzipFile(fileobj=io.BytesIO(raw)) as stream:
             data = stream.read(MAX_XML_BYTES + 1)
@@ -272,11 +286,6 @@ def _overlap(pieces: Sequence[VoxelPiece]) -> tuple[str, str] | None:
                 return owner[cell], piece.name
             owner[cell] = piece.name
     return None
-
-
-@cache
-def _document(path: Path) -> ElementTree.Element:
-    return _parse(path)
 
 
 def _problem(root: ElementTree.Element, problem: int, source: str) -> ElementTree.Element:

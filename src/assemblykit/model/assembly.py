@@ -4,19 +4,27 @@ conventions").
 A :class:`Part` is a triangle mesh already placed in the world, the pose that placed it,
 and, for CAD input, the exact surfaces of its faces. An :class:`Assembly` is an ordered
 set of parts with their units, the file they came from and the tolerance its geometry
-is compared with. Both are plain data: the contacts between parts (Liu 1997 and Wilson &
-Latombe 1992 start from "the specification of the contact surfaces between parts") and
-the surfaces recognised on each part are computed by :mod:`assemblykit.geometry`, a
-layer above, which keeps them in the assembly's :attr:`Assembly.memo` slot
-(:class:`Derived`), so that they live as long as the assembly and a sub-assembly keeps
-those of its parts.
+is compared with. Both are plain data: what is derived from the parts is computed by the
+layers above: the contacts between parts (Liu 1997 and Wilson & Latombe 1992 start from
+"the specification of the contact surfaces between parts") and the surfaces recognised
+on each part by :mod:`assemblykit.geometry`, the blocking terms, graphs and obstacles by
+:mod:`assemblykit.blocking`.
+
+Each assembly keeps what was derived from it in its :attr:`Assembly.memo`, a
+:class:`Memo` created empty with it: one store per kind of derived data (a
+:class:`Store`, its class defined by the layer that fills it), made on first use by
+:meth:`Memo.of`. So derived data lives exactly as long as its assembly, two assemblies
+never share a store, and nothing outside the assembly holds it. A sub-assembly starts
+with :meth:`Memo.restricted`: what each store still holds for the parts it keeps
+(contacts among them), the rest dropped. Every kind of assembly (:class:`AssemblyLike`:
+meshes, voxels, polygons in the plane) carries a memo so.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Mapping, Set
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Protocol, Self
+from typing import Any, ClassVar, Protocol, Self, TypeVar
 
 import numpy as np
 import trimesh
@@ -37,20 +45,73 @@ class Precision:
     source: str
 
 
-class Derived(Protocol):
-    """What a higher layer computed from the parts of an assembly and keeps with it
-    (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts, surfaces)."""
+class Store(Protocol):
+    """One kind of data derived from an assembly's parts, kept in its :class:`Memo`
+    (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts and surfaces;
+    :class:`assemblykit.blocking.cache.BlockingCache`: blocking terms, graphs and
+    obstacles; :class:`assemblykit.blocking.polygons.PolygonContacts`: contact segments
+    of polygons). Its class is created with no arguments, empty."""
 
-    def restricted(self, names: Set[str]) -> Derived:
-        """What of it still holds for the parts ``names`` alone (the same parts)."""
+    def restricted(self, names: Set[str]) -> Store | None:
+        """What of it still holds for the parts ``names`` alone (the same part objects):
+        a new store, or ``None`` when nothing of it does."""
         ...
+
+
+StoreT = TypeVar("StoreT", bound=Store)
+
+
+class Memo:
+    """What was derived from one assembly's parts (module docstring): one :class:`Store`
+    per kind, by its class."""
+
+    __slots__ = ("_stores",)
+
+    def __init__(self, stores: Iterable[Store] = ()) -> None:
+        self._stores: dict[type[Store], Store] = {type(store): store for store in stores}
+
+    def of(self, kind: type[StoreT]) -> StoreT:
+        """The store of type ``kind``, created empty (``kind()``) the first time."""
+        found = self._stores.get(kind)
+        if found is None:
+            found = self._stores[kind] = kind()
+        assert isinstance(found, kind)
+        return found
+
+    def __contains__(self, kind: object) -> bool:
+        """Whether a store of type ``kind`` was made."""
+        return kind in self._stores
+
+    def __len__(self) -> int:
+        """How many stores were made."""
+        return len(self._stores)
+
+    def kinds(self) -> tuple[type[Store], ...]:
+        """The types of the stores made, in the order they were made."""
+        return tuple(self._stores)
+
+    def restricted(self, names: Set[str]) -> Memo:
+        """A new memo for the parts ``names`` alone: each store's
+        :meth:`Store.restricted`, those with nothing left dropped."""
+        return Memo(
+            kept for store in self._stores.values() if (kept := store.restricted(names)) is not None
+        )
+
+    def __repr__(self) -> str:
+        return f"Memo({', '.join(kind.__name__ for kind in self._stores)})"
 
 
 class AssemblyLike(Protocol):
     """What every assembly offers, whatever its parts are (meshes, voxels, polygons in
     the plane): their names in order, the space they move in (``dimension``: 3, or 2
     for polygons) and the tolerance policy scaled to the drawing. Code that works for
-    every kind reads these, not the class."""
+    every kind reads these, not the class. Each carries the :class:`Memo` of what was
+    derived from it (``memo``)."""
+
+    @property
+    def memo(self) -> Memo:
+        """What was derived from its parts, one store per kind."""
+        ...
 
     @property
     def names(self) -> list[str]:
@@ -150,8 +211,8 @@ class Assembly:
     those it declares (COMPAS ``is_support``) or, for a block assembly that declares
     none, those resting on its lowest plane; a plan keeps them and the ground plane under
     them, with +Z up.
-    ``memo`` is the slot where the geometry layer keeps what it computed from the parts
-    (:class:`Derived`; ``None`` until it is asked).
+    ``memo`` keeps what the layers above derived from the parts (:class:`Memo`, empty
+    until they ask).
     """
 
     dimension: ClassVar[int] = 3
@@ -201,7 +262,7 @@ class Assembly:
         self.warnings = tuple(warnings)
         self.overlaps = tuple(overlaps)
         self.joined = {name: tuple(members) for name, members in (joined or {}).items()}
-        self.memo: Derived | None = None
+        self.memo = Memo()
 
     def __len__(self) -> int:
         return len(self.parts)
@@ -333,13 +394,12 @@ class Assembly:
         )
 
     def _kept(self, parts: Iterable[Part], scale: float | None) -> Self:
-        """This assembly with just ``parts``; the memo keeps what concerns the parts it
-        shares with this one."""
+        """This assembly with just ``parts``; its memo keeps what this one's holds for the
+        parts they share (:meth:`Memo.restricted`)."""
         derived = type(self).like(self, parts, scale)
-        if self.memo is not None:
-            derived.memo = self.memo.restricted(
-                {n for n, p in derived.parts.items() if self.parts.get(n) is p}
-            )
+        derived.memo = self.memo.restricted(
+            {n for n, p in derived.parts.items() if self.parts.get(n) is p}
+        )
         return derived
 
     def subset(self, names: Iterable[str]) -> Self:
