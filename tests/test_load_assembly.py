@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 import assemblykit
-from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.errors import InputError
 from assemblykit.io.polygons import load_polygons
+from assemblykit.model.polygons import PolygonAssembly
 from cli_runs import run
 
 PLANAR = Path(assemblykit.__file__).parent / "examples" / "planar"

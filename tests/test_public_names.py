@@ -330,6 +330,26 @@ def test_the_inputs_and_outputs_users_meet_are_exported() -> None:
             "assemblykit.geometry.occlusion.triangle_overlaps",
             "assemblykit.geometry.occlusion.clip_triangles",
         ),
+        (
+            "assemblykit.blocking.polygons.PolygonAssembly",
+            "assemblykit.model.polygons.PolygonAssembly",
+        ),
+        (
+            "assemblykit.blocking.polygons.PolygonContacts",
+            "assemblykit.blocking.planar.PolygonContacts",
+        ),
+        (
+            "assemblykit.blocking.polygons.counter_clockwise",
+            "assemblykit.blocking.planar.counter_clockwise",
+        ),
+        (
+            "assemblykit.blocking.polygons.edge_contacts",
+            "assemblykit.blocking.planar.edge_contacts",
+        ),
+        (
+            "assemblykit.blocking.polygons.section_polygons",
+            "assemblykit.blocking.planar.section_polygons",
+        ),
     ],
 )
 def test_module_functions_that_moved_or_were_renamed_still_work(old: str, new: str) -> None:

@@ -491,12 +491,11 @@ def _multi_move_plan(
     """The multi-move plan of a loaded voxel puzzle, compared with its stored level, or
     of a mesh assembly, never moving the ``fixed`` parts (docs/planning.md, "Fixed
     parts")."""
-    from assemblykit.io.burrtools import VoxelAssembly
     from assemblykit.planning.multimove import MAX_STATES, plan_voxels
     from assemblykit.planning.multimove_mesh import plan_meshes
 
     limit = MAX_STATES if max_states is None else max_states
-    if not isinstance(loaded, VoxelAssembly):
+    if loaded.kind != "voxels":
         return plan_meshes(loaded, tol, max_states=limit, progress=progress, fixed=fixed)
     puzzle = loaded.puzzle
     return plan_voxels(
@@ -724,10 +723,7 @@ def plan_cmd(
     with _progress_bar() as bar:
         update = _updater(bar)
         loaded = _plan_input(assembly, tol, as_written, problem, solution, partial)
-        from assemblykit.io.burrtools import VoxelAssembly
-        from assemblykit.model.assembly import Assembly
-
-        if isinstance(loaded, Assembly) and not isinstance(loaded, VoxelAssembly):
+        if loaded.kind == "meshes":
             from assemblykit.geometry.overlaps import resolve_overlaps
 
             update("interfering parts", 0, 1)

@@ -11,7 +11,15 @@ import trimesh
 from blocking_helpers import mesh_assembly
 
 from assemblykit.blocking.cache import BlockingCache
-from assemblykit.blocking.extended import extended_arcs, extended_dbg, extended_free, shown_arcs
+from assemblykit.blocking.extended import (
+    assembly_extended_terms,
+    exact_extended,
+    extended_arcs,
+    extended_dbg,
+    extended_free,
+    extended_terms,
+    shown_arcs,
+)
 from assemblykit.blocking.free_cones import ChartSet, _distinct_cones, exact_free_directions
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.queries import can_extract, removable_parts
@@ -20,6 +28,8 @@ from assemblykit.geometry.interference import solid
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.packings import box_mesh as box
+from assemblykit.model.polygons import PolygonAssembly
+from assemblykit.tolerance import Tolerance
 from datasets import shared_assembly
 
 
@@ -319,3 +329,24 @@ def test_a_drawer_slides_along_its_rails_in_any_frame(seed):
     swept = manifold3d.Manifold.hull_points(np.vstack([corners, corners + 20 * along]))
     for name in ("floor", "left", "right", "lid"):
         assert (swept ^ solid(meshes[name])).volume() < 1e-6, name
+
+
+def test_extended_terms_and_their_exactness_are_dispatched_on_the_kind_of_assembly():
+    tol = Tolerance(scale=2.0)
+    boxes = mesh_assembly({"low": box([0, 0, 0], [1, 1, 1]), "high": box([0, 0, 1], [1, 1, 2])})
+    terms = assembly_extended_terms(boxes, tol)
+    assert [(t.moving, t.blocker) for t in terms] == [
+        (t.moving, t.blocker) for t in extended_terms(boxes, tol)
+    ]
+    assert exact_extended(boxes, boxes.names)
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    # an L is not convex: its Γ_e in the plane is exact all the same
+    ell = np.array([[1, 0], [3, 0], [3, 2], [2, 2], [2, 1], [1, 1]], dtype=float)
+    drawn = PolygonAssembly({"square": square, "ell": ell})
+    assert exact_extended(drawn, drawn.names)
+    assert {(t.moving, t.blocker) for t in assembly_extended_terms(drawn, tol)} == {
+        ("square", "ell"),
+        ("ell", "square"),
+    }
+    with pytest.raises(TypeError, match="no extended translations for a str"):
+        exact_extended("neither", [])

@@ -8,9 +8,9 @@ import pytest
 from blocking_helpers import ContactAssembly, compas_folder, cylinder, random_box_contacts, square
 
 from assemblykit.blocking.graphs import blocking_graph
-from assemblykit.blocking.polygons import PolygonAssembly
-from assemblykit.geometry.contacts import Contact
+from assemblykit.geometry.contacts import Contact, assembly_contacts
 from assemblykit.io.polygons import load_polygons
+from assemblykit.model.polygons import PolygonAssembly
 
 
 def crossing_equals_direct(g) -> None:
@@ -84,7 +84,7 @@ def test_planar_partition_has_4k_regions_and_crossing_equals_direct():
         "roof": [[1, 3], [3, 1], [4, 1], [4, 4], [0, 4], [0, 3]],
     }
     asm = PolygonAssembly({k: np.array(v, dtype=float) for k, v in polygons.items()})
-    contacts = asm.contacts()
+    contacts = assembly_contacts(asm)
     normals = {tuple(np.round(np.abs(p.normal), 6)) for c in contacts for p in c.planar}
     assert len(normals) == 3
     g = blocking_graph(asm)
@@ -101,7 +101,7 @@ def test_polygon_yaml(tmp_path):
     path = tmp_path / "p.yaml"
     path.write_text("parts:\n  a: [[0,0],[1,0],[1,1],[0,1]]\n  b: [[1,0],[2,0],[2,1],[1,1]]\n")
     asm = load_polygons(path)
-    (contact,) = asm.contacts()
+    (contact,) = assembly_contacts(asm)
     assert np.allclose(contact.planar[0].normal, [1, 0, 0])
     assert contact.planar[0].area == pytest.approx(1.0)
     g = blocking_graph(asm)
@@ -191,13 +191,13 @@ def test_to_dict_contract():
 
 
 def test_cross_section_of_stacked_boxes():
-    from assemblykit.blocking.polygons import section_polygons
+    from assemblykit.blocking.planar import section_polygons
     from assemblykit.model.packings import box_mesh as box
 
     meshes = {"low": box([0, 0, 0], [2, 1, 1]), "high": box([0.5, 0, 1], [1.5, 1, 2])}
     planar = section_polygons(meshes, np.array([0, 0.5, 0]), np.array([0, 1.0, 0]))
     assert sorted(planar.names) == ["high", "low"]
-    (contact,) = planar.contacts()
+    (contact,) = assembly_contacts(planar)
     (patch,) = contact.planar
     assert patch.area == pytest.approx(1.0)
     g = blocking_graph(planar)

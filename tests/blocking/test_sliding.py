@@ -15,10 +15,10 @@ import pytest
 import trimesh
 
 from assemblykit.blocking.extended import extended_free
-from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.queries import can_extract, parts_to_remove_before, removal_before
 from assemblykit.model.assembly import Assembly, Part
 from assemblykit.model.packings import box_mesh as box
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.planning.planner import plan, separable_by_translations
 from assemblykit.planning.sequence import Step
 from cli_runs import run

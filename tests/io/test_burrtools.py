@@ -65,13 +65,18 @@ def test_rotations_are_the_24_proper_ones_in_burrtools_order():
     assert (ROTATIONS[5] @ [1, 2, 3]).tolist() == [-2, -3, 1]
 
 
-def test_pieces_are_placed_by_transform_and_position(tmp_path):
-    # an L tromino (0,0,0), (1,0,0), (0,1,0); transform 5 sends (x, y, z) to (-y, -z, x)
+def two_trominoes(folder: Path) -> Path:
+    """A puzzle of two L trominoes (0,0,0), (1,0,0), (0,1,0), the second placed by
+    transform 5, which sends (x, y, z) to (-y, -z, x)."""
     tromino = ("2 2 1", "###_", "L")
     result = ("3 3 3", "#" * 27, "Result")
-    path = tmp_path / "l.xmpuzzle"
+    path = folder / "l.xmpuzzle"
     path.write_bytes(gzip.compress(puzzle_xml([tromino, result], [2], "0 0 0 0 2 2 0 5").encode()))
-    puzzle = load_puzzle(path)
+    return path
+
+
+def test_pieces_are_placed_by_transform_and_position(tmp_path):
+    puzzle = load_puzzle(two_trominoes(tmp_path))
     assert puzzle.names == ["L-1", "L-2"]
     assert cells(puzzle.pieces[0].voxels) == {(0, 0, 0), (1, 0, 0), (0, 1, 0)}
     assert cells(puzzle.pieces[1].voxels) == {(2, 2, 0), (2, 2, 1), (1, 2, 0)}
@@ -252,3 +257,12 @@ def test_every_six_piece_burr_fills_the_knot():
     # each solution stores only the shape of BurrTools' separation tree (separationInfo)
     levels = [load_puzzle(path, solution=s).level for s in range(314)]
     assert levels == ["1.1.1.1.1"] * 257 + ["1.2.1.1.1"] * 57
+
+
+def test_a_voxel_assembly_is_an_assembly_of_meshes_of_kind_voxels(tmp_path):
+    path = two_trominoes(tmp_path)
+    loaded = load_burrtools(path)
+    assert (loaded.dimension, loaded.kind) == (3, "voxels")
+    part = loaded.subset(["L-2"])
+    assert part.kind == "voxels" and part.puzzle.names == ["L-2"]
+    assert load_assembly(path).kind == "voxels"

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from assemblykit.errors import GeometryError, InputError, SchemaError
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io.polygons import is_polygon_file, load_polygons
 
 PLANAR = Path(__file__).resolve().parents[2] / "src" / "assemblykit" / "examples" / "planar"
@@ -34,7 +35,7 @@ def test_polygons_are_read_counter_clockwise_in_file_order(tmp_path):
     assert {tuple(p) for p in model.polygons["b"]} == {(0, 1), (0, 2), (2, 2), (2, 1)}
     # the two share the edge y = 1 from x = 0 to 2: one contact of length 2, its normal
     # from b (above) into a (below)
-    (contact,) = model.contacts()
+    (contact,) = assembly_contacts(model)
     assert (contact.a, contact.b) == ("b", "a")
     (patch,) = contact.planar
     assert patch.area == 2.0

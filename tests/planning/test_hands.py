@@ -12,9 +12,9 @@ import pytest
 import trimesh
 
 from assemblykit.blocking.planar import convex_pieces
-from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.io.polygons import load_polygons
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.planning.hands import hands_needed, partitions
 from assemblykit.planning.planner import plan
 

@@ -7,13 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
-from assemblykit.blocking import polygons as polygon_model
+from assemblykit.blocking.planar import PolygonContacts
 from assemblykit.features.primitives import Feature
 from assemblykit.geometry.contact_values import Contacts
 from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
 from assemblykit.io import assembly as assembly_files
 from assemblykit.io import polygons as polygon_files
 from assemblykit.model import assembly as assembly_model
+from assemblykit.model import polygons as polygon_model
 from assemblykit.model.surfaces import Surface
 from assemblykit.tolerance import Tolerance
 
@@ -43,7 +44,7 @@ class Assembly(assembly_model.Assembly):
 
 class PolygonAssembly(polygon_model.PolygonAssembly):
     """A planar assembly of named polygons
-    (:class:`assemblykit.blocking.polygons.PolygonAssembly`; Wilson & Latombe 1992,
+    (:class:`assemblykit.model.polygons.PolygonAssembly`; Wilson & Latombe 1992,
     "2D case") that prints as one line and shows as a table: the value
     :func:`load_assembly` returns for a polygon file, which ``plan`` plans in the plane
     (docs/planning.md, "Planar assemblies")."""
@@ -76,13 +77,13 @@ class PolygonAssembly(polygon_model.PolygonAssembly):
 
     def contacts(self, tol: Tolerance | None = None) -> Contacts:
         """The contact segments between every two polygons, computed once per tolerance
-        (:meth:`assemblykit.blocking.polygons.PolygonAssembly.contacts`), as a list that
-        shows as a table."""
-        found = super().contacts(tol)
+        (:func:`assemblykit.blocking.planar.polygon_contacts`), as a list that shows as
+        a table."""
+        found = assembly_contacts(self, tol)
         if isinstance(found, Contacts):
             return found
         shown = Contacts(found)
-        self.memo.of(polygon_model.PolygonContacts).found[self.tolerance(tol)] = shown
+        self.memo.of(PolygonContacts).found[self.tolerance(tol)] = shown
         return shown
 
 

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Collection, Iterable, Mapping, Sequence
+from functools import singledispatch
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -50,11 +51,11 @@ from assemblykit.geometry.occlusion import (
     view_frame,
     witnesses_hold_along,
 )
+from assemblykit.model.assembly import Assembly, AssemblyLike
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.blocking.obstacles import Obstacles
-    from assemblykit.model.assembly import Assembly
 
 
 def all_convex(assembly: Assembly, parts: Iterable[str]) -> bool:
@@ -75,6 +76,35 @@ def extended_terms(
             terms.append(BlockingTerm(a, b, cone))
             terms.append(BlockingTerm(b, a, -cone))
     return terms
+
+
+@singledispatch
+def exact_extended(assembly: AssemblyLike, parts: Iterable[str]) -> bool:
+    """Whether the NDBG of Γ_e of the ``parts`` of ``assembly`` built from its terms
+    (:func:`assembly_extended_terms`) is exact, dispatched on the assembly's type: for
+    an :class:`~assemblykit.model.assembly.Assembly` when those parts are unions of
+    convex bodies (:func:`all_convex`); polygons register theirs
+    (:mod:`assemblykit.blocking.planar`: always)."""
+    raise TypeError(f"no extended translations for a {type(assembly).__name__}")
+
+
+@exact_extended.register(Assembly)
+def _exact_for_meshes(assembly: Assembly, parts: Iterable[str]) -> bool:
+    return all_convex(assembly, parts)
+
+
+@singledispatch
+def assembly_extended_terms(assembly: AssemblyLike, tol: Tolerance) -> list[BlockingTerm]:
+    """The Γ_e terms of the whole assembly, dispatched on its type: the cones between
+    the convex bodies of an :class:`~assemblykit.model.assembly.Assembly`'s meshes
+    (:func:`extended_terms`); polygons register theirs
+    (:func:`assemblykit.blocking.planar.planar_extended_terms`)."""
+    raise TypeError(f"no extended translations for a {type(assembly).__name__}")
+
+
+@assembly_extended_terms.register(Assembly)
+def _mesh_extended_terms(assembly: Assembly, tol: Tolerance) -> list[BlockingTerm]:
+    return extended_terms(assembly, tol)
 
 
 def sweep_candidates(

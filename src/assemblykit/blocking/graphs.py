@@ -19,7 +19,13 @@ import numpy as np
 
 from assemblykit.blocking.cache import BlockingCache
 from assemblykit.blocking.constraints import BlockingTerm, infinitesimal_terms
-from assemblykit.blocking.extended import all_convex, extended_arcs, extended_dbg, extended_terms
+from assemblykit.blocking.extended import (
+    assembly_extended_terms,
+    exact_extended,
+    extended_arcs,
+    extended_dbg,
+    extended_terms,
+)
 from assemblykit.blocking.ndbg import (
     ConstraintTable,
     Motion,
@@ -27,8 +33,6 @@ from assemblykit.blocking.ndbg import (
     build_ndbg,
 )
 from assemblykit.blocking.obstacles import of_meshes
-from assemblykit.blocking.planar import planar_extended_terms
-from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import assembly_contacts
@@ -45,10 +49,8 @@ def blocking_terms(assembly: AssemblyLike, motion: str, tol: Tolerance) -> list[
     cache = BlockingCache.of(assembly).terms
     key = (motion, tol)
     if key not in cache:
-        if motion == "extended" and isinstance(assembly, PolygonAssembly):
-            cache[key] = planar_extended_terms(assembly, tol)
-        elif motion == "extended":
-            cache[key] = extended_terms(of_meshes(assembly), tol)
+        if motion == "extended":
+            cache[key] = assembly_extended_terms(assembly, tol)
         else:
             cache[key] = infinitesimal_terms(assembly_contacts(assembly, tol))
     return cache[key]
@@ -165,20 +167,10 @@ def blocking_graph(
     if key not in graphs and isinstance(whole, NonDirectionalBlockingGraph):
         # a sub-assembly of an assembly already analysed: drop the other parts' slots
         graphs[key] = whole.without_parts(set(whole.parts) - inside)
-    if (
-        key not in graphs
-        and motion == "extended"
-        and not isinstance(assembly, PolygonAssembly)  # polygons: exact terms, any shape
-        and not all_convex(of_meshes(assembly), names)
-    ):
+    if key not in graphs and motion == "extended" and not exact_extended(assembly, names):
         local = blocking_graph(assembly, "infinitesimal", names, tol)
         graphs[key] = sampled_ndbg(of_meshes(assembly), names, local, tol)
-    if (
-        key not in graphs
-        and motion == "extended"
-        and not isinstance(assembly, PolygonAssembly)
-        and not all_convex(of_meshes(assembly), assembly.names)
-    ):
+    if key not in graphs and motion == "extended" and not exact_extended(assembly, assembly.names):
         # convex parts of an assembly with others that are not: cones among them alone
         # (a stopped set of boards in a cabinet with slotted brackets)
         terms = extended_terms(of_meshes(assembly), tol, names)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import itertools
 import weakref
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,16 +25,17 @@ from assemblykit.geometry.interference import interference_threshold, part_solid
 from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
 from assemblykit.geometry.occlusion import hull_vertices, triangle_spheres
 from assemblykit.geometry.settling import settle
-from assemblykit.model.assembly import Assembly
+from assemblykit.model.assembly import Assembly, AssemblyLike
 from assemblykit.tolerance import Tolerance
 
 
-def of_meshes(assembly: object) -> Assembly:
-    """``assembly``, which must be an :class:`~assemblykit.model.assembly.Assembly`: the
-    obstacles of extended translations in 3D are built from the parts' meshes (polygon
-    assemblies have exact planar terms, :mod:`assemblykit.blocking.planar`)."""
-    assert isinstance(assembly, Assembly)
-    return assembly
+def of_meshes(assembly: AssemblyLike) -> Assembly:
+    """``assembly``, whose parts must be in space (``dimension`` 3: an
+    :class:`~assemblykit.model.assembly.Assembly` of meshes): the obstacles of extended
+    translations in 3D are built from the parts' meshes (polygon assemblies have exact
+    planar terms, :mod:`assemblykit.blocking.planar`)."""
+    assert assembly.dimension == 3, f"no meshes in a {type(assembly).__name__}"
+    return cast("Assembly", assembly)
 
 
 WITNESSES_KEPT = 8

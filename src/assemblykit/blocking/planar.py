@@ -1,14 +1,30 @@
-"""Extended translations of polygons, Γ_e in the plane (Wilson & Latombe 1992, "Extended
-translations", 2D case).
+"""Polygons in the plane (Wilson & Latombe 1992, "2D case"), the blocking layer: the
+contact segments and the blocking terms of a
+:class:`~assemblykit.model.polygons.PolygonAssembly`, the planar variants of what
+:mod:`assemblykit.geometry.contacts` and :mod:`assemblykit.blocking.extended` find for
+meshes (registered with :func:`~assemblykit.geometry.contacts.assembly_contacts`,
+:func:`~assemblykit.blocking.extended.assembly_extended_terms` and
+:func:`~assemblykit.blocking.extended.exact_extended`). The package imports this module,
+so the registrations are made whenever :mod:`assemblykit.blocking` is used.
 
-Part ``j`` blocks part ``i`` along ``d`` (a direction of the circle S¹) iff the area
-``i`` sweeps out when it translates along ``d`` to infinity meets the interior of ``j``.
-Each polygon is cut into convex pieces (a constrained triangulation whose triangles are
-merged while their union stays convex). For a convex piece ``p`` of ``i`` and ``q`` of
-``j`` the sweep of ``p`` meets the interior of ``q`` iff the ray from the origin along
-``d`` enters the interior of the grown obstacle ``M = q ⊕ (−p)`` (the convex hull of the
-vertex differences; Wilson & Latombe 1992 with [Lozano-Pérez, 1983]). So the blocked directions of a
-pair of pieces are read off ``M`` seen from the origin, exactly, from the vertices:
+Contacts. Two parts are in contact along a segment where an edge of one lies on an edge
+of the other with opposite outward normals and the two overlap with positive length.
+Each contact segment becomes a :class:`PlanarPatch` with its in-plane normal (from part
+``a`` into part ``b``), its two endpoints (z = 0) and its length as area, so that the
+NDBG machinery treats the planar case on the circle of directions S¹. The contacts found
+are kept per tolerance in the :class:`PolygonContacts` store of the assembly's
+:class:`~assemblykit.model.assembly.Memo`. Polygons are cut from 3D meshes by a plane
+with :func:`section_polygons`.
+
+Extended translations (Γ_e in the plane). Part ``j`` blocks part ``i`` along ``d`` (a
+direction of the circle S¹) iff the area ``i`` sweeps out when it translates along ``d``
+to infinity meets the interior of ``j``. Each polygon is cut into convex pieces (a
+constrained triangulation whose triangles are merged while their union stays convex).
+For a convex piece ``p`` of ``i`` and ``q`` of ``j`` the sweep of ``p`` meets the
+interior of ``q`` iff the ray from the origin along ``d`` enters the interior of the
+grown obstacle ``M = q ⊕ (−p)`` (the convex hull of the vertex differences; Wilson &
+Latombe 1992 with [Lozano-Pérez, 1983]). So the blocked directions of a pair of pieces
+are read off ``M`` seen from the origin, exactly, from the vertices:
 
 * origin outside ``M``: the open arc between the two extreme directions of the vertices
   of ``M`` (an open cone of angle below π: two half-planes ``n . d > 0``);
@@ -27,19 +43,25 @@ DBG is constant over each, and ``dbg(d)`` holds for any ``d``.
 from __future__ import annotations
 
 import itertools
-from typing import TYPE_CHECKING
+from collections.abc import Iterable, Set
+from dataclasses import dataclass, field
 
 import numpy as np
 import shapely
+import trimesh
 from numpy.typing import NDArray
 from shapely.geometry import MultiPoint, Point, Polygon
+from shapely.geometry.polygon import orient
 from shapely.ops import unary_union
 
+from assemblykit.algebra import se3
 from assemblykit.blocking.constraints import BlockingTerm
+from assemblykit.blocking.extended import assembly_extended_terms, exact_extended
+from assemblykit.errors import GeometryError
+from assemblykit.geometry.contact_values import Contact, PlanarPatch
+from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.tolerance import Tolerance
-
-if TYPE_CHECKING:
-    from assemblykit.blocking.polygons import PolygonAssembly
 
 
 def convex_pieces(polygon: NDArray[np.float64], tol: Tolerance) -> list[NDArray[np.float64]]:
@@ -110,8 +132,9 @@ def blocked_normals(
     return np.array([_left(first), -_left(last)])
 
 
+@assembly_extended_terms.register(PolygonAssembly)
 def planar_extended_terms(model: PolygonAssembly, tol: Tolerance) -> list[BlockingTerm]:
-    """The Γ_e terms of a polygon assembly (:class:`assemblykit.blocking.polygons.
+    """The Γ_e terms of a polygon assembly (:class:`assemblykit.model.polygons.
     PolygonAssembly`): one per pair of convex pieces of every two parts, both ways."""
     pieces = {name: convex_pieces(poly, tol) for name, poly in model.polygons.items()}
     terms: list[BlockingTerm] = []
@@ -124,6 +147,118 @@ def planar_extended_terms(model: PolygonAssembly, tol: Tolerance) -> list[Blocki
     return terms
 
 
+@exact_extended.register(PolygonAssembly)
+def _exact_for_polygons(assembly: PolygonAssembly, parts: Iterable[str]) -> bool:
+    """Γ_e of polygons is exact whatever their shape (module docstring)."""
+    return True
+
+
 def areas(model: PolygonAssembly) -> dict[str, float]:
     """The area of each polygon (the planar planner keeps the largest part as base)."""
     return {name: float(Polygon(poly).area) for name, poly in model.polygons.items()}
+
+
+@dataclass(eq=False)
+class PolygonContacts:
+    """The contact segments of a polygon assembly per tolerance (``found``), a store of
+    its memo (:func:`polygon_contacts`)."""
+
+    found: dict[Tolerance, list[Contact]] = field(default_factory=dict)
+
+    def restricted(self, names: Set[str]) -> PolygonContacts:
+        """The contacts among the polygons ``names`` alone, per tolerance: contacts are
+        found pair by pair, so those of the other pairs still hold."""
+        return PolygonContacts(
+            {
+                tol: [c for c in found if c.a in names and c.b in names]
+                for tol, found in self.found.items()
+            }
+        )
+
+
+@assembly_contacts.register
+def polygon_contacts(assembly: PolygonAssembly, tol: Tolerance | None = None) -> list[Contact]:
+    """Contact segments between every two polygons of ``assembly`` (computed once per
+    tolerance, kept in the :class:`PolygonContacts` of its memo): its
+    :func:`~assemblykit.geometry.contacts.assembly_contacts`."""
+    tol = assembly.tolerance(tol)
+    kept = assembly.memo.of(PolygonContacts).found
+    if tol not in kept:
+        kept[tol] = edge_contacts(assembly.polygons, tol)
+    return kept[tol]
+
+
+def counter_clockwise(
+    points: NDArray[np.float64], name: str, source: str | None = None
+) -> NDArray[np.float64]:
+    """``points`` (k x 2) as a counter-clockwise polygon without its closing vertex;
+    :class:`GeometryError` naming part ``name`` when they are not a simple polygon of
+    positive area."""
+    poly = Polygon(points)
+    if not poly.is_valid or poly.area <= 0:
+        raise GeometryError(
+            "not a simple polygon of positive area", source=source, where=f"parts.{name}"
+        )
+    return np.asarray(orient(poly, 1.0).exterior.coords, dtype=np.float64)[:-1]
+
+
+def section_polygons(
+    meshes: dict[str, trimesh.Trimesh],
+    origin: NDArray[np.float64],
+    normal: NDArray[np.float64],
+) -> PolygonAssembly:
+    """Cross-sections of meshes by the plane through ``origin`` with ``normal``, as
+    polygons in one frame of that plane (the largest region of each part)."""
+    n = np.asarray(normal, dtype=np.float64)
+    n = n / np.linalg.norm(n)
+    # the polygons' coordinates are in the plane's frame: its turn is part of the answer
+    e1, e2 = se3.axis_basis(n, turned=True)
+    to_2d = np.eye(4)
+    to_2d[:3, :3] = np.vstack([e1, e2, n])
+    to_2d[:3, 3] = -to_2d[:3, :3] @ np.asarray(origin, dtype=np.float64)
+    polygons = {}
+    for name, mesh in meshes.items():
+        cut = mesh.section(plane_origin=origin, plane_normal=n)
+        if cut is None:
+            continue
+        planar, _ = cut.to_2D(to_2D=to_2d, check=False)
+        regions = planar.polygons_full
+        if regions:
+            # the triangulation leaves collinear vertices on the section's edges
+            biggest = max(regions, key=lambda p: p.area).simplify(0)
+            polygons[name] = counter_clockwise(np.asarray(biggest.exterior.coords)[:-1], name)
+    return PolygonAssembly(polygons)
+
+
+def _edges(poly: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    return poly, np.roll(poly, -1, axis=0)
+
+
+def edge_contacts(polygons: dict[str, NDArray[np.float64]], tol: Tolerance) -> list[Contact]:
+    """Contact segments between every two counter-clockwise polygons (module docstring)."""
+    contacts = []
+    boxes = {
+        n: (p.min(axis=0) - tol.length, p.max(axis=0) + tol.length) for n, p in polygons.items()
+    }
+    for a, b in itertools.combinations(polygons, 2):
+        (alo, ahi), (blo, bhi) = boxes[a], boxes[b]
+        if np.any(alo > bhi) or np.any(blo > ahi):
+            continue
+        patches = []
+        for p, q in zip(*_edges(polygons[a]), strict=True):
+            u = (q - p) / np.linalg.norm(q - p)
+            normal = np.array([u[1], -u[0]])  # outward for a counter-clockwise polygon
+            for r, s in zip(*_edges(polygons[b]), strict=True):
+                w = (s - r) / np.linalg.norm(s - r)
+                if u @ w > 0 or abs(u[0] * w[1] - u[1] * w[0]) > tol.angle:
+                    continue
+                if abs(normal @ (r - p)) > tol.length or abs(normal @ (s - p)) > tol.length:
+                    continue
+                lo = max(0.0, min(u @ (r - p), u @ (s - p)))
+                hi = min(float(u @ (q - p)), max(u @ (r - p), u @ (s - p)))
+                if hi - lo > tol.length:
+                    seg = np.array([[*(p + lo * u), 0.0], [*(p + hi * u), 0.0]])
+                    patches.append(PlanarPatch(np.array([*normal, 0.0]), seg, hi - lo))
+        if patches:
+            contacts.append(Contact(a, b, planar=tuple(patches)))
+    return contacts

@@ -1,177 +1,19 @@
-"""Planar assemblies of polygonal parts (Wilson & Latombe 1992, "2D case").
-
-Parts are simple polygons in the plane z = 0, in assembled position: read from a small
-YAML file (``parts: {name: [[x, y], ...]}``, by :mod:`assemblykit.io.polygons`) or cut
-from 3D meshes by a plane (trimesh ``section``). Two parts are in contact along a segment
-where an edge of one lies on an edge of the other with opposite outward normals and the
-two overlap with positive length. Each contact segment becomes a :class:`PlanarPatch`
-with its in-plane normal (from part ``a`` into part ``b``), its two endpoints (z = 0) and
-its length as area, so that the NDBG machinery treats the planar case on the circle of
-directions S¹. The contacts found are kept per tolerance in the :class:`PolygonContacts`
-store of the assembly's :class:`~assemblykit.model.assembly.Memo`.
-"""
+"""Former home of planar polygon assemblies: the data class is
+:class:`assemblykit.model.polygons.PolygonAssembly`, its contacts and blocking terms are
+in :mod:`assemblykit.blocking.planar`. The old names keep working, with a
+:class:`DeprecationWarning` (docs/architecture.md, "Deprecated names")."""
 
 from __future__ import annotations
 
-import itertools
-from collections.abc import Set
-from dataclasses import dataclass, field
+from assemblykit.deprecation import moved
 
-import numpy as np
-import trimesh
-from numpy.typing import NDArray
-from shapely.geometry import Polygon
-from shapely.geometry.polygon import orient
-
-from assemblykit.algebra import se3
-from assemblykit.errors import GeometryError, UnknownNameError
-from assemblykit.geometry.contact_values import Contact, PlanarPatch
-from assemblykit.geometry.contacts import assembly_contacts
-from assemblykit.model.assembly import Memo
-from assemblykit.tolerance import Tolerance, current
-
-
-@dataclass(eq=False)
-class PolygonContacts:
-    """The contact segments of a polygon assembly per tolerance (``found``), a store of
-    its memo (:meth:`PolygonAssembly.contacts`)."""
-
-    found: dict[Tolerance, list[Contact]] = field(default_factory=dict)
-
-    def restricted(self, names: Set[str]) -> PolygonContacts:
-        """The contacts among the polygons ``names`` alone, per tolerance: contacts are
-        found pair by pair, so those of the other pairs still hold."""
-        return PolygonContacts(
-            {
-                tol: [c for c in found if c.a in names and c.b in names]
-                for tol, found in self.found.items()
-            }
-        )
-
-
-@dataclass(eq=False)
-class PolygonAssembly:
-    """Named counter-clockwise polygons (k x 2) in the plane, in assembled position;
-    ``memo`` keeps what was derived from them (:class:`~assemblykit.model.assembly.Memo`)."""
-
-    polygons: dict[str, NDArray[np.float64]]
-    source: str | None = None
-    dimension: int = 2
-    memo: Memo = field(default_factory=Memo, repr=False)
-
-    @property
-    def names(self) -> list[str]:
-        """Part names in order."""
-        return list(self.polygons)
-
-    @property
-    def scale(self) -> float:
-        """Diagonal of the bounding box of all polygons (1 when empty)."""
-        if not self.polygons:
-            return 1.0
-        pts = np.concatenate(list(self.polygons.values()))
-        diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
-        return diag if diag > 0 else 1.0
-
-    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
-        """The tolerance policy scaled to this drawing."""
-        return (tol or current()).with_scale(self.scale)
-
-    def contacts(self, tol: Tolerance | None = None) -> list[Contact]:
-        """Contact segments between every two polygons (computed once per tolerance, kept
-        in the :class:`PolygonContacts` of its memo)."""
-        tol = self.tolerance(tol)
-        kept = self.memo.of(PolygonContacts).found
-        if tol not in kept:
-            kept[tol] = edge_contacts(self.polygons, tol)
-        return kept[tol]
-
-    def subset(self, names: list[str]) -> PolygonAssembly:
-        """The polygons named; its memo keeps what this one's holds for them."""
-        missing = set(names) - set(self.polygons)
-        if missing:
-            raise UnknownNameError(f"no part named {sorted(missing)[0]!r}", source=self.source)
-        return PolygonAssembly(
-            {n: self.polygons[n] for n in self.polygons if n in names},
-            self.source,
-            memo=self.memo.restricted(set(names)),
-        )
-
-
-assembly_contacts.register(PolygonAssembly, PolygonAssembly.contacts)
-
-
-def counter_clockwise(
-    points: NDArray[np.float64], name: str, source: str | None = None
-) -> NDArray[np.float64]:
-    """``points`` (k x 2) as a counter-clockwise polygon without its closing vertex;
-    :class:`GeometryError` naming part ``name`` when they are not a simple polygon of
-    positive area."""
-    poly = Polygon(points)
-    if not poly.is_valid or poly.area <= 0:
-        raise GeometryError(
-            "not a simple polygon of positive area", source=source, where=f"parts.{name}"
-        )
-    return np.asarray(orient(poly, 1.0).exterior.coords, dtype=np.float64)[:-1]
-
-
-def section_polygons(
-    meshes: dict[str, trimesh.Trimesh],
-    origin: NDArray[np.float64],
-    normal: NDArray[np.float64],
-) -> PolygonAssembly:
-    """Cross-sections of meshes by the plane through ``origin`` with ``normal``, as
-    polygons in one frame of that plane (the largest region of each part)."""
-    n = np.asarray(normal, dtype=np.float64)
-    n = n / np.linalg.norm(n)
-    # the polygons' coordinates are in the plane's frame: its turn is part of the answer
-    e1, e2 = se3.axis_basis(n, turned=True)
-    to_2d = np.eye(4)
-    to_2d[:3, :3] = np.vstack([e1, e2, n])
-    to_2d[:3, 3] = -to_2d[:3, :3] @ np.asarray(origin, dtype=np.float64)
-    polygons = {}
-    for name, mesh in meshes.items():
-        cut = mesh.section(plane_origin=origin, plane_normal=n)
-        if cut is None:
-            continue
-        planar, _ = cut.to_2D(to_2D=to_2d, check=False)
-        regions = planar.polygons_full
-        if regions:
-            # the triangulation leaves collinear vertices on the section's edges
-            biggest = max(regions, key=lambda p: p.area).simplify(0)
-            polygons[name] = counter_clockwise(np.asarray(biggest.exterior.coords)[:-1], name)
-    return PolygonAssembly(polygons)
-
-
-def _edges(poly: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    return poly, np.roll(poly, -1, axis=0)
-
-
-def edge_contacts(polygons: dict[str, NDArray[np.float64]], tol: Tolerance) -> list[Contact]:
-    """Contact segments between every two counter-clockwise polygons (module docstring)."""
-    contacts = []
-    boxes = {
-        n: (p.min(axis=0) - tol.length, p.max(axis=0) + tol.length) for n, p in polygons.items()
-    }
-    for a, b in itertools.combinations(polygons, 2):
-        (alo, ahi), (blo, bhi) = boxes[a], boxes[b]
-        if np.any(alo > bhi) or np.any(blo > ahi):
-            continue
-        patches = []
-        for p, q in zip(*_edges(polygons[a]), strict=True):
-            u = (q - p) / np.linalg.norm(q - p)
-            normal = np.array([u[1], -u[0]])  # outward for a counter-clockwise polygon
-            for r, s in zip(*_edges(polygons[b]), strict=True):
-                w = (s - r) / np.linalg.norm(s - r)
-                if u @ w > 0 or abs(u[0] * w[1] - u[1] * w[0]) > tol.angle:
-                    continue
-                if abs(normal @ (r - p)) > tol.length or abs(normal @ (s - p)) > tol.length:
-                    continue
-                lo = max(0.0, min(u @ (r - p), u @ (s - p)))
-                hi = min(float(u @ (q - p)), max(u @ (r - p), u @ (s - p)))
-                if hi - lo > tol.length:
-                    seg = np.array([[*(p + lo * u), 0.0], [*(p + hi * u), 0.0]])
-                    patches.append(PlanarPatch(np.array([*normal, 0.0]), seg, hi - lo))
-        if patches:
-            contacts.append(Contact(a, b, planar=tuple(patches)))
-    return contacts
+__getattr__ = moved(
+    __name__,
+    {
+        "PolygonAssembly": "assemblykit.model.polygons",
+        "PolygonContacts": "assemblykit.blocking.planar",
+        "counter_clockwise": "assemblykit.blocking.planar",
+        "edge_contacts": "assemblykit.blocking.planar",
+        "section_polygons": "assemblykit.blocking.planar",
+    },
+)

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from functools import singledispatch
 
 import networkx as nx
 import numpy as np
@@ -42,16 +42,12 @@ from assemblykit.blocking.ndbg import (
     NonDirectionalBlockingGraph,
     build_ndbg,
 )
-from assemblykit.blocking.obstacles import of_meshes
-from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.deprecation import moved
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import assembly_contacts
-from assemblykit.model.assembly import AssemblyLike
+from assemblykit.model.assembly import Assembly, AssemblyLike
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.tolerance import Tolerance
-
-if TYPE_CHECKING:
-    from assemblykit.model.assembly import Assembly
 
 _AXES = np.concatenate([np.eye(3), -np.eye(3)])
 
@@ -172,23 +168,31 @@ def can_extract(
         graph = blocking_graph(assembly, "rigid", tol=tol)
         twist = graph.free_twist(moving)
         return None if twist is None else Removal(chosen, (twist,))
-    if motion == "extended" and isinstance(assembly, PolygonAssembly):
-        exact = _planar_free(assembly, moving, names, tol)
-        return Removal(chosen, tuple(exact)) if len(exact) else None
     if motion == "extended":
-        return _extended_removal(of_meshes(assembly), moving, names, tol)
+        return _extended_removal(assembly, moving, names, tol)
     directions, _ = _local_free_regions(assembly, moving, tol)
     return Removal(chosen, tuple(directions)) if len(directions) else None
 
 
+@singledispatch
 def _extended_removal(
+    assembly: AssemblyLike, moving: set[str], among: Collection[str], tol: Tolerance
+) -> Removal | None:
+    """:func:`can_extract` by an extended translation among the parts ``among``,
+    dispatched on the assembly's type: meshes (:func:`_mesh_removal`) or polygons
+    (:func:`_planar_removal`)."""
+    raise TypeError(f"no extended translations for a {type(assembly).__name__}")
+
+
+@_extended_removal.register(Assembly)
+def _mesh_removal(
     assembly: Assembly, moving: set[str], among: Collection[str], tol: Tolerance
 ) -> Removal | None:
-    """:func:`can_extract` by an extended translation among the parts ``among``: none
-    when Γ_t holds it along every direction; else the locally free regions of Γ_t (the
-    highest dimension first, the open free cone when it has one), the other regions,
-    the principal axes and contact normals, each checked exactly; then the exact free
-    set (faces, then arcs and points)."""
+    """:func:`_extended_removal` of meshes: none when Γ_t holds ``moving`` along every
+    direction; else the locally free regions of Γ_t (the highest dimension first, the
+    open free cone when it has one), the other regions, the principal axes and contact
+    normals, each checked exactly; then the exact free set (faces, then arcs and
+    points)."""
     chosen = frozenset(moving)
     directions, dims = _local_free_regions(assembly, moving, tol, among)
     if not len(dims):
@@ -231,6 +235,16 @@ def _planar_free(
     return found
 
 
+@_extended_removal.register(PolygonAssembly)
+def _planar_removal(
+    model: PolygonAssembly, moving: set[str], among: Collection[str], tol: Tolerance
+) -> Removal | None:
+    """:func:`_extended_removal` of polygons: the regions of their exact NDBG along which
+    ``moving`` leaves (:func:`_planar_free`)."""
+    exact = _planar_free(model, moving, among, tol)
+    return Removal(frozenset(moving), tuple(exact)) if len(exact) else None
+
+
 def removable_parts(
     assembly: AssemblyLike,
     motion: Motion = "extended",
@@ -262,9 +276,7 @@ class Prerequisite:
     minimal: bool
 
 
-def removal_before(
-    assembly: Assembly | PolygonAssembly, part: str, tol: Tolerance | None = None
-) -> Prerequisite:
+def removal_before(assembly: AssemblyLike, part: str, tol: Tolerance | None = None) -> Prerequisite:
     """The fewest parts to remove before ``part`` can leave by an extended translation,
     over all directions (Wilson & Latombe 1992 §5): the directions are one per face of
     the overlay of the sets each other part blocks (over a face, the parts blocking
@@ -278,9 +290,24 @@ def removal_before(
     if part not in assembly.names:
         raise UnknownNameError(f"no part named {part!r}")
     tol = assembly.tolerance(tol)
-    names = list(assembly.names)
-    if isinstance(assembly, PolygonAssembly):
-        return _planar_removal_before(assembly, part, names, tol)
+    return _removal_before(assembly, part, list(assembly.names), tol)
+
+
+@singledispatch
+def _removal_before(
+    assembly: AssemblyLike, part: str, names: list[str], tol: Tolerance
+) -> Prerequisite:
+    """:func:`removal_before`, dispatched on the assembly's type: meshes
+    (:func:`_mesh_removal_before`) or polygons (:func:`_planar_removal_before`)."""
+    raise TypeError(f"no extended translations for a {type(assembly).__name__}")
+
+
+@_removal_before.register(Assembly)
+def _mesh_removal_before(
+    assembly: Assembly, part: str, names: list[str], tol: Tolerance
+) -> Prerequisite:
+    """:func:`removal_before` of meshes: over the faces of the overlay of the sets the
+    other parts block and the arcs and points where they meet (:func:`removal_before`)."""
     others = [n for n in names if n != part]
     sets = blocked_sets(assembly, [part], names, tol)
     if sets is None:
@@ -306,7 +333,7 @@ def removal_before(
 
 
 def _first_removable(
-    assembly: Assembly | PolygonAssembly,
+    assembly: AssemblyLike,
     part: str,
     options: dict[frozenset[str], NDArray[np.float64]],
     names: list[str],
@@ -325,6 +352,7 @@ def _first_removable(
     return Prerequisite(part, frozenset(n for n in names if n != part), None, False)
 
 
+@_removal_before.register(PolygonAssembly)
 def _planar_removal_before(
     model: PolygonAssembly, part: str, names: list[str], tol: Tolerance
 ) -> Prerequisite:
@@ -341,7 +369,7 @@ def _planar_removal_before(
 
 
 def _removable_first(
-    assembly: Assembly | PolygonAssembly, chosen: frozenset[str], names: list[str], tol: Tolerance
+    assembly: AssemblyLike, chosen: frozenset[str], names: list[str], tol: Tolerance
 ) -> bool:
     """Whether the parts of ``chosen`` can be taken out of ``names`` one at a time, each
     by an extended translation among the parts still there (:func:`_extended_removal`,
@@ -357,13 +385,9 @@ def _removable_first(
     return True
 
 
-def _leaves(
-    assembly: Assembly | PolygonAssembly, name: str, among: set[str], tol: Tolerance
-) -> bool:
+def _leaves(assembly: AssemblyLike, name: str, among: set[str], tol: Tolerance) -> bool:
     """Whether the part ``name`` leaves the other parts of ``among`` by one extended
     translation."""
-    if isinstance(assembly, PolygonAssembly):
-        return bool(len(_planar_free(assembly, {name}, among, tol)))
     return _extended_removal(assembly, {name}, among, tol) is not None
 
 
@@ -380,8 +404,7 @@ def parts_to_remove_before(
     if part not in assembly.names:
         raise UnknownNameError(f"no part named {part!r}")
     if motion == "extended":
-        model = assembly if isinstance(assembly, PolygonAssembly) else of_meshes(assembly)
-        return removal_before(model, part, tol).parts
+        return removal_before(assembly, part, tol).parts
     if motion == "rigid":
         graph = blocking_graph(assembly, "rigid", tol=tol)
         best = min(

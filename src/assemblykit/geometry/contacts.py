@@ -310,7 +310,7 @@ def near_curved_surfaces(
 def assembly_contacts(assembly: object, tol: Tolerance | None = None) -> list[Contact]:
     """The contacts between the touching parts of ``assembly``, dispatched on its type:
     an :class:`~assemblykit.model.assembly.Assembly` (:func:`_mesh_contacts`) or another
-    kind that registers its own (the planar polygons of ``assemblykit.blocking.polygons``)."""
+    kind that registers its own (the planar polygons of ``assemblykit.blocking.planar``)."""
     raise TypeError(f"no contacts for a {type(assembly).__name__}")
 
 

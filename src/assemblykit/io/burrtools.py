@@ -35,7 +35,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
-from typing import Self
+from typing import ClassVar, Literal, Self
 from xml.etree import ElementTree
 
 import numpy as np
@@ -467,6 +467,8 @@ def voxel_mesh(voxels: NDArray[np.int64], source: str | None = None) -> trimesh.
 class VoxelAssembly(Assembly):
     """An :class:`Assembly` of a BurrTools puzzle's pieces (unit-cube meshes) that keeps
     the :class:`VoxelPuzzle` for planning on the lattice (``puzzle``)."""
+
+    kind: ClassVar[Literal["meshes", "voxels"]] = "voxels"
 
     def __init__(self, puzzle: VoxelPuzzle, tol: Tolerance | None = None) -> None:
         parts = [

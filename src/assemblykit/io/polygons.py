@@ -1,6 +1,6 @@
 """Files of planar assemblies (Wilson & Latombe 1992, "2D case"): ``parts: {name: [[x, y], ...]}``
 in YAML, each part a simple polygon in assembled position, read into a
-:class:`~assemblykit.blocking.polygons.PolygonAssembly`.
+:class:`~assemblykit.model.polygons.PolygonAssembly`.
 
 The text is read through :mod:`assemblykit.io.documents` (UTF-8, size and alias
 limits); every polygon must be a list of at least three ``[x, y]`` points of finite
@@ -15,9 +15,10 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.blocking.polygons import PolygonAssembly, counter_clockwise
+from assemblykit.blocking.planar import counter_clockwise
 from assemblykit.errors import InputError, SchemaError
 from assemblykit.io.documents import MAX_COORDINATE, read_text, read_yaml
+from assemblykit.model.polygons import PolygonAssembly
 
 
 def _points(value: object) -> NDArray[np.float64]:

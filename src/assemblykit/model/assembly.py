@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Mapping, Set
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Protocol, Self, TypeVar
+from typing import Any, ClassVar, Literal, Protocol, Self, TypeVar
 
 import numpy as np
 import trimesh
@@ -49,7 +49,7 @@ class Store(Protocol):
     """One kind of data derived from an assembly's parts, kept in its :class:`Memo`
     (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts and surfaces;
     :class:`assemblykit.blocking.cache.BlockingCache`: blocking terms, graphs and
-    obstacles; :class:`assemblykit.blocking.polygons.PolygonContacts`: contact segments
+    obstacles; :class:`assemblykit.blocking.planar.PolygonContacts`: contact segments
     of polygons). Its class is created with no arguments, empty."""
 
     def restricted(self, names: Set[str]) -> Store | None:
@@ -104,9 +104,13 @@ class Memo:
 class AssemblyLike(Protocol):
     """What every assembly offers, whatever its parts are (meshes, voxels, polygons in
     the plane): their names in order, the space they move in (``dimension``: 3, or 2
-    for polygons) and the tolerance policy scaled to the drawing. Code that works for
-    every kind reads these, not the class. Each carries the :class:`Memo` of what was
-    derived from it (``memo``)."""
+    for polygons), what the parts are (``kind``) and the tolerance policy scaled to the
+    drawing. Code that works for every kind reads these, not the class: a layer whose
+    answer differs by kind gives its variants side by side, as functions dispatched on
+    the assembly (``functools.singledispatch``, the planar one registered by the module
+    of the 2D case) or on ``dimension``, which tells :class:`Assembly` (3) from
+    :class:`~assemblykit.model.polygons.PolygonAssembly` (2) to the type checker too.
+    Each carries the :class:`Memo` of what was derived from it (``memo``)."""
 
     @property
     def memo(self) -> Memo:
@@ -121,6 +125,12 @@ class AssemblyLike(Protocol):
     @property
     def dimension(self) -> int:
         """3 for parts in space, 2 for polygons in the plane."""
+        ...
+
+    @property
+    def kind(self) -> str:
+        """What the parts are: ``"meshes"``, ``"voxels"`` (the unit-cube meshes of a
+        voxel puzzle's pieces, which also move on their lattice) or ``"polygons"``."""
         ...
 
     def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
@@ -215,8 +225,11 @@ class Assembly:
     until they ask).
     """
 
-    dimension: ClassVar[int] = 3
+    dimension: ClassVar[Literal[3]] = 3
     """The space the parts move in: 3 (a polygon assembly, drawn in the plane, has 2)."""
+
+    kind: ClassVar[Literal["meshes", "voxels"]] = "meshes"
+    """What the parts are: triangle meshes (``"voxels"`` for a voxel puzzle's pieces)."""
 
     def __init__(
         self,

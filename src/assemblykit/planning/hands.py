@@ -43,7 +43,7 @@ from assemblykit.blocking.directions import DirectionTable, bits, mask_of, sever
 from assemblykit.blocking.extended import all_convex, extended_arcs
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
-from assemblykit.blocking.polygons import PolygonAssembly
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.planning.extended_directions import ExtendedDirections
 from assemblykit.planning.plan_values import Hands, HandsMove
 from assemblykit.planning.search import Search
@@ -61,7 +61,7 @@ HANDS_MAX_PARTS = 8
 
 def _sizes(assembly: Assembly | PolygonAssembly) -> dict[str, float]:
     """Volumes of the parts (areas for polygons): the largest stays fixed."""
-    if isinstance(assembly, PolygonAssembly):
+    if assembly.dimension == 2:
         from assemblykit.blocking.planar import areas
 
         return areas(assembly)
@@ -251,7 +251,7 @@ def hands_needed(
     planner stopped), so no two-handed search is made of them first."""
     tol = assembly.tolerance(tol)
     names = tuple(assembly.names if parts is None else parts)
-    if isinstance(assembly, PolygonAssembly) or all_convex(assembly, names):
+    if assembly.dimension == 2 or all_convex(assembly, names):
         search = _exact_search(assembly, names, max_hands, tol)
     else:
         search = _sampled_search(assembly, names, max_hands, tol)

@@ -52,17 +52,17 @@ from assemblykit import formatting as fmt
 from assemblykit.algebra import se3
 from assemblykit.blocking.arrangement import Arrangement
 from assemblykit.blocking.dbg import DirectionalBlockingGraph
-from assemblykit.blocking.extended import all_convex
+from assemblykit.blocking.extended import exact_extended
 from assemblykit.blocking.free_cones import blocked_by, exact_free_directions, overlay_faces
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.blocking.ndbg import Motion, NonDirectionalBlockingGraph
 from assemblykit.blocking.obstacles import of_meshes
 from assemblykit.blocking.planar import areas
-from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import Assembly
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.planning.candidates import EXACT_GROUP_PARTS
 from assemblykit.tolerance import Tolerance, order_key
 
@@ -593,11 +593,6 @@ def _ndbg_cells(graph: NonDirectionalBlockingGraph) -> tuple[_Cell, ...]:
     return tuple(sorted(cells, key=lambda c: (-c.dimension, c.regions[0])))
 
 
-def _exact_extended(assembly: Assembly | PolygonAssembly, parts: Sequence[str]) -> bool:
-    """Whether Γ_e's regions are regular: polygons, or parts made of convex bodies."""
-    return isinstance(assembly, PolygonAssembly) or all_convex(of_meshes(assembly), parts)
-
-
 def _translation_evidence(
     assembly: Assembly | PolygonAssembly, parts: tuple[str, ...], motion: Motion, tol: Tolerance
 ) -> _Evidence:
@@ -606,7 +601,7 @@ def _translation_evidence(
     ndbg = blocking_graph(assembly, motion, parts, tol)
     assert isinstance(ndbg, NonDirectionalBlockingGraph)
     cells = _ndbg_cells(ndbg)
-    if motion == "infinitesimal" or _exact_extended(assembly, parts):
+    if motion == "infinitesimal" or exact_extended(assembly, parts):
         return _Evidence(cells, (), ndbg, None, True)
     local = blocking_graph(assembly, "infinitesimal", parts, tol)
     return _refined(of_meshes(assembly), parts, ndbg, local, cells, tol)
@@ -734,7 +729,7 @@ def _ordered(parts: Iterable[str], names: Sequence[str]) -> list[str]:
 def _weights(assembly: Assembly | PolygonAssembly) -> dict[str, float]:
     """Volume (area for polygons) of every part: the heaviest stays, as the planner's
     base (docs/architecture.md, "Tolerances": ordered on rounded numbers)."""
-    if isinstance(assembly, PolygonAssembly):
+    if assembly.dimension == 2:
         return areas(assembly)
     return {name: assembly.parts[name].volume for name in assembly.names}
 

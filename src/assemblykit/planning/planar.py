@@ -1,5 +1,6 @@
-"""Planning for polygon assemblies (Wilson & Latombe 1992, "2D case"): the tables the planner of
-:mod:`assemblykit.planning.search` searches, and Γ_g restricted to the plane.
+"""Planning for polygon assemblies (:class:`~assemblykit.model.polygons.PolygonAssembly`;
+Wilson & Latombe 1992, "2D case"), the planning layer's planar variant: the tables the
+planner of :mod:`assemblykit.planning.search` searches, and Γ_g restricted to the plane.
 
 In the plane Γ_e is exact for every polygon (:mod:`assemblykit.blocking.planar`), so
 the candidate directions are the regions of one arrangement of S¹: the points and open
@@ -27,7 +28,7 @@ from assemblykit.planning.search import Progress, Search
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:
-    from assemblykit.blocking.polygons import PolygonAssembly
+    from assemblykit.model.polygons import PolygonAssembly
 
 # twists (omega; v) of the plane z = 0: a turn about z and a translation in the plane
 _PLANAR_TWIST_BOUNDS = [(0.0, 0.0), (0.0, 0.0), (-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0), (0.0, 0.0)]

@@ -16,12 +16,12 @@ import numpy as np
 
 from assemblykit.blocking.directions import DirectionTable, bits, mask_of, union_of
 from assemblykit.blocking.graphs import blocking_graph
-from assemblykit.blocking.polygons import PolygonAssembly
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.blocking.tables import translation_slots, translation_table, with_obstacles
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.geometry.interference import enclosures, interferences
 from assemblykit.model.assembly import Assembly
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.planning.candidates import exact_candidates, fit_axes
 from assemblykit.planning.equilibrium import equilibrium_model
 from assemblykit.planning.equilibrium_memory import EquilibriumMemory
@@ -50,7 +50,7 @@ def rigid_may_free(
     ``parts`` frees a proper part of it: the necessary condition of Wilson & Latombe
     1992, "Extension and Variant" ("a necessary condition for a subassembly S to be
     directly removable")."""
-    if isinstance(assembly, PolygonAssembly):
+    if assembly.dimension == 2:
         # polygons move in their plane: lifting off it would free every part
         return planar_rigid_may_free(assembly, parts, assembly.tolerance(tol))
     graph = blocking_graph(assembly, motion="rigid", parts=parts, tol=tol)
@@ -164,14 +164,14 @@ def plan(
     tol = assembly.tolerance(tol)
     names = tuple(assembly.names)
     supports: tuple[str, ...] = ()
-    if ground and gravity is None and isinstance(assembly, Assembly):
+    if ground and gravity is None and assembly.dimension == 3:
         supports = assembly.supports
     declared = fixed_parts(assembly, [*(fixed or ()), *supports], gravity)
     if gravity is not None and declared:
         gravity = replace(gravity, fixed=declared)
     report: Progress = progress or (lambda stage, done, total: None)
     report("blocking graph (infinitesimal translations)", 0, len(names))
-    if isinstance(assembly, PolygonAssembly):
+    if assembly.dimension == 2:
         if gravity is not None or one_at_a_time:
             raise InputError("--gravity and --one-at-a-time need 3D parts, not 2D polygons")
 
@@ -224,7 +224,7 @@ def fixed_parts(
     a name the assembly does not have."""
     wanted = {*(fixed or ()), *((gravity.fixed or ()) if gravity is not None else ())}
     for name in sorted(wanted):
-        if isinstance(assembly, Assembly):
+        if assembly.dimension == 3:
             assembly.part(name)
         elif name not in assembly.names:
             raise UnknownNameError(f"no part named {name!r} (parts: {', '.join(assembly.names)})")
@@ -391,7 +391,7 @@ def finish_plan(
     report("done", len(names), len(names))
     unfinished = tuple(names[i] for i in bits(union_of(search.unfinished)))
     steps = tuple(search.steps)
-    if isinstance(assembly, Assembly):
+    if assembly.dimension == 3:
         steps = _with_fasteners(assembly, steps, tol)
     return Plan(
         names,
@@ -438,7 +438,7 @@ def _interlock(
     held = tuple(names[i] for i in bits(locked & ~members))
     interfering: tuple[tuple[str, str, float], ...] = ()
     enclosed: tuple[tuple[str, str], ...] = ()
-    if not isinstance(assembly, PolygonAssembly):
+    if assembly.dimension == 3:
         stopped = assembly.subset([*parts, *held])
         interfering = tuple(interferences(stopped, tol))
         enclosed = tuple(enclosures(stopped))

@@ -1,5 +1,6 @@
-"""Tests of extended translations of polygons, Γ_e in the plane (Wilson & Latombe 1992, 2D case),
-on hand-drawn parts whose blocked arcs are derived from their vertices."""
+"""Tests of the blocking layer of polygons (Wilson & Latombe 1992, 2D case): extended
+translations, Γ_e in the plane, on hand-drawn parts whose blocked arcs are derived from
+their vertices, and the contact segments kept in the memo."""
 
 from __future__ import annotations
 
@@ -12,10 +13,16 @@ from shapely.ops import unary_union
 
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
-from assemblykit.blocking.planar import blocked_normals, convex_pieces
-from assemblykit.blocking.polygons import PolygonAssembly, PolygonContacts, counter_clockwise
+from assemblykit.blocking.planar import (
+    PolygonContacts,
+    blocked_normals,
+    convex_pieces,
+    counter_clockwise,
+)
 from assemblykit.errors import GeometryError
+from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io.polygons import load_polygons
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.tolerance import Tolerance
 
 PLANAR = Path(__file__).resolve().parents[2] / "src" / "assemblykit" / "examples" / "planar"
@@ -124,10 +131,10 @@ def test_clockwise_points_are_turned_and_self_crossing_ones_refused():
 
 def test_polygon_contacts_are_kept_in_the_memo_and_restricted():
     hands = load_polygons(PLANAR / "three_hands.yaml")
-    found = hands.contacts()
+    found = assembly_contacts(hands)
     assert [c.pair for c in found] == [("base", "bar"), ("base", "block"), ("bar", "block")]
     assert hands.memo.of(PolygonContacts).found == {hands.tolerance(): found}
-    assert hands.contacts() is found
+    assert assembly_contacts(hands) is found
     two = hands.subset(["bar", "base"])
     (kept,) = two.memo.of(PolygonContacts).found.values()
     assert [c.pair for c in kept] == [("base", "bar")] and kept[0] is found[0]
