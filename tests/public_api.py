@@ -162,7 +162,7 @@ PUBLIC_NAMES: tuple[str, ...] = (
     "assemblykit.model.assembly.Memo.of",
     "assemblykit.model.assembly.Memo.restricted",
     "assemblykit.model.assembly.Store",
-    "assemblykit.blocking.planar.PolygonContacts",
+    "assemblykit.geometry.polygons.PolygonContacts",
     "assemblykit.geometry.precision",
     # motion and mating (docs/motion.md, docs/mating.md)
     "assemblykit.mating.search.MatingResult.or_and",

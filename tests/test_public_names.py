@@ -336,19 +336,19 @@ def test_the_inputs_and_outputs_users_meet_are_exported() -> None:
         ),
         (
             "assemblykit.blocking.polygons.PolygonContacts",
-            "assemblykit.blocking.planar.PolygonContacts",
+            "assemblykit.geometry.polygons.PolygonContacts",
         ),
         (
             "assemblykit.blocking.polygons.counter_clockwise",
-            "assemblykit.blocking.planar.counter_clockwise",
+            "assemblykit.geometry.polygons.counter_clockwise",
         ),
         (
             "assemblykit.blocking.polygons.edge_contacts",
-            "assemblykit.blocking.planar.edge_contacts",
+            "assemblykit.geometry.polygons.edge_contacts",
         ),
         (
             "assemblykit.blocking.polygons.section_polygons",
-            "assemblykit.blocking.planar.section_polygons",
+            "assemblykit.geometry.polygons.section_polygons",
         ),
     ],
 )

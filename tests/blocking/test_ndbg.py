@@ -191,7 +191,7 @@ def test_to_dict_contract():
 
 
 def test_cross_section_of_stacked_boxes():
-    from assemblykit.blocking.planar import section_polygons
+    from assemblykit.geometry.polygons import section_polygons
     from assemblykit.model.packings import box_mesh as box
 
     meshes = {"low": box([0, 0, 0], [2, 1, 1]), "high": box([0.5, 0, 1], [1.5, 1, 2])}

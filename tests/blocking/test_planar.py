@@ -1,26 +1,18 @@
 """Tests of the blocking layer of polygons (Wilson & Latombe 1992, 2D case): extended
 translations, Γ_e in the plane, on hand-drawn parts whose blocked arcs are derived from
-their vertices, and the contact segments kept in the memo."""
+their vertices."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
-import pytest
 from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
-from assemblykit.blocking.planar import (
-    PolygonContacts,
-    blocked_normals,
-    convex_pieces,
-    counter_clockwise,
-)
-from assemblykit.errors import GeometryError
-from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.blocking.planar import blocked_normals, convex_pieces
 from assemblykit.io.polygons import load_polygons
 from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.tolerance import Tolerance
@@ -116,26 +108,3 @@ def test_extended_blocking_sees_parts_that_do_not_touch():
     assert local.dbg([0, 1]).is_free(frozenset({"box"}))
     assert grown.dbg([0, 1]).arcs >= {("box", "roof")}
     assert grown.dbg([1, 0]).is_free(frozenset({"box"}))
-
-
-def test_clockwise_points_are_turned_and_self_crossing_ones_refused():
-    clockwise = np.array([[0, 0], [0, 1], [1, 1], [1, 0]], dtype=float)
-    turned = counter_clockwise(clockwise, "a")
-    x, y = turned[:, 0], turned[:, 1]
-    assert 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) == 1.0  # shoelace: +1
-    assert {tuple(p) for p in turned} == {tuple(p) for p in clockwise}
-    bow_tie = np.array([[0, 0], [1, 1], [1, 0], [0, 1]], dtype=float)
-    with pytest.raises(GeometryError, match=r"parts\.tie"):
-        counter_clockwise(bow_tie, "tie", "f.yaml")
-
-
-def test_polygon_contacts_are_kept_in_the_memo_and_restricted():
-    hands = load_polygons(PLANAR / "three_hands.yaml")
-    found = assembly_contacts(hands)
-    assert [c.pair for c in found] == [("base", "bar"), ("base", "block"), ("bar", "block")]
-    assert hands.memo.of(PolygonContacts).found == {hands.tolerance(): found}
-    assert assembly_contacts(hands) is found
-    two = hands.subset(["bar", "base"])
-    (kept,) = two.memo.of(PolygonContacts).found.values()
-    assert [c.pair for c in kept] == [("base", "bar")] and kept[0] is found[0]
-    assert len(hands.memo.of(PolygonContacts).found[hands.tolerance()]) == 3

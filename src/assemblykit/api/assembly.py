@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
-from assemblykit.blocking.planar import PolygonContacts
 from assemblykit.features.primitives import Feature
 from assemblykit.geometry.contact_values import Contacts
 from assemblykit.geometry.contacts import assembly_contacts, assembly_surfaces
+from assemblykit.geometry.polygons import PolygonContacts
 from assemblykit.io import assembly as assembly_files
 from assemblykit.io import polygons as polygon_files
 from assemblykit.model import assembly as assembly_model
@@ -77,7 +77,7 @@ class PolygonAssembly(polygon_model.PolygonAssembly):
 
     def contacts(self, tol: Tolerance | None = None) -> Contacts:
         """The contact segments between every two polygons, computed once per tolerance
-        (:func:`assemblykit.blocking.planar.polygon_contacts`), as a list that shows as
+        (:func:`assemblykit.geometry.polygons.polygon_contacts`), as a list that shows as
         a table."""
         found = assembly_contacts(self, tol)
         if isinstance(found, Contacts):

@@ -67,9 +67,11 @@ from assemblykit.geometry.narrow_phase import (
     planar_patches,
     surface_size,
 )
+from assemblykit.geometry.polygons import polygon_contacts
 from assemblykit.geometry.recognition import recognise_curved, recognise_planes, segment
 from assemblykit.geometry.snapping import snap_classes, snapped
 from assemblykit.model.assembly import Assembly
+from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.model.surfaces import Surface
 from assemblykit.tolerance import Tolerance
 
@@ -309,9 +311,13 @@ def near_curved_surfaces(
 @singledispatch
 def assembly_contacts(assembly: object, tol: Tolerance | None = None) -> list[Contact]:
     """The contacts between the touching parts of ``assembly``, dispatched on its type:
-    an :class:`~assemblykit.model.assembly.Assembly` (:func:`_mesh_contacts`) or another
-    kind that registers its own (the planar polygons of ``assemblykit.blocking.planar``)."""
+    an :class:`~assemblykit.model.assembly.Assembly` (:func:`_mesh_contacts`) or a
+    :class:`~assemblykit.model.polygons.PolygonAssembly` (its contact segments,
+    :func:`~assemblykit.geometry.polygons.polygon_contacts`)."""
     raise TypeError(f"no contacts for a {type(assembly).__name__}")
+
+
+assembly_contacts.register(PolygonAssembly, polygon_contacts)
 
 
 @assembly_contacts.register

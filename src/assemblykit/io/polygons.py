@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.blocking.planar import counter_clockwise
 from assemblykit.errors import InputError, SchemaError
+from assemblykit.geometry.polygons import counter_clockwise
 from assemblykit.io.documents import MAX_COORDINATE, read_text, read_yaml
 from assemblykit.model.polygons import PolygonAssembly
 

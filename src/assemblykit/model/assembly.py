@@ -49,7 +49,7 @@ class Store(Protocol):
     """One kind of data derived from an assembly's parts, kept in its :class:`Memo`
     (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts and surfaces;
     :class:`assemblykit.blocking.cache.BlockingCache`: blocking terms, graphs and
-    obstacles; :class:`assemblykit.blocking.planar.PolygonContacts`: contact segments
+    obstacles; :class:`assemblykit.geometry.polygons.PolygonContacts`: contact segments
     of polygons). Its class is created with no arguments, empty."""
 
     def restricted(self, names: Set[str]) -> Store | None:

@@ -2,7 +2,7 @@
 
 A :class:`PolygonAssembly` is named simple polygons in the plane z = 0, counter-clockwise,
 in assembled position: read from a YAML file by :mod:`assemblykit.io.polygons` or cut
-from 3D meshes by a plane (:func:`assemblykit.blocking.planar.section_polygons`). It is
+from 3D meshes by a plane (:func:`assemblykit.geometry.polygons.section_polygons`). It is
 an :class:`~assemblykit.model.assembly.AssemblyLike` of ``dimension`` 2 and ``kind``
 ``"polygons"``: the layers above give their planar variant for it, side by side with
 the one for meshes (its contact segments and exact blocking terms in
