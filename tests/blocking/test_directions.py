@@ -1,5 +1,5 @@
-"""Tests of direction tables and set bit masks (:mod:`assemblykit.blocking.directions`)
-on random tables and blocking terms."""
+"""Tests of direction tables (:mod:`assemblykit.blocking.directions`) on random tables
+and blocking terms."""
 
 from __future__ import annotations
 
@@ -10,14 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from assemblykit.blocking.constraints import BlockingTerm
-from assemblykit.blocking.directions import (
-    BlockedRows,
-    DirectionTable,
-    mask_vector,
-    row_mask,
-    several,
-    term_slots,
-)
+from assemblykit.blocking.directions import BlockedRows, DirectionTable, term_slots
+from assemblykit.part_sets import row_mask, several
 from assemblykit.tolerance import Tolerance
 
 
@@ -64,11 +58,6 @@ def test_the_memory_of_blocked_rows_answers_any_sets_as_a_fresh_table(seed, aske
         np.testing.assert_array_equal(
             rows.free_bits(members, movers), tab.free_bits(members, movers)
         )
-
-
-@given(mask=st.integers(0, 2**80), count=st.integers(0, 90))
-def test_a_mask_as_a_vector_holds_its_first_bits(mask, count):
-    assert mask_vector(mask, count).tolist() == [bool(mask >> i & 1) for i in range(count)]
 
 
 def test_free_bits_past_one_byte_count_the_free_movers_of_shrinking_sets():

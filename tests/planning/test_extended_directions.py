@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from assemblykit.blocking.directions import mask_of
 from assemblykit.blocking.extended import extended_dbg
+from assemblykit.part_sets import mask_of
 from assemblykit.planning.extended_directions import ExtendedDirections
 from datasets import shared_assembly
 

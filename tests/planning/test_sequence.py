@@ -11,19 +11,14 @@ import pytest
 import trimesh
 
 from assemblykit.blocking import tables
-from assemblykit.blocking.directions import (
-    BlockedRows,
-    DirectionTable,
-    local_table,
-    mask_of,
-    several,
-)
+from assemblykit.blocking.directions import BlockedRows, DirectionTable, local_table
 from assemblykit.blocking.extended import extended_dbg, extended_free
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.blocking.tables import translation_table
 from assemblykit.geometry.overlaps import resolve_overlaps
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly, Part
+from assemblykit.part_sets import mask_of, several
 from assemblykit.planning import planner
 from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import (

@@ -24,6 +24,7 @@ from scipy.sparse.csgraph import connected_components
 
 from assemblykit.blocking.arrangement import snap_normals, sphere_arrangement
 from assemblykit.blocking.constraints import BlockingTerm
+from assemblykit.part_sets import bits, count_bits, mask_vector
 from assemblykit.tolerance import Tolerance
 
 
@@ -332,52 +333,3 @@ def term_slots(
             held[:, order], starts, axis=1
         ).view(bool)
     return slots
-
-
-def bits(mask: int) -> Iterable[int]:
-    """The indices of the set bits of ``mask``, in increasing order."""
-    index = 0
-    while mask:
-        if mask & 1:
-            yield index
-        mask >>= 1
-        index += 1
-
-
-def mask_of(indices: Iterable[int]) -> int:
-    """The bit mask of a set of indices."""
-    total = 0
-    for i in indices:
-        total |= 1 << int(i)  # numpy integers would overflow past 63 parts
-    return total
-
-
-def union_of(masks: Iterable[int]) -> int:
-    """The union of bit masks."""
-    total = 0
-    for mask in masks:
-        total |= mask
-    return total
-
-
-def mask_vector(mask: int, count: int) -> NDArray[np.bool_]:
-    """The bit mask ``mask`` as a boolean vector of its first ``count`` bits."""
-    size = max(count, mask.bit_length(), 1)
-    packed = np.frombuffer(mask.to_bytes((size + 7) // 8, "little"), dtype=np.uint8)
-    return np.unpackbits(packed, count=count, bitorder="little").astype(bool)
-
-
-def row_mask(row: NDArray[np.uint8]) -> int:
-    """The bit mask held by one row of little-endian packed bits (``np.packbits(...,
-    bitorder="little")``)."""
-    return int.from_bytes(row.tobytes(), "little")
-
-
-def count_bits(mask: int) -> int:
-    """The number of set bits of ``mask``."""
-    return bin(mask).count("1")
-
-
-def several(mask: int) -> bool:
-    """Whether ``mask`` has more than one bit set."""
-    return (mask & (mask - 1)) != 0

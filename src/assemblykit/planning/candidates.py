@@ -26,8 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.blocking.arrangement import snap_normals
-from assemblykit.blocking.directions import bits
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.part_sets import bits
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:

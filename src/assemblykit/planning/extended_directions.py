@@ -29,9 +29,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.blocking.cache import BlockingCache
-from assemblykit.blocking.directions import DirectionTable, bits, mask_of
+from assemblykit.blocking.directions import DirectionTable
 from assemblykit.blocking.extended import extended_arcs, shown_along, shown_pairs
 from assemblykit.geometry.occlusion import view_frame
+from assemblykit.part_sets import bits, mask_of
 from assemblykit.tolerance import Tolerance
 
 if TYPE_CHECKING:

@@ -19,7 +19,8 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 from assemblykit.blocking.dbg import blocking_components
-from assemblykit.blocking.directions import DirectionTable, mask_of, several
+from assemblykit.blocking.directions import DirectionTable
+from assemblykit.part_sets import mask_of, several
 
 if TYPE_CHECKING:
     from assemblykit.planning.extended_directions import ExtendedDirections

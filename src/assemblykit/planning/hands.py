@@ -39,11 +39,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.blocking.directions import DirectionTable, bits, mask_of, several
+from assemblykit.blocking.directions import DirectionTable
 from assemblykit.blocking.extended import all_convex, extended_arcs
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.ndbg import NonDirectionalBlockingGraph
 from assemblykit.model.polygons import PolygonAssembly
+from assemblykit.part_sets import bits, mask_of, several
 from assemblykit.planning.extended_directions import ExtendedDirections
 from assemblykit.planning.plan_values import Hands, HandsMove
 from assemblykit.planning.search import Search

@@ -23,7 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from assemblykit.blocking.directions import DirectionTable, bits, several
+from assemblykit.blocking.directions import DirectionTable
+from assemblykit.part_sets import bits, several
 from assemblykit.planning.extended_directions import ExtendedDirections
 from assemblykit.planning.free_sets import closed_under, separable, sinks
 

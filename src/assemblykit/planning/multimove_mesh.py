@@ -42,10 +42,10 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import ConvexHull, QhullError
 
-from assemblykit.blocking.directions import mask_vector
 from assemblykit.errors import GeometryError
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.minkowski import convex_pieces
+from assemblykit.part_sets import mask_vector
 from assemblykit.planning.multimove import (
     MAX_STATES,
     Found,

@@ -32,7 +32,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit import formatting as fmt
-from assemblykit.blocking.directions import DirectionTable, bits, mask_of, several
+from assemblykit.blocking.directions import DirectionTable
+from assemblykit.part_sets import bits, mask_of, several
 from assemblykit.planning.fasteners import Fastener, drawn_summary
 from assemblykit.planning.multimove import moving_groups
 

@@ -20,10 +20,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.optimize import linprog
 
-from assemblykit.blocking.directions import DirectionTable, mask_of
+from assemblykit.blocking.directions import DirectionTable
 from assemblykit.blocking.rigid import RIGID_MAX_SIZE, RigidBlockingGraph, wrenches
 from assemblykit.blocking.tables import planar_direction_tables
 from assemblykit.geometry.contacts import assembly_contacts
+from assemblykit.part_sets import mask_of
 from assemblykit.planning.search import Progress, Search
 from assemblykit.tolerance import Tolerance
 

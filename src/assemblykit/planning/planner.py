@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from assemblykit.blocking.directions import DirectionTable, bits, mask_of, union_of
+from assemblykit.blocking.directions import DirectionTable
 from assemblykit.blocking.graphs import blocking_graph
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.blocking.tables import translation_slots, translation_table, with_obstacles
@@ -22,6 +22,7 @@ from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.geometry.interference import enclosures, interferences
 from assemblykit.model.assembly import Assembly
 from assemblykit.model.polygons import PolygonAssembly
+from assemblykit.part_sets import bits, mask_of, union_of
 from assemblykit.planning.candidates import exact_candidates, fit_axes
 from assemblykit.planning.equilibrium import equilibrium_model
 from assemblykit.planning.equilibrium_memory import EquilibriumMemory

@@ -40,16 +40,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.blocking.directions import (
-    BlockedRows,
-    DirectionTable,
-    bits,
-    count_bits,
-    row_mask,
-    several,
-    union_of,
-)
+from assemblykit.blocking.directions import BlockedRows, DirectionTable
 from assemblykit.blocking.extended import extended_arcs
+from assemblykit.part_sets import bits, count_bits, row_mask, several, union_of
 from assemblykit.planning.extended_directions import ExtendedDirections
 from assemblykit.planning.free_sets import closed_under, separable, sinks
 from assemblykit.planning.plan_values import Step
