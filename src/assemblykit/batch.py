@@ -76,10 +76,10 @@ ONE_THREAD: dict[str, str] = {
     "OPENBLAS_NUM_THREADS": "1",
 }
 """The environment a worker's numerical libraries start with, unless the batch's own
-environment sets these variables: one thread each, as Dask starts its workers
-(``distributed.nanny.pre-spawn-environ``). The workers are the batch's parallelism; a
-linear algebra library's own threads would only compete with the other workers, and
-OpenBLAS's keep spinning after each call, taking the core another worker needs."""
+environment sets these variables: one thread each, as Dask starts the worker processes
+of its nannies (``distributed.nanny.pre-spawn-environ``). The workers are the batch's
+parallelism, one per core asked for; a linear algebra library's own threads, one per
+core in each worker, would compete with the other workers for the same cores."""
 
 
 @dataclass(frozen=True)
