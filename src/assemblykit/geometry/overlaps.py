@@ -632,10 +632,10 @@ def resolve_overlaps(
         if trimmed is None:
             overlaps.append(Overlap(a, b, volume))
             continue
-        cut, made = trimmed
-        result = result.with_part(cut)
+        part, made = trimmed
+        result = result.with_part(part)
         if made is not None:
-            keep_solid(result, cut.name, made)
+            keep_solid(result, part.name, made)
         overlaps.append(Overlap(a, b, volume, f"trimmed from {small.name}"))
     # the same parts: what was derived from them (their solids) is kept
     prepared = result.subset(result.parts)
