@@ -151,8 +151,6 @@ PUBLIC_NAMES: tuple[str, ...] = (
     "assemblykit.geometry.interference.interferences",
     "assemblykit.geometry.interference.interferes",
     "assemblykit.geometry.interference.overlap_volume",
-    "assemblykit.geometry.interference.Solids",
-    "assemblykit.geometry.interference.part_solid",
     "assemblykit.geometry.overlaps.DESIGNED_SHARE",
     "assemblykit.geometry.overlaps.joined",
     "assemblykit.geometry.overlaps.resolve_overlaps",

@@ -12,7 +12,6 @@ from assemblykit.geometry.interference import (
     interferences,
     interferes,
     overlap_volume,
-    part_solid,
     solid,
 )
 from assemblykit.geometry.overlaps import mesh_of
@@ -83,15 +82,3 @@ def test_a_part_in_a_cavity_is_enclosed_and_one_in_an_open_cup_is_not():
     )
     assert enclosures(asm) == [("ball", "housing")]
     assert enclosures(asm, ["housing", "above", "cup", "cube"]) == []
-
-
-def test_a_part_solid_is_its_mesh_as_long_as_the_part_stays():
-    a = Assembly([Part("a", box([0, 0, 0], [2, 2, 2])), Part("b", box([1, 1, 1], [3, 3, 3]))])
-    assert part_solid(a, "a").volume() == pytest.approx(8.0)
-    # the sub-assembly of the same part keeps its solid; a part replaced gets its own
-    assert part_solid(a.subset(["a"]), "a") is part_solid(a, "a")
-    moved = a.with_part(Part("a", box([0, 0, 0], [1, 1, 1])))
-    assert part_solid(moved, "a").volume() == pytest.approx(1.0)
-    assert interferences(moved, Tolerance(rel_length=1e-6)) == []
-    assert part_solid(a, "a").volume() == pytest.approx(8.0)
-    assert [(x, y) for x, y, _ in interferences(a, Tolerance(rel_length=1e-6))] == [("a", "b")]

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from assemblykit.blocking.lattice import lattice_cells
 from assemblykit.geometry.booleans import manifold3d
-from assemblykit.geometry.interference import interference_threshold, part_solid, shared_volume
+from assemblykit.geometry.interference import interference_threshold, shared_volume, solid
 from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
 from assemblykit.geometry.occlusion import hull_vertices, triangle_spheres
 from assemblykit.geometry.settling import settle
@@ -57,6 +57,7 @@ class Obstacles:
         self.pieces: dict[str, list[NDArray[np.float64]] | None] = {}
         self.cones: dict[tuple[str, str, Tolerance], list[NDArray[np.float64]]] = {}
         self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
+        self.solids: dict[str, manifold3d.Manifold] = {}
         self.hulls: dict[str, NDArray[np.float64]] = {}
         self.balls: dict[str, NDArray[np.float64]] = {}
         self.lattice: dict[str, NDArray[np.int64] | None] = {}
@@ -117,9 +118,10 @@ class Obstacles:
         return self.balls[name]
 
     def solid(self, name: str) -> manifold3d.Manifold:
-        """The manifold3d solid of a part's mesh, made once for the assembly
-        (:func:`~assemblykit.geometry.interference.part_solid`)."""
-        return part_solid(self.assembly, name)
+        """The manifold3d solid of a part's mesh, made once."""
+        if name not in self.solids:
+            self.solids[name] = solid(self.assembly.parts[name].mesh)
+        return self.solids[name]
 
     def backout(self, moving: str, blocker: str, tol: Tolerance) -> NDArray[np.float64]:
         """The translation that backs ``moving`` out of ``blocker`` before blocking is

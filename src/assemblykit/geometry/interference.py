@@ -9,8 +9,7 @@ the smaller part's surface, i.e. when ``volume > tol.length x min(area_a, area_b
 
 from __future__ import annotations
 
-from collections.abc import Collection, Set
-from dataclasses import dataclass, field
+from collections.abc import Collection
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -65,37 +64,6 @@ def solid(
             f"mesh is not a closed oriented manifold ({result.status()})", where=name
         )
     return result
-
-
-@dataclass(eq=False)
-class Solids:
-    """The manifold3d solid of each part's mesh (:func:`solid`), by part name: a store of
-    the assembly's :class:`~assemblykit.model.assembly.Memo` (docs/architecture.md,
-    "Caching"), filled by :func:`part_solid`. An assembly's parts never change, and a
-    sub-assembly keeps the solids of the parts it keeps (the same part objects), so the
-    interference tests, the cuts of :mod:`assemblykit.geometry.overlaps` and the
-    back-outs of blocking build each part's solid once."""
-
-    made: dict[str, manifold3d.Manifold] = field(default_factory=dict)
-
-    def restricted(self, names: Set[str]) -> Solids | None:
-        """The solids of the parts ``names`` (``None`` when none was made)."""
-        kept = {name: made for name, made in self.made.items() if name in names}
-        return Solids(kept) if kept else None
-
-
-def part_solid(assembly: Assembly, name: str) -> manifold3d.Manifold:
-    """The solid of part ``name`` of ``assembly``, made once (:class:`Solids`)."""
-    made = assembly.memo.of(Solids).made
-    if name not in made:
-        made[name] = solid(assembly.parts[name].mesh, name)
-    return made[name]
-
-
-def keep_solid(assembly: Assembly, name: str, made: manifold3d.Manifold) -> None:
-    """Keep ``made``, already built by :func:`solid` from the mesh of part ``name`` of
-    ``assembly``, as that part's solid (:class:`Solids`)."""
-    assembly.memo.of(Solids).made[name] = made
 
 
 def overlap_volume(mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh) -> float:
@@ -160,10 +128,14 @@ def interferences(
     if among is not None:
         asked = np.isin(np.array(names, dtype=object), list(among))
         pairs = pairs[asked[pairs].any(axis=1)]
+    solids = {}
     found = []
     for i, j in pairs:
         a, b = assembly.parts[names[i]], assembly.parts[names[j]]
-        volume = shared_volume(part_solid(assembly, a.name), part_solid(assembly, b.name))
+        for k, part in ((i, a), (j, b)):
+            if k not in solids:
+                solids[k] = solid(part.mesh, part.name)
+        volume = shared_volume(solids[i], solids[j])
         if volume > interference_threshold(a.mesh, b.mesh, tol):
             found.append((a.name, b.name, volume))
     return found

@@ -39,13 +39,7 @@ from numpy.typing import NDArray
 
 from assemblykit.algebra import se3
 from assemblykit.geometry.booleans import manifold3d
-from assemblykit.geometry.interference import (
-    interference_threshold,
-    interferences,
-    keep_solid,
-    part_solid,
-    solid,
-)
+from assemblykit.geometry.interference import interference_threshold, interferences, solid
 from assemblykit.geometry.occlusion import blocking_witnesses, shadows
 from assemblykit.model.assembly import Assembly, Overlap, Part
 from assemblykit.model.surfaces import Surface
@@ -118,7 +112,7 @@ def touching_products(assembly: Assembly) -> dict[str, tuple[str, ...]]:
     found: dict[str, tuple[str, ...]] = {}
     for product, members in assembly.products.items():
         meshes = {name: assembly[name].mesh for name in members}
-        bodies = {name: part_solid(assembly, name) for name in members}
+        bodies = {name: solid(mesh, name) for name, mesh in meshes.items()}
         graph: nx.Graph = nx.Graph()
         graph.add_nodes_from(members)
         for a, b in itertools.combinations(members, 2):
@@ -317,19 +311,15 @@ def _extruded_shadow(
     return prism.transform(frame)
 
 
-def _trimmed(
-    part: Part, other: Part, theirs: manifold3d.Manifold, tol: Tolerance
-) -> tuple[Part, manifold3d.Manifold | None] | None:
-    """``part`` without what it shares with ``other`` (whose solid is ``theirs``), and
-    without the rest of ``part``
+def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
+    """``part`` without what it shares with ``other``, and without the rest of ``part``
     in that shared volume's shadow along the axis it was pressed in by: of its
     :func:`insertion_axes`, the first whose cut lets the two parts apart along it
     (:func:`_parts_leave_along`), else the first. A screw loses its thread's ring along
     the whole shank, so that it leaves along its axis through the hole it is screwed
     into; a plate that a motor is drawn through loses what the motor passes through,
     not a strip across it. Its exact surfaces keep the triangles that remain of them
-    (:func:`_cut_surfaces`), with the solid of its mesh (:func:`solid`; ``None`` when
-    ``part`` is left as it is). A part that an earlier cut already took out of ``other``
+    (:func:`_cut_surfaces`). A part that an earlier cut already took out of ``other``
     (a screw through two plates, trimmed along its whole shank by the first) is left
     as it is: what it still shares is rounding, whose shadow means nothing. ``None``
     when what the cut leaves of ``part`` still shares more than the interference
@@ -343,9 +333,10 @@ def _trimmed(
         ids[surface.faces] = k
     original_id = manifold3d.Manifold.reserve_ids(1)
     mine = solid(part.mesh, part.name, original_id=original_id, face_ids=ids)
+    theirs = solid(other.mesh, other.name)
     common = mine ^ theirs
     if common.volume() <= interference_threshold(part.mesh, other.mesh, tol):
-        return part, None
+        return part
     bodies = _bodies(common)
     shared = mesh_of(bodies)
     size = float(np.linalg.norm(np.ptp(np.vstack([part.mesh.bounds, other.mesh.bounds]), axis=0)))
@@ -363,14 +354,12 @@ def _trimmed(
     mesh, source = traced_mesh(cut, original_id)
     if (cut ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
         return None
-    made = solid(mesh)
-    if (made ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
+    if (solid(mesh) ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
         mesh, source = _cut_again(mesh, source, theirs)
-        made = solid(mesh)
-        if (made ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
+        if (solid(mesh) ^ theirs).volume() > interference_threshold(mesh, other.mesh, tol):
             return None
     surfaces = _cut_surfaces(part, other, mesh, source, axis, tol) if part.surfaces else ()
-    return replace(part, mesh=mesh, surfaces=surfaces), made
+    return replace(part, mesh=mesh, surfaces=surfaces)
 
 
 def _removed_along(
@@ -619,26 +608,17 @@ def resolve_overlaps(
             {*pending, *interferences(result, tol, among=set(into.values()))},
             key=lambda pair: (order[pair[0]], order[pair[1]]),
         )
-    joined = result
-    whole = dict(joined.parts)
+    whole = dict(result.parts)
     for a, b, volume in pending:
         small, large = sorted((whole[a], whole[b]), key=lambda p: p.volume)
         limit = DESIGNED_SHARE * small.volume if ignore_overlap is None else ignore_overlap
-        trimmed = (
-            None
-            if volume > limit
-            else _trimmed(result.parts[small.name], large, part_solid(joined, large.name), tol)
-        )
+        trimmed = None if volume > limit else _trimmed(result.parts[small.name], large, tol)
         if trimmed is None:
             overlaps.append(Overlap(a, b, volume))
             continue
-        part, made = trimmed
-        result = result.with_part(part)
-        if made is not None:
-            keep_solid(result, part.name, made)
+        result = result.with_part(trimmed)
         overlaps.append(Overlap(a, b, volume, f"trimmed from {small.name}"))
-    # the same parts: what was derived from them (their solids) is kept
-    prepared = result.subset(result.parts)
+    prepared = type(result).like(result, scale=result.scale)
     prepared.overlaps = tuple(replace(o, units=assembly.units) for o in overlaps)
     members: dict[str, list[str]] = {}
     for name, part in into.items():
