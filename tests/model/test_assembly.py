@@ -147,3 +147,11 @@ def test_to_dict_summarises_parts(tower):
     assert summary["units"] == "mm" and summary["source"] == "tower"
     assert summary["parts"]["b"]["triangles"] == 12
     assert summary["parts"]["b"]["volume"] == pytest.approx(1.0)
+
+
+def test_a_part_s_size_is_its_volume_in_part_order():
+    model = Assembly(
+        [Part("long", box([0, 0, 0], [3, 1, 1])), Part("cube", box([3, 0, 0], [5, 2, 2]))]
+    )
+    assert model.sizes() == pytest.approx({"long": 3.0, "cube": 8.0})
+    assert list(model.sizes()) == ["long", "cube"]

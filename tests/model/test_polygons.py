@@ -38,3 +38,13 @@ def test_a_subset_keeps_the_polygons_named_in_order():
     assert kept.polygons["a"] is model.polygons["a"]
     with pytest.raises(UnknownNameError, match="'c'"):
         model.subset(["c"])
+
+
+def test_a_polygon_s_size_is_its_area_and_nothing_is_cut_or_joined():
+    # a unit square and a right triangle of legs 2 and 3 (shoelace: 3)
+    model = PolygonAssembly(
+        {"square": square(0, 0), "triangle": np.array([[2.0, 0.0], [4.0, 0.0], [2.0, 3.0]])}
+    )
+    assert model.sizes() == pytest.approx({"square": 1.0, "triangle": 3.0})
+    assert list(model.sizes()) == ["square", "triangle"]
+    assert model.overlaps == () and model.joined == {}

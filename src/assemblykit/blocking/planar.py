@@ -134,8 +134,3 @@ def planar_extended_terms(model: PolygonAssembly, tol: Tolerance) -> list[Blocki
 def _exact_for_polygons(assembly: PolygonAssembly, parts: Iterable[str]) -> bool:
     """Γ_e of polygons is exact whatever their shape (module docstring)."""
     return True
-
-
-def areas(model: PolygonAssembly) -> dict[str, float]:
-    """The area of each polygon (the planar planner keeps the largest part as base)."""
-    return {name: float(Polygon(poly).area) for name, poly in model.polygons.items()}

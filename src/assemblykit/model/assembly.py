@@ -138,6 +138,10 @@ class AssemblyLike(Protocol):
         drawing."""
         ...
 
+    def sizes(self) -> dict[str, float]:
+        """The size of each part: its volume (its area for a polygon in the plane)."""
+        ...
+
 
 @dataclass(frozen=True)
 class Skipped:
@@ -312,6 +316,10 @@ class Assembly:
     def names(self) -> list[str]:
         """Part names in order."""
         return list(self.parts)
+
+    def sizes(self) -> dict[str, float]:
+        """The volume of each part, by name in order."""
+        return {name: part.volume for name, part in self.parts.items()}
 
     def part(self, name: str) -> Part:
         """The part called ``name``; :class:`UnknownNameError` if there is none."""

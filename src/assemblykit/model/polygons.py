@@ -16,9 +16,10 @@ from typing import ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
+from shapely.geometry import Polygon
 
 from assemblykit.errors import UnknownNameError
-from assemblykit.model.assembly import Memo
+from assemblykit.model.assembly import Memo, Overlap
 from assemblykit.tolerance import Tolerance, current
 
 
@@ -41,6 +42,22 @@ class PolygonAssembly:
     def names(self) -> list[str]:
         """Part names in order."""
         return list(self.polygons)
+
+    @property
+    def overlaps(self) -> tuple[Overlap, ...]:
+        """No interfering pairs are resolved for polygons (an assembly of meshes lists
+        those :func:`~assemblykit.geometry.overlaps.resolve_overlaps` found)."""
+        return ()
+
+    @property
+    def joined(self) -> dict[str, tuple[str, ...]]:
+        """No parts are joined for polygons (an assembly of meshes lists its joined
+        parts' members)."""
+        return {}
+
+    def sizes(self) -> dict[str, float]:
+        """The area of each polygon, by name in order."""
+        return {name: float(Polygon(poly).area) for name, poly in self.polygons.items()}
 
     @property
     def scale(self) -> float:

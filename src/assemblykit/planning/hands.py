@@ -60,15 +60,6 @@ HANDS_MAX_PARTS = 8
 """The largest set split into groups (the partitions grow as k^n / k!)."""
 
 
-def _sizes(assembly: Assembly | PolygonAssembly) -> dict[str, float]:
-    """Volumes of the parts (areas for polygons): the largest stays fixed."""
-    if assembly.dimension == 2:
-        from assemblykit.blocking.planar import areas
-
-        return areas(assembly)
-    return {name: float(assembly.parts[name].volume) for name in assembly.names}
-
-
 def partitions(items: Sequence[int], k: int) -> Iterator[tuple[tuple[int, ...], ...]]:
     """Every partition of ``items`` into exactly ``k`` non-empty groups, the group of
     ``items[0]`` first (restricted growth strings)."""
@@ -275,7 +266,7 @@ def _exact_search(
         outside = {table.names[j] for j in bits(others)}
         return not any(i in inside and j in outside for i, j in arcs)
 
-    sizes = _sizes(assembly)
+    sizes = assembly.sizes()
     circles = np.asarray(ndbg.arrangement.normals, dtype=np.float64)
     parts = tuple(sizes[n] for n in table.names)
     return _HandsSearch(table, table, leaves, circles, parts, max_hands, tol)
@@ -299,7 +290,7 @@ def _sampled_search(
         still = [order[j] for j in bits(others)]
         return not extended_arcs(assembly, direction, moving, still, tol)
 
-    sizes = _sizes(assembly)
+    sizes = assembly.sizes()
     circles = np.asarray(local.arrangement.normals, dtype=np.float64)
     volumes = tuple(sizes[n] for n in order)
     return _HandsSearch(translations, extended, leaves, circles, volumes, max_hands, tol)

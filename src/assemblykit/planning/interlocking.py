@@ -57,7 +57,6 @@ from assemblykit.blocking.free_cones import blocked_by, exact_free_directions, o
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.blocking.ndbg import Motion, NonDirectionalBlockingGraph
 from assemblykit.blocking.obstacles import of_meshes
-from assemblykit.blocking.planar import areas
 from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import InputError, UnknownNameError
 from assemblykit.graphs import component_labels
@@ -445,7 +444,7 @@ def interlocking(
                 where="keys",
             )
     tol = assembly.tolerance(tol)
-    weights = _weights(assembly)
+    weights = assembly.sizes()
     first = _stage(assembly, names, motion, tol)
     found = _single_keys(first.classes, names, weights)
     key_set = chosen if chosen is not None else frozenset(found)
@@ -724,14 +723,6 @@ def _ordered(parts: Iterable[str], names: Sequence[str]) -> list[str]:
     """``parts`` in the assembly's order."""
     inside = set(parts)
     return [n for n in names if n in inside]
-
-
-def _weights(assembly: Assembly | PolygonAssembly) -> dict[str, float]:
-    """Volume (area for polygons) of every part: the heaviest stays, as the planner's
-    base (docs/architecture.md, "Tolerances": ordered on rounded numbers)."""
-    if assembly.dimension == 2:
-        return areas(assembly)
-    return {name: assembly.parts[name].volume for name in assembly.names}
 
 
 def _heaviest(parts: Sequence[str], weights: dict[str, float]) -> str:

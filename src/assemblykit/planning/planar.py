@@ -62,10 +62,9 @@ def planar_tables(
     """Γ_t and Γ_e of a polygon assembly along the regions of their common arrangement
     of S¹ (module docstring, :func:`~assemblykit.blocking.tables.planar_direction_tables`),
     and the parts' areas (the largest stays as the base)."""
-    from assemblykit.blocking.planar import areas
 
     local, exact = planar_direction_tables(model, tol)
-    area = areas(model)
+    area = model.sizes()
     return (
         local,
         PlanarExtended(exact.names, exact.directions, exact.slots, exact.moving, exact.blocker),

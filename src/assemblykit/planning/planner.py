@@ -186,7 +186,7 @@ def plan(
         translation_slots(assembly, contacting, tol),
         [
             (index[o.a], index[o.b])
-            for o in getattr(assembly, "overlaps", ())
+            for o in assembly.overlaps
             if not o.resolution and o.a in index and o.b in index
         ],
     )
@@ -401,8 +401,8 @@ def finish_plan(
         and_or,
         len(translations.directions),
         hands,
-        overlaps=getattr(assembly, "overlaps", ()),
-        joined=getattr(assembly, "joined", {}),
+        overlaps=assembly.overlaps,
+        joined=assembly.joined,
         unfinished=unfinished,
     )
 
