@@ -88,9 +88,7 @@ def exact_extended(assembly: AssemblyLike, parts: Iterable[str]) -> bool:
     raise TypeError(f"no extended translations for a {type(assembly).__name__}")
 
 
-@exact_extended.register(Assembly)
-def _exact_for_meshes(assembly: Assembly, parts: Iterable[str]) -> bool:
-    return all_convex(assembly, parts)
+exact_extended.register(Assembly, all_convex)
 
 
 @singledispatch
@@ -102,9 +100,7 @@ def assembly_extended_terms(assembly: AssemblyLike, tol: Tolerance) -> list[Bloc
     raise TypeError(f"no extended translations for a {type(assembly).__name__}")
 
 
-@assembly_extended_terms.register(Assembly)
-def _mesh_extended_terms(assembly: Assembly, tol: Tolerance) -> list[BlockingTerm]:
-    return extended_terms(assembly, tol)
+assembly_extended_terms.register(Assembly, extended_terms)
 
 
 def sweep_candidates(
