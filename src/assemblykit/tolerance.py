@@ -132,9 +132,15 @@ def order_key(value: float, scale: float) -> int:
     return round(value / (ORDER_RESOLUTION * scale)) if scale > 0 else 0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Tolerance:
-    """Tolerances for one model: a length scale and relative/absolute thresholds."""
+    """A tolerance policy: a length scale and relative/absolute thresholds.
+
+    A tolerance goes through three stages (docs/architecture.md, "Tolerances"): the
+    policy asked for (``--tolerance``, :meth:`relative`, or :data:`DEFAULT`), that policy
+    scaled to a model (:meth:`with_scale`), and the :class:`ModelTolerance` a model's
+    geometry is compared with. Two tolerances with the same numbers are equal, whatever
+    their stage, since every predicate gives them the same answers."""
 
     scale: float = 1.0
     rel_length: float = DEFAULT_REL_LENGTH
@@ -147,6 +153,17 @@ class Tolerance:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"tolerance {name} must be a positive number, got {value!r}")
+
+    def _numbers(self) -> tuple[float, float, float, float, float]:
+        return (self.scale, self.rel_length, self.angle, self.mesh_rel_length, self.mesh_angle)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Tolerance):
+            return NotImplemented
+        return self._numbers() == other._numbers()
+
+    def __hash__(self) -> int:
+        return hash(self._numbers())
 
     @property
     def length(self) -> float:
@@ -214,6 +231,23 @@ class Tolerance:
     def for_mesh(self) -> Tolerance:
         """The policy applied to approximate geometry: mesh thresholds become the exact ones."""
         return replace(self, rel_length=self.mesh_rel_length, angle=self.mesh_angle)
+
+
+class ModelTolerance(Tolerance):
+    """The tolerance one model's geometry is compared with (docs/architecture.md,
+    "Tolerances"): a policy scaled to the model's size and, for mesh input, raised to the
+    mesh thresholds and to the precision measured in the input. The entry points of the
+    library (``plan``, ``blocking_graph``, ``motion``, ``Task.solve``, ...) resolve the
+    policy they are given once (``assembly.tolerance(tol)``); the functions below them
+    take a :class:`ModelTolerance` and use it as it is, and a model given its own
+    tolerance back returns it unchanged."""
+
+    @classmethod
+    def of(cls, tol: Tolerance) -> ModelTolerance:
+        """``tol``'s numbers as the tolerance of a model (no change when it is one)."""
+        if isinstance(tol, ModelTolerance):
+            return tol
+        return cls(tol.scale, tol.rel_length, tol.angle, tol.mesh_rel_length, tol.mesh_angle)
 
 
 LENGTH_MISMATCHES = frozenset({"distance", "radius", "size", "residual", "loop"})

@@ -16,7 +16,7 @@ from assemblykit.algebra.connected_meets import connected_meet
 from assemblykit.algebra.groups import classify_algebra
 from assemblykit.algebra.subspaces import psd_solve
 from assemblykit.errors import GroupError
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import DEFAULT, Tolerance
 
 G = SymmetryGroup
 Z = (0.0, 0.0, 1.0)
@@ -138,7 +138,7 @@ def test_element_places_the_canonical_family():
     ],
 )
 def test_classify_algebra_recovers_the_group(group):
-    found = classify_algebra(group.algebra)
+    found = classify_algebra(group.algebra, tol=DEFAULT)
     assert found.kind is group.kind
     assert found.equals(group)
     if group.kind in (Kind.HELICAL, Kind.PSEUDO_PLANAR):
@@ -258,15 +258,15 @@ def test_discrete_screw_lattice_meets_in_closed_form():
 def test_one_parameter_groups_through_lattice_generators():
     from assemblykit.algebra.groups import lattice_parameter, one_parameter
 
-    t = one_parameter(tr(0, 0, 1.5))
+    t = one_parameter(tr(0, 0, 1.5), tol=DEFAULT)
     assert t is not None and t.kind is Kind.PRISMATIC
     assert lattice_parameter(t, tr(0, 0, 1.5), tr(0, 0, -4.5)) == pytest.approx(-3.0)
     tau = se3.screw((1, 0, 0), Z, 0.5, 2.0)
-    h = one_parameter(tau)
+    h = one_parameter(tau, tol=DEFAULT)
     assert h is not None and h.kind is Kind.HELICAL and h.pitch == pytest.approx(0.5)
     assert h.contains(tau) and h.contains(tau @ tau @ tau)
     assert lattice_parameter(h, tau, tau @ tau @ tau) == pytest.approx(3.0)
-    assert one_parameter(se3.rot_z(0.5)) is None
+    assert one_parameter(se3.rot_z(0.5), tol=DEFAULT) is None
 
 
 def test_with_known_discrete_merges_components_without_closure_checks():

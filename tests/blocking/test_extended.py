@@ -29,7 +29,7 @@ from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.packings import box_mesh as box
 from assemblykit.model.polygons import PolygonAssembly
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import DEFAULT, Tolerance
 from datasets import shared_assembly
 
 
@@ -253,14 +253,14 @@ def test_triangle_cones_of_a_face_above_a_face():
     # the unit triangle at z = 0 swept upwards meets the same triangle at z = 1 (shifted
     # by 0.1 in x): the cone is spanned by the nine differences, all with z = 1
     tri = np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]])
-    normals, valid = triangle_cones(tri, tri + np.array([0.1, 0.0, 1.0]), None, None)
+    normals, valid = triangle_cones(tri, tri + np.array([0.1, 0.0, 1.0]), None, None, tol=DEFAULT)
     assert valid.all()
     inside = np.all(normals[0] @ np.array([0.1, 0.0, 1.0]) >= 0)
     assert inside and np.any(normals[0] @ np.array([0.0, 0.0, -1.0]) < 0)
     # (2, 0, 1) is a difference only at a vertex: on the boundary, not inside (open cone)
     assert not np.all(normals[0][np.linalg.norm(normals[0], axis=1) > 0] @ [2.0, 0, 1] > 0)
     # coplanar faces (in contact) have no cone with an interior
-    _, flat = triangle_cones(tri, tri + np.array([0.5, 0.5, 0.0]), None, None)
+    _, flat = triangle_cones(tri, tri + np.array([0.5, 0.5, 0.0]), None, None, tol=DEFAULT)
     assert not flat.any()
 
 

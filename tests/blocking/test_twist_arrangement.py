@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
+from assemblykit.tolerance import DEFAULT
 
 
 def general_position_count(m: int, d: int) -> int:
@@ -32,7 +33,7 @@ def test_region_formula_by_hand():
 @pytest.mark.parametrize(("m", "seed"), [(1, 0), (3, 1), (6, 2), (7, 3), (8, 4)])
 def test_random_hyperplanes_give_the_general_position_count(m, seed):
     normals = unit_rows(np.random.default_rng(seed), m)
-    signs, points = arrangement_cells(normals)
+    signs, points = arrangement_cells(normals, tol=DEFAULT)
     assert len(signs) == general_position_count(m, 6)
     assert len({s.tobytes() for s in signs}) == len(signs)
     # each representative lies strictly inside its cell
@@ -44,21 +45,21 @@ def test_rank_deficient_arrangement_counts_in_the_span():
     # four generic hyperplanes whose normals span a 3-space of R^6: 14 cells as in R^3
     rng = np.random.default_rng(5)
     normals = np.hstack([unit_rows(rng, 4, 3), np.zeros((4, 3))])
-    signs, points = arrangement_cells(normals)
+    signs, points = arrangement_cells(normals, tol=DEFAULT)
     assert len(signs) == 14
     # the representatives drop the sliding part (last three coordinates)
     assert np.allclose(points[:, 3:], 0.0)
 
 
 def test_no_hyperplane_is_one_cell():
-    signs, points = arrangement_cells(np.zeros((0, 6)))
+    signs, points = arrangement_cells(np.zeros((0, 6)), tol=DEFAULT)
     assert signs.shape == (1, 0) and points.shape == (1, 6)
 
 
 def test_snapping_merges_parallel_and_antiparallel_rows():
     a = np.array([1.0, 2.0, 0.0, 0.0, 0.0, 2.0])
     b = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
-    planes, index, orient = snap_hyperplanes(np.array([a, -3 * a, b, 2 * a + 1e-12]))
+    planes, index, orient = snap_hyperplanes(np.array([a, -3 * a, b, 2 * a + 1e-12]), tol=DEFAULT)
     assert np.allclose(planes, [a / 3, b])
     assert index.tolist() == [0, 0, 1, 0]
     assert orient.tolist() == [1, -1, 1, 1]

@@ -13,7 +13,7 @@ from assemblykit.geometry.minkowski import (
     convex_bodies,
     overlap_depth,
 )
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import DEFAULT, Tolerance
 
 TOL = Tolerance()
 
@@ -68,7 +68,7 @@ def test_convex_pieces_split_bodies():
     b = trimesh.creation.box(
         extents=(1, 1, 1), transform=trimesh.transformations.translation_matrix([3, 0, 0])
     )
-    pieces = convex_bodies(trimesh.util.concatenate([a, b]))
+    pieces = convex_bodies(trimesh.util.concatenate([a, b]), tol=DEFAULT)
     assert pieces is not None and len(pieces) == 2
     assert sorted(round(float(p[:, 0].mean()), 9) for p in pieces) == [0.0, 3.0]
 
@@ -81,7 +81,7 @@ def test_a_hollow_box_is_not_two_convex_solids():
     cavity.invert()
     hollow = trimesh.util.concatenate([outer, cavity])
     assert hollow.body_count == 2 and hollow.volume == pytest.approx(45 - 3)
-    assert convex_bodies(hollow) is None
+    assert convex_bodies(hollow, tol=DEFAULT) is None
 
 
 def test_a_non_convex_body_has_no_convex_decomposition():
@@ -90,7 +90,7 @@ def test_a_non_convex_body_has_no_convex_decomposition():
             extents=(1, 1, 1), transform=trimesh.transformations.translation_matrix([0.5, 0.5, 0.5])
         )
     )
-    assert convex_bodies(notch) is None
+    assert convex_bodies(notch, tol=DEFAULT) is None
 
 
 def test_a_ring_is_no_convex_body_and_a_cube_beside_it_does_not_change_that():
@@ -100,14 +100,14 @@ def test_a_ring_is_no_convex_body_and_a_cube_beside_it_does_not_change_that():
         trimesh.creation.box(extents=(2, 2, 2))
     )
     assert ring.is_watertight and ring.euler_number == 0
-    assert convex_bodies(ring) is None
+    assert convex_bodies(ring, tol=DEFAULT) is None
     beside = trimesh.creation.box(
         extents=(1, 1, 1), transform=trimesh.transformations.translation_matrix([6, 0, 0])
     )
-    assert convex_bodies(trimesh.util.concatenate([ring, beside])) is None
+    assert convex_bodies(trimesh.util.concatenate([ring, beside]), tol=DEFAULT) is None
     # two cubes apart are two convex bodies (Euler characteristic 4, two bodies)
     apart = trimesh.util.concatenate([beside, trimesh.creation.box(extents=(1, 1, 1))])
-    assert apart.euler_number == 4 and len(convex_bodies(apart) or []) == 2
+    assert apart.euler_number == 4 and len(convex_bodies(apart, tol=DEFAULT) or []) == 2
 
 
 def test_overlap_depth_is_the_largest_ball_inside_both_hulls():

@@ -15,6 +15,7 @@ from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.interference import interferences, overlap_volume
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.meshes import load_manifest, pose_from_spec, pose_from_state, read_mesh
+from assemblykit.tolerance import DEFAULT
 from datasets import BUNDLED, dataset, shared_assembly
 
 ASAP = BUNDLED / "asap_beam_assembly"
@@ -69,7 +70,9 @@ def test_manifest_poses_units_and_relative_paths(tmp_path):
 def test_pose_spec_rejects_non_rigid_matrix():
     with pytest.raises(SchemaError, match=r"parts\[0\]\.pose"):
         pose_from_spec(
-            [[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], where="parts[0].pose"
+            [[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
+            where="parts[0].pose",
+            tol=DEFAULT,
         )
 
 

@@ -16,9 +16,9 @@ from assemblykit.geometry.contacts import (
     assembly_surfaces,
     memo_of,
 )
-from assemblykit.model.assembly import Assembly, Memo, Part
+from assemblykit.model.assembly import Assembly, Memo, Part, Precision
 from assemblykit.model.packings import box_mesh as box
-from assemblykit.tolerance import Tolerance, using
+from assemblykit.tolerance import ModelTolerance, Tolerance, using
 
 
 @pytest.fixture
@@ -48,6 +48,38 @@ def test_tolerance_uses_mesh_thresholds_scaled_to_the_model(tower):
     with using(Tolerance.relative(1e-9)):
         assert exact.tolerance().length == pytest.approx(1e-9 * np.sqrt(11))
         assert tower.tolerance().length == pytest.approx(1e-6 * np.sqrt(11))
+
+
+def test_a_model_resolves_a_policy_once_and_keeps_its_own_tolerance(tower):
+    policy = Tolerance.relative(1e-5)
+    resolved = tower.tolerance(policy)
+    assert isinstance(resolved, ModelTolerance) and not isinstance(policy, ModelTolerance)
+    # mesh input: the policy's length, at least the mesh floor, over the model's size
+    assert resolved.length == pytest.approx(1e-5 * np.sqrt(11))
+    assert resolved.angle == pytest.approx(1e-5)
+    # given back, to the model or to a part of it (the same scale), it stays as it is
+    assert tower.tolerance(resolved) is resolved
+    assert tower.subset(["a", "b"]).tolerance(resolved) is resolved
+    # a model of another size resolves it again, to its own scale
+    tall = Assembly([Part("t", box([0, 0, 0], [1, 1, 30]))])
+    assert tall.tolerance(resolved).scale == pytest.approx(np.sqrt(902))
+    # a measured precision coarser than the policy raises the length, once
+    rounded = Assembly(tower.parts, precision=Precision(1e-3, "rounded poses"))
+    raised = rounded.tolerance(policy)
+    assert raised.length == pytest.approx(1e-3)
+    assert rounded.tolerance(raised) is raised
+    assert rounded.tolerance_summary(policy)["from"] == "measured"
+    assert tower.tolerance_summary(policy)["from"] == "policy"
+
+
+def test_tolerances_with_the_same_numbers_are_equal_at_every_stage():
+    policy = Tolerance(scale=2.0, rel_length=1e-5)
+    model = ModelTolerance.of(policy)
+    assert model == policy and hash(model) == hash(policy)
+    assert ModelTolerance.of(model) is model
+    assert {policy: "kept"}[model] == "kept"
+    assert model != Tolerance(scale=3.0, rel_length=1e-5)
+    assert (policy == "tolerance") is False
 
 
 @dataclass

@@ -775,23 +775,22 @@ class _CosetTable:
                 self.add(g, key, reach)
 
 
-def classify_algebra(basis: NDArray[np.float64], tol: Tolerance | None = None) -> SymmetryGroup:
+def classify_algebra(basis: NDArray[np.float64], tol: Tolerance) -> SymmetryGroup:
     """The connected group whose Lie algebra is spanned by ``basis`` (6 x k) (§2.1 steps
     1-5, :func:`assemblykit.algebra.lie.classify_subalgebra`)."""
-    placed = classify_subalgebra(basis, tol or current())
+    placed = classify_subalgebra(basis, tol)
     if placed.kind is Kind.FIXED:
         return SymmetryGroup.identity()
     return SymmetryGroup.connected(placed.kind, placed.frame, placed.pitch)
 
 
-def one_parameter(tau: NDArray[np.float64], tol: Tolerance | None = None) -> SymmetryGroup | None:
+def one_parameter(tau: NDArray[np.float64], tol: Tolerance) -> SymmetryGroup | None:
     """The connected one-parameter group {exp(s log tau)} through a lattice generator
     that translates along its axis (a translation: T; a screw: H), else ``None``.
 
     Its elements are exp(s log tau), with s the ratio of their translation along the
     axis to that of tau (:func:`lattice_parameter`).
     """
-    tol = tol or current()
     group = classify_algebra(se3.log(tau)[:, None], tol)
     if group.kind not in (Kind.PRISMATIC, Kind.HELICAL):
         return None

@@ -410,7 +410,7 @@ def _frame_columns(
 
 
 def tuple_frame(
-    invariants: tuple[Invariant, ...] | list[Invariant], tol: Tolerance | None = None
+    invariants: tuple[Invariant, ...] | list[Invariant], tol: Tolerance
 ) -> NDArray[np.float64]:
     """A frame built from the tuple by a rule that commutes with rigid motions up to the
     tuple's stabiliser (§2.5: "the same rule on both sides").
@@ -420,7 +420,7 @@ def tuple_frame(
     direction (line, normal, free direction) or offset from the origin to an object is
     +z; the first one not parallel to it fixes +x.
     """
-    columns = _frame_columns(tuple(_flat(i) for i in invariants), tol or current())
+    columns = _frame_columns(tuple(_flat(i) for i in invariants), tol)
     if len(columns) == 1:
         return se3.translation(columns[0])
     return se3.matrix_from_columns(columns)
@@ -430,7 +430,7 @@ def pair_frame(
     first: Invariant, second: Invariant, tol: Tolerance | None = None
 ) -> NDArray[np.float64]:
     """The §2.5 pair frame of two invariants (``tuple_frame`` of the pair)."""
-    return tuple_frame((first, second), tol)
+    return tuple_frame((first, second), tol or current())
 
 
 # ----------------------------------------------------------------------------- stabilisers

@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from fractions import Fraction
 
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import Tolerance
 
 __all__ = [
     "MAX_LATTICE_DENOMINATOR",
@@ -29,21 +29,19 @@ __all__ = [
 MAX_LATTICE_DENOMINATOR = 10_000
 
 
-def lattice_denominator(tol: Tolerance | None = None) -> int:
+def lattice_denominator(tol: Tolerance) -> int:
     """The largest denominator a ratio may have to count as commensurate at ``tol``:
     ``1 / sqrt(10 x rel_length)``, at most :data:`MAX_LATTICE_DENOMINATOR` (docs/algebra.md
     §7). Every number lies within about ``1 / n**2`` of a fraction of denominator up to
     ``n`` (Dirichlet), so with larger denominators every ratio would be one; at this bound
     a ratio is taken for a fraction only when it is ten times nearer to it than a number
     in general is: √2 is not commensurate at 1e-6 (239/169 is 1.2e-5 away) nor at 1e-9."""
-    tol = tol or current()
     return max(1, min(MAX_LATTICE_DENOMINATOR, math.floor(1 / math.sqrt(10 * tol.rel_length))))
 
 
-def commensurate(ratio: float, tol: Tolerance | None = None) -> Fraction | None:
+def commensurate(ratio: float, tol: Tolerance) -> Fraction | None:
     """The fraction r/n (n <= :func:`lattice_denominator`) equal to ``ratio`` within the
     relative length tolerance, or ``None`` when the ratio is incommensurate (§7)."""
-    tol = tol or current()
     if not math.isfinite(ratio):
         return None
     frac = Fraction(ratio).limit_denominator(lattice_denominator(tol))
@@ -61,7 +59,7 @@ class IntegerPoints:
 
 
 def integer_points(
-    offset: float, period: Fraction, unit: float, tol: Tolerance | None = None
+    offset: float, period: Fraction, unit: float, tol: Tolerance
 ) -> IntegerPoints | None:
     """The integers k in ``offset + period * Z`` (``period`` 0: k = ``offset``), or
     ``None`` when there are none.
@@ -71,7 +69,6 @@ def integer_points(
     k = offset + j r / n is an integer iff n * offset is one, and then j is fixed
     modulo n by j r = -n offset (mod n): the solutions are spaced |r| apart.
     """
-    tol = tol or current()
     slack = tol.length / abs(unit)
     r, n = period.numerator, period.denominator
     scaled = n * offset

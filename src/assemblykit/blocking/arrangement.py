@@ -37,7 +37,7 @@ from scipy.sparse.csgraph import connected_components
 
 from assemblykit.algebra.se3 import line_classes
 from assemblykit.ragged import group_of, ranges
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import ModelTolerance
 
 # Rounding error of a 3-term dot product of unit vectors, in units of its magnitude.
 _DOT_ROUNDING = 4 * float(np.finfo(np.float64).eps)
@@ -87,14 +87,13 @@ def _exact_sign(a: NDArray[np.float64], b: NDArray[np.float64]) -> int:
 
 
 def side_signs(
-    normals: NDArray[np.float64], directions: NDArray[np.float64], tol: Tolerance | None = None
+    normals: NDArray[np.float64], directions: NDArray[np.float64], tol: ModelTolerance
 ) -> NDArray[np.int8]:
     """Side of every direction (rows) with respect to every circle (columns): ``+1``,
     ``-1``, or ``0`` when the direction is within the angle tolerance of the circle.
 
     Signs whose magnitude is within rounding error (only possible when the angle
     tolerance is below it) are decided exactly (module docstring, robustness)."""
-    tol = tol or current()
     dots = np.atleast_2d(directions) @ np.asarray(normals, dtype=np.float64).T
     signs = np.sign(dots).astype(np.int8)
     signs[np.abs(dots) <= tol.angle] = 0
@@ -106,13 +105,12 @@ def side_signs(
 
 
 def snap_normals(
-    normals: NDArray[np.float64], tol: Tolerance | None = None
+    normals: NDArray[np.float64], tol: ModelTolerance
 ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int8]]:
     """Group normals that are parallel or antiparallel within the angle tolerance.
 
     Returns the distinct circle normals (the first unit normal of each group), the
     circle of each input normal and its orientation (+1 same, -1 opposite)."""
-    tol = tol or current()
     units = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     return line_classes(units / np.linalg.norm(units, axis=1, keepdims=True), tol.angle)
 
@@ -140,7 +138,7 @@ def _whole(
     )
 
 
-def circle_partition(normals: NDArray[np.float64], tol: Tolerance | None = None) -> Arrangement:
+def circle_partition(normals: NDArray[np.float64], tol: ModelTolerance) -> Arrangement:
     """The partition of S¹ (Wilson & Latombe 1992, 2D case) by the diameters perpendicular to the
     given in-plane circle normals (distinct, z = 0): points and open arcs, in angular
     order, each arc linked to its two endpoints. O(c log c)."""

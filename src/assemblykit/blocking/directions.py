@@ -25,7 +25,7 @@ from scipy.sparse.csgraph import connected_components
 from assemblykit.blocking.arrangement import snap_normals, sphere_arrangement
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.part_sets import bits, count_bits, mask_vector
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 
 @dataclass(frozen=True, eq=False)
@@ -254,7 +254,7 @@ class BlockedRows:
 
 
 def local_table(
-    names: tuple[str, ...], terms: Sequence[BlockingTerm], tol: Tolerance
+    names: tuple[str, ...], terms: Sequence[BlockingTerm], tol: ModelTolerance
 ) -> DirectionTable:
     """Γ_t along the regions of each part's own arrangement (the great circles of the
     terms that block it: the arrangement of Wilson & Latombe 1992, "3D case", one part
@@ -293,7 +293,7 @@ def term_slots(
     terms: Sequence[BlockingTerm],
     owners: Sequence[int],
     count: int,
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> NDArray[np.bool_]:
     """``slots[k, s]``: some term of slot ``s`` (``owners[t]`` is term ``t``'s slot) holds
     strictly along direction ``k``, every normal ``n`` of it with ``n . d > tol.angle``: a

@@ -52,7 +52,7 @@ from assemblykit.geometry.occlusion import (
     witnesses_hold_along,
 )
 from assemblykit.model.assembly import Assembly, AssemblyLike
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 if TYPE_CHECKING:
     from assemblykit.blocking.obstacles import Obstacles
@@ -65,7 +65,7 @@ def all_convex(assembly: Assembly, parts: Iterable[str]) -> bool:
 
 
 def extended_terms(
-    assembly: Assembly, tol: Tolerance, parts: Iterable[str] | None = None
+    assembly: Assembly, tol: ModelTolerance, parts: Iterable[str] | None = None
 ) -> list[BlockingTerm]:
     """One cone term per pair of convex bodies of every pair of ``parts`` (default: all),
     both ways (those parts must be unions of convex bodies, :func:`all_convex`)."""
@@ -92,7 +92,7 @@ exact_extended.register(Assembly, all_convex)
 
 
 @singledispatch
-def assembly_extended_terms(assembly: AssemblyLike, tol: Tolerance) -> list[BlockingTerm]:
+def assembly_extended_terms(assembly: AssemblyLike, tol: ModelTolerance) -> list[BlockingTerm]:
     """The Γ_e terms of the whole assembly, dispatched on its type: the cones between
     the convex bodies of an :class:`~assemblykit.model.assembly.Assembly`'s meshes
     (:func:`extended_terms`); polygons register theirs
@@ -127,7 +127,7 @@ def extended_arcs(
     direction: ArrayLike,
     movers: Iterable[str],
     blockers: Iterable[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
     *,
     first_only: bool = False,
     known: Collection[tuple[str, str]] | None = None,
@@ -158,7 +158,7 @@ def _lattice_arcs(
     direction: NDArray[np.float64],
     movers: list[str],
     blockers: list[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> set[tuple[str, str]] | None:
     """The arcs of :func:`extended_arcs` when every part is made of unit cells and
     ``direction`` is a lattice direction (:func:`~assemblykit.blocking.lattice.cells_block`);
@@ -182,7 +182,7 @@ def projected_arcs(
     d: NDArray[np.float64],
     moving_parts: list[str],
     blockers: list[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
     *,
     first_only: bool = False,
     known: Collection[tuple[str, str]] | None = None,
@@ -233,7 +233,7 @@ def shown_arcs(
     direction: ArrayLike,
     movers: Iterable[str],
     blockers: Iterable[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> set[tuple[str, str]]:
     """Some of the arcs of :func:`extended_arcs`, found without projecting a mesh: the
     pairs where the two faces that showed a block along another direction show it along
@@ -247,7 +247,10 @@ def shown_arcs(
 
 
 def _may_block(
-    cache: Obstacles, direction: NDArray[np.float64], pairs: list[tuple[str, str]], tol: Tolerance
+    cache: Obstacles,
+    direction: NDArray[np.float64],
+    pairs: list[tuple[str, str]],
+    tol: ModelTolerance,
 ) -> list[tuple[str, str]]:
     """The pairs (moving, blocker) of ``pairs`` whose convex hulls allow a block along
     ``direction`` (:func:`~assemblykit.geometry.occlusion.hulls_may_block`): the others
@@ -262,7 +265,10 @@ def _may_block(
 
 
 def shown_pairs(
-    assembly: Assembly, direction: NDArray[np.float64], pairs: list[tuple[str, str]], tol: Tolerance
+    assembly: Assembly,
+    direction: NDArray[np.float64],
+    pairs: list[tuple[str, str]],
+    tol: ModelTolerance,
 ) -> set[tuple[str, str]]:
     """The pairs (moving, blocker) of ``pairs`` that block along the unit ``direction`` as shown by
     some two faces that showed it along another direction (kept in the assembly's
@@ -283,7 +289,7 @@ def shown_along(
     assembly: Assembly,
     frames: NDArray[np.float64],
     witnesses: Mapping[tuple[str, str], Sequence[tuple[int, int]]],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> dict[tuple[str, str], NDArray[np.bool_]]:
     """Per pair (moving, blocker) of ``witnesses``, whether some of the pairs of faces
     given for it (blocking witnesses, as
@@ -310,7 +316,7 @@ def _occluded(
     direction: NDArray[np.float64],
     pairs: list[tuple[str, str]],
     shifts: dict[str, NDArray[np.float64]],
-    tol: Tolerance,
+    tol: ModelTolerance,
     first_only: bool = False,
 ) -> set[tuple[str, str]]:
     """Which of ``pairs`` (moving, blocker) block along ``direction`` by the projection
@@ -350,7 +356,7 @@ def _occluded(
 
 
 def extended_dbg(
-    assembly: Assembly, direction: ArrayLike, parts: tuple[str, ...], tol: Tolerance
+    assembly: Assembly, direction: ArrayLike, parts: tuple[str, ...], tol: ModelTolerance
 ) -> DirectionalBlockingGraph:
     """G(d, A) for extended translations along one direction, over ``parts`` (exact)."""
     d = np.asarray(direction, dtype=np.float64).ravel()
@@ -364,7 +370,7 @@ def extended_free(
     assembly: Assembly,
     subassembly: Iterable[str],
     direction: ArrayLike,
-    tol: Tolerance,
+    tol: ModelTolerance,
     among: Iterable[str] | None = None,
 ) -> bool:
     """Whether ``subassembly`` leaves the other parts of ``among`` (default: all) by one

@@ -50,7 +50,7 @@ from assemblykit.deprecation import moved
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.minkowski import triangle_cones
 from assemblykit.ragged import group_of
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
@@ -280,7 +280,7 @@ class Faces:
     thin: NDArray[np.float64]
 
 
-def _faces(polygons: Sequence[tuple[int, shapely.Polygon]], tol: Tolerance) -> Faces:
+def _faces(polygons: Sequence[tuple[int, shapely.Polygon]], tol: ModelTolerance) -> Faces:
     wide: list[tuple[float, NDArray[np.float64]]] = []
     thin: list[tuple[float, NDArray[np.float64]]] = []
     for c, poly in polygons:
@@ -335,7 +335,7 @@ def _arcs_on_circle(
     cones: NDArray[np.float64],
     u: NDArray[np.float64],
     v: NDArray[np.float64],
-    tol: Tolerance,
+    tol: ModelTolerance,
     closed: bool = False,
 ) -> _Arcs:
     """Where the open cones meet the great circle ``cos t u + sin t v``: one open arc
@@ -383,7 +383,7 @@ def _arcs_meet(first: _Arcs, second: _Arcs, slack: float, chunk: int = 1 << 20) 
 
 
 def _cells_of_circle(
-    sets: Sequence[NDArray[np.float64]], m: NDArray[np.float64], tol: Tolerance
+    sets: Sequence[NDArray[np.float64]], m: NDArray[np.float64], tol: ModelTolerance
 ) -> CircleCells:
     """:func:`circle_cells` on one circle: the arc ends are clustered within the mesh
     angle tolerance, and the arcs of each set holding each cell are counted in one
@@ -445,7 +445,7 @@ def _cells_of_circle(
 
 
 def circle_cells(
-    sets: Sequence[NDArray[np.float64]], circles: NDArray[np.float64], tol: Tolerance
+    sets: Sequence[NDArray[np.float64]], circles: NDArray[np.float64], tol: ModelTolerance
 ) -> CircleCells:
     """The cells (points and open arcs) of the arrangement the cones of ``sets`` (each
     ``cones x rows x 3``) cut on each great circle of ``circles`` (unit normals), and
@@ -464,7 +464,7 @@ def circle_cells(
     )
 
 
-def sliding_circles(sets: Sequence[ChartSet], tol: Tolerance) -> NDArray[np.float64]:
+def sliding_circles(sets: Sequence[ChartSet], tol: ModelTolerance) -> NDArray[np.float64]:
     """The great circles where a set of directions may be thinner than a face: those of
     the contacts (a part held between two others slides along their common plane; a pin
     in its hole along its axis, where the circles of its contact meet) and those along
@@ -482,7 +482,7 @@ def sliding_circles(sets: Sequence[ChartSet], tol: Tolerance) -> NDArray[np.floa
     return snap_normals(candidates, tol)[0]
 
 
-def _abutting_circles(cones: NDArray[np.float64], tol: Tolerance) -> NDArray[np.float64]:
+def _abutting_circles(cones: NDArray[np.float64], tol: ModelTolerance) -> NDArray[np.float64]:
     """The circles of cone rows (snapped within the angle tolerance) that bound cones on
     both sides, where the facet (closed arc) of such a cone on one side meets that of
     one on the other: only there can the two cones leave a gap of no width."""
@@ -528,7 +528,7 @@ def _abutting_circles(cones: NDArray[np.float64], tol: Tolerance) -> NDArray[np.
     return np.array(found).reshape(-1, 3)
 
 
-def free_cells(blocked: ChartSet, tol: Tolerance) -> NDArray[np.float64]:
+def free_cells(blocked: ChartSet, tol: ModelTolerance) -> NDArray[np.float64]:
     """A direction in every arc and at every point of :func:`sliding_circles` outside
     ``blocked``: its free directions that lie in no face (a part that may only slide),
     longest arcs first, then points (Wilson & Latombe 1992 §5)."""
@@ -545,7 +545,7 @@ def _distinct_directions(directions: NDArray[np.float64]) -> NDArray[np.float64]
     return directions[np.sort(first)]
 
 
-def lower_cells(sets: Sequence[ChartSet], tol: Tolerance) -> NDArray[np.float64]:
+def lower_cells(sets: Sequence[ChartSet], tol: ModelTolerance) -> NDArray[np.float64]:
     """One direction per distinct combination of the sets holding it among the arcs and
     points of :func:`sliding_circles` (longest first): where the sets meet without a
     gap, the combinations no face shows (a part held by fewer parts while it slides)."""
@@ -555,7 +555,7 @@ def lower_cells(sets: Sequence[ChartSet], tol: Tolerance) -> NDArray[np.float64]
     return cells.directions[order[np.sort(first)]]
 
 
-def free_faces(blocked: ChartSet, tol: Tolerance) -> Faces:
+def free_faces(blocked: ChartSet, tol: ModelTolerance) -> Faces:
     """A direction in every face of the complement of ``blocked``."""
     square = shapely.box(-1.0, -1.0, 1.0, 1.0)
     polygons: list[tuple[int, shapely.Polygon]] = []
@@ -565,7 +565,7 @@ def free_faces(blocked: ChartSet, tol: Tolerance) -> Faces:
     return _faces(polygons, tol)
 
 
-def overlay_faces(sets: Sequence[ChartSet], tol: Tolerance, limit: int = 20_000) -> Faces:
+def overlay_faces(sets: Sequence[ChartSet], tol: ModelTolerance, limit: int = 20_000) -> Faces:
     """A direction in every face of the overlay of the sets' boundaries (the arrangement
     refined by the obstacle boundaries), at most ``limit`` faces per chart, then one per
     combination of the sets seen only on arcs and points of :func:`sliding_circles`
@@ -584,7 +584,7 @@ def overlay_faces(sets: Sequence[ChartSet], tol: Tolerance, limit: int = 20_000)
 
 
 def blocked_by(
-    assembly: Assembly, moving: Iterable[str], blocker: str, tol: Tolerance
+    assembly: Assembly, moving: Iterable[str], blocker: str, tol: ModelTolerance
 ) -> ChartSet | None:
     """The directions along which ``blocker`` blocks some part of ``moving`` (Wilson & Latombe 1992
     §5), or ``None`` when there are more triangle pairs than :data:`TRIANGLE_PAIRS`.
@@ -600,7 +600,7 @@ def blocked_by(
 
 
 def _blocked_by(
-    assembly: Assembly, cache: Obstacles, moving: tuple[str, ...], blocker: str, tol: Tolerance
+    assembly: Assembly, cache: Obstacles, moving: tuple[str, ...], blocker: str, tol: ModelTolerance
 ) -> ChartSet | None:
     """:func:`blocked_by` computed: the union of the cones of every pair of convex
     pieces, or of front and back triangles of non-convex parts, with the normals of
@@ -643,7 +643,7 @@ def _blocked_by(
 
 
 def _contact_normals(
-    assembly: Assembly, moving: tuple[str, ...], blockers: str | Iterable[str], tol: Tolerance
+    assembly: Assembly, moving: tuple[str, ...], blockers: str | Iterable[str], tol: ModelTolerance
 ) -> NDArray[np.float64]:
     """The normals of the Γ_t terms of the contacts where a part of ``blockers`` (one
     name or several) touches a part of ``moving``
@@ -678,7 +678,7 @@ class ExactFree:
 
 
 def blocked_sets(
-    assembly: Assembly, moving: Iterable[str], among: Iterable[str], tol: Tolerance
+    assembly: Assembly, moving: Iterable[str], among: Iterable[str], tol: ModelTolerance
 ) -> dict[str, ChartSet] | None:
     """Per other part of ``among``, the directions along which it blocks ``moving``
     (``None`` when one is too large to compute)."""
@@ -695,7 +695,7 @@ def blocked_sets(
 def exact_free_directions(
     assembly: Assembly,
     moving: Iterable[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
     among: Iterable[str] | None = None,
     limit: int = 8,
 ) -> ExactFree:

@@ -37,13 +37,13 @@ from assemblykit.blocking.rigid import RigidBlockingGraph
 from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.model.assembly import AssemblyLike
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
 
 
-def blocking_terms(assembly: AssemblyLike, motion: str, tol: Tolerance) -> list[BlockingTerm]:
+def blocking_terms(assembly: AssemblyLike, motion: str, tol: ModelTolerance) -> list[BlockingTerm]:
     """The blocking terms of the whole assembly for a motion, computed once per
     assembly and tolerance (subsets filter them)."""
     cache = BlockingCache.of(assembly).terms
@@ -190,7 +190,10 @@ def blocking_graph(
 
 
 def sampled_ndbg(
-    assembly: Assembly, parts: tuple[str, ...], local: NonDirectionalBlockingGraph, tol: Tolerance
+    assembly: Assembly,
+    parts: tuple[str, ...],
+    local: NonDirectionalBlockingGraph,
+    tol: ModelTolerance,
 ) -> NonDirectionalBlockingGraph:
     """Γ_e over the regions of the Γ_t graph ``local`` of the same parts, each region's
     DBG computed exactly at its representative direction; ``dbg(d)`` is exact for any

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 _SPREAD = np.array([0.5 + 1e-3 * np.pi, 0.5 + 1e-3 * np.exp(1.0)])
 """Where in its cell's cross-section a cell is probed (:func:`lattice_cells`): off every
@@ -74,7 +74,9 @@ def lattice_cells(mesh: Any) -> NDArray[np.int64] | None:
     return cells
 
 
-def lattice_direction(direction: NDArray[np.float64], tol: Tolerance) -> NDArray[np.int64] | None:
+def lattice_direction(
+    direction: NDArray[np.float64], tol: ModelTolerance
+) -> NDArray[np.int64] | None:
     """The lattice direction ``e`` (components -1, 0 or 1) within the angle tolerance of
     ``direction``, or ``None``."""
     d = np.asarray(direction, dtype=np.float64)

@@ -37,7 +37,7 @@ from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.directions import DirectionTable
 from assemblykit.model.assembly import AssemblyLike as AssemblyLike
 from assemblykit.ragged import group_of, group_starts, ranges
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 Motion = Literal["infinitesimal", "extended", "rigid"]
 _CHUNK = 8192
@@ -66,7 +66,7 @@ class ConstraintTable:
         cls,
         parts: Sequence[str],
         terms: Sequence[BlockingTerm],
-        tol: Tolerance,
+        tol: ModelTolerance,
         normals: NDArray[np.float64] | None = None,
         spare: Iterable[int] | None = None,
     ) -> ConstraintTable:
@@ -115,7 +115,9 @@ class ConstraintTable:
             return satisfied
         return np.logical_or.reduceat(satisfied, self.starts, axis=1)
 
-    def direct_arcs(self, directions: NDArray[np.float64], tol: Tolerance) -> NDArray[np.bool_]:
+    def direct_arcs(
+        self, directions: NDArray[np.float64], tol: ModelTolerance
+    ) -> NDArray[np.bool_]:
         """Which slots block along each direction, computed from scratch."""
         out = [
             self.arcs(self.weights(side_signs(self.normals, directions[lo : lo + _CHUNK], tol)))
@@ -190,7 +192,7 @@ class NonDirectionalBlockingGraph:
     table: ConstraintTable
     packed: NDArray[np.uint8]
     contacts: int
-    tol: Tolerance
+    tol: ModelTolerance
     exact: Callable[[NDArray[np.float64], tuple[str, ...]], DirectionalBlockingGraph] | None = None
 
     def _graph(
@@ -525,7 +527,7 @@ def build_ndbg(
     motion: str,
     terms: Sequence[BlockingTerm],
     contacts: int,
-    tol: Tolerance,
+    tol: ModelTolerance,
     dimension: int = 3,
 ) -> NonDirectionalBlockingGraph:
     """The NDBG of the parts for the given terms: arrangement of the snapped circles

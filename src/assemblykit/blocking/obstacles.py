@@ -26,7 +26,7 @@ from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
 from assemblykit.geometry.occlusion import hull_vertices, triangle_spheres
 from assemblykit.geometry.settling import settle
 from assemblykit.model.assembly import Assembly, AssemblyLike
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 
 def of_meshes(assembly: AssemblyLike) -> Assembly:
@@ -123,7 +123,7 @@ class Obstacles:
             self.solids[name] = solid(self.assembly.parts[name].mesh)
         return self.solids[name]
 
-    def backout(self, moving: str, blocker: str, tol: Tolerance) -> NDArray[np.float64]:
+    def backout(self, moving: str, blocker: str, tol: ModelTolerance) -> NDArray[np.float64]:
         """The translation that backs ``moving`` out of ``blocker`` before blocking is
         decided: their separation when they share a volume counted as touching (module
         docstring), beyond rounding (the cube of the length tolerance), and it is longer
@@ -150,7 +150,7 @@ class Obstacles:
                 self.backouts[key] = shift
         return self.backouts[key]
 
-    def cones_of(self, moving: str, blocker: str, tol: Tolerance) -> list[NDArray[np.float64]]:
+    def cones_of(self, moving: str, blocker: str, tol: ModelTolerance) -> list[NDArray[np.float64]]:
         """The cones along which ``blocker`` blocks ``moving``, both unions of convex
         bodies (:meth:`convex`; other parts go to the projection test, which backs them
         out). An empty cone (they overlap) is recomputed with ``moving`` backed out of
@@ -169,7 +169,7 @@ class Obstacles:
         return self.cones[key]
 
     def _cones(
-        self, moving: str, blocker: str, tol: Tolerance, shift: NDArray[np.float64]
+        self, moving: str, blocker: str, tol: ModelTolerance, shift: NDArray[np.float64]
     ) -> list[NDArray[np.float64]]:
         pieces, obstacles = self.of(moving), self.of(blocker)
         assert pieces is not None and obstacles is not None

@@ -44,10 +44,10 @@ from shapely.ops import unary_union
 from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.extended import assembly_extended_terms, exact_extended
 from assemblykit.model.polygons import PolygonAssembly
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 
-def convex_pieces(polygon: NDArray[np.float64], tol: Tolerance) -> list[NDArray[np.float64]]:
+def convex_pieces(polygon: NDArray[np.float64], tol: ModelTolerance) -> list[NDArray[np.float64]]:
     """Convex pieces (counter-clockwise vertex arrays) whose union is the simple polygon:
     the triangles of a constrained Delaunay triangulation, two pieces sharing an edge
     merged while their union is convex (its area is its hull's, within the length
@@ -87,7 +87,7 @@ def _left(v: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def blocked_normals(
-    moving: NDArray[np.float64], blocker: NDArray[np.float64], tol: Tolerance
+    moving: NDArray[np.float64], blocker: NDArray[np.float64], tol: ModelTolerance
 ) -> NDArray[np.float64]:
     """The half-planes ``n . d > 0`` (rows ``n``, unit, z = 0) whose intersection is the
     set of directions along which the convex piece ``blocker`` blocks the convex piece
@@ -116,7 +116,7 @@ def blocked_normals(
 
 
 @assembly_extended_terms.register(PolygonAssembly)
-def planar_extended_terms(model: PolygonAssembly, tol: Tolerance) -> list[BlockingTerm]:
+def planar_extended_terms(model: PolygonAssembly, tol: ModelTolerance) -> list[BlockingTerm]:
     """The Γ_e terms of a polygon assembly (:class:`assemblykit.model.polygons.
     PolygonAssembly`): one per pair of convex pieces of every two parts, both ways."""
     pieces = {name: convex_pieces(poly, tol) for name, poly in model.polygons.items()}

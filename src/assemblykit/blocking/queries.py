@@ -47,7 +47,7 @@ from assemblykit.errors import UnknownNameError
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.model.assembly import Assembly, AssemblyLike
 from assemblykit.model.polygons import PolygonAssembly
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 _AXES = np.concatenate([np.eye(3), -np.eye(3)])
 
@@ -67,7 +67,7 @@ def removable_subassemblies(
 def _local_graph(
     assembly: AssemblyLike,
     subassembly: set[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
     among: Collection[str] | None = None,
 ) -> NonDirectionalBlockingGraph | None:
     """Γ_t of the contacts leaving ``subassembly`` for the other parts of ``among``
@@ -88,7 +88,7 @@ def _local_graph(
 def _local_free_regions(
     assembly: AssemblyLike,
     subassembly: set[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
     among: Collection[str] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.int8]]:
     """Directions and dimensions of the Γ_t regions where ``subassembly`` is locally
@@ -106,7 +106,7 @@ def _local_free_regions(
 def _extra_directions(
     assembly: AssemblyLike,
     subassembly: set[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
     among: Collection[str] | None = None,
 ) -> NDArray[np.float64]:
     """The principal axes (both ways) of the moving parts' meshes and the unit normals
@@ -176,7 +176,7 @@ def can_extract(
 
 @singledispatch
 def _extended_removal(
-    assembly: AssemblyLike, moving: set[str], among: Collection[str], tol: Tolerance
+    assembly: AssemblyLike, moving: set[str], among: Collection[str], tol: ModelTolerance
 ) -> Removal | None:
     """:func:`can_extract` by an extended translation among the parts ``among``,
     dispatched on the assembly's type: meshes (:func:`_mesh_removal`) or polygons
@@ -186,7 +186,7 @@ def _extended_removal(
 
 @_extended_removal.register(Assembly)
 def _mesh_removal(
-    assembly: Assembly, moving: set[str], among: Collection[str], tol: Tolerance
+    assembly: Assembly, moving: set[str], among: Collection[str], tol: ModelTolerance
 ) -> Removal | None:
     """:func:`_extended_removal` of meshes: none when Γ_t holds ``moving`` along every
     direction; else the locally free regions of Γ_t (the highest dimension first, the
@@ -210,7 +210,9 @@ def _mesh_removal(
     return None
 
 
-def _planar_table(model: PolygonAssembly, among: Collection[str], tol: Tolerance) -> DirectionTable:
+def _planar_table(
+    model: PolygonAssembly, among: Collection[str], tol: ModelTolerance
+) -> DirectionTable:
     """Γ_e of the polygons ``among`` over every region of its exact NDBG: the points and
     open arcs of S¹ (docs/blocking.md, "Three kinds of motion"), arcs first."""
     graph = blocking_graph(model, "extended", [n for n in model.names if n in among], tol)
@@ -223,7 +225,7 @@ def _planar_table(model: PolygonAssembly, among: Collection[str], tol: Tolerance
 
 
 def _planar_free(
-    model: PolygonAssembly, moving: set[str], among: Collection[str], tol: Tolerance
+    model: PolygonAssembly, moving: set[str], among: Collection[str], tol: ModelTolerance
 ) -> NDArray[np.float64]:
     """The directions of the regions of the exact NDBG of the polygons ``among`` along
     which ``moving`` leaves the others (:func:`_planar_table`)."""
@@ -237,7 +239,7 @@ def _planar_free(
 
 @_extended_removal.register(PolygonAssembly)
 def _planar_removal(
-    model: PolygonAssembly, moving: set[str], among: Collection[str], tol: Tolerance
+    model: PolygonAssembly, moving: set[str], among: Collection[str], tol: ModelTolerance
 ) -> Removal | None:
     """:func:`_extended_removal` of polygons: the regions of their exact NDBG along which
     ``moving`` leaves (:func:`_planar_free`)."""
@@ -295,7 +297,7 @@ def removal_before(assembly: AssemblyLike, part: str, tol: Tolerance | None = No
 
 @singledispatch
 def _removal_before(
-    assembly: AssemblyLike, part: str, names: list[str], tol: Tolerance
+    assembly: AssemblyLike, part: str, names: list[str], tol: ModelTolerance
 ) -> Prerequisite:
     """:func:`removal_before`, dispatched on the assembly's type: meshes
     (:func:`_mesh_removal_before`) or polygons (:func:`_planar_removal_before`)."""
@@ -304,7 +306,7 @@ def _removal_before(
 
 @_removal_before.register(Assembly)
 def _mesh_removal_before(
-    assembly: Assembly, part: str, names: list[str], tol: Tolerance
+    assembly: Assembly, part: str, names: list[str], tol: ModelTolerance
 ) -> Prerequisite:
     """:func:`removal_before` of meshes: over the faces of the overlay of the sets the
     other parts block and the arcs and points where they meet (:func:`removal_before`)."""
@@ -337,7 +339,7 @@ def _first_removable(
     part: str,
     options: dict[frozenset[str], NDArray[np.float64]],
     names: list[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
     complete: bool,
 ) -> Prerequisite:
     """The smallest set of ``options`` (each with a direction along which ``part`` leaves
@@ -354,7 +356,7 @@ def _first_removable(
 
 @_removal_before.register(PolygonAssembly)
 def _planar_removal_before(
-    model: PolygonAssembly, part: str, names: list[str], tol: Tolerance
+    model: PolygonAssembly, part: str, names: list[str], tol: ModelTolerance
 ) -> Prerequisite:
     """:func:`removal_before` of polygons: the parts blocking ``part`` over each region
     of the exact NDBG (points and arcs of S¹), so every set of direct blockers is seen."""
@@ -369,7 +371,7 @@ def _planar_removal_before(
 
 
 def _removable_first(
-    assembly: AssemblyLike, chosen: frozenset[str], names: list[str], tol: Tolerance
+    assembly: AssemblyLike, chosen: frozenset[str], names: list[str], tol: ModelTolerance
 ) -> bool:
     """Whether the parts of ``chosen`` can be taken out of ``names`` one at a time, each
     by an extended translation among the parts still there (:func:`_extended_removal`,
@@ -385,7 +387,7 @@ def _removable_first(
     return True
 
 
-def _leaves(assembly: AssemblyLike, name: str, among: set[str], tol: Tolerance) -> bool:
+def _leaves(assembly: AssemblyLike, name: str, among: set[str], tol: ModelTolerance) -> bool:
     """Whether the part ``name`` leaves the other parts of ``among`` by one extended
     translation."""
     return _extended_removal(assembly, {name}, among, tol) is not None

@@ -45,7 +45,7 @@ from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.twist_arrangement import arrangement_cells, snap_hyperplanes
 from assemblykit.geometry.contact_values import Contact, PlanarPatch
 from assemblykit.graphs import component_labels
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 RIGID_MAX_SIZE = 2
 # about 4 s of linear programs at 12 hyperplanes in general position (2048 cells); the
@@ -97,7 +97,7 @@ def wrenches(
 
 
 def stops_every_twist(
-    points: NDArray[np.float64], normals: NDArray[np.float64], tol: Tolerance
+    points: NDArray[np.float64], normals: NDArray[np.float64], tol: ModelTolerance
 ) -> bool:
     """Whether contacts at ``points`` with ``normals`` stop every twist of one part
     against the other: their wrenches (:func:`wrenches`, about the points' centroid)
@@ -159,7 +159,7 @@ class TwistArrangement:
         return f"built: {m} hyperplanes, {len(self.signs)} regions"
 
 
-def twist_arrangement(contacts: Iterable[Contact], tol: Tolerance) -> TwistArrangement:
+def twist_arrangement(contacts: Iterable[Contact], tol: ModelTolerance) -> TwistArrangement:
     """The hyperplanes of every contact point of the contacts (normals from ``a`` into
     ``b``), snapped (:func:`~assemblykit.blocking.twist_arrangement.snap_hyperplanes`),
     and the cells of their arrangement when there are at most
@@ -187,7 +187,7 @@ class RigidBlockingGraph:
 
     parts: tuple[str, ...]
     contacts: tuple[Contact, ...]
-    tol: Tolerance
+    tol: ModelTolerance
     motion: str = "rigid"
 
     def constraints(

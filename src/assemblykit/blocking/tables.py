@@ -21,13 +21,13 @@ from assemblykit.blocking.arrangement import circle_partition, snap_normals
 from assemblykit.blocking.directions import DirectionTable, local_table, term_slots
 from assemblykit.blocking.graphs import blocking_graph, blocking_terms
 from assemblykit.model.assembly import AssemblyLike
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 FULL_ARRANGEMENT_REGIONS = 250_000
 """The largest arrangement of Γ_t whose regions all become candidate directions."""
 
 
-def translation_table(assembly: AssemblyLike, tol: Tolerance) -> DirectionTable:
+def translation_table(assembly: AssemblyLike, tol: ModelTolerance) -> DirectionTable:
     """Γ_t along the candidate directions of the planner: the regions of the whole
     arrangement when it is small enough (about ``3 c²`` regions for ``c`` circles, at
     most ``FULL_ARRANGEMENT_REGIONS``), else those of each part's own arrangement
@@ -41,7 +41,7 @@ def translation_table(assembly: AssemblyLike, tol: Tolerance) -> DirectionTable:
 
 
 def translation_slots(
-    assembly: AssemblyLike, table: DirectionTable, tol: Tolerance
+    assembly: AssemblyLike, table: DirectionTable, tol: ModelTolerance
 ) -> Callable[[NDArray[np.float64]], NDArray[np.bool_]]:
     """Γ_t along new directions over the slots of ``table``: a slot blocks when one of its
     infinitesimal terms holds strictly (beyond the angle tolerance, as the arrangement's
@@ -97,7 +97,7 @@ def with_obstacles(
 
 
 def planar_direction_tables(
-    assembly: AssemblyLike, tol: Tolerance
+    assembly: AssemblyLike, tol: ModelTolerance
 ) -> tuple[DirectionTable, DirectionTable]:
     """Γ_t and Γ_e of a polygon assembly along the regions of one arrangement of S¹: the
     points and open arcs cut by the diameters of both (contacts and grown obstacles). It

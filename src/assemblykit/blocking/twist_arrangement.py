@@ -20,18 +20,17 @@ from numpy.typing import NDArray
 from scipy.optimize import linprog
 
 from assemblykit.errors import NumericError
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import ModelTolerance
 
 
 def snap_hyperplanes(
-    rows: NDArray[np.float64], tol: Tolerance | None = None
+    rows: NDArray[np.float64], tol: ModelTolerance
 ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int8]]:
     """Group rows (m x d) that define the same central hyperplane (parallel or antiparallel
     within the mesh angle tolerance: contact points come from meshes).
 
     Returns the distinct unit normals (the first row of each group), the hyperplane of
     each row and its orientation (+1 same, -1 opposite)."""
-    tol = tol or current()
     units = np.asarray(rows, dtype=np.float64)
     units = units / np.linalg.norm(units, axis=1, keepdims=True)
     planes: list[NDArray[np.float64]] = []
@@ -51,13 +50,12 @@ def snap_hyperplanes(
 
 
 def cell_point(
-    normals: NDArray[np.float64], signs: NDArray[np.int8], tol: Tolerance | None = None
+    normals: NDArray[np.float64], signs: NDArray[np.int8], tol: ModelTolerance
 ) -> NDArray[np.float64] | None:
     """A point ``x`` in the box ``|x_i| <= 1`` with ``signs * (normals @ x)`` at least a
     common margin as large as possible (linear program), or ``None`` when that margin
     does not exceed the mesh angle tolerance (HiGHS solves to about 1e-7): the sign
     vector is then no full-dimensional cell."""
-    tol = tol or current()
     m, d = normals.shape
     result = linprog(
         c=np.r_[np.zeros(d), -1.0],
@@ -72,13 +70,12 @@ def cell_point(
 
 
 def arrangement_cells(
-    normals: NDArray[np.float64], tol: Tolerance | None = None
+    normals: NDArray[np.float64], tol: ModelTolerance
 ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
     """Every full-dimensional cell of the arrangement of the central hyperplanes with
     the given unit ``normals`` (m x d): their sign vectors (R x m, entries ±1) and one
     interior point of each (R x d), in the span of the normals, in breadth-first order
     (module docstring). With no hyperplane the whole space is one cell."""
-    tol = tol or current()
     m, d = normals.shape
     if m == 0:
         return np.ones((1, 0), dtype=np.int8), np.eye(d)[:1]

@@ -77,11 +77,10 @@ def shared_volume(a: manifold3d.Manifold, b: manifold3d.Manifold) -> float:
 
 
 def interference_threshold(
-    mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh, tol: Tolerance | None = None
+    mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh, tol: Tolerance
 ) -> float:
     """The largest shared volume still counted as touching: the length tolerance times
     the smaller surface area (module docstring)."""
-    tol = tol or current()
     return tol.length * min(float(mesh_a.area), float(mesh_b.area))
 
 
@@ -91,7 +90,7 @@ def interferes(
     """Whether two closed meshes share more than a tolerance-thin volume."""
     if not _boxes_meet(mesh_a, mesh_b):
         return False
-    return overlap_volume(mesh_a, mesh_b) > interference_threshold(mesh_a, mesh_b, tol)
+    return overlap_volume(mesh_a, mesh_b) > interference_threshold(mesh_a, mesh_b, tol or current())
 
 
 def solids_interfere(a: manifold3d.Manifold, b: manifold3d.Manifold, threshold: float) -> bool:

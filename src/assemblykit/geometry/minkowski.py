@@ -41,9 +41,7 @@ LP_FIRST = 20_000
 whether the pieces overlap (then the hull of their differences is not needed)."""
 
 
-def convex_bodies(
-    mesh: trimesh.Trimesh, tol: Tolerance | None = None
-) -> list[NDArray[np.float64]] | None:
+def convex_bodies(mesh: trimesh.Trimesh, tol: Tolerance) -> list[NDArray[np.float64]] | None:
     """Vertex sets of the connected bodies of the mesh when each is a convex solid within
     the length tolerance, else ``None`` (also for a hollow part, whose cavity is a shell
     facing inwards).
@@ -52,7 +50,6 @@ def convex_bodies(
     ``tol.length`` inside its convex hull: blocks whose polygon faces are not quite
     planar (COMPAS vaults) stay on the exact cone route, and treating them as their hull
     moves their surface by at most the tolerance."""
-    tol = tol or current()
     # a convex body's closed surface is a sphere (Euler characteristic 2): a closed mesh
     # whose bodies have handles (a plate with holes) is no union of convex bodies, and
     # neither split nor hull is needed to say so
@@ -162,12 +159,11 @@ def obstacle_hull(obstacle: NDArray[np.float64], moving: NDArray[np.float64]) ->
 
 
 def blocking_cone(
-    obstacle: NDArray[np.float64], moving: NDArray[np.float64], tol: Tolerance | None = None
+    obstacle: NDArray[np.float64], moving: NDArray[np.float64], tol: Tolerance
 ) -> NDArray[np.float64]:
     """Normals ``n`` (m x 3) such that translating the convex piece ``moving`` along ``d``
     to infinity enters the interior of the convex piece ``obstacle`` iff ``n . d > 0`` for
     all of them. An empty array means every direction (the pieces overlap)."""
-    tol = tol or current()
     obstacle = np.asarray(obstacle, dtype=np.float64)
     moving = np.asarray(moving, dtype=np.float64)
     if len(obstacle) * len(moving) > LP_FIRST and overlap_depth(obstacle, moving) > tol.length:
@@ -217,7 +213,7 @@ def triangle_cones(
     obstacle: NDArray[np.float64],
     moving_normals: NDArray[np.float64] | None,
     obstacle_normals: NDArray[np.float64] | None,
-    tol: Tolerance | None = None,
+    tol: Tolerance,
 ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
     """Open cones of the directions along which each triangle of ``moving`` (m x 3 x 3),
     swept to infinity, crosses each triangle of ``obstacle`` (k x 3 x 3): for the pair,
@@ -235,7 +231,6 @@ def triangle_cones(
     to its boundary. Pairs whose generators span no volume (coplanar faces in contact)
     or surround the origin (the triangles cross at rest) are not valid; the second kind
     is reported by the caller's interference test instead."""
-    tol = tol or current()
     mt = np.asarray(moving, dtype=np.float64).reshape(-1, 3, 3)
     ot = np.asarray(obstacle, dtype=np.float64).reshape(-1, 3, 3)
     gens = (ot[None, :, :, None, :] - mt[:, None, None, :, :]).reshape(len(mt) * len(ot), 9, 3)

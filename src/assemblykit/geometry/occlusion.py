@@ -160,7 +160,7 @@ def faces_near_outlines(
     hulls: Sequence[NDArray[np.float64]],
     pairs: NDArray[np.int64],
     direction: ArrayLike,
-    tol: Tolerance | None = None,
+    tol: Tolerance,
 ) -> list[NDArray[np.int64]]:
     """Per mesh (its :func:`triangle_spheres` and the points of its convex hull), the
     faces that may take part in a block between the pairs ``(i, j)`` of ``pairs`` along
@@ -169,7 +169,6 @@ def faces_near_outlines(
     triangles shows a block only where their projections overlap (module docstring),
     inside both meshes' outlines, so a face whose ball projects clear of the other
     outline's box takes part in none."""
-    tol = tol or current()
     frame = view_frame(direction)[:2]
     boxes = []
     for points in hulls:
@@ -201,7 +200,7 @@ def hulls_may_block(
     hulls: Sequence[NDArray[np.float64]],
     pairs: NDArray[np.int64],
     direction: ArrayLike,
-    tol: Tolerance | None = None,
+    tol: Tolerance,
 ) -> NDArray[np.bool_]:
     """Per pair ``(i, j)`` of ``pairs`` (rows of indices into ``hulls``, each the points
     of a part's convex hull), whether ``j`` may block the extended translation of ``i``
@@ -214,7 +213,6 @@ def hulls_may_block(
     of the hulls with ``A <= P tol / 2`` holds no triangle overlap that counts
     (``A > P tol``, as :func:`occluded_pairs` counts them). All pairs at once (shapely's
     vectorised hulls and intersections)."""
-    tol = tol or current()
     if not len(pairs):
         return np.zeros(0, dtype=bool)
     frame = view_frame(direction)
@@ -257,12 +255,11 @@ def _shadow_width(flat: NDArray[np.float64]) -> NDArray[np.float64]:
 def shadows(
     meshes: Sequence[trimesh.Trimesh],
     direction: ArrayLike,
-    tol: Tolerance | None = None,
+    tol: Tolerance,
     faces: Sequence[NDArray[np.int64]] | None = None,
 ) -> Shadows:
     """Project the meshes' triangles on the plane ``⟂ direction`` (module docstring):
     all of them, or those listed per mesh in ``faces``."""
-    tol = tol or current()
     frame = view_frame(direction)
     owner, facing, corners, normals, kept = [], [], [], [], []
     for k, mesh in enumerate(meshes):
@@ -469,13 +466,13 @@ def occluded_pairs(
     """The pairs ``(i, j)`` of meshes such that ``j`` blocks the extended translation of
     ``i`` along the view direction, among those with ``allowed[i, j]`` (module
     docstring; :func:`blocking_witnesses` without the witnesses)."""
-    return set(blocking_witnesses(view, allowed, tol, first_only=first_only))
+    return set(blocking_witnesses(view, allowed, tol or current(), first_only=first_only))
 
 
 def blocking_witnesses(
     view: Shadows,
     allowed: NDArray[np.bool_],
-    tol: Tolerance | None = None,
+    tol: Tolerance,
     *,
     first_only: bool = False,
 ) -> dict[tuple[int, int], tuple[int, int]]:
@@ -488,7 +485,6 @@ def blocking_witnesses(
     others are then examined over all their triangles. With ``first_only``, a mesh
     found blocked by one is not examined further: each blocked mesh has at least one
     pair, the others may be missing (whether a part can leave, not all that holds it)."""
-    tol = tol or current()
     found = _occluded_among(view, allowed, _largest(view, _FIRST_TRIANGLES), tol, first_only)
     rest = allowed.copy()
     for i, j in found:
@@ -511,20 +507,21 @@ def witnesses_hold(
     show that ``j`` blocks ``i`` along ``direction`` too: the test of the module
     docstring on these two triangles alone. A witness that holds shows the block (a
     pair of triangles is enough); one that fails shows nothing."""
-    return witnesses_hold_along(meshes, witnesses, view_frame(direction)[None], tol)[:, 0]
+    return witnesses_hold_along(meshes, witnesses, view_frame(direction)[None], tol or current())[
+        :, 0
+    ]
 
 
 def witnesses_hold_along(
     meshes: Sequence[trimesh.Trimesh],
     witnesses: Sequence[tuple[int, int, int, int]],
     frames: NDArray[np.float64],
-    tol: Tolerance | None = None,
+    tol: Tolerance,
 ) -> NDArray[np.bool_]:
     """:func:`witnesses_hold` along the direction of each of the view ``frames``
     (``f x 3 x 3``, :func:`view_frame`), as ``witnesses x f``: the faces are gathered
     once and the overlaps of every direction's pairs clipped at once, so that a search
     over many directions asks once for a pair of parts instead of once per direction."""
-    tol = tol or current()
     table = np.asarray(witnesses, dtype=np.int64).reshape(-1, 4)
     count = len(table)
     if not count or not len(frames):

@@ -44,7 +44,7 @@ from assemblykit.geometry.occlusion import blocking_witnesses, shadows
 from assemblykit.model.assembly import Assembly, Overlap, Part
 from assemblykit.model.surfaces import Surface
 from assemblykit.ragged import group_of, group_starts
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 DESIGNED_SHARE = 0.25
 """The largest shared volume, as a fraction of the smaller part's volume, read as
@@ -190,7 +190,7 @@ def _joined(
 
 
 def _union_mesh(
-    parts: Sequence[Part], tol: Tolerance
+    parts: Sequence[Part], tol: ModelTolerance
 ) -> tuple[trimesh.Trimesh, NDArray[np.int64], NDArray[np.int64]]:
     """The closed mesh of the union of ``parts``, and per triangle the part it comes
     from (an index into ``parts``) and the number of the surface it lies on there
@@ -311,7 +311,7 @@ def _extruded_shadow(
     return prism.transform(frame)
 
 
-def _trimmed(part: Part, other: Part, tol: Tolerance) -> Part | None:
+def _trimmed(part: Part, other: Part, tol: ModelTolerance) -> Part | None:
     """``part`` without what it shares with ``other``, and without the rest of ``part``
     in that shared volume's shadow along the axis it was pressed in by: of its
     :func:`insertion_axes`, the first whose cut lets the two parts apart along it
@@ -368,7 +368,7 @@ def _removed_along(
     shared: trimesh.Trimesh,
     axis: NDArray[np.float64],
     size: float,
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[manifold3d.Manifold, NDArray[np.float64]]:
     """What :func:`_trimmed` cuts from a part that shares ``bodies`` (whose mesh is
     ``shared``) with ``other`` when it was pressed in along ``axis``, and the axis it
@@ -397,7 +397,7 @@ def _removed_along(
 
 
 def _parts_leave_along(
-    cut: trimesh.Trimesh, other: trimesh.Trimesh, axis: NDArray[np.float64], tol: Tolerance
+    cut: trimesh.Trimesh, other: trimesh.Trimesh, axis: NDArray[np.float64], tol: ModelTolerance
 ) -> bool:
     """Whether a part trimmed to ``cut`` and ``other`` come apart along ``axis`` one way
     or the other (the projection test of :mod:`assemblykit.geometry.occlusion`): a cut
@@ -466,7 +466,7 @@ def _sheets(
 
 
 def _hole_along(
-    other: Part, shared: trimesh.Trimesh, axis: NDArray[np.float64] | None, tol: Tolerance
+    other: Part, shared: trimesh.Trimesh, axis: NDArray[np.float64] | None, tol: ModelTolerance
 ) -> Surface | None:
     """The hole (a cylinder of ``other`` with its material outside) along ``axis`` (any
     axis when ``None``) that the volume ``shared`` with it surrounds, its inner side on
@@ -532,7 +532,7 @@ def _cut_surfaces(
     mesh: trimesh.Trimesh,
     source: NDArray[np.int64],
     axis: NDArray[np.float64],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[Surface, ...]:
     """The exact surfaces of ``part`` trimmed by ``other`` to ``mesh``, whose triangles
     lie on the surfaces of ``part`` numbered ``source`` (its k-th surface k, -1 on the

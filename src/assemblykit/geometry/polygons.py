@@ -29,7 +29,7 @@ from assemblykit.algebra import se3
 from assemblykit.errors import GeometryError
 from assemblykit.geometry.contact_values import Contact, PlanarPatch
 from assemblykit.model.polygons import PolygonAssembly
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 
 @dataclass(eq=False)
@@ -107,7 +107,7 @@ def _edges(poly: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.f
     return poly, np.roll(poly, -1, axis=0)
 
 
-def edge_contacts(polygons: dict[str, NDArray[np.float64]], tol: Tolerance) -> list[Contact]:
+def edge_contacts(polygons: dict[str, NDArray[np.float64]], tol: ModelTolerance) -> list[Contact]:
     """Contact segments between every two counter-clockwise polygons (module docstring)."""
     contacts = []
     boxes = {

@@ -495,20 +495,20 @@ def is_convex(
 def recognise(mesh: trimesh.Trimesh, tol: Tolerance | None = None) -> tuple[Surface, ...]:
     """The surfaces of ``mesh``: its cylinders, cones and spheres, then its flat coplanar
     groups outside them as planes (module docstring)."""
+    tol = tol or current()
     curved = recognise_curved(mesh, tol)
     return curved + recognise_planes(mesh, curved, tol)
 
 
 def recognise_curved(
     mesh: trimesh.Trimesh,
-    tol: Tolerance | None = None,
+    tol: Tolerance,
     within: NDArray[np.int64] | None = None,
 ) -> tuple[Surface, ...]:
     """The cylinders, cones and spheres of ``mesh`` (method steps 1-4 on the strict
     groups): all that contacts need, the planes being the coplanar groups they match.
     ``within``: the ids of the only triangles to look at (numbered in the mesh, as the
     surfaces' faces are): the surfaces of that region alone."""
-    tol = tol or current()
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     if within is not None:
@@ -533,11 +533,10 @@ def _curved(
 
 
 def recognise_planes(
-    mesh: trimesh.Trimesh, curved: tuple[Surface, ...], tol: Tolerance | None = None
+    mesh: trimesh.Trimesh, curved: tuple[Surface, ...], tol: Tolerance
 ) -> tuple[Surface, ...]:
     """The flat coplanar groups of ``mesh`` with no face on its ``curved`` surfaces
     (:func:`recognise_curved`), as planes."""
-    tol = tol or current()
     vertices = np.asarray(mesh.vertices, dtype=np.float64)
     faces = np.asarray(mesh.faces, dtype=np.int64)
     return planes(segment(vertices, faces, tol), faces_on(curved, len(faces)))

@@ -29,7 +29,7 @@ from assemblykit.errors import AssemblyKitError
 from assemblykit.inference.network import action_label, relation_label, stationary_label
 from assemblykit.inference.solution import Conflict, Solution
 from assemblykit.model.task import Action, ActionKind, Situation, Task
-from assemblykit.tolerance import LENGTH_MISMATCHES, Tolerance
+from assemblykit.tolerance import LENGTH_MISMATCHES, ModelTolerance
 
 Solver = Callable[[Task, bool], Solution]
 """Solves a task (the reduction of Corner et al. 1983 §III, without this module), with
@@ -135,7 +135,7 @@ def _referenced(task: Task, kept: Collection[Statement]) -> Task:
     return replace(narrowed, bodies=bodies, situations=situations)
 
 
-def _same(found: Conflict, wanted: Conflict, tol: Tolerance) -> bool:
+def _same(found: Conflict, wanted: Conflict, tol: ModelTolerance) -> bool:
     """Whether ``found`` is the conflict ``wanted``: the same kind and size (a residual
     found numerically by its kind alone)."""
     if found.kind != wanted.kind:
@@ -147,7 +147,7 @@ def _same(found: Conflict, wanted: Conflict, tol: Tolerance) -> bool:
 
 
 def _reproduced(
-    task: Task, kept: Collection[Statement], wanted: Conflict, solve: Solver, tol: Tolerance
+    task: Task, kept: Collection[Statement], wanted: Conflict, solve: Solver, tol: ModelTolerance
 ) -> Conflict | None:
     """The conflict ``wanted`` as the task of ``kept`` alone has it, or None. Only a
     conflict found numerically needs the residue solver to be found again."""
@@ -167,7 +167,7 @@ def narrow(
     task: Task,
     conflict: Conflict,
     solve: Solver,
-    tol: Tolerance,
+    tol: ModelTolerance,
     table: dict[str, tuple[Statement, ...]],
 ) -> Conflict:
     """``conflict`` naming the fewest statements that still have it (module docstring):
@@ -229,7 +229,9 @@ def _solve_without(
         return solve(keeping(task, every - left_out), False)
 
 
-def without_conflicts(task: Task, solution: Solution, solve: Solver, tol: Tolerance) -> Solution:
+def without_conflicts(
+    task: Task, solution: Solution, solve: Solver, tol: ModelTolerance
+) -> Solution:
     """``solution`` of an inconsistent task with each conflict narrowed to the statements
     that take part (:func:`narrow`), and the poses and freedoms of the task without
     them, marked as valid only so (:attr:`Solution.valid_without`)."""

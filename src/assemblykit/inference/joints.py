@@ -35,7 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from assemblykit.algebra import Coset, Mismatch, MismatchKind, SymmetryGroup, se3
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 Vector = NDArray[np.float64]
 
@@ -104,7 +104,7 @@ def _line_of(held: PointHold) -> tuple[Vector, Vector]:
     return foot, direction
 
 
-def line_joint(held: Sequence[PointHold], tol: Tolerance) -> Coset | Mismatch | None:
+def line_joint(held: Sequence[PointHold], tol: ModelTolerance) -> Coset | Mismatch | None:
     """Points held on one line ℓ (module docstring): the coset of C(ℓ)⋊{I, flip} at the
     pose of least motion, or a ``distance`` mismatch when the body's points are not on one
     line (how far off their best line); None when the loci are not one line."""
@@ -138,7 +138,7 @@ def line_joint(held: Sequence[PointHold], tol: Tolerance) -> Coset | Mismatch | 
     return Coset(group, _pose(turn, foot - moved))
 
 
-def _normal_of(held: Sequence[PointHold], tol: Tolerance) -> tuple[Vector, Vector] | None:
+def _normal_of(held: Sequence[PointHold], tol: ModelTolerance) -> tuple[Vector, Vector] | None:
     """The common unit normal of plane loci and each plane's height along it, or None
     when some locus is no plane or the planes are not parallel."""
     if any(len(h.rows) != 1 for h in held):
@@ -159,7 +159,7 @@ def _short(gap: float, spread: float, slope: float) -> Mismatch:
 
 
 def _directions(
-    points: Vector, heights: Vector, shape: Layout, tol: Tolerance
+    points: Vector, heights: Vector, shape: Layout, tol: ModelTolerance
 ) -> tuple[tuple[Vector, ...], bool] | Mismatch:
     """The unit body directions m with m·cᵢ + k = hᵢ for all points (for some k), and
     whether they are the two sides ±e of the points' plane (equal heights): one or two
@@ -206,7 +206,9 @@ def _tilt(gap: float) -> Mismatch:
     )
 
 
-def _along_line(points: Vector, heights: Vector, shape: Layout, tol: Tolerance) -> Mismatch | None:
+def _along_line(
+    points: Vector, heights: Vector, shape: Layout, tol: ModelTolerance
+) -> Mismatch | None:
     """Points of one body line held on parallel planes: the line must rise between them
     as their planes do, at a slope of at most 1 (the line along the normal). The mismatch
     by which they cannot, else None (the poses then make no coset: 4 dof)."""
@@ -225,7 +227,7 @@ def _along_line(points: Vector, heights: Vector, shape: Layout, tol: Tolerance) 
     return _short(gap, reach, abs(slope)) if gap > tol.length else None
 
 
-def plane_joint(held: Sequence[PointHold], tol: Tolerance) -> Coset | Mismatch | None:
+def plane_joint(held: Sequence[PointHold], tol: ModelTolerance) -> Coset | Mismatch | None:
     """Points held on parallel planes, at least three not on one line (module docstring):
     the coset of G(n) (or G(n)⋊{I, flip} when the points lie on one plane at one height)
     at the pose of least motion, or the ``distance`` mismatch by which the points miss

@@ -18,7 +18,7 @@ import numpy as np
 
 from assemblykit.algebra import Kind, Locus, LocusKind, se3
 from assemblykit.model.relations import signed_angle
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 
 @dataclass(frozen=True)
@@ -85,7 +85,7 @@ def rotation_about(point: np.ndarray, direction: np.ndarray, angle: float) -> np
     return se3.translation(point) @ se3.rotation(direction, angle) @ se3.translation(-point)
 
 
-def circle_circle(first: Circle, second: Circle, tol: Tolerance) -> list[np.ndarray] | None:
+def circle_circle(first: Circle, second: Circle, tol: ModelTolerance) -> list[np.ndarray] | None:
     """Common points of two coplanar circles (0, 1 or 2); None if they coincide (a
     continuum) or are not parallel (use :func:`circle_meets` with a circle locus)."""
     c1, n1, r1 = first.center, first.normal, first.radius
@@ -111,7 +111,7 @@ def circle_circle(first: Circle, second: Circle, tol: Tolerance) -> list[np.ndar
     return [base + h * side, base - h * side]
 
 
-def _on_circle(circle: Circle, point: np.ndarray, tol: Tolerance) -> bool:
+def _on_circle(circle: Circle, point: np.ndarray, tol: ModelTolerance) -> bool:
     d = point - circle.center
     along = float(np.dot(d, circle.normal))
     radial = float(np.linalg.norm(d - along * circle.normal))
@@ -119,7 +119,7 @@ def _on_circle(circle: Circle, point: np.ndarray, tol: Tolerance) -> bool:
 
 
 def circle_plane(
-    circle: Circle, point: np.ndarray, normal: np.ndarray, tol: Tolerance
+    circle: Circle, point: np.ndarray, normal: np.ndarray, tol: ModelTolerance
 ) -> list[np.ndarray] | None:
     """Points of a circle on the plane through ``point`` with unit ``normal``: 0, 1 or 2,
     None when the circle lies in the plane. With ``e1`` the in-plane direction of the
@@ -146,7 +146,7 @@ def circle_plane(
 
 
 def circle_line(
-    circle: Circle, point: np.ndarray, direction: np.ndarray, tol: Tolerance
+    circle: Circle, point: np.ndarray, direction: np.ndarray, tol: ModelTolerance
 ) -> list[np.ndarray] | None:
     """Points of a circle on the line through ``point`` with unit ``direction``: 0, 1
     or 2. A line across the circle's plane meets it once at most; a line in the plane
@@ -169,7 +169,7 @@ def circle_line(
 
 
 def circle_sphere(
-    circle: Circle, center: np.ndarray, radius: float, tol: Tolerance
+    circle: Circle, center: np.ndarray, radius: float, tol: ModelTolerance
 ) -> list[np.ndarray] | None:
     """Points of a circle on a sphere: the sphere cuts the circle's plane in a circle
     (radius² = R² − h², h the centre's height over the plane), then circle-circle."""
@@ -181,7 +181,7 @@ def circle_sphere(
     return circle_circle(circle, cut, tol)
 
 
-def circle_meets(circle: Circle, locus: Locus, tol: Tolerance) -> list[np.ndarray] | None:
+def circle_meets(circle: Circle, locus: Locus, tol: ModelTolerance) -> list[np.ndarray] | None:
     """Common points of a circle and an orbit (docs/algebra.md §2.3): a point, circle, line,
     plane or sphere. None for a continuum or a locus without a closed form here."""
     if locus.kind == LocusKind.POINT:
@@ -211,7 +211,7 @@ def _single(value: Any, kinds: tuple[Kind, ...]) -> bool:
     return value.group.kind in kinds and value.n_components == 1
 
 
-def point_loop(first: Any, second: Any, closing: Any, tol: Tolerance) -> LoopPoses | None:
+def point_loop(first: Any, second: Any, closing: Any, tol: ModelTolerance) -> LoopPoses | None:
     """Closed-form R·(R or S) ∩ coset (docs/algebra.md §5.2 rule 4): circle against the
     closing orbit.
 
@@ -287,7 +287,7 @@ def _axis_ends(link: Any) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarr
     return (point, axis), (se3.apply(back, point), back[:3, :3] @ axis)
 
 
-def loop_reach(links: list[Any], tol: Tolerance) -> Reach | None:
+def loop_reach(links: list[Any], tol: ModelTolerance) -> Reach | None:
     """The reach bound of a loop of revolute, cylindrical or helical joints with parallel
     axes (docs/algebra.md §5.2 rule 4, "R·R vs R·R with all four axes parallel (planar 4-bar
     loop)"), a necessary condition for the loop to close.

@@ -42,7 +42,7 @@ from assemblykit.inference.joints import PointHold, line_joint, plane_joint
 from assemblykit.inference.numeric import Constraint, Node, Residual
 from assemblykit.model.relations import HeldLine, HeldPoint, Relation, RelationType
 from assemblykit.model.task import Action, ActionKind, Situation, Task
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import ModelTolerance, current
 
 WORLD: Node = ("world", "")
 
@@ -325,7 +325,7 @@ def meet_loci(
     origin: np.ndarray,
     rows: np.ndarray,
     extra: Sequence[tuple[np.ndarray, np.ndarray]],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[np.ndarray, np.ndarray] | float:
     """The intersection of the affine locus ``rows @ (y - origin) = 0`` with the planes
     ``n @ (y - o) = 0`` of ``extra`` (unit normals ``n``), as ``(origin, rows)`` with
@@ -350,7 +350,7 @@ def meet_loci(
 
 
 def _incidences(
-    constraint: Constraint, tol: Tolerance
+    constraint: Constraint, tol: ModelTolerance
 ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """The higher pair as points of the held body in planes of the other: ``(point,
     origin, normal)``. A point in a locus is its point in each plane of the locus; a line
@@ -363,7 +363,7 @@ def _incidences(
     return [(geometry.point, geometry.origin, row) for row in geometry.rows]
 
 
-def _held_points(group: Sequence[Constraint], tol: Tolerance) -> list[PointHold] | float:
+def _held_points(group: Sequence[Constraint], tol: ModelTolerance) -> list[PointHold] | float:
     """The distinct points a pair's higher pairs hold, each with the locus its planes
     meet in; or, when two planes of one point are parallel and apart, that distance."""
     points: list[np.ndarray] = []
@@ -386,7 +386,7 @@ def _held_points(group: Sequence[Constraint], tol: Tolerance) -> list[PointHold]
     return held
 
 
-def _joint_link(group: Sequence[Constraint], tol: Tolerance) -> Link | None:
+def _joint_link(group: Sequence[Constraint], tol: ModelTolerance) -> Link | None:
     """The coset link of the higher pairs between one pair of instances when they make a
     joint together (:mod:`assemblykit.inference.joints`: points on one line, points on
     parallel planes), or its conflict; None when they make none."""
@@ -419,7 +419,7 @@ def _pair_of(constraint: Constraint) -> tuple[Node, Node] | None:
 
 
 def _fold_joints(
-    constraints: list[Constraint], tol: Tolerance
+    constraints: list[Constraint], tol: ModelTolerance
 ) -> tuple[list[Link], list[Constraint]]:
     """The higher pairs between each pair of instances that make a joint together,
     replaced by its coset link (:func:`_joint_link`); the others left as they are."""
@@ -439,7 +439,7 @@ def _fold_joints(
 
 
 def _fold_point_loci(
-    constraints: list[Constraint], tol: Tolerance
+    constraints: list[Constraint], tol: ModelTolerance
 ) -> tuple[list[Link], list[Constraint]]:
     """Higher pairs of one point met together (docs/algebra.md §3, §5.2 rule 1 for loci).
 
@@ -584,7 +584,7 @@ def build_network(task: Task) -> Network:
                 links.append(part)
             else:
                 constraints.append(part)
-    folded, constraints = _fold_point_loci(constraints, current())
+    folded, constraints = _fold_point_loci(constraints, ModelTolerance.of(current()))
     return Network(
         instances,
         (*links, *folded),

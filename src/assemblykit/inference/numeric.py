@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from assemblykit.algebra import se3
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import Tolerance
 
 Residual = Callable[[Sequence[np.ndarray]], np.ndarray]
 Node = tuple[str, str]
@@ -212,7 +212,7 @@ def _start_points(problem: ResidueProblem, count: int, seed: int, scale: float) 
 
 def solve_residue(
     problem: ResidueProblem,
-    tol: Tolerance | None = None,
+    tol: Tolerance,
     *,
     starts: int = 8,
     seed: int = 0,
@@ -231,7 +231,6 @@ def solve_residue(
     halfway between them satisfy the constraints too. ``tol.scale`` is the length scale
     of the start spread.
     """
-    tol = tol or current()
     if not problem.unknowns:
         r, poses = _residual_vector(problem, {}, np.zeros(0))
         worst = float(np.abs(r).max()) if r.size else 0.0

@@ -27,17 +27,19 @@ from collections.abc import Sequence
 import numpy as np
 
 from assemblykit.algebra import Chain, Coset, Kind, SymmetryGroup
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 
-def _joined(first: SymmetryGroup, second: SymmetryGroup, tol: Tolerance) -> SymmetryGroup | None:
+def _joined(
+    first: SymmetryGroup, second: SymmetryGroup, tol: ModelTolerance
+) -> SymmetryGroup | None:
     """The group ``first·second`` when the product of the two groups is one."""
     found = Coset(first, np.eye(4)).product(Coset(second, np.eye(4)), tol)
     return found.group if isinstance(found, Coset) else None
 
 
 def _spherical(
-    first: SymmetryGroup, middle: SymmetryGroup, last: SymmetryGroup, tol: Tolerance
+    first: SymmetryGroup, middle: SymmetryGroup, last: SymmetryGroup, tol: ModelTolerance
 ) -> SymmetryGroup | None:
     """S(N) when three connected revolutes turn about axes through one point N with the
     middle axis perpendicular to the other two (docs/algebra.md §5.3), else None."""
@@ -63,7 +65,7 @@ def _spherical(
     return SymmetryGroup.spherical(center)
 
 
-def _push(stack: list[SymmetryGroup], group: SymmetryGroup, tol: Tolerance) -> None:
+def _push(stack: list[SymmetryGroup], group: SymmetryGroup, tol: ModelTolerance) -> None:
     """Put ``group`` on the stack of joined groups and join the top while a rule of the
     module docstring applies."""
     stack.append(group)
@@ -101,7 +103,7 @@ def _as_set(stack: list[SymmetryGroup], rep: np.ndarray) -> Coset | Chain:
     return Chain((*(Coset(g, np.eye(4)) for g in stack[:-1]), Coset(stack[-1], rep)))
 
 
-def chain_product(factors: Sequence[Coset], tol: Tolerance) -> Coset | Chain:
+def chain_product(factors: Sequence[Coset], tol: ModelTolerance) -> Coset | Chain:
     """The product set of the cosets ``factors`` in order: a coset when the chain joins
     into one group (module docstring), else a :class:`Chain` of the groups joined."""
     groups, rep = _at_start(factors)
@@ -111,7 +113,7 @@ def chain_product(factors: Sequence[Coset], tol: Tolerance) -> Coset | Chain:
     return _as_set(stack, rep)
 
 
-def extend(above: Coset | Chain | None, link: Coset, tol: Tolerance) -> Coset | Chain:
+def extend(above: Coset | Chain | None, link: Coset, tol: ModelTolerance) -> Coset | Chain:
     """The poses along a chain that ends with ``link``: ``above`` (the chain so far, as
     this module leaves it, None at its start) times ``link``. Only the new group is
     joined: the groups of ``above`` are joined already."""

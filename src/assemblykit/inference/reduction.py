@@ -116,6 +116,7 @@ from assemblykit.tolerance import (
     MAX_ANGLE,
     MAX_REL_LENGTH,
     ROUNDING_MARGIN,
+    ModelTolerance,
     Tolerance,
     current,
     using,
@@ -166,7 +167,7 @@ class _Edge:
 class Reducer:
     """The state of one reduction: merged instances, live links, conflicts and trace."""
 
-    tol: Tolerance
+    tol: ModelTolerance
     parent: dict[Node, tuple[Node, np.ndarray]] = field(default_factory=dict)
     edges: dict[frozenset[Node], _Edge] = field(default_factory=dict)
     adjacency: dict[Node, set[Node]] = field(default_factory=dict)
@@ -583,7 +584,9 @@ class Reducer:
         return any(_is_finite_branch(e.value) for e in self.edges.values())
 
 
-def _intersect_parallel(values: list[Any], tol: Tolerance) -> tuple[Any, list[GroupEvent], int]:
+def _intersect_parallel(
+    values: list[Any], tol: ModelTolerance
+) -> tuple[Any, list[GroupEvent], int]:
     """Intersect the cosets of parallel links in order (rule 1); an empty intersection is
     an event and leaves the value as it was (later links still meet it). Stops at a
     lattice, which is flagged rather than intersected: returns how many values were used."""
@@ -619,7 +622,7 @@ _NOUNS = {
 the characteristic invariants of each family)."""
 
 
-def _invariant_miss(first: Invariant, second: Invariant, tol: Tolerance) -> Mismatch | None:
+def _invariant_miss(first: Invariant, second: Invariant, tol: ModelTolerance) -> Mismatch | None:
     """The mismatch between two invariants of one type that should coincide: the angle
     between their directions, else the distance between the planes, axes or points."""
     noun = _NOUNS[type(first)]
@@ -646,7 +649,7 @@ def _invariant_miss(first: Invariant, second: Invariant, tol: Tolerance) -> Mism
     return Mismatch(MismatchKind.DISTANCE, distance, text)
 
 
-def _point_mismatch(value: Coset, x: np.ndarray, tol: Tolerance) -> Mismatch | None:
+def _point_mismatch(value: Coset, x: np.ndarray, tol: ModelTolerance) -> Mismatch | None:
     """Why the pose ``x`` is not in the coset H·x0 of a relation, in the words of the
     relation's own features: x ∈ H·x0 exactly when x carries the body-2 objects x0⁻¹·I
     onto the body-1 objects I that H keeps (its characteristic invariants, docs/algebra.md
@@ -668,7 +671,9 @@ _FIRST = {LineInvariant: 0, PlaneInvariant: 1, DirectionInvariant: 2, PointInvar
 relations name before the points where they meet (docs/algebra.md §2.4)."""
 
 
-def _features_mismatch(first: Coset, second: Coset, found: Mismatch, tol: Tolerance) -> Mismatch:
+def _features_mismatch(
+    first: Coset, second: Coset, found: Mismatch, tol: ModelTolerance
+) -> Mismatch:
     """The mismatch ``found`` between two cosets of connected TR groups said, when it can
     be, between the axes or planes of the relations rather than a point where they meet
     (the marked point of a revolute pair): the congruence tests of docs/algebra.md §2.5
@@ -693,7 +698,7 @@ def _features_mismatch(first: Coset, second: Coset, found: Mismatch, tol: Tolera
     return found
 
 
-def meet(first: Any, second: Any, tol: Tolerance) -> Any:
+def meet(first: Any, second: Any, tol: ModelTolerance) -> Any:
     """``first ∩ second`` (docs/algebra.md §2.5); when it is empty the mismatch is said in
     the words of the relations' features: against a single pose (an instance merged, a
     fixed relation or action) by :func:`_point_mismatch`, else between their axes or
@@ -732,7 +737,7 @@ def _axis(value: Any) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def revolute_loop(
-    first: Any, second: Any, closing: Any, tol: Tolerance
+    first: Any, second: Any, closing: Any, tol: ModelTolerance
 ) -> tuple[list[tuple[np.ndarray, np.ndarray]], float] | None:
     """Closed-form R·R ∩ R (docs/algebra.md §5.2 rule 4: "the orbit of a point under two
     revolutes gives circle-circle intersections").
@@ -894,7 +899,7 @@ def _residue_constraints(
 
 
 def _solve_component(
-    network: Network, reducer: Reducer, component: set[Node], tol: Tolerance, residue: bool
+    network: Network, reducer: Reducer, component: set[Node], tol: ModelTolerance, residue: bool
 ) -> tuple[dict[Node, _Instance], list[Conflict]]:
     """Rule 5 for one connected group of representatives; without ``residue`` what only
     the residue solver would answer is left unanswered (a mechanism of unknown dof)."""
@@ -938,7 +943,7 @@ def _solve_component(
 
 
 def _higher_pairs(
-    network: Network, reducer: Reducer, component: set[Node], tol: Tolerance
+    network: Network, reducer: Reducer, component: set[Node], tol: ModelTolerance
 ) -> tuple[dict[Node, _Instance], list[Conflict]] | None:
     """Rule 5 in closed form for a component whose instances hang from the world alone,
     each by at most one coset link and at most one higher pair (:func:`_point_in_locus`,
@@ -1007,7 +1012,7 @@ def _held(
     pairs: list[Constraint],
     value: Coset | None,
     labels: tuple[str, ...],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[_Instance, list[Conflict]] | None:
     """The closed form for one instance's higher pairs from the world: one point or line
     contact (with at most one coset ``value``), or a line contact and a point with no
@@ -1028,7 +1033,7 @@ def _point_in_locus(
     constraint: Constraint,
     value: Coset | None,
     labels: tuple[str, ...],
-    tol: Tolerance,
+    tol: ModelTolerance,
     subject: str = "point",
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A point held in a world locus (a plane or a line, :class:`PointLocus`), alone or
@@ -1116,7 +1121,11 @@ def _point_in_locus(
 
 
 def _lay_line(
-    point: np.ndarray, along: np.ndarray, normal: np.ndarray, origin: np.ndarray, tol: Tolerance
+    point: np.ndarray,
+    along: np.ndarray,
+    normal: np.ndarray,
+    origin: np.ndarray,
+    tol: ModelTolerance,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """The pose of least motion laying the line through ``point`` along ``along`` parallel
     to the plane ``normal · (y − origin) = 0``, with the line's point and direction there.
@@ -1160,7 +1169,7 @@ def _line_on_plane(
     constraint: Constraint,
     value: Coset | None,
     labels: tuple[str, ...],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A line of an instance lying parallel to a world plane at a distance (a cylinder on a
     plane, an edge on a face: :class:`LineOnPlane`) in closed form (docs/algebra.md §3).
@@ -1190,7 +1199,7 @@ def _line_with_coset(
     constraint: Constraint,
     value: Coset,
     labels: tuple[str, ...],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A line contact met with a lower pair H·x0 from the world, in closed form (docs/algebra.md
     §3, §5.3), when every rotation of H keeps the plane's normal n or the line's direction
@@ -1252,7 +1261,7 @@ def _line_and_point(
     line: Constraint,
     point: Constraint,
     labels: tuple[str, ...],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[_Instance, list[Conflict]] | None:
     """A line contact and a point of the same instance held in a parallel world plane (a
     roller on a table with a lever's tip on the table), in closed form (docs/algebra.md §3).
@@ -1316,7 +1325,7 @@ def _coset_meets_locus(
     reached: np.ndarray,
     origin: np.ndarray,
     rows: np.ndarray,
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> Coset | float | None:
     """The members h of a connected ``group`` that put the point at ``reached`` into the
     locus ``rows @ (y - origin) = 0`` (a plane or a line), when they form a coset.
@@ -1362,7 +1371,7 @@ def _coset_meets_locus(
     return Coset(intersect_groups(group, kernel_of, tol), se3.translation(step))
 
 
-def _fixes(group: SymmetryGroup, point: np.ndarray, tol: Tolerance) -> bool:
+def _fixes(group: SymmetryGroup, point: np.ndarray, tol: ModelTolerance) -> bool:
     """Whether every rotation of a connected ``group`` fixes ``point``: a revolute or
     cylindrical group whose axis passes through it, a spherical group centred on it."""
     kind = group.kind
@@ -1394,7 +1403,7 @@ def _numeric_component(
     reducer: Reducer,
     component: set[Node],
     start: Mapping[Node, np.ndarray],
-    tol: Tolerance,
+    tol: ModelTolerance,
     starts: int = 8,
     candidates: Mapping[Node, Any] | None = None,
 ) -> tuple[dict[Node, _Instance], list[Conflict]]:
@@ -1498,7 +1507,7 @@ def _support(
 
 
 def _leaf_report(
-    network: Network, reducer: Reducer, tol: Tolerance, residue: bool = True
+    network: Network, reducer: Reducer, tol: ModelTolerance, residue: bool = True
 ) -> tuple[dict[Node, _Instance], list[Conflict]]:
     """Rule 5: every representative's pose set, then every instance through its merge.
     Each conflict carries the statements it was derived from (:func:`_support`)."""
@@ -1538,7 +1547,9 @@ def _said(key: str, instance: _Instance) -> str:
 
 
 def _combine(
-    network: Network, reports: list[tuple[dict[Node, _Instance], list[Conflict]]], tol: Tolerance
+    network: Network,
+    reports: list[tuple[dict[Node, _Instance], list[Conflict]]],
+    tol: ModelTolerance,
 ) -> tuple[dict[str, BodyInstanceResult], list[Conflict]]:
     """Merge the answers of the consistent branches: distinct poses become alternatives."""
     consistent = [r for r in reports if not r[1]] or reports[:1]
@@ -1608,8 +1619,9 @@ def solve_network(
 ) -> Solution:
     """Reduce a network (rules 1-4), then report every instance (rule 5); without
     ``residue`` the residue solver is not called (what it would answer stays unknown:
-    the reduction's own conflicts and closed forms only)."""
-    tol = tol or current()
+    the reduction's own conflicts and closed forms only). ``tol`` (default: the one in
+    force) is taken as the network's own (:class:`~assemblykit.tolerance.ModelTolerance`)."""
+    tol = ModelTolerance.of(tol or current())
     root = Reducer(tol)
     cache: dict[Hashable, tuple[Any, list[GroupEvent], int]] = {}
     for group in _parallel_groups(network.links):
@@ -1646,7 +1658,7 @@ def model_scale(task: Task) -> float:
     return diagonal if diagonal > 0 else 1.0
 
 
-def task_tolerance(task: Task, tol: Tolerance | None = None) -> Tolerance:
+def task_tolerance(task: Task, tol: Tolerance | None = None) -> ModelTolerance:
     """The tolerance ``task`` is solved with: ``tol`` (default: the one in force) scaled to
     :func:`model_scale`, its length and angle raised to :data:`ROUNDING_MARGIN` times
     the rounding of the numbers its file wrote (:attr:`Task.rounding`; docs/inference.md,
@@ -1655,7 +1667,7 @@ def task_tolerance(task: Task, tol: Tolerance | None = None) -> Tolerance:
     policy = (tol or current()).with_scale(model_scale(task))
     written = task.rounding
     return replace(
-        policy,
+        ModelTolerance.of(policy),
         rel_length=min(
             max(policy.rel_length, ROUNDING_MARGIN * written.length / policy.scale),
             MAX_REL_LENGTH,
@@ -1693,7 +1705,7 @@ def solve_task(
 def solve_numeric_only(task: Task, tol: Tolerance | None = None, starts: int = 8) -> Solution:
     """The whole network solved by the residue solver alone, without reduction (the
     "equation solving" system Corner et al. 1983 §III G compares against; used for benchmarks)."""
-    tol = tol or current().with_scale(model_scale(task))
+    tol = ModelTolerance.of((tol or current()).with_scale(model_scale(task)))
     with using(tol):
         network = build_network(task.validate())
         reducer = Reducer(tol)

@@ -333,11 +333,10 @@ def _numbers(values: Sequence[Any]) -> bool:
 
 
 def pose_from_spec(
-    spec: Any, *, source: str | None = None, where: str = "pose", tol: Tolerance | None = None
+    spec: Any, *, source: str | None = None, where: str = "pose", tol: Tolerance
 ) -> NDArray[np.float64]:
     """The 4x4 pose of a manifest ``pose``: a 4x4 matrix (rigid, last row ``0 0 0 1``,
     checked with the mesh angle tolerance) or ``{translation, rotation_xyz_deg}``."""
-    tol = tol or current()
     if spec is None:
         return np.eye(4)
     if isinstance(spec, Mapping):
@@ -403,7 +402,9 @@ def load_manifest(path: str | Path, tol: Tolerance | None = None) -> Assembly:
         name = str(name)
         if any(p.name == name for p in parts):
             raise SchemaError(f"duplicate part name {name!r}", source=source, where=where)
-        pose = pose_from_spec(entry.get("pose"), source=source, where=f"{where}.pose", tol=tol)
+        pose = pose_from_spec(
+            entry.get("pose"), source=source, where=f"{where}.pose", tol=tol or current()
+        )
         mesh_path = path.parent / entry["mesh"]
         mesh = read_mesh(mesh_path, notes)
         measured.append(mesh_precision(mesh))

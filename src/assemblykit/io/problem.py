@@ -53,7 +53,7 @@ from assemblykit.mating.problem import (
     mating_body,
     problem_diagonal,
 )
-from assemblykit.tolerance import MAX_MAGNITUDE, Tolerance, current
+from assemblykit.tolerance import MAX_MAGNITUDE, ModelTolerance, Tolerance, current
 
 
 def _not_bool(value: Any) -> Any:
@@ -220,7 +220,7 @@ def parse_problem(
             name: _mesh(body.mesh, folder or Path("."), f"bodies.{name}.mesh")
             for name, body in model.bodies.items()
         }
-        tol = (tol or current()).with_scale(problem_diagonal(features, meshes))
+        tol = ModelTolerance.of((tol or current()).with_scale(problem_diagonal(features, meshes)))
         bodies = {
             name: _body(name, body, features[name], meshes[name], tol)
             for name, body in model.bodies.items()

@@ -45,7 +45,7 @@ from assemblykit.algebra import Coset, Kind, se3
 from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.interference import interference_threshold, solid, solids_interfere
 from assemblykit.geometry.solids import placed
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 #: Polygon sides of a full revolution (manifold3d uses as many for a partial one).
 SEGMENTS = 48
@@ -166,7 +166,7 @@ class Mover:
         return (radius,)
 
 
-def mover(name: str, mesh: trimesh.Trimesh, coset: Coset, tol: Tolerance) -> Mover:
+def mover(name: str, mesh: trimesh.Trimesh, coset: Coset, tol: ModelTolerance) -> Mover:
     """The body ``name`` over its world ``coset``: fixed when the coset is a point, else
     moving over a full turn and, for a slide, the model's size either way."""
     if coset.is_point or coset.kind not in SWEPT:
@@ -190,7 +190,7 @@ def sweepable(coset: Coset) -> bool:
 # ----------------------------------------------------------------------------- bounds
 
 
-def profile(mesh: trimesh.Trimesh, motion_frame: np.ndarray, tol: Tolerance) -> Profile:
+def profile(mesh: trimesh.Trimesh, motion_frame: np.ndarray, tol: ModelTolerance) -> Profile:
     """The cylindrical-coordinate bounds of ``mesh`` placed by ``motion_frame`` (module
     docstring): pieces by band and sector, and the confirmed discs about the axis."""
     body = solid(placed(mesh, motion_frame))
@@ -251,7 +251,7 @@ def _shape(section: manifold3d.CrossSection) -> shapely.Geometry:
     return region
 
 
-def _disc(body: manifold3d.Manifold, z0: float, z1: float, tol: Tolerance) -> Disc | None:
+def _disc(body: manifold3d.Manifold, z0: float, z1: float, tol: ModelTolerance) -> Disc | None:
     """The disc about the axis inside ``body`` between z0 and z1: its radius read from the
     mid-height section, then confirmed (halved if needed) by an empty difference."""
     region = _shape(body.slice(0.5 * (z0 + z1)))
@@ -333,14 +333,16 @@ class PairResult:
 
 
 def overlaps(
-    first: Mover, a: Sequence[float], second: Mover, b: Sequence[float], tol: Tolerance
+    first: Mover, a: Sequence[float], second: Mover, b: Sequence[float], tol: ModelTolerance
 ) -> bool:
     """The exact test at one joint parameter value (manifold3d volumes)."""
     threshold = interference_threshold(first.mesh, second.mesh, tol.for_mesh())
     return solids_interfere(first.solid_at(a), second.solid_at(b), threshold)
 
 
-def judge_pair(first: Mover, second: Mover, tol: Tolerance, budget: int = BOX_BUDGET) -> PairResult:
+def judge_pair(
+    first: Mover, second: Mover, tol: ModelTolerance, budget: int = BOX_BUDGET
+) -> PairResult:
     """The verdict on ``first`` and ``second`` over their joint parameter box (module
     docstring): sweeps for the whole range, then bisection with kernels and exact
     centres."""

@@ -45,7 +45,7 @@ from assemblykit.geometry.interference import interferes
 from assemblykit.geometry.solids import placed
 from assemblykit.mating.problem import Goal, MatingBody, MatingProblem
 from assemblykit.model.relations import relation_coset
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 #: Rarity of primitive feature types (Liu & Popplestone 1990 step one: threads, gears and cylinders
 #: are matched first because surfaces with given parameters are rare). Higher is rarer.
@@ -104,7 +104,7 @@ Domains = dict[int, tuple[Candidate, ...]]
 """The domain of each goal (by goal number): its remaining candidates."""
 
 
-def matable(a: Feature, b: Feature, tol: Tolerance) -> str | None:
+def matable(a: Feature, b: Feature, tol: ModelTolerance) -> str | None:
     """The relation by which primitive ``a`` mates with ``b``: ``against`` for two planes,
     ``fits`` for complementary features (Liu 1997 Def. 3.1.2), else ``None``."""
     if isinstance(a, Plane) and isinstance(b, Plane):
@@ -115,7 +115,7 @@ def matable(a: Feature, b: Feature, tol: Tolerance) -> str | None:
 def pairings(
     first: Sequence[Feature],
     second: Sequence[Feature],
-    tol: Tolerance,
+    tol: ModelTolerance,
     kinds: Sequence[Sequence[str | None]] | None = None,
 ) -> Iterator[tuple[tuple[int, int, str], ...]]:
     """Every one-to-one pairing of two primitive lists in which each pair mates:
@@ -135,7 +135,7 @@ def pair_coset(
     first: Sequence[Feature],
     second: Sequence[Feature],
     pairing: Sequence[tuple[int, int, str]],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> Coset | EmptySet:
     """The relative position allowed by all the paired primitives at once: the
     intersection of their relation cosets (Liu & Popplestone 1990 eq. (3), docs/algebra.md §2.5)."""
@@ -151,7 +151,9 @@ def pair_coset(
     return result
 
 
-def up_to_symmetry(coset: Coset, first: MatingBody, second: MatingBody, tol: Tolerance) -> bool:
+def up_to_symmetry(
+    coset: Coset, first: MatingBody, second: MatingBody, tol: ModelTolerance
+) -> bool:
     """Whether the common group equals the symmetry group of one of the bodies, so that
     every member of the coset places that body onto the same point set: the relative
     position is determined up to the body's own symmetry (Liu & Popplestone 1990 step one, Example
@@ -164,7 +166,9 @@ def up_to_symmetry(coset: Coset, first: MatingBody, second: MatingBody, tol: Tol
     )
 
 
-def positions(coset: Coset, first: MatingBody, second: MatingBody, tol: Tolerance) -> list[Coset]:
+def positions(
+    coset: Coset, first: MatingBody, second: MatingBody, tol: ModelTolerance
+) -> list[Coset]:
     """The relative positions a candidate stands for: a finite coset determined up to a
     body's symmetry is one position (its representative); another finite coset is split
     into its single positions; any other coset is kept whole."""
@@ -218,7 +222,7 @@ def goal_candidates(
 
 
 def interfering(
-    first: MatingBody, second: MatingBody, relative: np.ndarray, tol: Tolerance
+    first: MatingBody, second: MatingBody, relative: np.ndarray, tol: ModelTolerance
 ) -> bool:
     """Whether ``first`` placed at ``relative`` in ``second``'s frame shares a volume with
     ``second`` (mesh tolerance); bodies without meshes never interfere."""

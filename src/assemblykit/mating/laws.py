@@ -32,7 +32,7 @@ from assemblykit.features.compound import feature_transporter
 from assemblykit.mating.clearance import Verdict, judge_pair, mover, sweepable
 from assemblykit.mating.graph import Candidate, Domains
 from assemblykit.mating.problem import Goal, MatingBody, MatingProblem
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 
 def compatible(a: Candidate, b: Candidate) -> bool:
@@ -63,14 +63,14 @@ def mandatory_request(domains: Domains) -> Domains:
     return current
 
 
-def _congruent(a: object, b: object, tol: Tolerance) -> bool:
+def _congruent(a: object, b: object, tol: ModelTolerance) -> bool:
     return type(a) is type(b) and relationship(a, b, tol) in (  # type: ignore[arg-type]
         Relationship.ONE_CONGRUENT,
         Relationship.TWO_CONGRUENT,
     )
 
 
-def compound_orbits(body: MatingBody, tol: Tolerance) -> dict[str, str]:
+def compound_orbits(body: MatingBody, tol: ModelTolerance) -> dict[str, str]:
     """The representative (first in file order) of each compound feature's orbit under
     the body's symmetry group (Liu & Popplestone 1990 equivalent feature law): ``c ~ c'`` when some
     discrete element g of the group maps every primitive of ``c`` onto one of ``c'``."""

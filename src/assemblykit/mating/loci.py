@@ -25,7 +25,7 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from assemblykit.algebra import Coset, Kind, Locus, SymmetryGroup, se3
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 World = dict[str, Coset]
 """The set of possible world poses of each placed body (a right coset)."""
@@ -40,7 +40,7 @@ SOLVER_PRECISION = 1e-15
 
 
 def circle_plane(
-    circle: Locus, point: np.ndarray, normal: np.ndarray, tol: Tolerance
+    circle: Locus, point: np.ndarray, normal: np.ndarray, tol: ModelTolerance
 ) -> list[np.ndarray] | None:
     """The points of ``circle`` on the plane (``point``, unit ``normal``): 0, 1 or 2
     points; ``None`` when the circle lies in the plane (infinitely many)."""
@@ -65,7 +65,7 @@ def circle_plane(
 
 
 def circle_sphere(
-    circle: Locus, center: np.ndarray, radius: float, tol: Tolerance
+    circle: Locus, center: np.ndarray, radius: float, tol: ModelTolerance
 ) -> list[np.ndarray] | None:
     """The points of ``circle`` on the sphere (``center``, ``radius``): the circle meets
     the radical plane |p − center|² − |p − c|² = radius² − r² (``None`` when the
@@ -85,7 +85,7 @@ def circle_sphere(
     return [p for p in found if abs(se3.norm(p - center) - radius) <= tol.length]
 
 
-def locus_meet(a: Locus, b: Locus, tol: Tolerance) -> list[np.ndarray] | None:
+def locus_meet(a: Locus, b: Locus, tol: ModelTolerance) -> list[np.ndarray] | None:
     """The common points of two loci that are points or circles (docs/algebra.md §2.3 orbit
     table): circles in one plane meet in 0, 1 or 2 points, circles in other planes too
     (:func:`circle_sphere` then the other's plane). ``None`` when there is no closed form
@@ -115,7 +115,7 @@ def turn_to(coset: Coset, start: np.ndarray, target: np.ndarray) -> np.ndarray:
 
 
 def loci_branches(
-    world: Mapping[str, Coset], second: str, first: str, relative: Coset, tol: Tolerance
+    world: Mapping[str, Coset], second: str, first: str, relative: Coset, tol: ModelTolerance
 ) -> list[World] | None:
     """Representative-point loci (Liu & Popplestone 1990 Figs 4-5) for a goal X =
     L_second⁻¹·L_first ∈ ``relative`` whose two bodies each have a revolute world coset and whose
@@ -152,7 +152,9 @@ def _starts(dof: int) -> list[np.ndarray]:
     return [np.asarray(s, dtype=np.float64) for s in itertools.islice(grid, MAX_STARTS)]
 
 
-def _isolated(residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray, tol: Tolerance) -> bool:
+def _isolated(
+    residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray, tol: ModelTolerance
+) -> bool:
     """Whether the solution ``x`` is isolated: the Jacobian (central differences with the
     step that balances truncation and rounding, eps^(1/3)) has full column rank."""
     if x.size == 0:
@@ -166,7 +168,7 @@ def _isolated(residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray, tol: 
 
 
 def numeric_closure(
-    world: Mapping[str, Coset], second: str, first: str, relative: Coset, tol: Tolerance
+    world: Mapping[str, Coset], second: str, first: str, relative: Coset, tol: ModelTolerance
 ) -> list[World] | None:
     """Numeric closure of a loop (module docstring): the distinct solutions of
     L_second(t)⁻¹·L_first(t') = h(s)·x₀ over the parameters of both world cosets (a

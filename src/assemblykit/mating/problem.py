@@ -20,7 +20,7 @@ from assemblykit.features import CompoundFeature, Feature, Plane
 from assemblykit.features.compound import compound_group
 from assemblykit.geometry.interference import overlap_volume
 from assemblykit.geometry.solids import placed
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import ModelTolerance, Tolerance, current
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,7 +62,7 @@ class MatingProblem:
     bodies: Mapping[str, MatingBody]
     goals: tuple[Goal, ...]
     source: str | None = None
-    tolerance: Tolerance = field(default_factory=current)
+    tolerance: ModelTolerance = field(default_factory=lambda: ModelTolerance.of(current()))
 
     def __repr__(self) -> str:
         from assemblykit import formatting as fmt
@@ -122,10 +122,9 @@ def body_symmetry(
     return SymmetryGroup.identity().extended_by(kept, tol=tol)
 
 
-def preserves(mesh: trimesh.Trimesh, g: np.ndarray, tol: Tolerance | None = None) -> bool:
+def preserves(mesh: trimesh.Trimesh, g: np.ndarray, tol: Tolerance) -> bool:
     """Whether ``g`` maps the solid onto itself: vol(M ∩ gM) = vol(M) within the mesh
     tolerance over its surface."""
-    tol = tol or current()
     shared = overlap_volume(mesh, placed(mesh, g))
     return abs(float(mesh.volume) - shared) <= tol.mesh_length * float(mesh.area)
 

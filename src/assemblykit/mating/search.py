@@ -57,7 +57,7 @@ from assemblykit.mating.laws import (
 )
 from assemblykit.mating.loci import World, loci_branches, numeric_closure
 from assemblykit.mating.problem import MatingProblem
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 LAWS = (
     "candidates",
@@ -406,7 +406,7 @@ def place(problem: MatingProblem, pairs: tuple[Candidate, ...]) -> Placement:
     return Placement(tuple(configurations), tuple(rejections))
 
 
-def _units(pairs: Sequence[Candidate], world: World, tol: Tolerance) -> list[list[str]]:
+def _units(pairs: Sequence[Candidate], world: World, tol: ModelTolerance) -> list[list[str]]:
     """Bodies that move together: a goal with a determined relative position between two
     bodies with the same world group attaches them rigidly (one set of parameters)."""
     unit = {name: name for name in world}
@@ -441,7 +441,7 @@ def _root(pairs: Sequence[Candidate], names: Sequence[str]) -> str:
     return max(names, key=lambda name: degree[name])
 
 
-def _positions(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> list[World]:
+def _positions(world: World, pairs: Sequence[Candidate], tol: ModelTolerance) -> list[World]:
     """Every consistent set of world cosets reachable from ``world``: chain and intersect
     until quiescent, then branch on a loop that is not closed yet: representative-point
     loci (Liu & Popplestone 1990 Figs 4-5), else the numeric closure. A closed form with no meeting
@@ -462,7 +462,7 @@ def _positions(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> list
     return [settled]
 
 
-def _implied(second: Coset, first: Coset, relative: Coset, tol: Tolerance) -> bool:
+def _implied(second: Coset, first: Coset, relative: Coset, tol: ModelTolerance) -> bool:
     """Whether a goal X = L_second⁻¹·L_first ∈ ``relative`` holds for every pose left:
     both poses fixed (propagation checked it), or one world coset exactly the goal's
     image of the other (the goal is how that body was reached)."""
@@ -480,7 +480,7 @@ def _implied(second: Coset, first: Coset, relative: Coset, tol: Tolerance) -> bo
     return False
 
 
-def _propagate(world: World, pairs: Sequence[Candidate], tol: Tolerance) -> World | None:
+def _propagate(world: World, pairs: Sequence[Candidate], tol: ModelTolerance) -> World | None:
     """Chain point positions through the goals' relative cosets (X = L_second⁻¹·L_first),
     carry bodies rigidly attached to a moving body along with it, and intersect with
     what is known; ``None`` when an intersection is empty."""
@@ -596,7 +596,7 @@ def _joint_witness(
     movers: Mapping[str, Mover],
     units: Sequence[list[str]],
     open_pairs: Sequence[tuple[str, str]],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[list[tuple[float, ...]] | None, bool]:
     """Parameters of every moving unit such that no open pair interferes (exact checks),
     by backtracking over candidate values; each unit's value is then pulled back towards
@@ -668,7 +668,7 @@ def _ranges(
     params: tuple[float, ...],
     poses: Mapping[str, np.ndarray],
     open_pairs: Sequence[tuple[str, str]],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> dict[str, Motion]:
     """The range of motion of a one-parameter unit with every other body at its chosen
     pose: the whole turn or travel when no pair of it is open (its sweeps clear them,
@@ -698,7 +698,7 @@ def _ranges(
 
 
 def interfering_movers(
-    first: Mover, pose_a: np.ndarray, second: Mover, pose_b: np.ndarray, tol: Tolerance
+    first: Mover, pose_a: np.ndarray, second: Mover, pose_b: np.ndarray, tol: ModelTolerance
 ) -> bool:
     """Whether two bodies at world poses share more than a touching volume (their
     solids built once, moved to the poses)."""

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from assemblykit.errors import UnknownNameError
 from assemblykit.model.surfaces import Surface
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import ModelTolerance, Tolerance, current
 
 
 @dataclass(frozen=True)
@@ -133,9 +133,10 @@ class AssemblyLike(Protocol):
         voxel puzzle's pieces, which also move on their lattice) or ``"polygons"``."""
         ...
 
-    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
-        """The tolerance policy ``tol`` (the current one when ``None``) scaled to the
-        drawing."""
+    def tolerance(self, tol: Tolerance | None = None) -> ModelTolerance:
+        """The tolerance the parts are compared with: the policy ``tol`` (the current
+        one when ``None``) resolved for this drawing, or ``tol`` itself when it is this
+        drawing's already (docs/architecture.md, "Tolerances")."""
         ...
 
     def sizes(self) -> dict[str, float]:
@@ -364,14 +365,18 @@ class Assembly:
             angle=max(policy.angle, policy.mesh_angle),
         )
 
-    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
+    def tolerance(self, tol: Tolerance | None = None) -> ModelTolerance:
         """The tolerance geometry is compared with: :meth:`policy_tolerance`, with its
         length raised to the measured :attr:`precision` of the input when that is coarser
-        (``max(policy, measured)``, :mod:`assemblykit.geometry.precision`)."""
+        (``max(policy, measured)``, :mod:`assemblykit.geometry.precision`). A tolerance
+        this model resolved already (of its scale) is returned as it is: resolving it
+        again would give the same numbers."""
+        if isinstance(tol, ModelTolerance) and tol.scale == self.scale:
+            return tol
         policy = self.policy_tolerance(tol)
         if self.precision is None or self.precision.length <= policy.length:
-            return policy
-        return replace(policy, rel_length=self.precision.length / self.scale)
+            return ModelTolerance.of(policy)
+        return ModelTolerance.of(replace(policy, rel_length=self.precision.length / self.scale))
 
     def tolerance_summary(self, tol: Tolerance | None = None) -> dict[str, Any]:
         """Which length tolerance applies and why: ``length`` (model units), ``relative``

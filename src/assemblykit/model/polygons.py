@@ -20,7 +20,7 @@ from shapely.geometry import Polygon
 
 from assemblykit.errors import UnknownNameError
 from assemblykit.model.assembly import Memo, Overlap
-from assemblykit.tolerance import Tolerance, current
+from assemblykit.tolerance import ModelTolerance, Tolerance, current
 
 
 @dataclass(eq=False)
@@ -68,9 +68,12 @@ class PolygonAssembly:
         diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
         return diag if diag > 0 else 1.0
 
-    def tolerance(self, tol: Tolerance | None = None) -> Tolerance:
-        """The tolerance policy scaled to this drawing."""
-        return (tol or current()).with_scale(self.scale)
+    def tolerance(self, tol: Tolerance | None = None) -> ModelTolerance:
+        """The tolerance policy ``tol`` (the current one when ``None``) scaled to this
+        drawing; ``tol`` itself when it is this drawing's already."""
+        if isinstance(tol, ModelTolerance) and tol.scale == self.scale:
+            return tol
+        return ModelTolerance.of((tol or current()).with_scale(self.scale))
 
     def subset(self, names: list[str]) -> PolygonAssembly:
         """The polygons named; its memo keeps what this one's holds for them."""

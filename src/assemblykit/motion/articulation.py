@@ -31,7 +31,7 @@ from scipy.linalg import null_space
 from assemblykit.algebra import Kind
 from assemblykit.model.assembly import Assembly
 from assemblykit.motion.freedom import Motion, MotionReport, motion
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 Vector = NDArray[np.float64]
 
@@ -97,7 +97,9 @@ def revolute_of(assembly: Assembly, moved: Motion) -> Revolute | None:
     )
 
 
-def _mesh_ratio(first: Revolute, second: Revolute, distance: float, tol: Tolerance) -> float | None:
+def _mesh_ratio(
+    first: Revolute, second: Revolute, distance: float, tol: ModelTolerance
+) -> float | None:
     """ω_second / ω_first, each about its own axis direction, for two revolutes on
     parallel axes ``distance`` apart; ``None`` if their pitch circles are not tangent
     (module docstring: an external mesh, or one gear inside the other's ring)."""
@@ -114,7 +116,7 @@ def _mesh_ratio(first: Revolute, second: Revolute, distance: float, tol: Toleran
     return ratio if float(first.direction @ second.direction) > 0 else -ratio
 
 
-def gear_meshes(joints: Sequence[Revolute], tol: Tolerance) -> list[GearMesh]:
+def gear_meshes(joints: Sequence[Revolute], tol: ModelTolerance) -> list[GearMesh]:
     """The pairs of revolutes with parallel axes and tangent pitch circles, external or
     internal (a gear in a ring gear)."""
     found = []
@@ -129,7 +131,7 @@ def gear_meshes(joints: Sequence[Revolute], tol: Tolerance) -> list[GearMesh]:
     return found
 
 
-def gear_trains(meshes: Iterable[GearMesh], tol: Tolerance) -> list[GearTrain]:
+def gear_trains(meshes: Iterable[GearMesh], tol: ModelTolerance) -> list[GearTrain]:
     """The gear trains (connected components of the meshes) with their coupled motion."""
     meshes = list(meshes)
     graph: nx.Graph[str] = nx.Graph()

@@ -38,7 +38,7 @@ from assemblykit.geometry.contact_values import Contact, CurvedPatch
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.model.assembly import Assembly
 from assemblykit.motion.unilateral import UnilateralReading, unilateral_readings
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 Vector = NDArray[np.float64]
 ContactFeature = Plane | Ball | Socket | Shaft | Hole | Cone
@@ -78,7 +78,7 @@ def _patch_feature(patch: CurvedPatch, inside: bool) -> ContactFeature:
     return Cone(point=patch.center, axis=patch.axis, half_angle=patch.half_angle, male=inside)
 
 
-def _same_feature(f: ContactFeature, g: ContactFeature, tol: Tolerance) -> bool:
+def _same_feature(f: ContactFeature, g: ContactFeature, tol: ModelTolerance) -> bool:
     """Whether two features are the same oriented surface (so one is kept)."""
     if type(f) is not type(g):
         return False
@@ -101,7 +101,9 @@ def _same_feature(f: ContactFeature, g: ContactFeature, tol: Tolerance) -> bool:
     return bool(on_line and parallel and abs(f.radius - g.radius) <= tol.length)
 
 
-def _distinct(features: Iterable[ContactFeature], tol: Tolerance) -> tuple[ContactFeature, ...]:
+def _distinct(
+    features: Iterable[ContactFeature], tol: ModelTolerance
+) -> tuple[ContactFeature, ...]:
     kept: list[ContactFeature] = []
     for feature in features:
         if not any(_same_feature(feature, k, tol) for k in kept):
@@ -115,7 +117,7 @@ def boundary_contacts(contacts: Iterable[Contact], moving: frozenset[str]) -> li
 
 
 def moving_features(
-    contacts: Iterable[Contact], moving: frozenset[str], tol: Tolerance
+    contacts: Iterable[Contact], moving: frozenset[str], tol: ModelTolerance
 ) -> tuple[tuple[ContactFeature, ...], ContactSamples]:
     """The compound feature of ``moving`` (its oriented contact surfaces, Liu 1997
     Def. 3.0.1) and the sampled contact points with normals out of ``moving``; contacts
@@ -238,7 +240,7 @@ class Motion(GroupMotion):
         return out
 
 
-def _feature_key(feature: ContactFeature, anchor: Vector, tol: Tolerance) -> tuple[Any, ...]:
+def _feature_key(feature: ContactFeature, anchor: Vector, tol: ModelTolerance) -> tuple[Any, ...]:
     """The feature seen from ``anchor``, rounded to the tolerance: equal keys mean the
     same oriented surface up to the translation between the anchors."""
 

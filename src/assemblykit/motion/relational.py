@@ -39,7 +39,7 @@ from assemblykit.inference.reduction import solve_task, task_tolerance
 from assemblykit.model.relations import Relation
 from assemblykit.model.task import Task
 from assemblykit.motion.freedom import GroupMotion, motion_summary
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 
 def relation_label(relation: Relation) -> str:
@@ -101,7 +101,7 @@ class TaskMotionReport:
 
 
 def placed_group(
-    task: Task, relation: Relation, poses: Mapping[str, np.ndarray], tol: Tolerance
+    task: Task, relation: Relation, poses: Mapping[str, np.ndarray], tol: ModelTolerance
 ) -> SymmetryGroup | str:
     """The world motions of either body that keep ``relation`` with the other body held:
     its coset's group conjugated by the second body's pose (module docstring); or the
@@ -137,7 +137,7 @@ def situation_motions(
     situation: str,
     relations: Sequence[Relation],
     solution: Solution,
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> list[RelationMotion]:
     """The motion of every movable body in the situation named ``situation`` where
     ``relations`` hold (module docstring)."""

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from assemblykit.blocking.arrangement import snap_normals
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.part_sets import bits
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
@@ -38,7 +38,7 @@ EXACT_GROUP_PARTS = 12
 overlay of every pair's blocked set (single parts always get their free set's)."""
 
 
-def fit_axes(assembly: Assembly, tol: Tolerance) -> NDArray[np.float64]:
+def fit_axes(assembly: Assembly, tol: ModelTolerance) -> NDArray[np.float64]:
     """The coordinate axes and the axes of the cylindrical contacts, both ways, each once
     within the angle tolerance: where the circles of every radial contact normal of a
     fit meet. Normals a rounding apart (tessellated CAD) make the arrangement a cluster
@@ -57,7 +57,9 @@ def fit_axes(assembly: Assembly, tol: Tolerance) -> NDArray[np.float64]:
     return np.vstack([lines, -lines])
 
 
-def exact_candidates(assembly: Assembly, tol: Tolerance) -> Callable[[int], NDArray[np.float64]]:
+def exact_candidates(
+    assembly: Assembly, tol: ModelTolerance
+) -> Callable[[int], NDArray[np.float64]]:
     """For a set of parts the sampled candidates do not separate: a direction in every
     face of each part's exact free set among the set (Wilson & Latombe 1992, "Extension
     and Variant": extended translations; each checked free), and,

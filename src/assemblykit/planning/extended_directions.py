@@ -33,7 +33,7 @@ from assemblykit.blocking.directions import DirectionTable
 from assemblykit.blocking.extended import extended_arcs, shown_along, shown_pairs
 from assemblykit.geometry.occlusion import view_frame
 from assemblykit.part_sets import bits, mask_of
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
@@ -79,7 +79,7 @@ class ExtendedDirections:
         self,
         assembly: Assembly,
         directions: NDArray[np.float64],
-        tol: Tolerance,
+        tol: ModelTolerance,
         parts: Sequence[str] | None = None,
     ) -> None:
         self.assembly = assembly

@@ -59,7 +59,7 @@ from assemblykit.geometry.contact_values import CurvedPatch
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.overlaps import ring_radius
 from assemblykit.model.assembly import Assembly
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 FastenerKind = Literal["screw", "pin", "pressed", "nut", "bolt"]
 
@@ -283,7 +283,7 @@ def step_fastener(
     parts: Sequence[str],
     direction: NDArray[np.float64],
     rest: Sequence[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> Fastener | None:
     """The fastener a step moving ``parts`` along ``direction`` out of ``rest`` takes
     out, or ``None`` (module docstring): a single part with a cylindrical fit along the
@@ -350,7 +350,7 @@ def _fits(
     part: str,
     direction: NDArray[np.float64],
     staying: set[str],
-    tol: Tolerance,
+    tol: ModelTolerance,
     *,
     inner: bool,
 ) -> dict[str, list[CurvedPatch]]:

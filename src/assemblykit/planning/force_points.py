@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.ragged import group_of, group_starts
-from assemblykit.tolerance import MIN_REL_LENGTH, Tolerance
+from assemblykit.tolerance import MIN_REL_LENGTH, ModelTolerance, Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
@@ -143,7 +143,7 @@ def _corners(polygons: Sequence[NDArray[np.float64]], resolution: float) -> NDAr
 
 
 def _tangents(
-    normals: NDArray[np.float64], down: NDArray[np.float64], tol: Tolerance
+    normals: NDArray[np.float64], down: NDArray[np.float64], tol: ModelTolerance
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Per normal, ``u`` along gravity's component in the contact plane (a coordinate
     axis across the normal when gravity is along it) and ``v = n x u``."""

@@ -48,7 +48,7 @@ from assemblykit.part_sets import bits, mask_of, several
 from assemblykit.planning.extended_directions import ExtendedDirections
 from assemblykit.planning.plan_values import Hands, HandsMove
 from assemblykit.planning.search import Search
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
@@ -94,7 +94,7 @@ class _HandsSearch:
     circles: NDArray[np.float64]
     sizes: tuple[float, ...]
     max_hands: int
-    tol: Tolerance
+    tol: ModelTolerance
 
     def __post_init__(self) -> None:
         self.necessary = [self.translations.masks(k) for k in range(len(self.directions))]
@@ -252,7 +252,10 @@ def hands_needed(
 
 
 def _exact_search(
-    assembly: Assembly | PolygonAssembly, names: tuple[str, ...], max_hands: int, tol: Tolerance
+    assembly: Assembly | PolygonAssembly,
+    names: tuple[str, ...],
+    max_hands: int,
+    tol: ModelTolerance,
 ) -> _HandsSearch:
     """The search over the exact Γ_e NDBG (polygons, convex parts): its regions'
     DBGs serve as both tables, its terms decide any direction."""
@@ -273,7 +276,7 @@ def _exact_search(
 
 
 def _sampled_search(
-    assembly: Assembly, names: tuple[str, ...], max_hands: int, tol: Tolerance
+    assembly: Assembly, names: tuple[str, ...], max_hands: int, tol: ModelTolerance
 ) -> _HandsSearch:
     """The search for parts that are not all convex, as the planner searches: the
     regions of Γ_t of ``names`` give the candidate directions, Γ_e is computed exactly

@@ -63,7 +63,7 @@ from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import Assembly
 from assemblykit.model.polygons import PolygonAssembly
 from assemblykit.planning.candidates import EXACT_GROUP_PARTS
-from assemblykit.tolerance import Tolerance, order_key
+from assemblykit.tolerance import ModelTolerance, Tolerance, order_key
 
 Verdict = Literal["interlocking", "recursively interlocking", "not interlocking"]
 FreeKind = Literal["direction", "arc", "circle", "region", "everywhere"]
@@ -300,7 +300,7 @@ class Interlocking:
     exact: bool
     limits: str
     planar: bool
-    tol: Tolerance
+    tol: ModelTolerance
 
     @property
     def interlocking(self) -> bool:
@@ -539,7 +539,10 @@ class _Stage:
 
 
 def _stage(
-    assembly: Assembly | PolygonAssembly, parts: tuple[str, ...], motion: Motion, tol: Tolerance
+    assembly: Assembly | PolygonAssembly,
+    parts: tuple[str, ...],
+    motion: Motion,
+    tol: ModelTolerance,
 ) -> _Stage:
     """The evidence of ``motion`` among ``parts`` and the classes it leaves together."""
     if motion == "rigid":
@@ -593,7 +596,10 @@ def _ndbg_cells(graph: NonDirectionalBlockingGraph) -> tuple[_Cell, ...]:
 
 
 def _translation_evidence(
-    assembly: Assembly | PolygonAssembly, parts: tuple[str, ...], motion: Motion, tol: Tolerance
+    assembly: Assembly | PolygonAssembly,
+    parts: tuple[str, ...],
+    motion: Motion,
+    tol: ModelTolerance,
 ) -> _Evidence:
     """The DBGs of Γ_t or Γ_e over every region; for Γ_e sampled at the regions of
     Γ_t, the sets Γ_t lets move decided over every direction (module docstring)."""
@@ -612,7 +618,7 @@ def _refined(
     ndbg: NonDirectionalBlockingGraph,
     local: NonDirectionalBlockingGraph,
     cells: tuple[_Cell, ...],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> _Evidence:
     """Γ_e sampled at the regions of Γ_t (``ndbg``), completed where the samples may
     miss a motion: a set closed in a DBG of Γ_t (``local``, a necessary condition) that
@@ -679,7 +685,7 @@ def _refined(
 
 
 def _rigid_evidence(
-    assembly: Assembly | PolygonAssembly, parts: tuple[str, ...], tol: Tolerance
+    assembly: Assembly | PolygonAssembly, parts: tuple[str, ...], tol: ModelTolerance
 ) -> _Evidence:
     """Γ_g: the DBGs of the full-dimensional cells of the twist arrangement and the
     subsets its linear programs free (:meth:`RigidBlockingGraph.removable`: motions that
@@ -781,7 +787,7 @@ def _freedoms(
     keys: frozenset[str] | None,
     holds: bool,
     weights: dict[str, float],
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[Freedom, ...]:
     """The subsets that move, each once: when interlocking, the moves of the keys;
     otherwise the least sets of each DBG (sink components) and the witnesses, with keys
@@ -813,7 +819,7 @@ def _freedoms(
 
 
 def _freedom(
-    assembly: Assembly | PolygonAssembly, stage: _Stage, side: frozenset[str], tol: Tolerance
+    assembly: Assembly | PolygonAssembly, stage: _Stage, side: frozenset[str], tol: ModelTolerance
 ) -> Freedom:
     """Where ``side`` is free, one direction that frees it and how to block it."""
     parts = stage.parts
@@ -906,7 +912,7 @@ def _recursion(
     keys: frozenset[str],
     weights: dict[str, float],
     motion: Motion,
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> tuple[tuple[KeyRemoval, ...], tuple[str, ...], list[_Stage]]:
     """The keys in the order they leave: the key, then while at least two parts remain
     the single key of the rest (the lighter of two parts); the parts left where no
@@ -1055,7 +1061,10 @@ def _around(
 
 
 def _contact_normals(
-    assembly: Assembly | PolygonAssembly, side: frozenset[str], parts: Sequence[str], tol: Tolerance
+    assembly: Assembly | PolygonAssembly,
+    side: frozenset[str],
+    parts: Sequence[str],
+    tol: ModelTolerance,
 ) -> tuple[NDArray[np.float64], bool]:
     """Unit normals of the contacts of ``side`` with the other ``parts``, out of
     ``side`` (Γ_t's half-spaces: Wilson & Latombe 1992, §4), and whether there are any."""

@@ -56,13 +56,13 @@ from assemblykit.planning.multimove import (
     fixed_indices,
 )
 from assemblykit.ragged import group_starts
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.assembly import Assembly
 
 
-def candidate_directions(assembly: Assembly, tol: Tolerance) -> NDArray[np.float64]:
+def candidate_directions(assembly: Assembly, tol: ModelTolerance) -> NDArray[np.float64]:
     """Unit directions (rows) to move along: the regions of Γ_t's arrangement and the
     contact normals (of planar patches; axes of curved ones), each both ways, one per
     direction within the angle tolerance; those along an axis first."""
@@ -125,7 +125,7 @@ class _Intervals:
         obstacles: _Obstacles,
         alpha: NDArray[np.float64],
         offsets: NDArray[np.float64],
-        tol: Tolerance,
+        tol: ModelTolerance,
     ) -> None:
         relative = offsets[obstacles.first] - offsets[obstacles.second]
         beta = (
@@ -163,7 +163,7 @@ class _MeshSearch(MultiMoveSearch):
     def __init__(
         self,
         assembly: Assembly,
-        tol: Tolerance,
+        tol: ModelTolerance,
         max_states: int,
         progress: Progress,
         fixed: Iterable[int] = (),

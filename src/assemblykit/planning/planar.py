@@ -26,7 +26,7 @@ from assemblykit.blocking.tables import planar_direction_tables
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.part_sets import mask_of
 from assemblykit.planning.search import Progress, Search
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance
 
 if TYPE_CHECKING:
     from assemblykit.model.polygons import PolygonAssembly
@@ -57,7 +57,7 @@ class PlanarExtended(DirectionTable):
 
 
 def planar_tables(
-    model: PolygonAssembly, tol: Tolerance
+    model: PolygonAssembly, tol: ModelTolerance
 ) -> tuple[DirectionTable, PlanarExtended, tuple[float, ...]]:
     """Γ_t and Γ_e of a polygon assembly along the regions of their common arrangement
     of S¹ (module docstring, :func:`~assemblykit.blocking.tables.planar_direction_tables`),
@@ -74,7 +74,7 @@ def planar_tables(
 
 def planar_search(
     model: PolygonAssembly,
-    tol: Tolerance,
+    tol: ModelTolerance,
     report: Progress,
     max_steps: int | None = None,
     fixed: Sequence[str] = (),
@@ -100,7 +100,9 @@ def planar_search(
     return search
 
 
-def planar_rigid_may_free(model: PolygonAssembly, parts: Iterable[str], tol: Tolerance) -> bool:
+def planar_rigid_may_free(
+    model: PolygonAssembly, parts: Iterable[str], tol: ModelTolerance
+) -> bool:
     """Whether some infinitesimal rigid motion of the plane (a turn about z and a
     translation in z = 0) moves a proper part of ``parts`` away from the others without
     penetration, breaking some contact (Γ_g in 2D, Wilson & Latombe 1992, "Extension and

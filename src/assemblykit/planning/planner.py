@@ -37,7 +37,7 @@ from assemblykit.planning.multimove import moving_groups
 from assemblykit.planning.plan_values import Hands, Interlock, Plan, Step, and_or_graph
 from assemblykit.planning.planar import planar_rigid_may_free, planar_search
 from assemblykit.planning.search import FirstAdmitted, Progress, Search, base_part, one_set
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 UP = (0.0, 0.0, 1.0)
 """Up for an assembly planned on the ground (+Z, the convention of block assemblies):
@@ -249,7 +249,7 @@ def _plan_under_gravity(
     assembly: Assembly,
     search: Search,
     gravity: Gravity,
-    tol: Tolerance,
+    tol: ModelTolerance,
     max_and_or_parts: int,
     max_hands: int,
 ) -> Plan:
@@ -343,7 +343,7 @@ def _indices(search: Search, parts: Iterable[str]) -> list[int]:
 def finish_plan(
     assembly: Assembly | PolygonAssembly,
     search: Search,
-    tol: Tolerance,
+    tol: ModelTolerance,
     max_and_or_parts: int,
     max_hands: int,
     report: Progress,
@@ -407,7 +407,9 @@ def finish_plan(
     )
 
 
-def _with_fasteners(assembly: Assembly, steps: Sequence[Step], tol: Tolerance) -> tuple[Step, ...]:
+def _with_fasteners(
+    assembly: Assembly, steps: Sequence[Step], tol: ModelTolerance
+) -> tuple[Step, ...]:
     """``steps`` with the fasteners each draws out of the parts it leaves: the fastener
     of each of its moves of one part (:func:`step_fastener`), a pin that a nut came
     off earlier read as a bolt (:func:`bolts_after_nuts`), and the step's own when it
@@ -433,7 +435,7 @@ def _interlock(
     members: int,
     locked: int,
     translations: DirectionTable,
-    tol: Tolerance,
+    tol: ModelTolerance,
 ) -> Interlock:
     parts = tuple(names[i] for i in bits(members))
     held = tuple(names[i] for i in bits(locked & ~members))

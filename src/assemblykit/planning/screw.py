@@ -63,7 +63,7 @@ from assemblykit.model.surfaces import Surface
 from assemblykit.planning.fasteners import ISO_COARSE_PITCH, MILLIMETRES
 from assemblykit.planning.plan_values import Plan
 from assemblykit.planning.planner import plan
-from assemblykit.tolerance import Tolerance
+from assemblykit.tolerance import ModelTolerance, Tolerance
 
 MAX_ANGLE = math.pi / 2
 """Largest turn tried: a quarter turn frees the hooks and latches this looks for."""
@@ -126,7 +126,7 @@ class ScrewStep:
 
 
 def _candidates(
-    points: NDArray[np.float64], normals: NDArray[np.float64], tol: Tolerance, pitched: bool
+    points: NDArray[np.float64], normals: NDArray[np.float64], tol: ModelTolerance, pitched: bool
 ) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float]]:
     """Screw lines ``(point, signed axis, pitch)`` that pass Γ_g's first-order test (no
     contact pushed into, at least one left): pure turns, or with ``pitched`` the ends of
@@ -159,7 +159,9 @@ def _candidates(
     return found
 
 
-def _pitches(turn: NDArray[np.float64], along: NDArray[np.float64], tol: Tolerance) -> list[float]:
+def _pitches(
+    turn: NDArray[np.float64], along: NDArray[np.float64], tol: ModelTolerance
+) -> list[float]:
     """The finite, nonzero ends of the interval of pitches ``h`` with
     ``turn + h along <= 0`` at every contact (module docstring)."""
     slanted = np.abs(along) > tol.angle
@@ -272,7 +274,7 @@ def _follows(
 
 
 def _thread_candidates(
-    assembly: Assembly, moving: tuple[str, ...], rest: tuple[str, ...], tol: Tolerance
+    assembly: Assembly, moving: tuple[str, ...], rest: tuple[str, ...], tol: ModelTolerance
 ) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float, float]]:
     """The thread motions of ``moving`` out of ``rest`` (module docstring) as ``(point,
     unit axis it advances along, pitch per radian, angle)``: for each cylinder of a
@@ -308,7 +310,7 @@ def _thread_candidates(
 
 
 def _coaxial_fits(
-    assembly: Assembly, moving: tuple[str, ...], rest: tuple[str, ...], tol: Tolerance
+    assembly: Assembly, moving: tuple[str, ...], rest: tuple[str, ...], tol: ModelTolerance
 ) -> list[tuple[Surface, Surface, str]]:
     """``(inner, outer, other)``: a convex cylinder inside a concave one on the same
     axis (within 5% of the smaller radius), one on a moving part and one on a part
