@@ -92,6 +92,14 @@ def test_jsonable_converts_nested_results():
     json.dumps(out, allow_nan=False)
 
 
+def test_jsonable_keeps_truth_values_and_rounds_numbers_under_the_tolerance_given():
+    loose = Tolerance(rel_length=1e-3, angle=1e-3)
+    assert jsonable([True, np.bool_(False), 1, np.float32(0.5)]) == [True, False, 1, 0.5]
+    assert type(jsonable(True)) is bool and type(jsonable(np.int32(7))) is int
+    assert jsonable({"small": np.float64(5e-4), "big": 2e-3}, loose) == {"small": 0.0, "big": 0.002}
+    assert jsonable((np.float64(5e-4),)) == [0.0005]
+
+
 def test_jsonable_rejects_what_it_cannot_represent():
     with pytest.raises(TypeError, match="cannot turn a object into JSON"):
         jsonable(object())

@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import functools
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from collections.abc import Set as AbstractSet
 from pathlib import PurePath
 from typing import Any
 
@@ -45,39 +47,78 @@ def json_number(x: float, tol: Tolerance | None = None) -> float | str:
     return float(f"{value:.{SIGNIFICANT_DIGITS}g}")
 
 
-def jsonable(obj: Any, tol: Tolerance | None = None) -> JsonValue:
-    """``obj`` as a value :func:`json.dumps` accepts, numbers rounded by :func:`json_number`.
+@functools.singledispatch
+def jsonable(obj: object, tol: Tolerance | None = None) -> JsonValue:
+    """``obj`` as a value :func:`json.dumps` accepts, numbers rounded by :func:`json_number`,
+    dispatched on its type (:func:`functools.singledispatch`, beside
+    :func:`assemblykit.render.render` for the readable form).
 
-    Objects with a ``to_dict()`` method are converted through it; dataclasses become
-    dictionaries of their fields; mappings get string keys; sets become sorted lists
-    (so the output is deterministic); enums give their value; paths their text.
+    Results (objects with a ``to_dict()`` method, docs/architecture.md, "Results and
+    errors") are converted through it; other dataclasses become dictionaries of their
+    fields; mappings get string keys; sets become sorted lists (so the output is
+    deterministic); enums give their value; paths their text; arrays and sequences lists.
     """
-    tol = current() if tol is None else tol
-    if obj is None or isinstance(obj, bool | str):
-        return obj
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    if isinstance(obj, int | np.integer):
-        return int(obj)
-    if isinstance(obj, float | np.floating):
-        return json_number(float(obj), tol)
-    if isinstance(obj, enum.Enum):
-        return jsonable(obj.value, tol)
-    if isinstance(obj, PurePath):
-        return str(obj)
-    if isinstance(obj, np.ndarray):
-        return [jsonable(item, tol) for item in obj.tolist()]
     if hasattr(obj, "to_dict") and not isinstance(obj, type):
         return jsonable(obj.to_dict(), tol)
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return {f.name: jsonable(getattr(obj, f.name), tol) for f in dataclasses.fields(obj)}
-    if isinstance(obj, Mapping):
-        return {str(key): jsonable(value, tol) for key, value in obj.items()}
-    if isinstance(obj, set | frozenset):
-        return sorted((jsonable(item, tol) for item in obj), key=repr)
-    if isinstance(obj, list | tuple):
-        return [jsonable(item, tol) for item in obj]
     raise TypeError(f"cannot turn a {type(obj).__name__} into JSON")
+
+
+@jsonable.register(type(None))
+@jsonable.register(bool)
+@jsonable.register(str)
+def _as_it_is(obj: bool | str | None, tol: Tolerance | None = None) -> JsonValue:
+    return obj
+
+
+@jsonable.register
+def _truth(obj: np.bool_, tol: Tolerance | None = None) -> JsonValue:
+    return bool(obj)
+
+
+@jsonable.register(int)
+@jsonable.register(np.integer)
+def _whole(obj: int | np.integer[Any], tol: Tolerance | None = None) -> JsonValue:
+    return int(obj)
+
+
+@jsonable.register(float)
+@jsonable.register(np.floating)
+def _real(obj: float | np.floating[Any], tol: Tolerance | None = None) -> JsonValue:
+    return json_number(float(obj), current() if tol is None else tol)
+
+
+@jsonable.register
+def _member(obj: enum.Enum, tol: Tolerance | None = None) -> JsonValue:
+    return jsonable(obj.value, tol)
+
+
+@jsonable.register
+def _path(obj: PurePath, tol: Tolerance | None = None) -> JsonValue:
+    return str(obj)
+
+
+@jsonable.register
+def _array(obj: np.ndarray, tol: Tolerance | None = None) -> JsonValue:
+    return [jsonable(item, tol) for item in obj.tolist()]
+
+
+@jsonable.register(Mapping)
+def _mapping(obj: Mapping[object, object], tol: Tolerance | None = None) -> JsonValue:
+    return {str(key): jsonable(value, tol) for key, value in obj.items()}
+
+
+@jsonable.register(set)
+@jsonable.register(frozenset)
+def _set(obj: AbstractSet[object], tol: Tolerance | None = None) -> JsonValue:
+    return sorted((jsonable(item, tol) for item in obj), key=repr)
+
+
+@jsonable.register(list)
+@jsonable.register(tuple)
+def _sequence(obj: Sequence[object], tol: Tolerance | None = None) -> JsonValue:
+    return [jsonable(item, tol) for item in obj]
 
 
 def pose_list(pose: Any, tol: Tolerance | None = None) -> list[list[float]]:
