@@ -427,14 +427,31 @@ def _plan_input(
 
 
 @dataclass(frozen=True)
+class PlanRequest:
+    """What ``plan`` is asked besides the assembly: the options its modes read."""
+
+    tol: Tolerance | None
+    progress: Callable[[str, int, int], None]
+    fixed: tuple[str, ...] = ()
+    max_hands: int = 4
+    gravity: Gravity | None = None
+    one_at_a_time: bool = False
+    max_steps: int | None = None
+    ground: bool = True
+    max_states: int | None = None
+
+
+@dataclass(frozen=True)
 class PlanMode:
-    """A way the ``plan`` command plans (``--moves``), and the options it takes. Only
-    plans of single translations (``monotone``) take the options of that search
-    (:data:`TRANSLATION_OPTIONS`) and plan polygons in the plane; the others move 3D
-    parts, and what it moves them by is its ``motion`` (said when it is given polygons)."""
+    """A way the ``plan`` command plans (``--moves``): its planner (``run``) and the
+    options it takes. Only plans of single translations (``monotone``) take the options
+    of that search (:data:`TRANSLATION_OPTIONS`) and plan polygons in the plane; the
+    others move 3D parts, and what it moves them by is its ``motion`` (said when it is
+    given polygons)."""
 
     name: str
     translations: bool
+    run: Callable[[Any, PlanRequest], Result]
     motion: str = "moves"
 
     def check_options(self, given: set[str]) -> None:
@@ -468,35 +485,40 @@ TRANSLATION_OPTIONS = (
 PLANE_REFUSED = (("--gltf",), ("--html", "--png"))
 """The options of ``plan`` that draw meshes, which an assembly of polygons has not."""
 
-PLAN_MODES = {
-    "monotone": PlanMode("monotone", translations=True),
-    "multi": PlanMode("multi", translations=False),
-    "rigid": PlanMode("rigid", translations=False, motion="turns"),
-}
-"""The ways of ``plan --moves``."""
-
 
 def _listed(options: tuple[str, ...]) -> str:
     """``a``, ``a and b``, ``a, b and c``."""
     return options[0] if len(options) == 1 else f"{', '.join(options[:-1])} and {options[-1]}"
 
 
-def _multi_move_plan(
-    loaded: Any,
-    tol: Tolerance,
-    max_states: int | None,
-    progress: Callable[[str, int, int], None],
-    fixed: tuple[str, ...] = (),
-) -> Result:
+def _monotone_plan(loaded: Any, request: PlanRequest) -> Result:
+    """The plan of single translations (Wilson & Latombe 1992), under gravity when asked."""
+    from assemblykit.planning.planner import plan
+
+    return plan(
+        loaded,
+        tol=request.tol,
+        progress=request.progress,
+        max_hands=request.max_hands,
+        gravity=request.gravity,
+        one_at_a_time=request.one_at_a_time,
+        max_steps=request.max_steps,
+        fixed=request.fixed,
+        ground=request.ground,
+    )
+
+
+def _multi_move_plan(loaded: Any, request: PlanRequest) -> Result:
     """The multi-move plan of a loaded voxel puzzle, compared with its stored level, or
     of a mesh assembly, never moving the ``fixed`` parts (docs/planning.md, "Fixed
     parts")."""
     from assemblykit.planning.multimove import MAX_STATES, plan_voxels
     from assemblykit.planning.multimove_mesh import plan_meshes
 
-    limit = MAX_STATES if max_states is None else max_states
+    limit = MAX_STATES if request.max_states is None else request.max_states
+    progress, fixed = request.progress, request.fixed
     if loaded.kind != "voxels":
-        return plan_meshes(loaded, tol, max_states=limit, progress=progress, fixed=fixed)
+        return plan_meshes(loaded, request.tol, max_states=limit, progress=progress, fixed=fixed)
     puzzle = loaded.puzzle
     return plan_voxels(
         puzzle.names,
@@ -507,6 +529,57 @@ def _multi_move_plan(
         progress=progress,
         fixed=fixed,
     )
+
+
+def _screw_plan(loaded: Any, request: PlanRequest) -> Result:
+    """The plan of rigid motions: translations, turns and screws (docs/planning.md)."""
+    from assemblykit.planning.screw import plan_with_screws
+
+    return plan_with_screws(loaded, request.tol, fixed=request.fixed)
+
+
+PLAN_MODES = {
+    "monotone": PlanMode("monotone", translations=True, run=_monotone_plan),
+    "multi": PlanMode("multi", translations=False, run=_multi_move_plan),
+    "rigid": PlanMode("rigid", translations=False, run=_screw_plan, motion="turns"),
+}
+"""The ways of ``plan --moves``."""
+
+
+@dataclass(frozen=True)
+class PlanFiles:
+    """The files ``plan`` writes for a plan of translations (``None``: not asked)."""
+
+    html: str | None
+    png: str | None
+    out: str | None
+    gltf: str | None
+    plotly: Literal["inline", "cdn"] = "inline"
+
+
+def _write_plan(
+    loaded: Any, result: Any, files: PlanFiles, update: Callable[[str, int, int], None]
+) -> None:
+    """Write the report, the exploded view, the step table and the glTF scene asked for."""
+    if files.html is not None:
+        from assemblykit.viz.viewer import write_report
+
+        update("writing the report", 0, 1)
+        write_report(loaded, result, files.html, plotlyjs=files.plotly)
+    if files.png is not None:
+        from assemblykit.viz.plots import exploded_view_png
+
+        update("drawing the exploded view", 0, 1)
+        exploded_view_png(loaded, result, files.png)
+    if files.out is not None:
+        from assemblykit.io.exports import write_plan
+
+        write_plan(result, files.out, loaded.tolerance())
+    if files.gltf is not None:
+        from assemblykit.io.exports import write_gltf
+
+        update("writing the glTF scene", 0, 1)
+        write_gltf(loaded, result, files.gltf, loaded.tolerance())
 
 
 def _holds(extra: int | None, holds: int | None) -> int:
@@ -696,8 +769,6 @@ def plan_cmd(
     polygons 'parts: {name: [[x, y], ...]}' (planned in the plane), or a BurrTools
     .xmpuzzle (placed as its stored --solution of --problem).
     """
-    from assemblykit.planning.planner import plan
-
     mode = PLAN_MODES[moves]
     given = {
         "--html": html is not None,
@@ -738,48 +809,24 @@ def plan_cmd(
             raise InputError("--join and --join-interfering need 3D parts")
         if loaded.dimension == 2:
             mode.check_plane({option for option, on in given.items() if on}, assembly)
-        if moves == "multi":
-            result = _multi_move_plan(loaded, tol, max_states, update, fixed)
-        elif moves == "rigid":
-            from assemblykit.planning.screw import plan_with_screws
-
-            result = plan_with_screws(loaded, tol, fixed=fixed)
-        else:
-            monotone = plan(
-                loaded,
-                tol=tol,
-                progress=update,
-                max_hands=max_hands,
-                gravity=_gravity(gravity, friction, _holds(extra_holds, holds), fixed),
-                one_at_a_time=one_at_a_time,
-                max_steps=max_steps,
-                fixed=fixed,
-                ground=not floating,
-            )
-            if html is not None:
-                from assemblykit.viz.viewer import write_report
-
-                update("writing the report", 0, 1)
-                write_report(loaded, monotone, html, plotlyjs=plotly)
-            if png is not None:
-                from assemblykit.viz.plots import exploded_view_png
-
-                update("drawing the exploded view", 0, 1)
-                exploded_view_png(loaded, monotone, png)
-            if out is not None:
-                from assemblykit.io.exports import write_plan
-
-                write_plan(monotone, out, getattr(loaded, "tolerance", lambda: tol)())
-            if gltf is not None:
-                from assemblykit.io.exports import write_gltf
-
-                update("writing the glTF scene", 0, 1)
-                write_gltf(loaded, monotone, gltf, loaded.tolerance())
-            result = monotone
+        request = PlanRequest(
+            tol,
+            update,
+            fixed,
+            max_hands=max_hands,
+            gravity=_gravity(gravity, friction, _holds(extra_holds, holds), fixed),
+            one_at_a_time=one_at_a_time,
+            max_steps=max_steps,
+            ground=not floating,
+            max_states=max_states,
+        )
+        result = mode.run(loaded, request)
+        if mode.translations:
+            _write_plan(loaded, result, PlanFiles(html, png, out, gltf, plotly), update)
     for written in (html, png, out, gltf):
         if written is not None:
             note(f"wrote {written}")
-    emit(result, as_json, shown=getattr(loaded, "tolerance", lambda: tol)())
+    emit(result, as_json, shown=loaded.tolerance())
 
 
 @command
