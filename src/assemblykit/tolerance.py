@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import functools
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
@@ -157,13 +158,21 @@ class Tolerance:
     def _numbers(self) -> tuple[float, float, float, float, float]:
         return (self.scale, self.rel_length, self.angle, self.mesh_rel_length, self.mesh_angle)
 
+    @functools.cached_property
+    def _hash(self) -> int:
+        """The hash of the numbers, found once: a tolerance keys the stores of derived
+        data, so its hash is asked for very often."""
+        return hash(self._numbers())
+
     def __eq__(self, other: object) -> bool:
+        if self is other:
+            return True
         if not isinstance(other, Tolerance):
             return NotImplemented
-        return self._numbers() == other._numbers()
+        return self._hash == other._hash and self._numbers() == other._numbers()
 
     def __hash__(self) -> int:
-        return hash(self._numbers())
+        return self._hash
 
     @property
     def length(self) -> float:
