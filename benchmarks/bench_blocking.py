@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from assemblykit.blocking.arrangement import sphere_arrangement
+from assemblykit.blocking.arrangement import Arrangement, sphere_arrangement
 from assemblykit.blocking.constraints import infinitesimal_terms
 from assemblykit.blocking.ndbg import ConstraintTable, build_ndbg, crossing_rule
 from assemblykit.blocking.rigid import RIGID_MAX_HYPERPLANES, RigidBlockingGraph
@@ -74,6 +74,16 @@ def timed(fn, *args, repeats: int = REPEATS):
     return out, statistics.median(walls), statistics.median(cpus)
 
 
+def resolved_regions(arr: Arrangement, normals: np.ndarray, regions: np.ndarray) -> np.ndarray:
+    """Which of ``regions`` are wider than the angle tolerance: a face whose direction is
+    within the tolerance of no circle, an edge of one, a vertex of two. Random planes
+    leave a few regions narrower (circles passing within 1e-6 rad of a vertex), where
+    the direct test, which takes a direction within the tolerance of a circle as on it,
+    and the arrangement's exact sides may differ."""
+    near = (np.abs(arr.directions[regions] @ normals.T) <= TOL.angle).sum(axis=1)
+    return near <= 2 - arr.dims[regions]
+
+
 def per_region(table: ConstraintTable, directions: np.ndarray) -> list[np.ndarray]:
     """Each region's DBG recomputed on its own (Wilson & Latombe 1992: inner products with every
     contact normal, then the arcs), one direction at a time."""
@@ -89,6 +99,7 @@ def bench_gamma_t() -> None:
     )
     previous = None
     rows = []
+    unresolved: list[int] = []
     for c in PLANES:
         names, contacts = synthetic(c)
         terms = infinitesimal_terms(contacts)
@@ -105,7 +116,10 @@ def bench_gamma_t() -> None:
         _, _, t_each = timed(per_region, table, arr.directions[one_by_one], repeats=1)
         t_each *= len(arr) / len(one_by_one)
         slots = np.unpackbits(packed[sample], axis=1, count=len(table.starts)).astype(bool)
-        assert np.array_equal(slots, direct), "crossing rule differs from direct DBGs"
+        resolved = resolved_regions(arr, table.normals, sample)
+        same = np.all(slots == direct, axis=1)
+        assert same[resolved].all(), "crossing rule differs from direct DBGs"
+        unresolved.append(int((~resolved).sum()))
         total = t_arr + t_cross
         per = 1e9 * total / (c * c * N_PARTS**2)
         print(
@@ -118,6 +132,12 @@ def bench_gamma_t() -> None:
         previous = total
         rows.append((c, t_arr, t_cross, t_each))
     cs = np.log([r[0] for r in rows])
+    print(
+        "  the crossing rule equals the direct DBGs on every sampled region but those "
+        "narrower than the angle tolerance "
+        f"({', '.join(f'c = {c}: {k}' for c, k in zip(PLANES, unresolved, strict=True))}), "
+        "where the direct test takes a direction within the tolerance of a circle as on it"
+    )
     print("summary (target: crossing rule >= 10x faster than one region at a time)")
     for c, t_arr, t_cross, t_each in rows:
         print(
