@@ -16,6 +16,7 @@ The keyword arguments are exactly the keys of the task file (DESIGN §5.1), so
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from abc import ABC, abstractmethod
@@ -87,7 +88,9 @@ def _is_number(value: Any) -> bool:
 def _vector(value: Any, field: str, owner: str) -> Vector:
     """Three finite numbers of magnitude at most ``MAX_MAGNITUDE``: a flat list from a
     file, or any array of three numbers from code."""
-    if isinstance(value, np.ndarray):
+    if type(value) is list and len(value) == 3 and all(type(v) in (int, float) for v in value):
+        items, numeric = value, True  # the common case: three numbers read from a file
+    elif isinstance(value, np.ndarray):
         numeric = value.size == 3 and value.dtype.kind in "iuf"
         items = value.reshape(-1).tolist() if numeric else []
     else:
@@ -565,6 +568,14 @@ FEATURE_TYPES: Mapping[str, type[Feature]] = {
 _ANGLE_KEYS = frozenset({"half_angle", "phase"})
 
 
+@functools.cache
+def _keys(cls: type[Feature]) -> tuple[frozenset[str], frozenset[str]]:
+    """The keys a task file may give a feature of type ``cls``, and those it must."""
+    named = [f for f in fields(cls) if f.name != "name"]  # type: ignore[arg-type]
+    required = (f.name for f in named if f.default is MISSING and f.default_factory is MISSING)
+    return frozenset(f.name for f in named), frozenset(required)
+
+
 def feature_from_dict(name: str, data: Mapping[str, Any], where: str | None = None) -> Feature:
     """Build a feature from its task-file mapping (DESIGN §5.1), e.g.
     ``{type: plane, point: [0, 0, 0], normal: [0, 0, 1]}``.
@@ -581,7 +592,7 @@ def feature_from_dict(name: str, data: Mapping[str, Any], where: str | None = No
         known = ", ".join(FEATURE_TYPES)
         raise SchemaError(f"unknown feature type {kind!r} (expected one of {known})", where=where)
     cls = FEATURE_TYPES[kind]
-    allowed = {f.name for f in fields(cls)} - {"name"}  # type: ignore[arg-type]
+    allowed, required = _keys(cls)
     values = {key: value for key, value in data.items() if key != "type"}
     if unknown := sorted(set(values) - allowed):
         raise SchemaError(
@@ -589,11 +600,6 @@ def feature_from_dict(name: str, data: Mapping[str, Any], where: str | None = No
             f"(allowed: {', '.join(sorted(allowed))})",
             where=where,
         )
-    required = {
-        f.name
-        for f in fields(cls)  # type: ignore[arg-type]
-        if f.name in allowed and f.default is MISSING and f.default_factory is MISSING
-    }
     if missing := sorted(required - set(values)):
         raise SchemaError(f"a {kind} needs {', '.join(missing)}", where=where)
     for key in _ANGLE_KEYS & set(values):

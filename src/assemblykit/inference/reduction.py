@@ -33,12 +33,10 @@ world outward is reduced in near-linear time; cycles are searched only at a fixp
 
 from __future__ import annotations
 
-import gc
 import itertools
 import math
 from collections import deque
 from collections.abc import Hashable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -69,6 +67,7 @@ from assemblykit.algebra.invariants import (
     PointInvariant,
     frame_invariants,
 )
+from assemblykit.collector import collector_paused
 from assemblykit.inference.conflicts import without_conflicts
 from assemblykit.inference.loops import (
     Circle,
@@ -1588,23 +1587,6 @@ def _combine(
     return bodies, consistent[0][1]
 
 
-@contextmanager
-def _collector_paused() -> Iterator[None]:
-    """Pause the cyclic garbage collector for the duration (restoring its state after).
-
-    Building and reducing a network allocates many small objects that all stay alive
-    until the answer is built; every collection the allocations trigger would rescan all
-    of them, which makes a large network cost quadratic time. Nothing here is cyclic
-    garbage, so nothing is lost by collecting once afterwards."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
-
-
 MAX_BRANCHES = 64
 """Default number of branches (finite alternatives, assembly modes) followed to the end;
 an answer whose search was cut says how many alternatives it did not follow."""
@@ -1695,7 +1677,7 @@ def solve_task(
     def solve(part: Task, residue: bool = True) -> Solution:
         return solve_network(build_network(part), tol, explain, branches, residue)
 
-    with using(tol), _collector_paused():
+    with using(tol), collector_paused():
         solution = solve(task.validate())
         if solution.conflicts:
             solution = without_conflicts(task, solution, solve, tol)
