@@ -13,7 +13,8 @@ first):
   tolerance that makes its crown joints contacts (``CROWN_JOINTS``), where it stands;
 * one state of the cross vault that stands and one that does not, the programs each
   candidate step of a plan runs, solved whole (a plan decides many states from the
-  balance it last found instead);
+  balance it last found instead); four slack programs of the dome solved one after
+  another and together on threads;
 * plans with gravity: the ASAP beam (also without gravity) and the COMPAS arch with three
   holds, each followed by the time of the stability work alone: assembling the
   equations and checking every state of the plan once, the programs the plan solved,
@@ -46,6 +47,7 @@ import scipy
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.io.assembly import load_assembly
 from assemblykit.model.assembly import Assembly
+from assemblykit.planning.equilibrium_programs import PROGRAM_THREADS_VARIABLE, program_threads
 from assemblykit.planning.planner import plan
 from assemblykit.planning.sequence import Plan
 from assemblykit.planning.stability import (
@@ -238,6 +240,41 @@ def dome_steps(path: Path | None, steps: int) -> None:
     )
 
 
+def slack_together(path: Path | None, count: int = 4) -> None:
+    """Time the slack programs of ``count`` states of the dome that fall (its 40 highest
+    blocks taken away, then one more each time), solved one after another and together
+    on the threads the process may use (:meth:`EquilibriumModel.solve_slack`), and check
+    that both keep the same residuals."""
+    if path is None:
+        print(f"{'dome slack programs':<24} skipped (not found; set ASSEMBLYKIT_DATA)")
+        return
+    model = equilibrium_model(load_assembly(path))
+    present = model.mask(None)
+    fixed = present & model.mask(model.fixed)
+    highest = np.argsort(model.levels)
+    states = []
+    for k in range(count):
+        state = present.copy()
+        state[highest[: 40 + k]] = False
+        states.append((state, fixed))
+    found = []
+    for threads in ("1", str(program_threads())):
+        os.environ[PROGRAM_THREADS_VARIABLE] = threads
+        memory = EquilibriumMemory()
+        start = time.perf_counter()
+        model.solve_slack(states, memory=memory)
+        found.append((time.perf_counter() - start, list(memory.residuals.items())))
+    os.environ.pop(PROGRAM_THREADS_VARIABLE)
+    (alone, first), (together, second) = found
+    assert [k for k, _ in first] == [k for k, _ in second]
+    assert all(np.array_equal(a, b) for (_, a), (_, b) in zip(first, second, strict=True))
+    print(
+        f"{'dome slack programs':<24} {len(first)} programs: {alone:.2f} s one after another, "
+        f"{together:.2f} s on {program_threads()} threads ({alone / together:.2f}x), "
+        "the same residuals"
+    )
+
+
 def state_programs(path: Path | None, tol: Tolerance) -> None:
     """Time one state of the cross vault that stands (the whole vault) and one that does
     not (its three highest blocks taken away), each solved whole, then the second decided
@@ -282,6 +319,7 @@ def main() -> None:
     whole("crossvault, tol 5e-5", vault, CROWN_JOINTS)
     print("one state of a plan (equilibrium program, and the slack program when it falls)")
     state_programs(vault, CROWN_JOINTS)
+    slack_together(dataset("compas_assembly/dome_assembly.json"))
     print("plans (one run; contacts and blocking included)")
     beam = dataset("asap_beam_assembly")
     planned("asap beam", beam, None)

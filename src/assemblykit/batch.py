@@ -74,12 +74,15 @@ ONE_THREAD: dict[str, str] = {
     "OMP_NUM_THREADS": "1",
     "MKL_NUM_THREADS": "1",
     "OPENBLAS_NUM_THREADS": "1",
+    "ASSEMBLYKIT_PROGRAM_THREADS": "1",
 }
 """The environment a worker's numerical libraries start with, unless the batch's own
 environment sets these variables: one thread each, as Dask starts the worker processes
-of its nannies (``distributed.nanny.pre-spawn-environ``). The workers are the batch's
-parallelism, one per core asked for; a linear algebra library's own threads, one per
-core in each worker, would compete with the other workers for the same cores."""
+of its nannies (``distributed.nanny.pre-spawn-environ``), and the equilibrium programs
+of a plan under gravity one at a time
+(:data:`~assemblykit.planning.equilibrium_programs.PROGRAM_THREADS_VARIABLE`). The
+workers are the batch's parallelism, one per core asked for; a library's own threads,
+one per core in each worker, would compete with the other workers for the same cores."""
 
 
 @dataclass(frozen=True)

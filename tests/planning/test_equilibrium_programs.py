@@ -2,28 +2,34 @@
 (:mod:`assemblykit.planning.equilibrium_programs`): the least-residual balance names
 every equation some optimum leaves unbalanced, the slack program falls back to HiGHS
 when Clarabel stops short, an answer Clarabel calls *almost* found is taken only once
-checked, and the pyramid's gauge is that of its sides."""
+checked, the pyramid's gauge is that of its sides, and programs solved together on
+threads answer as one after another."""
 
 from __future__ import annotations
 
 import math
+import os
 
 import clarabel
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from assemblykit.errors import InputError
 from assemblykit.planning import equilibrium_programs
 from assemblykit.planning.equilibrium_programs import (
     CONE_SIDES,
     LP_FEASIBILITY,
+    PROGRAM_THREADS_VARIABLE,
     RETRY_REGULARIZATION,
     _balances,
     _proves_none,
     balance,
     cone_directions,
     least_residuals,
+    program_threads,
     pyramid_gauge,
+    solve_all,
 )
 
 
@@ -106,3 +112,49 @@ def test_a_force_along_a_generator_is_on_the_pyramid_and_one_between_two_is_beyo
     cos, sin = cone_directions(math.pi / CONE_SIDES)
     between = np.stack([cos, sin], axis=1)
     np.testing.assert_allclose(pyramid_gauge(between), 1 / math.cos(math.pi / CONE_SIDES))
+
+
+def test_programs_solved_together_answer_in_order_as_one_after_another(monkeypatch):
+    # slack programs of random stacked systems: each answer is that of the program
+    # solved alone, in the order given, on two threads as on one
+    rng = np.random.default_rng(7)
+    programs = []
+    for rows in (6, 12, 18, 24, 30):
+        matrix = sp.csc_matrix(
+            rng.normal(size=(rows, 3 * rows)) * (rng.random((rows, 3 * rows)) < 0.3)
+        )
+        rhs = rng.normal(size=rows)
+        programs.append((matrix, rhs))
+    alone = [least_residuals(m, r) for m, r in programs]
+    monkeypatch.setattr(equilibrium_programs, "program_threads", lambda: 2)
+    together = solve_all([lambda m=m, r=r: least_residuals(m, r) for m, r in programs])
+    assert len(together) == len(alone)
+    for one, other in zip(alone, together, strict=True):
+        assert np.array_equal(one, other)
+
+
+def test_a_program_that_fails_among_others_fails_them_all(monkeypatch):
+    monkeypatch.setattr(equilibrium_programs, "program_threads", lambda: 2)
+
+    def fails() -> float:
+        raise ValueError("no answer")
+
+    with pytest.raises(ValueError, match="no answer"):
+        solve_all([lambda: 1.0, fails, lambda: 2.0])
+    assert solve_all([lambda: 1.0, lambda: 2.0, lambda: 3.0]) == [1.0, 2.0, 3.0]
+    monkeypatch.setattr(equilibrium_programs, "program_threads", lambda: 1)
+    assert solve_all([lambda: 1.0, lambda: 2.0]) == [1.0, 2.0]
+
+
+def test_the_threads_are_the_cores_capped_by_the_variable(monkeypatch):
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    monkeypatch.delenv(PROGRAM_THREADS_VARIABLE, raising=False)
+    assert program_threads() == cores
+    monkeypatch.setenv(PROGRAM_THREADS_VARIABLE, "1")
+    assert program_threads() == 1
+    monkeypatch.setenv(PROGRAM_THREADS_VARIABLE, " 64 ")
+    assert program_threads() == cores
+    for bad in ("0", "two", "-1", "1.5"):
+        monkeypatch.setenv(PROGRAM_THREADS_VARIABLE, bad)
+        with pytest.raises(InputError, match=PROGRAM_THREADS_VARIABLE):
+            program_threads()

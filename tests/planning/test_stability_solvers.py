@@ -209,6 +209,54 @@ def test_the_slack_program_solved_piece_by_piece_is_the_whole_program():
     assert again["left"] < model.threshold
 
 
+def test_slack_programs_solved_together_are_those_slack_solves_one_by_one(monkeypatch):
+    # the states of taking each block of the two stacks away (each falls: the loose
+    # cube does): solved together on two threads (however small), then read by slack,
+    # as slack alone solves them, with the memory holding the same residuals in the
+    # same order
+    model = equilibrium_model(two_stacks(), friction=0.5, fixed=["ground"])
+    present, fixed = model.mask(None), model.mask(["ground"])
+    states = [(present & ~model.mask([name]), fixed) for name in ("left_top", "right", "left")]
+    alone = EquilibriumMemory()
+    expected = [model.slack(p, f, memory=alone) for p, f in states]
+    monkeypatch.setattr(equilibrium_programs, "program_threads", lambda: 2)
+    monkeypatch.setattr(equilibrium, "THREADED_PARTS", 1)
+    together = EquilibriumMemory()
+    model.solve_slack(states, memory=together)
+    assert [key for key, _ in together.residuals.items()] == [
+        key for key, _ in alone.residuals.items()
+    ]
+    kept = len(together.residuals)
+    for (p, f), residuals in zip(states, expected, strict=True):
+        assert np.array_equal(model.slack(p, f, memory=together), residuals)
+    assert len(together.residuals) == kept
+    # what is kept already is not solved again
+    model.solve_slack(states, memory=together)
+    assert len(together.residuals) == kept
+
+
+def test_a_plan_under_gravity_is_the_same_with_its_slack_programs_solved_together(monkeypatch):
+    # the arch with one hold: from its first steps no removal stands, and each step
+    # takes the one that leaves the fewest blocks falling, whose slack programs are
+    # solved together (on threads, however few its blocks)
+    arch = load_assembly(dataset("compas_assembly/arch_assembly.json"))
+    solved: list[int] = []
+    solve_slack = EquilibriumModel.solve_slack
+
+    def counted(self, states, friction=None, *, memory):
+        states = list(states)
+        solved.append(len(states))
+        return solve_slack(self, states, friction, memory=memory)
+
+    monkeypatch.setattr(EquilibriumModel, "solve_slack", counted)
+    monkeypatch.setattr(equilibrium_programs, "program_threads", lambda: 1)
+    one = plan(arch, gravity=Gravity()).to_dict()
+    assert max(solved) >= 2
+    monkeypatch.setattr(equilibrium_programs, "program_threads", lambda: 2)
+    monkeypatch.setattr(equilibrium, "THREADED_PARTS", 1)
+    assert plan(arch, gravity=Gravity()).to_dict() == one
+
+
 def bisected(model: EquilibriumModel, present: np.ndarray, fixed: np.ndarray) -> float | None:
     """The least friction coefficient by plain bisection, each state solved whole."""
     if not model.stands(present, fixed, local=False):

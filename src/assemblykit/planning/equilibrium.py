@@ -44,7 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 from assemblykit.errors import InputError, NumericError
 from assemblykit.graphs import component_labels
 from assemblykit.model.assembly import lowest_parts
-from assemblykit.planning.equilibrium_memory import EquilibriumMemory, KeptBalance
+from assemblykit.planning.equilibrium_memory import EquilibriumMemory, KeptBalance, ResidualKey
 from assemblykit.planning.equilibrium_programs import (
     CONE_SIDES,
     LP_FEASIBILITY,
@@ -54,6 +54,7 @@ from assemblykit.planning.equilibrium_programs import (
     least_residuals,
     point_sums,
     pyramid_gauge,
+    solve_all,
 )
 from assemblykit.planning.force_points import contact_points
 from assemblykit.planning.gravity import DOWN, FRICTION, Equilibrium, gravity_direction
@@ -70,6 +71,15 @@ LOCAL_HOPS = 1
 parts by, one at a time, before it leaves the verdict to the whole program: a region
 that one contact more does not prove falling rarely falls with more (docs/planning.md,
 "Under gravity": the states a plan asks about)."""
+
+
+THREADED_PARTS = 100
+"""The free parts from which a piece's slack program is solved on a thread of its own
+(:meth:`EquilibriumModel.solve_slack`): on the 527-block dome four such programs take
+5.4 s on two threads against 9.1 s one after another, while the programs of a few dozen
+parts, whose setup under Python's interpreter lock takes most of their time, gain
+nothing and cost CPU time (the cross vault's whole plan: the same wall clock time,
+16% more CPU)."""
 
 
 def _own(memory: EquilibriumMemory | None) -> EquilibriumMemory:
@@ -412,18 +422,65 @@ class EquilibriumModel:
     ) -> NDArray[np.float64]:
         """The slack program of :meth:`residuals` alone, for a state known not to stand:
         per part, the largest scaled residual of its equations at its optimum. It is
-        solved piece by piece (:meth:`pieces`), and ``memory`` keeps a piece's residuals:
-        a removal elsewhere leaves them as they were."""
+        solved piece by piece (:meth:`pieces`, together: :meth:`solve_slack`), and
+        ``memory`` keeps a piece's residuals: a removal elsewhere leaves them as they
+        were."""
         memory = _own(memory)
         mu = self.friction if friction is None else friction
+        keyed = self._keyed_pieces(present, fixed, mu)
+        self._solve_pieces([(present, keyed)], mu, memory)
         out = np.zeros(len(self.names))
-        immobile = (present & fixed).tobytes()
-        for piece in self.pieces(present, fixed):
-            key = (piece.tobytes(), immobile, mu)
+        for key, piece in keyed:
             out[piece] = memory.residuals.recall(
                 key, partial(self._piece_residuals, present, piece, mu)
             )
         return out
+
+    def solve_slack(
+        self,
+        states: Iterable[tuple[NDArray[np.bool_], NDArray[np.bool_]]],
+        friction: float | None = None,
+        *,
+        memory: EquilibriumMemory,
+    ) -> None:
+        """Solve together the slack programs of the pieces of ``states`` (each
+        ``(present, fixed)``, known not to stand) whose residuals ``memory`` lacks, and
+        keep them there as :meth:`slack` would, state after state: :meth:`slack` then
+        answers each of them from ``memory``. The candidates of a plan's step where no
+        removal stands each ask one (docs/planning.md, "Under gravity")."""
+        mu = self.friction if friction is None else friction
+        keyed = [(present, self._keyed_pieces(present, fixed, mu)) for present, fixed in states]
+        self._solve_pieces(keyed, mu, memory)
+
+    def _keyed_pieces(
+        self, present: NDArray[np.bool_], fixed: NDArray[np.bool_], mu: float
+    ) -> list[tuple[ResidualKey, NDArray[np.bool_]]]:
+        """The pieces of a state (:meth:`pieces`), each with the key of its residuals."""
+        immobile = (present & fixed).tobytes()
+        return [((piece.tobytes(), immobile, mu), piece) for piece in self.pieces(present, fixed)]
+
+    def _solve_pieces(
+        self,
+        keyed: Sequence[tuple[NDArray[np.bool_], list[tuple[ResidualKey, NDArray[np.bool_]]]]],
+        mu: float,
+        memory: EquilibriumMemory,
+    ) -> None:
+        """Solve the slack programs of the pieces (``keyed``, per state its parts and its
+        :meth:`_keyed_pieces`) that ``memory`` lacks, each once, those of
+        :data:`THREADED_PARTS` or more on threads (:func:`solve_all`: a piece's program
+        is a function of the piece alone, whichever thread solves it), and keep their
+        residuals in the order met."""
+        missing: dict[ResidualKey, partial[NDArray[np.float64]]] = {}
+        large: list[ResidualKey] = []
+        for present, pieces in keyed:
+            for key, piece in pieces:
+                if key not in memory.residuals and key not in missing:
+                    missing[key] = partial(self._piece_residuals, present, piece, mu)
+                    if int(piece.sum()) >= THREADED_PARTS:
+                        large.append(key)
+        solved = dict(zip(large, solve_all([missing[key] for key in large]), strict=True))
+        for key, program in missing.items():
+            memory.residuals.keep(key, solved[key] if key in solved else program())
 
     def _piece_residuals(
         self, present: NDArray[np.bool_], piece: NDArray[np.bool_], mu: float

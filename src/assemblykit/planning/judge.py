@@ -40,6 +40,8 @@ class _Assessment:
     held: NDArray[np.bool_]
     stands: bool
     states: tuple[tuple[NDArray[np.bool_], NDArray[np.bool_]], ...]
+    asked: tuple[tuple[NDArray[np.bool_], NDArray[np.bool_]], ...]
+    """The states without the holds whose residuals :attr:`residuals` takes."""
     residual: Callable[[], NDArray[np.float64]]
     """Per part, its residual without the holds (a slack program per state that falls)."""
     threshold: float
@@ -163,15 +165,17 @@ class StateJudge:
         if several:
             held_moved, moved_ok = self._hold(taken, grip, budget - int(held_rest.sum()))
         held = grip | base_held | held_rest | held_moved
+        asked = ((rest, rest & ground), (taken, grip)) if several else ((rest, rest & ground),)
 
         def residual() -> NDArray[np.float64]:
-            left = self.residual(rest, rest & ground)
-            return np.maximum(left, self.residual(taken, grip)) if several else left
+            found: NDArray[np.float64] = np.maximum.reduce([self.residual(*s) for s in asked])
+            return found
 
         return _Assessment(
             held=held,
             stands=rest_ok and moved_ok and int(held.sum()) <= self.holds,
             states=((rest, (rest & ground) | held_rest), (taken, grip | held_moved)),
+            asked=asked,
             residual=residual,
             threshold=self.model.threshold,
         )
@@ -198,8 +202,17 @@ class StateJudge:
 
     def fewest_falling(self, members: int, k: int, sets: list[int]) -> list[int]:
         """The set whose removal leaves the fewest parts falling (a step that does not
-        stand, reported as such)."""
-        return [min(self.ordered(sets), key=lambda m: int(self.assess(members, m).falls.sum()))]
+        stand, reported as such). The slack programs of the states known not to stand
+        are solved together first (:meth:`EquilibriumModel.solve_slack`)."""
+        ordered = self.ordered(sets)
+        falling = [
+            state
+            for mask in ordered
+            for state in self.assess(members, mask).asked
+            if not self._stands.get(_state(*state), True)
+        ]
+        self.model.solve_slack(falling, memory=self.memory)
+        return [min(ordered, key=lambda m: int(self.assess(members, m).falls.sum()))]
 
     def judge(self, members: int, moved: int) -> StepStability:
         """The step's stability, with the least friction its states need and, when
