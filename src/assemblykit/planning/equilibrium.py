@@ -76,10 +76,10 @@ that one contact more does not prove falling rarely falls with more (docs/planni
 THREADED_PARTS = 100
 """The free parts from which a piece's slack program is solved on a thread of its own
 (:meth:`EquilibriumModel.solve_slack`): on the 527-block dome four such programs take
-5.4 s on two threads against 9.1 s one after another, while the programs of a few dozen
-parts, whose setup under Python's interpreter lock takes most of their time, gain
-nothing and cost CPU time (the cross vault's whole plan: the same wall clock time,
-16% more CPU)."""
+5.1 to 5.5 s on two threads against 8.9 to 9.3 s one after another, while the programs
+of a few dozen parts, whose setup under Python's interpreter lock takes most of their
+time, gain nothing and cost CPU time (the cross vault's whole plan with every piece on
+threads: the same wall clock time, 16% more CPU)."""
 
 
 def _own(memory: EquilibriumMemory | None) -> EquilibriumMemory:
