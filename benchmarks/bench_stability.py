@@ -258,13 +258,17 @@ def slack_together(path: Path | None, count: int = 4) -> None:
         state[highest[: 40 + k]] = False
         states.append((state, fixed))
     found = []
+    before = os.environ.get(PROGRAM_THREADS_VARIABLE)
     for threads in ("1", str(program_threads())):
         os.environ[PROGRAM_THREADS_VARIABLE] = threads
         memory = EquilibriumMemory()
         start = time.perf_counter()
         model.solve_slack(states, memory=memory)
         found.append((time.perf_counter() - start, list(memory.residuals.items())))
-    os.environ.pop(PROGRAM_THREADS_VARIABLE)
+    if before is None:
+        os.environ.pop(PROGRAM_THREADS_VARIABLE)
+    else:
+        os.environ[PROGRAM_THREADS_VARIABLE] = before
     (alone, first), (together, second) = found
     assert [k for k, _ in first] == [k for k, _ in second]
     assert all(np.array_equal(a, b) for (_, a), (_, b) in zip(first, second, strict=True))
