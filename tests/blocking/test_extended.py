@@ -22,6 +22,7 @@ from assemblykit.blocking.extended import (
 )
 from assemblykit.blocking.free_cones import ChartSet, _distinct_cones, exact_free_directions
 from assemblykit.blocking.graphs import blocking_graph
+from assemblykit.blocking.obstacles import THIN_LAYER
 from assemblykit.blocking.queries import can_extract, removable_parts
 from assemblykit.geometry.contacts import assembly_contacts
 from assemblykit.geometry.interference import solid
@@ -103,6 +104,19 @@ def test_a_layer_thinner_than_the_interference_policy_is_a_contact():
     assert not any(extended_free(deep, ["post"], d, tol) for d in ([0, 0, 1], [1, 0, 0], [0, 1, 1]))
 
 
+def test_a_layer_far_thinner_than_the_length_tolerance_is_not_backed_out():
+    probe = post_on_plate(0.0)
+    tol = probe.tolerance()
+    # beyond rounding (the cube of the length tolerance), but settling would move the
+    # post by a shift the tests drop anyway: it is a contact as it stands
+    layer = THIN_LAYER * tol.length / 2
+    asm = post_on_plate(layer)
+    assert not BlockingCache.of(asm).obstacles.backout("post", "plate", tol).any()
+    for direction in ([0, 0, 1], [1, 0, 0], [0, 1, 1]):
+        assert extended_free(asm, ["post"], direction, tol)
+    assert not extended_free(asm, ["post"], [0, 0, -1], tol)
+
+
 def test_a_pin_sharing_a_rounding_volume_with_its_blind_hole_is_not_backed_out(monkeypatch):
     # a pin standing 4 deep in a blind hole of its radius: should its solids share a
     # volume of rounding (1e-15), backing it out of the hole along its whole depth would
@@ -114,7 +128,9 @@ def test_a_pin_sharing_a_rounding_volume_with_its_blind_hole_is_not_backed_out(m
     pin.apply_translation([0, 0, 5])
     asm = mesh_assembly({"block": block, "pin": pin})
     tol = asm.tolerance()
-    monkeypatch.setattr("assemblykit.blocking.obstacles.shared_volume", lambda *_: 1e-15)
+    monkeypatch.setattr(
+        "assemblykit.blocking.obstacles.layer_thickness", lambda *_: (1e-15, np.inf)
+    )
     assert not BlockingCache.of(asm).obstacles.backout("pin", "block", tol).any()
     assert extended_arcs(asm, [1, 0, 0], ["pin"], ["block"], tol) == {("pin", "block")}
     assert extended_free(asm, ["pin"], [0, 0, 1], tol)

@@ -12,6 +12,7 @@ from assemblykit.geometry.interference import (
     interferences,
     interferes,
     overlap_volume,
+    part_solid,
     solid,
 )
 from assemblykit.geometry.overlaps import mesh_of
@@ -24,6 +25,20 @@ def box(lo, hi) -> trimesh.Trimesh:
     return trimesh.creation.box(
         extents=hi - lo, transform=trimesh.transformations.translation_matrix((lo + hi) / 2)
     )
+
+
+def test_a_part_solid_is_made_once_and_follows_a_replaced_part():
+    asm = Assembly([Part("a", box([0, 0, 0], [2, 2, 2])), Part("b", box([2, 0, 0], [3, 1, 1]))])
+    assert part_solid(asm, "a") is part_solid(asm, "a")
+    assert part_solid(asm, "a").volume() == pytest.approx(8.0)
+    # the sub-assembly keeps the same part, so the same solid
+    assert part_solid(asm.subset(["a"]), "a") is part_solid(asm, "a")
+    # a part replaced by another mesh under its name gets that mesh's solid
+    moved = asm.with_part(Part("a", box([1, 0, 0], [3, 2, 2])))
+    assert part_solid(moved, "a").bounding_box() == pytest.approx((1, 0, 0, 3, 2, 2))
+    # (the replaced part comes last)
+    assert interferences(moved, Tolerance()) == [("b", "a", pytest.approx(1.0))]
+    assert interferences(asm, Tolerance()) == []
 
 
 def test_overlap_volume_of_boxes_is_exact():

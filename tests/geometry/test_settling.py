@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from assemblykit.geometry.interference import overlap_volume, solid
-from assemblykit.geometry.settling import overlap_gradient, settle
+from assemblykit.geometry.settling import layer_thickness, overlap_gradient, settle
 
 
 def cube(offset=(0.0, 0.0, 0.0), extents=(1.0, 1.0, 1.0)) -> trimesh.Trimesh:
@@ -32,6 +32,26 @@ def test_gradient_is_the_area_vector_of_the_moving_boundary_inside_the_other():
     # touching only: nothing shared, nothing to move
     c = solid(cube((1.0, 0.0, 0.0))).as_original()
     assert overlap_gradient(a, c, a.original_id()) == (0.0, pytest.approx(np.zeros(3)))
+
+
+@settings(max_examples=25, deadline=None)
+@given(depth=st.floats(1e-6, 0.2), axis=st.integers(0, 2))
+def test_a_flat_layer_is_as_thick_as_it_is_deep(depth, axis):
+    # two unit cubes overlapping by depth along one axis share a slab of volume depth,
+    # whose area vector is the moving cube's face inside the other: length 1
+    offset = np.zeros(3)
+    offset[axis] = 1.0 - depth
+    volume, thickness = layer_thickness(solid(cube()), solid(cube(offset)))
+    assert volume == pytest.approx(depth, rel=1e-6)
+    assert thickness == pytest.approx(depth, rel=1e-6)
+
+
+def test_a_part_enclosed_all_round_has_a_layer_of_no_finite_thickness():
+    # a small cube inside a large one: moving it any way shares as much, no gradient
+    volume, thickness = layer_thickness(solid(cube(extents=(0.2, 0.2, 0.2))), solid(cube()))
+    assert volume == pytest.approx(0.008)
+    assert thickness == np.inf
+    assert layer_thickness(solid(cube()), solid(cube((2.0, 0.0, 0.0)))) == (0.0, 0.0)
 
 
 def test_a_layer_is_closed_by_moving_each_part_half_its_thickness():

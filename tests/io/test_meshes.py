@@ -12,7 +12,13 @@ import trimesh
 
 from assemblykit.errors import GeometryError, SchemaError
 from assemblykit.geometry.contacts import assembly_contacts
-from assemblykit.geometry.interference import interferences, overlap_volume
+from assemblykit.geometry.interference import (
+    interferences,
+    overlap_volume,
+    part_solid,
+    shared_volume,
+    solid,
+)
 from assemblykit.io.assembly import load_assembly
 from assemblykit.io.meshes import load_manifest, pose_from_spec, pose_from_state, read_mesh
 from assemblykit.tolerance import DEFAULT
@@ -224,6 +230,19 @@ def test_asap_beam_touches_without_interfering_with_final_state_poses():
             part.settled, abs=1e-12
         )
     assert asm.to_dict()["parts"]["2"]["settled"] == list(asm["2"].settled)
+
+
+def test_the_solids_kept_by_the_loader_are_the_settled_parts():
+    # the loader settles with manifold3d solids and keeps them, moved as the parts were:
+    # each is the solid of its part's mesh as the assembly holds it, in a sub-assembly too
+    asm = shared_assembly("asap_beam_assembly")
+    for sub in (asm, asm.subset(["0", "2"])):
+        for name in sub.names:
+            kept = part_solid(sub, name)
+            made = solid(sub[name].mesh)
+            assert kept.volume() == pytest.approx(made.volume(), rel=1e-12)
+            np.testing.assert_allclose(kept.bounding_box(), made.bounding_box(), atol=1e-12)
+            assert shared_volume(kept, made) == pytest.approx(made.volume(), rel=1e-9)
 
 
 def test_asap_beam_as_written_shares_thin_layers():

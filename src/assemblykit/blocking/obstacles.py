@@ -21,10 +21,10 @@ from numpy.typing import NDArray
 
 from assemblykit.blocking.lattice import lattice_cells
 from assemblykit.geometry.booleans import manifold3d
-from assemblykit.geometry.interference import interference_threshold, shared_volume, solid
+from assemblykit.geometry.interference import interference_threshold, part_solid
 from assemblykit.geometry.minkowski import blocking_cone, convex_bodies
 from assemblykit.geometry.occlusion import hull_vertices, triangle_spheres
-from assemblykit.geometry.settling import settle
+from assemblykit.geometry.settling import layer_thickness, settle
 from assemblykit.model.assembly import Assembly, AssemblyLike
 from assemblykit.tolerance import ModelTolerance, Tolerance
 
@@ -45,6 +45,12 @@ over the sphere (proving a set stuck) is shown most blocks by a few such cones i
 of projecting the meshes along each direction."""
 
 
+THIN_LAYER = 0.125
+"""The share of the length tolerance below which a layer two parts share is not backed
+out of (:meth:`Obstacles.backout`): settling it would move a part by about its
+thickness, well within the length tolerance, and a shift that short is dropped."""
+
+
 class Obstacles:
     """Convex bodies, hulls, solids, bounding spheres and pairwise cones, back-outs and
     blocking witnesses of one assembly's parts, each computed when first asked for and
@@ -57,7 +63,6 @@ class Obstacles:
         self.pieces: dict[str, list[NDArray[np.float64]] | None] = {}
         self.cones: dict[tuple[str, str, Tolerance], list[NDArray[np.float64]]] = {}
         self.backouts: dict[tuple[str, str, Tolerance], NDArray[np.float64]] = {}
-        self.solids: dict[str, manifold3d.Manifold] = {}
         self.hulls: dict[str, NDArray[np.float64]] = {}
         self.balls: dict[str, NDArray[np.float64]] = {}
         self.lattice: dict[str, NDArray[np.int64] | None] = {}
@@ -118,16 +123,19 @@ class Obstacles:
         return self.balls[name]
 
     def solid(self, name: str) -> manifold3d.Manifold:
-        """The manifold3d solid of a part's mesh, made once."""
-        if name not in self.solids:
-            self.solids[name] = solid(self.assembly.parts[name].mesh)
-        return self.solids[name]
+        """The manifold3d solid of a part's mesh, made once for the assembly
+        (:func:`~assemblykit.geometry.interference.part_solid`)."""
+        return part_solid(self.assembly, name)
 
     def backout(self, moving: str, blocker: str, tol: ModelTolerance) -> NDArray[np.float64]:
         """The translation that backs ``moving`` out of ``blocker`` before blocking is
         decided: their separation when they share a volume counted as touching (module
         docstring), beyond rounding (the cube of the length tolerance), and it is longer
-        than the length tolerance the tests allow anyway, else zero."""
+        than the length tolerance the tests allow anyway, else zero. A layer thinner than
+        :data:`THIN_LAYER` of the length tolerance (:func:`layer_thickness`: the first
+        step of settling) is not settled: settling moves a part by about that thickness,
+        and such a shift is dropped (the layers a settled assembly keeps, 1e-6 thick on
+        the ASAP beam whose length tolerance is 9e-5)."""
         key = (moving, blocker, tol)
         if key not in self.backouts:
             flipped = (blocker, moving, tol)
@@ -138,11 +146,18 @@ class Obstacles:
                 shift = np.zeros(3)
                 # parts whose boxes are apart share no volume: no solid is made for them
                 apart = np.any(a.bounds[0] > b.bounds[1]) or np.any(b.bounds[0] > a.bounds[1])
-                volume = 0.0 if apart else shared_volume(self.solid(moving), self.solid(blocker))
+                volume, thickness = (
+                    (0.0, 0.0)
+                    if apart
+                    else layer_thickness(self.solid(moving), self.solid(blocker))
+                )
                 # a volume below the cube of the length tolerance is rounding: no
                 # layer to back out of (a pin trimmed to its hole, which would be
                 # backed out along its whole length)
-                if tol.length**3 < volume <= interference_threshold(a, b, tol):
+                if (
+                    tol.length**3 < volume <= interference_threshold(a, b, tol)
+                    and thickness > THIN_LAYER * tol.length
+                ):
                     pair = [self.solid(moving), self.solid(blocker)]
                     shifts = settle([a, b], [(0, 1)], pair).shifts
                     if np.linalg.norm(shifts[0] - shifts[1]) > tol.length:

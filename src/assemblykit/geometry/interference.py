@@ -9,7 +9,8 @@ the smaller part's surface, i.e. when ``volume > tol.length x min(area_a, area_b
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Collection, Set
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -64,6 +65,34 @@ def solid(
             f"mesh is not a closed oriented manifold ({result.status()})", where=name
         )
     return result
+
+
+@dataclass
+class Solids:
+    """The manifold3d solids of an assembly's parts (:func:`solid`), a store of its memo
+    (:class:`~assemblykit.model.assembly.Memo`): each made once, when first asked for
+    (:func:`part_solid`), or kept by the loader that made it to settle the parts
+    (:func:`keep_solids`), for the interference tests and the obstacles of blocking."""
+
+    by_name: dict[str, manifold3d.Manifold] = field(default_factory=dict)
+
+    def restricted(self, names: Set[str]) -> Solids:
+        """The solids of the parts ``names`` (the same meshes)."""
+        return Solids({name: made for name, made in self.by_name.items() if name in names})
+
+
+def part_solid(assembly: Assembly, name: str) -> manifold3d.Manifold:
+    """The solid of part ``name`` of ``assembly``, made once (:class:`Solids`)."""
+    kept = assembly.memo.of(Solids).by_name
+    if name not in kept:
+        kept[name] = solid(assembly.parts[name].mesh, name)
+    return kept[name]
+
+
+def keep_solids(assembly: Assembly, solids: dict[str, manifold3d.Manifold]) -> None:
+    """Keep ``solids``, those of parts of ``assembly`` by name, already made (each of its
+    part's mesh as it is in the assembly), for :func:`part_solid`."""
+    assembly.memo.of(Solids).by_name.update(solids)
 
 
 def overlap_volume(mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh) -> float:
@@ -127,14 +156,10 @@ def interferences(
     if among is not None:
         asked = np.isin(np.array(names, dtype=object), list(among))
         pairs = pairs[asked[pairs].any(axis=1)]
-    solids = {}
     found = []
     for i, j in pairs:
         a, b = assembly.parts[names[i]], assembly.parts[names[j]]
-        for k, part in ((i, a), (j, b)):
-            if k not in solids:
-                solids[k] = solid(part.mesh, part.name)
-        volume = shared_volume(solids[i], solids[j])
+        volume = shared_volume(part_solid(assembly, a.name), part_solid(assembly, b.name))
         if volume > interference_threshold(a.mesh, b.mesh, tol):
             found.append((a.name, b.name, volume))
     return found

@@ -80,6 +80,20 @@ def overlap_gradient(
     return volume, gradient
 
 
+def layer_thickness(a: manifold3d.Manifold, b: manifold3d.Manifold) -> tuple[float, float]:
+    """``vol(A ∩ B)`` and the thickness of the layer it makes: the volume over the length
+    of its gradient (:func:`overlap_gradient`), the length of the first Gauss–Newton
+    step of :func:`settle` (module docstring: exactly ``h`` for a flat layer of thickness
+    ``h``). A shared volume whose gradient vanishes (a part enclosed all round, where
+    moving it any way shares as much) has an infinite thickness; no volume, none."""
+    first = a.as_original()
+    volume, gradient = overlap_gradient(first, b, first.original_id())
+    if volume <= 0:
+        return 0.0, 0.0
+    length = float(np.linalg.norm(gradient))
+    return volume, volume / length if length > 0 else np.inf
+
+
 def settle(
     meshes: Sequence[trimesh.Trimesh],
     pairs: Sequence[tuple[int, int]],

@@ -42,7 +42,9 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from assemblykit.errors import GeometryError, SchemaError
+from assemblykit.geometry.booleans import manifold3d
 from assemblykit.geometry.broad_phase import candidate_pairs
+from assemblykit.geometry.interference import keep_solids, solid
 from assemblykit.geometry.precision import combined, mesh_precision, pose_precision
 from assemblykit.geometry.settling import settle as settle_parts
 from assemblykit.geometry.solids import placed
@@ -267,33 +269,43 @@ def load_mesh_folder(
             measured.append(rounding)
         reach.append(0.0 if rounding is None else rounding.length)
         parts.append(Part(file.stem, placed(mesh, pose), pose, source=str(file)))
+    solids: dict[str, manifold3d.Manifold] = {}
     if settle and any(reach):
-        parts = _settled(parts, reach)
-    return _assembly(parts, None, False, str(folder), tol, combined(measured), notes)
+        parts, solids = _settled(parts, reach)
+    assembly = _assembly(parts, None, False, str(folder), tol, combined(measured), notes)
+    keep_solids(assembly, solids)
+    return assembly
 
 
-def _settled(parts: list[Part], reach: Sequence[float]) -> list[Part]:
+def _settled(
+    parts: list[Part], reach: Sequence[float]
+) -> tuple[list[Part], dict[str, manifold3d.Manifold]]:
     """``parts`` moved apart by the least translations that close the layers they share
     (:func:`assemblykit.geometry.settling.settle`) when each stays within its ``reach``
-    (what its pose's rounding allows); else ``parts`` as they are."""
+    (what its pose's rounding allows); else ``parts`` as they are. With them, by name,
+    the solids made to settle them, moved as they were (what blocking and interference
+    ask of them next)."""
     pairs = [
         (int(i), int(j)) for i, j in candidate_pairs(np.array([p.mesh.bounds for p in parts]), 0.0)
     ]
     if not pairs:
-        return parts
-    result = settle_parts([p.mesh for p in parts], pairs)
+        return parts, {}
+    made = [solid(p.mesh, p.name) for p in parts]
+    result = settle_parts([p.mesh for p in parts], pairs, made)
     lengths = np.linalg.norm(result.shifts, axis=1)
     if not lengths.any() or np.any(lengths > np.asarray(reach)):
-        return parts
+        return parts, {p.name: body for p, body in zip(parts, made, strict=True)}
     settled = []
-    for part, shift in zip(parts, result.shifts, strict=True):
+    solids = {}
+    for part, shift, body in zip(parts, result.shifts, made, strict=True):
         pose = part.pose.copy()
         pose[:3, 3] += shift
         mesh = part.mesh.copy()
         mesh.apply_translation(shift)
         x, y, z = shift.tolist()
         settled.append(Part(part.name, mesh, pose, part.surfaces, part.source, (x, y, z)))
-    return settled
+        solids[part.name] = body.translate((x, y, z))
+    return settled, solids
 
 
 def _final_states(config: Path) -> dict[str, list[float]]:
