@@ -48,6 +48,7 @@ class Precision:
 class Store(Protocol):
     """One kind of data derived from an assembly's parts, kept in its :class:`Memo`
     (:class:`assemblykit.geometry.contacts.GeometryMemo`: contacts and surfaces;
+    :class:`assemblykit.geometry.interference.Solids`: the parts' manifold3d solids;
     :class:`assemblykit.blocking.cache.BlockingCache`: blocking terms, graphs and
     obstacles; :class:`assemblykit.geometry.polygons.PolygonContacts`: contact segments
     of polygons). Its class is created with no arguments, empty."""
