@@ -159,3 +159,41 @@ def test_points_off_the_sides_are_kept_and_change_what_stands(monkeypatch):
     found = contact_points(assembly, [0, 0, -1])
     assert len(found.points) == 16 and found.corners.all()
     assert equilibrium_model(assembly).check().stands
+
+
+def test_the_whole_arch_balance_proves_a_voussoir_removal_falls_from_the_gap_alone():
+    # the memory holds only the whole arch's balance as its reference: a state taken
+    # from the arch is proved to fall from the equations of the blocks around the gap,
+    # and the reference never shows a state to stand (no balance is kept)
+    model = equilibrium_model(shared_assembly("compas_assembly/arch_assembly.json"))
+    present = model.mask(None)
+    fixed = present & model.mask(model.fixed)
+    reference = model.reference(present, fixed)
+    assert reference is not None
+    for taken in ("9", "14", "20"):
+        state = present & ~model.mask([taken])
+        memory = EquilibriumMemory()
+        memory.reference = reference
+        assert not model.stands(state, fixed, memory=memory)
+        assert len(memory.balances) == 0
+        (y,) = memory.certificates.values()
+        # a few blocks' equations around the gap, not the arch's
+        assert np.count_nonzero(y) <= 6 * 4 < 6 * int((state & ~fixed).sum())
+        # an independent check of Farkas' lemma on the whole state's first program:
+        # no generator gains from y while the loads do, so no balance exists
+        free = state & ~fixed
+        rows = model._rows(free)
+        matrix = model._matrix(rows, model._touching(state) & model.corners, model.friction)
+        rhs = -model.load[rows]
+        assert rhs @ y[rows] < 0
+        assert (matrix.T @ y[rows]).min() >= 1e-7 * (rhs @ y[rows])
+        assert not linprog(
+            np.zeros(matrix.shape[1]), A_eq=matrix, b_eq=rhs, bounds=(0, None), method="highs"
+        ).success
+    # a state that stands is not decided by the reference: its own program says so
+    memory = EquilibriumMemory()
+    memory.reference = reference
+    assert model.stands(present, fixed, memory=memory)
+    # the whole state of an arch missing its keystone falls: no reference for it
+    keystone = present & ~model.mask(["14"])
+    assert model.reference(keystone, fixed & keystone) is None

@@ -243,16 +243,44 @@ class EquilibriumModel:
             hint = mu if end is None else end * self.resolution
             if hint < mu and self.stands(present, fixed, hint, memory=memory):
                 return True
+        found, certificate = self._whole_program(free, selected, mu)
+        if found is None:
+            if certificate is not None:
+                memory.keep_certificate(certificate)
+            return False
+        memory.keep_balance(found)
+        return True
+
+    def _whole_program(
+        self, free: NDArray[np.bool_], selected: NDArray[np.bool_], mu: float
+    ) -> tuple[KeptBalance | None, NDArray[np.float64] | None]:
+        """The first program of the ``free`` parts' equations over the ``selected``
+        points at ``mu`` (:func:`balance`): the balance found, as point forces, or else
+        the certificate that there is none, over every equation (``None`` when the
+        solver that answered gave none)."""
         rows = self._rows(free)
         found = balance(self._matrix(rows, selected, mu), -self.load[rows])
         if found.forces is None:
-            if found.certificate is not None:
-                memory.keep_certificate(self._over_every_equation(rows, found.certificate))
-            return False
+            if found.certificate is None:
+                return None, None
+            return None, self._over_every_equation(rows, found.certificate)
         weights = np.zeros(self.normal_part.shape[1])
         weights[self._columns(selected)] = found.forces
-        memory.keep_balance(self._point_forces(weights, mu))
-        return True
+        return self._point_forces(weights, mu), None
+
+    def reference(self, present: NDArray[np.bool_], fixed: NDArray[np.bool_]) -> KeptBalance | None:
+        """A balance of ``present`` with ``fixed`` immobile at the model's friction (one
+        first program on the whole state), ``None`` when it falls or has no free part:
+        for :attr:`EquilibriumMemory.reference`, whose states taken from this one are
+        then proved to fall from the equations around what they took
+        (:meth:`_local_verdict`). On the 527-block dome, whose first step judges 35
+        candidates that fall before one that stands, each is so proved in about 0.01 s
+        where its whole program takes 1.5 to 2 s."""
+        free = present & ~fixed
+        selected = self._touching(present) & self.corners
+        if not free.any() or not selected.any():
+            return None
+        return self._whole_program(free, selected, self.friction)[0]
 
     def _unbalanced(
         self, forces: NDArray[np.float64], free: NDArray[np.bool_]
@@ -328,8 +356,9 @@ class EquilibriumModel:
           state, still balances every free part with forces that ``mu``'s pyramids
           hold (a balance at one friction coefficient is one at every larger one);
         * *falls* when a certificate kept still proves it (:meth:`_first_certifying`), or when
-          the parts the last balance leaves unbalanced, or pushes on with more friction
-          than ``mu`` allows, grown by contacts (:data:`LOCAL_HOPS`), cannot balance
+          the parts the last balance (before any is kept, the memory's
+          :attr:`~EquilibriumMemory.reference`) leaves unbalanced, or pushes on with more
+          friction than ``mu`` allows, grown by contacts (:data:`LOCAL_HOPS`), cannot balance
           even with every part around them immobile (pushing on them however it must):
           a Farkas certificate on their equations alone is one for the whole state,
           and is kept.
@@ -350,9 +379,9 @@ class EquilibriumModel:
         if proof is not None:
             memory.use_certificate(proof)
             return False
-        if not len(memory.balances):
+        latest = memory.latest_balance() if len(memory.balances) else memory.reference
+        if latest is None:
             return None
-        latest = memory.latest_balance()
         forces, gauge = latest.forces * selected[:, None], latest.gauge
         region = self._unbalanced(forces, free)
         ends = self.point_parts

@@ -70,6 +70,14 @@ class EquilibriumMemory:
         self.residuals: Kept[ResidualKey, NDArray[np.float64]] = Kept(KEPT_RESIDUALS)
         """The residuals of pieces of states, per :data:`ResidualKey` (none is kept
         again: the oldest is forgotten first)."""
+        self.reference: KeptBalance | None = None
+        """A balance of the state the first states asked about are taken from (a plan's
+        whole assembly), kept apart from :attr:`balances`: it only tells where a state
+        taken from that one is left unbalanced, the region whose equations alone may
+        prove that state falls
+        (:meth:`~assemblykit.planning.equilibrium.EquilibriumModel.stands`), until a
+        balance is kept; it never shows a state to stand, so it changes no verdict and
+        no friction a balance shows."""
         self.bracket_end: int | None = None
         """The upper end of the last bracket of
         :meth:`~assemblykit.planning.equilibrium.EquilibriumModel.friction_needed`, in

@@ -257,7 +257,8 @@ def _plan_under_gravity(
     runs, as a new search: the fixed parts outweigh every other so that one of them is
     the base that stays, :class:`~assemblykit.planning.judge.StateJudge` picks and
     judges the steps, with one memory of what the equilibrium programs found for the
-    whole search, and no step goes down (docs/planning.md, "Under gravity")."""
+    whole search (from the start, the whole assembly's balance as its reference), and no
+    step goes down (docs/planning.md, "Under gravity")."""
     search.progress("equilibrium equations", 0, 1)
     model = equilibrium_model(
         assembly,
@@ -271,6 +272,7 @@ def _plan_under_gravity(
     supports = mask_of(k for k, name in enumerate(model.names) if name in set(model.fixed))
     everything = mask_of(range(len(model.names)))
     memory = EquilibriumMemory()
+    memory.reference = model.reference(model.mask(None), model.mask(model.fixed))
     judge = StateJudge(
         model,
         memory,
