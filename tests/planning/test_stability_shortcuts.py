@@ -12,6 +12,7 @@ import pytest
 import scipy.sparse as sp
 from scipy.optimize import linprog
 
+from assemblykit.errors import NumericError
 from assemblykit.planning import force_points
 from assemblykit.planning.stability import (
     CONE_SIDES,
@@ -197,3 +198,14 @@ def test_the_whole_arch_balance_proves_a_voussoir_removal_falls_from_the_gap_alo
     # the whole state of an arch missing its keystone falls: no reference for it
     keystone = present & ~model.mask(["14"])
     assert model.reference(keystone, fixed & keystone) is None
+
+
+def test_a_reference_no_solver_decides_is_none(monkeypatch):
+    model = equilibrium_model(shared_assembly("compas_assembly/arch_assembly.json"))
+    present = model.mask(None)
+
+    def undecided(matrix, rhs):
+        raise NumericError("equilibrium program failed: no answer")
+
+    monkeypatch.setattr("assemblykit.planning.equilibrium.balance", undecided)
+    assert model.reference(present, present & model.mask(model.fixed)) is None

@@ -273,14 +273,18 @@ class EquilibriumModel:
         first program on the whole state), ``None`` when it falls or has no free part:
         for :attr:`EquilibriumMemory.reference`, whose states taken from this one are
         then proved to fall from the equations around what they took
-        (:meth:`_local_verdict`). On the 527-block dome, whose first step judges 35
-        candidates that fall before one that stands, each is so proved in about 0.01 s
-        where its whole program takes 1.5 to 2 s."""
+        (:meth:`_local_verdict`); ``None`` too when no solver decides it
+        (:class:`NumericError`: a shortcut that cannot answer does not stop the plan).
+        The first step of the 527-block dome's plan proves 31 of its candidates fall so,
+        in 0.4 s together, where a whole program takes 1.5 to 2 s each."""
         free = present & ~fixed
         selected = self._touching(present) & self.corners
         if not free.any() or not selected.any():
             return None
-        return self._whole_program(free, selected, self.friction)[0]
+        try:
+            return self._whole_program(free, selected, self.friction)[0]
+        except NumericError:
+            return None
 
     def _unbalanced(
         self, forces: NDArray[np.float64], free: NDArray[np.bool_]
