@@ -9,6 +9,8 @@ Printed next to the targets:
 * seconds per beam in the batch (wall clock over 20), against 0.3 s, and the ratio to
   ASAP's 64 s per beam;
 * the Dask engine's speed-up with two workers over one, against 1.7;
+* one beam's CPU seconds in this process, warm, by stage (loading, contacts, planning):
+  two workers reach 0.3 s a beam only below 0.6 s;
 * the start-up of ``assemblykit --version`` beyond the imports it needs (the median of 5
   fresh processes, less that of a process importing the same modules), against 0.1 s.
 
@@ -77,6 +79,28 @@ def startup() -> tuple[float, float]:
     return whole, imports
 
 
+def stages(beam: Path, runs: int = 8) -> tuple[float, float, float]:
+    """Median CPU seconds of one beam's loading, contacts and planning in this process,
+    warm (after one run), over ``runs`` runs: where a beam's time goes."""
+    from assemblykit.geometry.contacts import assembly_contacts
+    from assemblykit.io.assembly import load_assembly
+    from assemblykit.planning.planner import plan
+
+    found = []
+    for k in range(runs + 1):
+        start = time.process_time()
+        assembly = load_assembly(beam)
+        loaded = time.process_time()
+        assembly_contacts(assembly)
+        touched = time.process_time()
+        plan(assembly).to_dict()
+        planned = time.process_time()
+        if k:
+            found.append((loaded - start, touched - loaded, planned - touched))
+    load, contacts, planning = (statistics.median(column) for column in zip(*found, strict=True))
+    return load, contacts, planning
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--copies", type=int, default=20)
@@ -104,6 +128,12 @@ def main() -> None:
         speedup = runs["dask", 1] / runs["dask", 2]
         print(f"dask, 2 workers over 1: {speedup:.2f}x (target >= 1.7)")
         print(f"local, 2 workers over 1: {runs['local', 1] / runs['local', 2]:.2f}x")
+    load, contacts, planning = stages(beam)
+    print(
+        f"one beam, warm (median CPU s): {load + contacts + planning:.3f} s, loading {load:.3f}, "
+        f"contacts {contacts:.3f}, planning {planning:.3f} (two workers at 0.3 s a beam need "
+        "<= 0.6)"
+    )
     whole, imports = startup()
     print(
         f"assemblykit --version {whole:.3f} s, its imports {imports:.3f} s: "
