@@ -187,7 +187,7 @@ def enclosures(assembly: Assembly, parts: Collection[str] | None = None) -> list
                 part = assembly.parts[inner].mesh
                 if inner == outer or np.any(part.bounds[0] < low) or np.any(part.bounds[1] > high):
                     continue
-                shared = shared_volume(inside, solid(part, inner))
+                shared = shared_volume(inside, part_solid(assembly, inner))
                 if shared >= (1 - ENCLOSED_SHARE) * part.volume:
                     found.append((inner, outer))
     return found
