@@ -8,8 +8,21 @@ import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from assemblykit.geometry import settling
 from assemblykit.geometry.interference import overlap_volume, solid
-from assemblykit.geometry.settling import layer_thickness, overlap_gradient, settle
+from assemblykit.geometry.settling import (
+    cut_to_meeting,
+    layer_thickness,
+    overlap_gradient,
+    settle,
+)
+
+
+def cylinder(offset=(0.0, 0.0, 0.0), sections=400) -> trimesh.Trimesh:
+    """A finely tessellated cylinder of radius 0.5 and height 1 (1,600 triangles)."""
+    mesh = trimesh.creation.cylinder(radius=0.5, height=1.0, sections=sections)
+    mesh.apply_translation(offset)
+    return mesh
 
 
 def cube(offset=(0.0, 0.0, 0.0), extents=(1.0, 1.0, 1.0)) -> trimesh.Trimesh:
@@ -98,3 +111,42 @@ def test_settled_cubes_share_no_volume_and_move_about_the_layer(depth, side, axi
     assert relative[axis] == pytest.approx(depth, rel=1e-6)
     # the strip of the side face inside the other cube tilts the step a little
     assert np.linalg.norm(relative) <= depth * (1 + depth / (1 - abs(side))) * (1 + 1e-9)
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    shift=st.tuples(*[st.floats(-0.99, 0.99)] * 3),
+    depth=st.floats(1e-4, 0.05),
+)
+def test_cut_solids_share_what_the_whole_ones_share_within_the_margin(shift, depth):
+    # two cylinders end to end overlapping by depth, the second also shifted by less
+    # than the margin in each coordinate: the cut pair's shared volume and gradient are
+    # the whole pair's, measured by booleans of the whole solids
+    a = solid(cylinder()).as_original()
+    b = solid(cylinder((0.2, 0.1, 1.0 - depth))).as_original()
+    cut_a, cut_b, margin = cut_to_meeting(a, b)
+    assert cut_a.num_tri() < a.num_tri() and cut_b.num_tri() < b.num_tri()
+    d = tuple(margin * np.asarray(shift))
+    whole_volume, whole_gradient = overlap_gradient(a, b.translate(d), a.original_id())
+    cut_volume, cut_gradient = overlap_gradient(cut_a, cut_b.translate(d), a.original_id())
+    assert cut_volume == pytest.approx(whole_volume, rel=1e-9, abs=1e-15)
+    np.testing.assert_allclose(cut_gradient, whole_gradient, rtol=1e-9, atol=1e-12)
+
+
+def test_small_pairs_are_not_cut():
+    a, b = solid(cube()), solid(cube((0.5, 0.0, 0.0)))
+    assert cut_to_meeting(a, b)[2] == np.inf
+
+
+def test_settling_cut_pairs_moves_parts_as_settling_whole_ones(monkeypatch):
+    # a tilted layer between tessellated cylinders: the shifts found on the cut pairs
+    # are those found on the whole pairs (no cut below a huge triangle count)
+    meshes = [cylinder(), cylinder((0.3, 0.0, 0.995))]
+    meshes[1].apply_transform(trimesh.transformations.rotation_matrix(0.002, [1, 0, 0]))
+    cut = settle(meshes, [(0, 1)])
+    monkeypatch.setattr(settling, "CUT_TRIANGLES", 10**9)
+    whole = settle(meshes, [(0, 1)])
+    assert whole.before[0] > 1e-4
+    np.testing.assert_allclose(cut.shifts, whole.shifts, rtol=0, atol=1e-12)
+    moved = [m.copy().apply_translation(s) for m, s in zip(meshes, cut.shifts, strict=True)]
+    assert overlap_volume(*moved) <= 1e-3 * whole.before[0]

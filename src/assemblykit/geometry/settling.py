@@ -14,11 +14,18 @@ layer and still in contact. Several pairs are closed together by the least-norm
 translations that zero every pair's linearised volume (``numpy.linalg.lstsq``); the
 step, shortened while it does not reduce the total volume, is repeated while the
 total keeps shrinking.
+
+Each round measures every pair anew, so each pair's solids are first cut to the box
+where they can meet: the overlap of their bounding boxes grown by a margin ``m``. While
+the pair's relative shift ``d`` stays below ``m`` in each coordinate, ``(A + d) ∩ B``
+lies in that box, and the faces the cut makes lie outside ``B``: the cut solids share
+the same volume, with the same faces of ``A`` inside ``B``, at a fraction of the
+triangles. A pair shifted farther is measured on its whole solids.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,6 +44,15 @@ PROGRESS = 0.9
 STEP_FRACTIONS = (1.0, 0.5, 0.25, 0.125)
 """The fractions of a Gauss–Newton step tried in turn (backtracking): tapered and curved
 layers make the linearised volume overshoot."""
+
+CUT_MARGIN = 0.01
+"""The margin ``m`` by which a pair's box overlap is grown before its solids are cut to
+it (module docstring), as a fraction of the diagonal of the smaller box: far beyond the
+shifts that settling makes, which close layers of a rounding's thickness."""
+
+CUT_TRIANGLES = 2000
+"""Pairs with fewer triangles together are measured whole: their booleans cost about
+what the cut itself does."""
 
 
 @dataclass(frozen=True)
@@ -94,6 +110,29 @@ def layer_thickness(a: manifold3d.Manifold, b: manifold3d.Manifold) -> tuple[flo
     return volume, volume / length if length > 0 else np.inf
 
 
+def cut_to_meeting(
+    a: manifold3d.Manifold, b: manifold3d.Manifold
+) -> tuple[manifold3d.Manifold, manifold3d.Manifold, float]:
+    """``a`` and ``b`` cut to the overlap of their bounding boxes grown by the margin
+    ``m`` (:data:`CUT_MARGIN`), and ``m``: while ``b`` is shifted from ``a`` by less than
+    ``m`` in each coordinate, the cut pair shares what the whole pair shares, through
+    the same faces of ``a`` (module docstring). The triangles of each keep its original
+    id. A pair of fewer than :data:`CUT_TRIANGLES` triangles is left whole (the margin
+    is then infinite)."""
+    if a.num_tri() + b.num_tri() < CUT_TRIANGLES:
+        return a, b, np.inf
+    low_a, high_a = np.split(np.asarray(a.bounding_box(), dtype=np.float64), 2)
+    low_b, high_b = np.split(np.asarray(b.bounding_box(), dtype=np.float64), 2)
+    diagonal = min(np.linalg.norm(high_a - low_a), np.linalg.norm(high_b - low_b))
+    margin = CUT_MARGIN * float(diagonal)
+    low = np.maximum(low_a, low_b) - margin
+    high = np.minimum(high_a, high_b) + margin
+    if np.any(low >= high) or margin <= 0:
+        return a, b, np.inf
+    box = manifold3d.Manifold.cube(tuple(high - low)).translate(tuple(low))
+    return a ^ box, b ^ box, margin
+
+
 def settle(
     meshes: Sequence[trimesh.Trimesh],
     pairs: Sequence[tuple[int, int]],
@@ -102,27 +141,53 @@ def settle(
     """The least-norm translations of ``meshes`` after which the ``pairs`` (indices into
     ``meshes``) no longer share volume, as far as Gauss–Newton on the shared volumes
     gets (module docstring). Pairs that share none stay out of the system. ``solids``:
-    the meshes' manifold3d solids when already made."""
+    the meshes' manifold3d solids when already made.
+
+    The rounds measure the pairs cut to where they meet (:func:`cut_to_meeting`). A cut
+    solid's booleans resolve slivers more coarsely (their tolerance is the box's): when
+    the cut pairs share nothing any more, the whole pairs are measured as well, and any
+    sliver they still share is closed by rounds on them."""
     made = [solid(mesh) for mesh in meshes] if solids is None else solids
     solids = [each.as_original() for each in made]
     ids = [s.original_id() for s in solids]
+    cut = [cut_to_meeting(solids[i], solids[j]) for i, j in pairs]
 
-    def measure(x: NDArray[np.float64]) -> list[tuple[float, NDArray[np.float64]]]:
-        return [
-            overlap_gradient(
-                solids[i].translate(tuple(x[i])), solids[j].translate(tuple(x[j])), ids[i]
+    def measure(x: NDArray[np.float64], whole: bool) -> list[tuple[float, NDArray[np.float64]]]:
+        found = []
+        for (i, j), (a, b, margin) in zip(pairs, cut, strict=True):
+            if whole or np.abs(x[i] - x[j]).max() >= margin:
+                a, b = solids[i], solids[j]
+            found.append(
+                overlap_gradient(a.translate(tuple(x[i])), b.translate(tuple(x[j])), ids[i])
             )
-            for i, j in pairs
-        ]
+        return found
 
-    state = measure(np.zeros((len(meshes), 3)))
-    before = tuple(volume for volume, _ in state)
-    best = (sum(before), np.zeros((len(meshes), 3)), before)
+    start = np.zeros((len(meshes), 3))
+    state = measure(start, whole=False)
+    shifts, after = _descend(lambda x: measure(x, whole=False), pairs, start, state)
+    if not any(after):
+        shifts, after = _descend(
+            lambda x: measure(x, whole=True), pairs, shifts, measure(shifts, whole=True)
+        )
+    return Settlement(tuple(pairs), shifts, tuple(volume for volume, _ in state), after)
+
+
+def _descend(
+    measure: Callable[[NDArray[np.float64]], list[tuple[float, NDArray[np.float64]]]],
+    pairs: Sequence[tuple[int, int]],
+    start: NDArray[np.float64],
+    state: list[tuple[float, NDArray[np.float64]]],
+) -> tuple[NDArray[np.float64], tuple[float, ...]]:
+    """Gauss–Newton rounds (at most :data:`ROUNDS`) from the shifts ``start``, whose
+    pairs' shared volumes and gradients are ``state``, on the volumes ``measure`` gives:
+    the best shifts found and their pairs' volumes (module docstring)."""
+    volumes = tuple(volume for volume, _ in state)
+    best = (sum(volumes), start, volumes)
     for _ in range(ROUNDS):
         rows = [(p, v, g) for p, (v, g) in enumerate(state) if v > 0 and g @ g > 0]
         if not rows:
             break
-        system = np.zeros((len(rows), 3 * len(meshes)))
+        system = np.zeros((len(rows), start.size))
         for row, (p, _, g) in enumerate(rows):
             i, j = pairs[p]
             system[row, 3 * i : 3 * i + 3] = g
@@ -141,4 +206,4 @@ def settle(
         best = (total, trial, tuple(volume for volume, _ in state))
         if not improved:
             break
-    return Settlement(tuple(pairs), best[1], before, best[2])
+    return best[1], best[2]
