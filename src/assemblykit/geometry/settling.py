@@ -15,8 +15,9 @@ translations that zero every pair's linearised volume (``numpy.linalg.lstsq``); 
 step, shortened while it does not reduce the total volume, is repeated while the
 total keeps shrinking.
 
-Each round measures every pair anew, so each pair's solids are first cut to the box
-where they can meet: the overlap of their bounding boxes grown by a margin ``m``. While
+Each round measures every pair anew, so the solids of a pair of many triangles
+(:data:`CUT_TRIANGLES`) are first cut to the box where they can meet: the overlap of
+their bounding boxes grown by a margin ``m``. While
 the pair's relative shift ``d`` stays below ``m`` in each coordinate, ``(A + d) ∩ B``
 lies in that box, and the faces the cut makes lie outside ``B``: the cut solids share
 the same volume, with the same faces of ``A`` inside ``B``, at a fraction of the
