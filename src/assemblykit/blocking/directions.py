@@ -24,7 +24,7 @@ from scipy.sparse.csgraph import connected_components
 
 from assemblykit.blocking.arrangement import snap_normals, sphere_arrangement
 from assemblykit.blocking.constraints import BlockingTerm
-from assemblykit.part_sets import bits, count_bits, mask_vector
+from assemblykit.part_sets import bits, count_bits, distinct_rows, mask_vector
 from assemblykit.tolerance import ModelTolerance
 
 
@@ -146,9 +146,7 @@ class DirectionTable:
         index[nodes] = np.arange(len(nodes))
         columns = self._active(members)
         moving, blocker = index[self.moving[columns]], index[self.blocker[columns]]
-        patterns, which = np.unique(
-            np.packbits(self.slots[:, columns], axis=1), axis=0, return_inverse=True
-        )
+        patterns, which = distinct_rows(np.packbits(self.slots[:, columns], axis=1))
         rows, arcs = np.nonzero(np.unpackbits(patterns, axis=1, count=len(columns)))
         tails, heads = rows * len(nodes) + moving[arcs], rows * len(nodes) + blocker[arcs]
         size = len(patterns) * len(nodes)
@@ -156,7 +154,7 @@ class DirectionTable:
         count, label = connected_components(union, directed=True, connection="strong")
         sink = np.ones(count, dtype=bool)
         sink[label[tails][label[tails] != label[heads]]] = False
-        return np.ravel(which), label.reshape(len(patterns), len(nodes)), sink
+        return which, label.reshape(len(patterns), len(nodes)), sink
 
     def free_set_sizes(self, members: int, keep: int) -> NDArray[np.int64]:
         """Per direction, how many parts of ``members`` its free sets take away: the
@@ -202,8 +200,7 @@ class DirectionTable:
 
     def distinct_directions(self) -> list[int]:
         """One direction per distinct DBG: the one closest to a coordinate axis."""
-        _, inverse = np.unique(self.slots, axis=0, return_inverse=True)
-        inverse = inverse.ravel()
+        inverse = distinct_rows(self.slots)[1]
         order = np.lexsort((-np.abs(self.directions).max(axis=1), inverse))
         return sorted(order[np.r_[True, inverse[order][1:] != inverse[order][:-1]]].tolist())
 

@@ -36,6 +36,7 @@ from assemblykit.blocking.constraints import BlockingTerm
 from assemblykit.blocking.dbg import DirectionalBlockingGraph, Region, Removal
 from assemblykit.blocking.directions import DirectionTable
 from assemblykit.model.assembly import AssemblyLike as AssemblyLike
+from assemblykit.part_sets import distinct_rows
 from assemblykit.ragged import group_of, group_starts, ranges
 from assemblykit.tolerance import ModelTolerance
 
@@ -239,9 +240,9 @@ class NonDirectionalBlockingGraph:
     def unique_dbgs(self) -> list[tuple[DirectionalBlockingGraph, NDArray[np.int64]]]:
         """Each distinct DBG of the regions, once, with the regions (increasing) that
         have it; the DBG's direction is the zero vector (it stands for all of them)."""
-        unique, inverse = np.unique(self.packed, axis=0, return_inverse=True)
-        by_row = np.argsort(inverse.ravel(), kind="stable")
-        cuts = np.cumsum(np.bincount(inverse.ravel(), minlength=len(unique)))[:-1]
+        unique, inverse = distinct_rows(self.packed)
+        by_row = np.argsort(inverse, kind="stable")
+        cuts = np.cumsum(np.bincount(inverse, minlength=len(unique)))[:-1]
         return [
             (self._graph(np.zeros(3), self._unpacked(row)), members)
             for row, members in zip(unique, np.split(by_row, cuts), strict=True)

@@ -319,8 +319,8 @@ class EquilibriumModel:
         computed."""
         if not len(memory.certificates):
             return None
-        numbers, certificates = zip(*memory.certificates.items(), strict=True)
-        kept = np.stack(certificates, axis=1) * np.repeat(free, 6)[:, None]
+        numbers, stacked = memory.stacked_certificates()
+        kept = stacked * np.repeat(free, 6)[:, None]
         shares = -self.load @ kept
         normal_wrench, u_wrench, v_wrench = (m[selected] for m in self._point_wrenches_by_point)
         proven = shares < 0
@@ -336,7 +336,10 @@ class EquilibriumModel:
             np.minimum(least, c * along_u + s * along_v, out=least)
         worst = (normal + mu * least).min(axis=0, initial=0.0)
         proven[proven] = worst >= LP_FEASIBILITY * shares[proven]
-        return int(numbers[int(np.argmax(proven))]) if proven.any() else None
+        if not proven.any():
+            return None
+        shown = {numbers[i] for i in np.flatnonzero(proven)}
+        return next(number for number, _ in memory.certificates.items() if number in shown)
 
     @cached_property
     def _point_wrenches_by_point(self) -> tuple[sp.csr_matrix, sp.csr_matrix, sp.csr_matrix]:

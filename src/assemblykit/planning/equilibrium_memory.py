@@ -85,6 +85,9 @@ class EquilibriumMemory:
         friction)."""
         self._numbers = itertools.count()
         """The numbers of the balances and certificates, in the order found."""
+        self._stacked: tuple[tuple[int, ...], NDArray[np.float64]] | None = None
+        """The certificates kept, in increasing number, as the columns of one matrix
+        (:meth:`stacked_certificates`), with their numbers."""
 
     def keep_balance(self, balance: KeptBalance) -> None:
         """Keep a balance just found, first."""
@@ -93,6 +96,17 @@ class EquilibriumMemory:
     def keep_certificate(self, certificate: NDArray[np.float64]) -> None:
         """Keep a certificate just found (its ``y`` over every equation), first."""
         self.certificates.keep(next(self._numbers), certificate)
+
+    def stacked_certificates(self) -> tuple[tuple[int, ...], NDArray[np.float64]]:
+        """The numbers of the certificates kept, increasing, and the certificates as the
+        columns of one matrix in that order: made again only when a certificate is kept
+        or forgotten, not when one is used (every state a plan asks about tests them
+        all at once)."""
+        numbers = tuple(sorted(number for number, _ in self.certificates.items()))
+        if self._stacked is None or self._stacked[0] != numbers:
+            columns = [self.certificates[number] for number in numbers]
+            self._stacked = (numbers, np.stack(columns, axis=1))
+        return self._stacked
 
     def latest_balance(self) -> KeptBalance:
         """The balance kept or used last."""

@@ -100,6 +100,7 @@ class ExtendedDirections:
         self._witnessed: tuple[int, dict[int, int]] = (0, {})
         self._asked: dict[tuple[int, int], int] = {}
         self._frames: dict[int, NDArray[np.float64]] = {}
+        self._same: dict[int, int] = {}
 
     def same_as(self, k: int) -> int:
         """The first candidate direction the same as direction ``k`` to the mesh angle
@@ -107,11 +108,17 @@ class ExtendedDirections:
         projection test: each part's arrangement of contact circles gives its own copy
         of a direction such as +z, a few 1e-8 apart on tessellated CAD, and the search
         asks along many of them; Γ_e is computed along the first. Where every part is a
-        union of convex bodies, cones decide exactly along ``k`` itself."""
-        if not any(self._projected):
-            return k
-        key = tuple(np.round(self.directions[k] / self.tol.mesh_angle).astype(np.int64).tolist())
-        return self._first.setdefault(key, k)
+        union of convex bodies, cones decide exactly along ``k`` itself. Once found, a
+        direction's first stays so: it is kept (the search asks along each direction at
+        every step)."""
+        same = self._same.get(k)
+        if same is None:
+            same = k
+            if any(self._projected):
+                rounded = np.round(self.directions[k] / self.tol.mesh_angle).astype(np.int64)
+                same = self._first.setdefault(tuple(rounded.tolist()), k)
+            self._same[k] = same
+        return same
 
     @cached_property
     def _projected(self) -> tuple[bool, ...]:
